@@ -1,0 +1,220 @@
+//! Errors and warnings shared by every stage.
+//!
+//! A parser knows lines and columns but not the file it reads: it returns a
+//! [`ParseError`] (`line:col: message`), and the `read` front end adds the path
+//! ([`ReadError`]), so a user sees `X.rtl:31:9: expected …, found …`.
+//! Lines and columns start at 1; a column counts characters, not bytes.
+//!
+//! Oddities that are not fatal are [`Warning`]s, returned next to the value;
+//! their `Display` says what to do about them.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use crate::measurement::Direction;
+
+/// A position in a text file. Both fields start at 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Position {
+    /// Line number, starting at 1.
+    pub line: usize,
+    /// Column in characters, starting at 1.
+    pub column: usize,
+}
+
+impl fmt::Display for Position {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}", self.line, self.column)
+    }
+}
+
+/// A fatal error found while parsing text, at a position.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{position}: {message}")]
+pub struct ParseError {
+    /// Where the problem is.
+    pub position: Position,
+    /// What was expected and what was found, lowercase, no trailing period.
+    pub message: String,
+}
+
+impl ParseError {
+    /// An error with a free-form message.
+    pub fn new(line: usize, column: usize, message: impl Into<String>) -> ParseError {
+        ParseError {
+            position: Position { line, column },
+            message: message.into(),
+        }
+    }
+
+    /// The usual shape: `expected X, found Y`.
+    pub fn expected(line: usize, column: usize, expected: &str, found: &str) -> ParseError {
+        ParseError::new(line, column, format!("expected {expected}, found {found}"))
+    }
+}
+
+/// Describes a token for an error message: quoted and shortened, or "end of line".
+pub fn describe_found(token: &str) -> String {
+    if token.is_empty() {
+        return "end of line".to_string();
+    }
+    let mut shown: String = token.chars().take(24).collect();
+    if token.chars().count() > 24 {
+        shown.push('…');
+    }
+    format!("{shown:?}")
+}
+
+/// An error from reading a measurement file: the parse error plus the path.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    /// The file could not be read at all.
+    #[error("{path}: {source}", path = path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file was read but its content is wrong at a position.
+    #[error("{path}:{error}", path = path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, and where.
+        error: ParseError,
+    },
+    /// Two files that cannot be one measurement.
+    #[error("{path}: {message}", path = path.display())]
+    Merge {
+        /// The second file.
+        path: PathBuf,
+        /// Why they do not fit together.
+        message: String,
+    },
+}
+
+/// Something odd that is not fatal. `Display` says what it means and what to do.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Warning {
+    /// A section the reader does not know was skipped.
+    UnknownSection {
+        /// Line of the section header.
+        line: usize,
+        /// Its name.
+        name: String,
+    },
+    /// A key the reader does not know was ignored.
+    UnknownKey {
+        /// Line of the key.
+        line: usize,
+        /// The key.
+        key: String,
+    },
+    /// Readings that the file lists as missing or does not list at all.
+    MissingReadings {
+        /// How many (run, target) readings are missing.
+        count: usize,
+        /// The first few, as "run 2↑ at 45.6 mm".
+        examples: Vec<String>,
+    },
+    /// A laser status other than "normal" on a data row.
+    LaserStatus {
+        /// Line of the row.
+        line: usize,
+        /// The status code.
+        status: i64,
+        /// What the file's legend says it means.
+        meaning: &'static str,
+    },
+    /// Metadata fields that contradict each other; the reader says which it used.
+    InconsistentMetadata {
+        /// What disagrees and what was used.
+        message: String,
+    },
+    /// Only one run in a direction: scatter is undefined.
+    SingleRun {
+        /// The direction with one run.
+        direction: Direction,
+    },
+    /// Only one direction was measured.
+    Unidirectional {
+        /// The direction that was measured.
+        measured: Direction,
+    },
+    /// A target lacks what a figure needs, so that figure is not evaluated.
+    TargetNotEvaluated {
+        /// The target.
+        target_mm: f64,
+        /// Which quantity is missing there.
+        missing: String,
+    },
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Warning::UnknownSection { line, name } => write!(
+                f,
+                "line {line}: unknown section {name:?} skipped; check the result if the file comes from newer software"
+            ),
+            Warning::UnknownKey { line, key } => {
+                write!(f, "line {line}: unknown key {key:?} ignored")
+            }
+            Warning::MissingReadings { count, examples } => write!(
+                f,
+                "{count} reading(s) missing ({}); they are left out, never counted as 0; re-measure those points if they matter",
+                examples.join(", ")
+            ),
+            Warning::LaserStatus {
+                line,
+                status,
+                meaning,
+            } => write!(
+                f,
+                "line {line}: laser status {status} ({meaning}); the reading is used, but check the beam path and re-measure if in doubt"
+            ),
+            Warning::InconsistentMetadata { message } => write!(f, "{message}"),
+            Warning::SingleRun { direction } => write!(
+                f,
+                "n = 1 run {direction}: s, R and A are not evaluated; measure ≥ 2 runs per direction (ISO 230-2 asks for 5)"
+            ),
+            Warning::Unidirectional { measured } => write!(
+                f,
+                "unidirectional test ({measured} only): bidirectional figures A, E, M, R, B and B̄ are not evaluated"
+            ),
+            Warning::TargetNotEvaluated { target_mm, missing } => write!(
+                f,
+                "target {target_mm} mm has no {missing}; the axis figures that need it are not evaluated"
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_error_reads_as_path_line_column() {
+        let error = ReadError::Parse {
+            path: PathBuf::from("X.rtl"),
+            error: ParseError::expected(31, 9, "a deviation value", "end of line"),
+        };
+        assert_eq!(
+            error.to_string(),
+            "X.rtl:31:9: expected a deviation value, found end of line"
+        );
+    }
+
+    #[test]
+    fn found_tokens_are_quoted_and_shortened() {
+        assert_eq!(describe_found(""), "end of line");
+        assert_eq!(describe_found("1,5"), "\"1,5\"");
+        assert_eq!(
+            describe_found("abcdefghijklmnopqrstuvwxyz"),
+            "\"abcdefghijklmnopqrstuvwx…\""
+        );
+    }
+}

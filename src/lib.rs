@@ -1,0 +1,46 @@
+//! axcomp: from a laser-interferometer log to ISO 230-2 figures and controller
+//! compensation tables.
+//!
+//! # Brief overview
+//!
+//! Data flows through one module per stage:
+//!
+//! - [`read`] opens a measurement file (Renishaw `.rtl`, ESS/PSI ecmc `.dat`,
+//!   API XD `.pos`, axcomp CSV), detects its format and returns a validated
+//!   [`measurement::Measurement`]: targets in mm, runs with their direction,
+//!   deviations in mm (`None` where a reading is missing), environment and
+//!   metadata.
+//! - [`evaluate`] computes the ISO 230-2 figures (A, E, M, R, B per direction
+//!   and per target) as an [`evaluate::Evaluation`], with `None` wherever the
+//!   standard leaves a figure undefined, and flags suspected outlier runs.
+//! - [`report`] turns them into the terminal report and the `--json` wire
+//!   format (µm, unit-suffixed keys).
+//! - [`output`] is the one place that creates files: via a temporary file and
+//!   a rename, never overwriting without `force`.
+//!
+//! Lengths are mm inside; [`units`] holds every conversion factor.
+//!
+//! # Example
+//!
+//! ```
+//! use axcomp::{evaluate::evaluate, measurement::SourceFormat, read};
+//!
+//! let csv = "target_mm,run,direction,deviation_um\n\
+//!            0,1,up,0\n100,1,up,4\n0,1,down,-2\n100,1,down,2\n\
+//!            0,2,up,2\n100,2,up,6\n0,2,down,0\n100,2,down,4\n";
+//! let (measurement, _warnings) = read::parse_str(csv, SourceFormat::Csv).unwrap();
+//! let evaluation = evaluate(&measurement);
+//! // B_i = x̄↑ − x̄↓ = 2 µm at both targets.
+//! assert!((evaluation.figures.b_mm.unwrap() - 0.002).abs() < 1e-12);
+//! ```
+
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod error;
+pub mod evaluate;
+pub mod measurement;
+pub mod output;
+pub mod read;
+pub mod report;
+pub mod units;

@@ -1,0 +1,624 @@
+//! The measurement of one linear axis: the plain, validated data every stage meets on.
+//!
+//! A [`Measurement`] holds the targets (mm, strictly increasing), the runs
+//! (each with its direction and one deviation per target, `None` where a
+//! reading is missing), the environment record and the metadata. It can only
+//! be built through [`Measurement::new`], which checks the invariants that
+//! `evaluate` relies on (`../shared/spec/style.md` §1, "Put preconditions in
+//! types"): readers check the same things first, with line and column, so
+//! this check is the last guard, not the user's error message.
+//!
+//! Deviations are positional deviations x_ij = P_ij − P_i (actual minus
+//! target, `../shared/spec/iso230-2.md` "Data"), stored in mm.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use chrono::NaiveDateTime;
+
+use crate::units::{LengthUnit, Mm};
+
+/// Approach direction of a run: ↑ moves in the positive direction, ↓ in the negative.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Direction {
+    /// Targets approached moving in the positive direction (↑).
+    Up,
+    /// Targets approached moving in the negative direction (↓).
+    Down,
+}
+
+impl Direction {
+    /// Both directions, ↑ first.
+    pub const BOTH: [Direction; 2] = [Direction::Up, Direction::Down];
+
+    /// `up` or `down`, as in JSON and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Direction::Up => "up",
+            Direction::Down => "down",
+        }
+    }
+
+    /// The other direction.
+    pub fn reversed(self) -> Direction {
+        match self {
+            Direction::Up => Direction::Down,
+            Direction::Down => Direction::Up,
+        }
+    }
+}
+
+impl fmt::Display for Direction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Direction::Up => "↑",
+            Direction::Down => "↓",
+        })
+    }
+}
+
+/// One pass over the targets in one direction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Run {
+    /// ↑ or ↓.
+    pub direction: Direction,
+    /// Run number within its direction, starting at 1, in the order measured
+    /// (ISO 230-2's j). Runs of a bidirectional test share numbers: run 2↑ and
+    /// run 2↓ are the two halves of the second cycle.
+    pub number: u32,
+    /// When the run started, in seconds after the test started, if known.
+    pub start_time_s: Option<f64>,
+    /// One deviation per target (same order as the targets), mm; `None` is a missing reading.
+    pub deviations_mm: Vec<Option<Mm>>,
+}
+
+impl Run {
+    /// `2↑`: how runs are named to users.
+    pub fn label(&self) -> String {
+        format!("{}{}", self.number, self.direction)
+    }
+}
+
+/// A value recorded at the start and at the end of the test.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StartEnd {
+    /// At the start of the test.
+    pub start: Option<f64>,
+    /// At the end of the test.
+    pub end: Option<f64>,
+}
+
+impl StartEnd {
+    /// Both values, when known.
+    pub fn new(start: Option<f64>, end: Option<f64>) -> StartEnd {
+        StartEnd { start, end }
+    }
+
+    /// Whether neither value is known.
+    pub fn is_empty(&self) -> bool {
+        self.start.is_none() && self.end.is_none()
+    }
+}
+
+/// The test conditions, in SI-style units whatever the source file used.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Environment {
+    /// Air temperature, °C.
+    pub air_temperature_c: StartEnd,
+    /// Air pressure, kPa.
+    pub air_pressure_kpa: StartEnd,
+    /// Relative humidity, %.
+    pub air_humidity_pct: StartEnd,
+    /// Up to three material temperature sensors, °C; `None` where no sensor was fitted.
+    pub material_temperature_c: [StartEnd; 3],
+    /// Expansion coefficient used for the normal-temperature correction, µm/(m·K) (ppm/°C).
+    pub expansion_coefficient_ppm_per_k: Option<f64>,
+    /// Renishaw's "environmental factor": the half wavelength in air the laser
+    /// used, λ_vac / (2·n_air), in µm (`../shared/spec/renishaw-rtl.md`).
+    pub environmental_factor_um: StartEnd,
+    /// The laser's vacuum wavelength, µm, when the file records it.
+    pub vacuum_wavelength_um: Option<f64>,
+}
+
+/// The date of the test as the file wrote it, and parsed when the pattern is known.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TestDate {
+    /// The text in the file.
+    pub raw: String,
+    /// The parsed date and time, when `raw` matched a known pattern.
+    pub parsed: Option<NaiveDateTime>,
+}
+
+/// The input formats axcomp reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SourceFormat {
+    /// Renishaw LaserXL / Laser10 `.rtl` linear data.
+    Rtl,
+    /// ESS/PSI ecmc ISO 230-2 data file (`TGT_DATA[i]=`, `REF_DATA_FWD[i,j]=`).
+    Ecmc,
+    /// API XD laser `.pos` linear data table.
+    ApiPos,
+    /// axcomp's plain CSV (`target_mm,run,direction,deviation_um`).
+    Csv,
+}
+
+impl SourceFormat {
+    /// Every format, in the order they are listed to users.
+    pub const ALL: [SourceFormat; 4] = [
+        SourceFormat::Rtl,
+        SourceFormat::Ecmc,
+        SourceFormat::ApiPos,
+        SourceFormat::Csv,
+    ];
+
+    /// The name used by `--format` and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            SourceFormat::Rtl => "rtl",
+            SourceFormat::Ecmc => "ecmc",
+            SourceFormat::ApiPos => "api-pos",
+            SourceFormat::Csv => "csv",
+        }
+    }
+
+    /// What it is, for lists of supported formats.
+    pub fn description(self) -> &'static str {
+        match self {
+            SourceFormat::Rtl => "Renishaw .rtl linear data (first line HEADER::)",
+            SourceFormat::Ecmc => "ESS/PSI ISO 230-2 data file (TGT_DATA[i]=, REF_DATA_FWD[i,j]=)",
+            SourceFormat::ApiPos => "API XD laser .pos linear data table (LinearError column)",
+            SourceFormat::Csv => "axcomp CSV (header target_mm,run,direction,deviation_um)",
+        }
+    }
+
+    /// Looks a format up by its `--format` name.
+    pub fn from_name(name: &str) -> Option<SourceFormat> {
+        SourceFormat::ALL
+            .into_iter()
+            .find(|format| format.name().eq_ignore_ascii_case(name))
+    }
+}
+
+/// Who measured what, where and when; all optional, as files leave fields empty.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Metadata {
+    /// Machine name or type.
+    pub machine: Option<String>,
+    /// Machine serial number.
+    pub serial_number: Option<String>,
+    /// Who measured.
+    pub operator: Option<String>,
+    /// When.
+    pub date: Option<TestDate>,
+    /// Where.
+    pub location: Option<String>,
+    /// Title or free description.
+    pub description: Option<String>,
+    /// The file the measurement was read from.
+    pub source_file: Option<PathBuf>,
+    /// Its format.
+    pub source_format: Option<SourceFormat>,
+    /// The length unit the file was written in (values are converted to mm on reading).
+    pub length_unit: LengthUnit,
+    /// Format-specific fields kept verbatim for the report (software version, flags, PV names).
+    pub extra: Vec<(String, String)>,
+}
+
+/// Why a set of targets and runs is not a valid measurement.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MeasurementError {
+    /// No targets.
+    #[error("no targets")]
+    NoTargets,
+    /// A target is NaN or infinite.
+    #[error("target {index} is not a finite number")]
+    NonFiniteTarget {
+        /// 1-based target number.
+        index: usize,
+    },
+    /// Targets not strictly increasing.
+    #[error(
+        "targets must be strictly increasing: target {index} ({value_mm} mm) follows {previous_mm} mm"
+    )]
+    TargetsNotIncreasing {
+        /// 1-based target number.
+        index: usize,
+        /// Its value.
+        value_mm: f64,
+        /// The value before it.
+        previous_mm: f64,
+    },
+    /// No runs.
+    #[error("no runs")]
+    NoRuns,
+    /// A run's deviation count differs from the target count.
+    #[error("run {run} has {found} deviations for {expected} targets")]
+    RunLength {
+        /// The run, as `2↑`.
+        run: String,
+        /// Target count.
+        expected: usize,
+        /// Deviation count.
+        found: usize,
+    },
+    /// A deviation is NaN or infinite.
+    #[error("run {run} has a non-finite deviation at target {index}")]
+    NonFiniteDeviation {
+        /// The run.
+        run: String,
+        /// 1-based target number.
+        index: usize,
+    },
+    /// A run has no reading at all.
+    #[error("run {run} has no readings")]
+    EmptyRun {
+        /// The run.
+        run: String,
+    },
+    /// Two runs share a direction and number.
+    #[error("run {run} appears twice")]
+    DuplicateRun {
+        /// The run.
+        run: String,
+    },
+    /// Run numbers must start at 1 and be consecutive per direction.
+    #[error(
+        "runs {direction} must be numbered 1, 2, 3, … in the order measured; found {numbers:?}"
+    )]
+    RunNumbering {
+        /// The direction.
+        direction: Direction,
+        /// The numbers found.
+        numbers: Vec<u32>,
+    },
+}
+
+/// Selects runs to leave out of an evaluation: a run number in one or both directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RunSelector {
+    /// Run number within its direction.
+    pub number: u32,
+    /// `None` selects that number in both directions.
+    pub direction: Option<Direction>,
+}
+
+impl RunSelector {
+    /// Whether this selector picks `run`.
+    pub fn selects(&self, run: &Run) -> bool {
+        run.number == self.number && self.direction.is_none_or(|d| d == run.direction)
+    }
+}
+
+impl fmt::Display for RunSelector {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.direction {
+            Some(direction) => write!(f, "{}:{}", self.number, direction.as_str()),
+            None => write!(f, "{}", self.number),
+        }
+    }
+}
+
+/// A validated measurement of one linear axis (see the module doc for the invariants).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measurement {
+    axis: String,
+    targets_mm: Vec<Mm>,
+    runs: Vec<Run>,
+    /// The test conditions.
+    pub environment: Environment,
+    /// Who, what, where, when, and from which file.
+    pub metadata: Metadata,
+}
+
+impl Measurement {
+    /// Builds a measurement, checking its invariants:
+    /// - at least one target, all finite and strictly increasing;
+    /// - at least one run, each with one finite-or-missing deviation per target
+    ///   and at least one reading;
+    /// - runs numbered 1, 2, 3, … per direction, without repeats.
+    ///
+    /// # Example
+    /// ```
+    /// use axcomp::measurement::{Direction, Measurement, Run};
+    /// let run = Run { direction: Direction::Up, number: 1, start_time_s: None,
+    ///                 deviations_mm: vec![Some(0.0), Some(0.002)] };
+    /// let m = Measurement::new("X", vec![0.0, 100.0], vec![run],
+    ///                          Default::default(), Default::default()).unwrap();
+    /// assert_eq!(m.targets_mm(), &[0.0, 100.0]);
+    /// assert!(Measurement::new("X", vec![100.0, 0.0], vec![], Default::default(),
+    ///                          Default::default()).is_err());
+    /// ```
+    pub fn new(
+        axis: impl Into<String>,
+        targets_mm: Vec<Mm>,
+        runs: Vec<Run>,
+        environment: Environment,
+        metadata: Metadata,
+    ) -> Result<Measurement, MeasurementError> {
+        check_targets(&targets_mm)?;
+        check_runs(&runs, targets_mm.len())?;
+        Ok(Measurement {
+            axis: axis.into(),
+            targets_mm,
+            runs,
+            environment,
+            metadata,
+        })
+    }
+
+    /// The axis name (`X`, `Y`, `Z`, `U`, …).
+    pub fn axis(&self) -> &str {
+        &self.axis
+    }
+
+    /// The targets P_i, mm, strictly increasing.
+    pub fn targets_mm(&self) -> &[Mm] {
+        &self.targets_mm
+    }
+
+    /// The runs, in the order measured.
+    pub fn runs(&self) -> &[Run] {
+        &self.runs
+    }
+
+    /// The runs in one direction, in the order measured.
+    pub fn runs_in(&self, direction: Direction) -> impl Iterator<Item = &Run> {
+        self.runs
+            .iter()
+            .filter(move |run| run.direction == direction)
+    }
+
+    /// How many runs go in `direction`.
+    pub fn run_count(&self, direction: Direction) -> usize {
+        self.runs_in(direction).count()
+    }
+
+    /// Renames the axis (for a file whose metadata names the wrong one).
+    pub fn set_axis(&mut self, axis: impl Into<String>) {
+        self.axis = axis.into();
+    }
+
+    /// The same measurement without the selected runs. Remaining runs keep
+    /// their numbers, so reports still name them as the file does.
+    pub fn without_runs(&self, excluded: &[RunSelector]) -> Result<Measurement, MeasurementError> {
+        let runs: Vec<Run> = self
+            .runs
+            .iter()
+            .filter(|run| !excluded.iter().any(|selector| selector.selects(run)))
+            .cloned()
+            .collect();
+        if runs.is_empty() {
+            return Err(MeasurementError::NoRuns);
+        }
+        Ok(Measurement {
+            runs,
+            ..self.clone()
+        })
+    }
+
+    /// Joins two measurements of the same axis and targets (e.g. the forward
+    /// and reverse `.pos` files of one test). Runs of `other` follow those of
+    /// `self` and are renumbered after them, per direction.
+    pub fn merge(&self, other: &Measurement) -> Result<Measurement, String> {
+        const SAME_TARGET_MM: f64 = 1e-6;
+        if self.targets_mm.len() != other.targets_mm.len()
+            || self
+                .targets_mm
+                .iter()
+                .zip(&other.targets_mm)
+                .any(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
+        {
+            return Err(format!(
+                "cannot join the files: targets differ ({} targets {:?}…{:?} mm against {} targets {:?}…{:?} mm)",
+                self.targets_mm.len(),
+                self.targets_mm.first().copied().unwrap_or_default(),
+                self.targets_mm.last().copied().unwrap_or_default(),
+                other.targets_mm.len(),
+                other.targets_mm.first().copied().unwrap_or_default(),
+                other.targets_mm.last().copied().unwrap_or_default(),
+            ));
+        }
+        let mut runs = self.runs.clone();
+        for run in &other.runs {
+            let already = runs.iter().filter(|r| r.direction == run.direction).count() as u32;
+            runs.push(Run {
+                number: already + 1,
+                ..run.clone()
+            });
+        }
+        Measurement::new(
+            self.axis.clone(),
+            self.targets_mm.clone(),
+            runs,
+            self.environment.clone(),
+            self.metadata.clone(),
+        )
+        .map_err(|error| error.to_string())
+    }
+}
+
+fn check_targets(targets_mm: &[Mm]) -> Result<(), MeasurementError> {
+    if targets_mm.is_empty() {
+        return Err(MeasurementError::NoTargets);
+    }
+    for (index, target) in targets_mm.iter().enumerate() {
+        if !target.is_finite() {
+            return Err(MeasurementError::NonFiniteTarget { index: index + 1 });
+        }
+        if index > 0 && targets_mm[index - 1] >= *target {
+            return Err(MeasurementError::TargetsNotIncreasing {
+                index: index + 1,
+                value_mm: *target,
+                previous_mm: targets_mm[index - 1],
+            });
+        }
+    }
+    Ok(())
+}
+
+fn check_runs(runs: &[Run], target_count: usize) -> Result<(), MeasurementError> {
+    if runs.is_empty() {
+        return Err(MeasurementError::NoRuns);
+    }
+    for run in runs {
+        if run.deviations_mm.len() != target_count {
+            return Err(MeasurementError::RunLength {
+                run: run.label(),
+                expected: target_count,
+                found: run.deviations_mm.len(),
+            });
+        }
+        if let Some(index) = run
+            .deviations_mm
+            .iter()
+            .position(|value| value.is_some_and(|v| !v.is_finite()))
+        {
+            return Err(MeasurementError::NonFiniteDeviation {
+                run: run.label(),
+                index: index + 1,
+            });
+        }
+        if run.deviations_mm.iter().all(Option::is_none) {
+            return Err(MeasurementError::EmptyRun { run: run.label() });
+        }
+    }
+    for direction in Direction::BOTH {
+        let numbers: Vec<u32> = runs
+            .iter()
+            .filter(|run| run.direction == direction)
+            .map(|run| run.number)
+            .collect();
+        let mut sorted = numbers.clone();
+        sorted.sort_unstable();
+        if let Some(pair) = sorted.windows(2).find(|pair| pair[0] == pair[1]) {
+            return Err(MeasurementError::DuplicateRun {
+                run: format!("{}{direction}", pair[0]),
+            });
+        }
+        if sorted.iter().enumerate().any(|(i, n)| *n != i as u32 + 1) {
+            return Err(MeasurementError::RunNumbering { direction, numbers });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(direction: Direction, number: u32, values: &[Option<f64>]) -> Run {
+        Run {
+            direction,
+            number,
+            start_time_s: None,
+            deviations_mm: values.to_vec(),
+        }
+    }
+
+    fn measurement(targets: Vec<f64>, runs: Vec<Run>) -> Result<Measurement, MeasurementError> {
+        Measurement::new(
+            "X",
+            targets,
+            runs,
+            Environment::default(),
+            Metadata::default(),
+        )
+    }
+
+    #[test]
+    fn invariants_are_checked() {
+        let ok = run(Direction::Up, 1, &[Some(0.0), None]);
+        assert!(measurement(vec![0.0, 1.0], vec![ok.clone()]).is_ok());
+        assert_eq!(
+            measurement(vec![], vec![ok.clone()]),
+            Err(MeasurementError::NoTargets)
+        );
+        assert!(matches!(
+            measurement(vec![0.0, 0.0], vec![ok.clone()]),
+            Err(MeasurementError::TargetsNotIncreasing { index: 2, .. })
+        ));
+        assert!(matches!(
+            measurement(vec![0.0, f64::NAN], vec![ok.clone()]),
+            Err(MeasurementError::NonFiniteTarget { index: 2 })
+        ));
+        assert_eq!(
+            measurement(vec![0.0, 1.0], vec![]),
+            Err(MeasurementError::NoRuns)
+        );
+        assert!(matches!(
+            measurement(vec![0.0], vec![ok.clone()]),
+            Err(MeasurementError::RunLength { .. })
+        ));
+        let nan = run(Direction::Up, 1, &[Some(f64::INFINITY), None]);
+        assert!(matches!(
+            measurement(vec![0.0, 1.0], vec![nan]),
+            Err(MeasurementError::NonFiniteDeviation { index: 1, .. })
+        ));
+        let empty = run(Direction::Down, 1, &[None, None]);
+        assert!(matches!(
+            measurement(vec![0.0, 1.0], vec![ok.clone(), empty]),
+            Err(MeasurementError::EmptyRun { .. })
+        ));
+        let twice = vec![ok.clone(), ok.clone()];
+        assert!(matches!(
+            measurement(vec![0.0, 1.0], twice),
+            Err(MeasurementError::DuplicateRun { .. })
+        ));
+        let gap = run(Direction::Up, 3, &[Some(0.0), None]);
+        assert!(matches!(
+            measurement(vec![0.0, 1.0], vec![ok, gap]),
+            Err(MeasurementError::RunNumbering { .. })
+        ));
+    }
+
+    #[test]
+    fn excluding_runs_keeps_their_numbers() {
+        let runs = vec![
+            run(Direction::Up, 1, &[Some(0.0)]),
+            run(Direction::Down, 1, &[Some(0.0)]),
+            run(Direction::Up, 2, &[Some(0.0)]),
+            run(Direction::Down, 2, &[Some(0.0)]),
+        ];
+        let m = measurement(vec![0.0], runs).unwrap();
+        let both = RunSelector {
+            number: 1,
+            direction: None,
+        };
+        let kept = m.without_runs(&[both]).unwrap();
+        assert_eq!(kept.runs().len(), 2);
+        assert!(kept.runs().iter().all(|r| r.number == 2));
+        let down_only = RunSelector {
+            number: 2,
+            direction: Some(Direction::Down),
+        };
+        assert_eq!(m.without_runs(&[down_only]).unwrap().runs().len(), 3);
+    }
+
+    #[test]
+    fn merging_forward_and_reverse_files() {
+        let forward = measurement(
+            vec![0.0, 5.0],
+            vec![run(Direction::Up, 1, &[Some(0.0), Some(1.0)])],
+        )
+        .unwrap();
+        let reverse = measurement(
+            vec![0.0, 5.0],
+            vec![run(Direction::Down, 1, &[Some(0.5), Some(1.5)])],
+        )
+        .unwrap();
+        let both = forward.merge(&reverse).unwrap();
+        assert_eq!(both.run_count(Direction::Up), 1);
+        assert_eq!(both.run_count(Direction::Down), 1);
+        let other = measurement(
+            vec![0.0, 6.0],
+            vec![run(Direction::Down, 1, &[Some(0.5), None])],
+        )
+        .unwrap();
+        assert!(
+            forward
+                .merge(&other)
+                .unwrap_err()
+                .contains("targets differ")
+        );
+    }
+}

@@ -1,0 +1,467 @@
+//! ESS/PSI ecmc ISO 230-2 data files (`report.md_ISO230.dat`): parser.
+//!
+//! The format, as the ecmc scripts write it and the real files under
+//! `../shared/data/ecmc/` show (`../shared/data/SOURCES.md`, "Format quirks"):
+//! `KEY=VALUE` lines, `#` comments, blank lines anywhere. Keys:
+//! `UNIT` (mm), `CYCLES` (n), `POSITIONS` (m), `DEC` (print decimals),
+//! `REF_PV`/`TEST_PV`/`TGT_SET_PV` (EPICS names, kept), `TGT_DATA[i]` (target i),
+//! `REF_DATA_FWD[i,j]` and `REF_DATA_BWD[i,j]` (actual position at target i in
+//! cycle j). The first line of most files glues a comment onto a key
+//! (`TEST_DATA=# Input data file…`); it is kept as a note. Spaces around `=`,
+//! `[` and `,`, and trailing spaces after values, are accepted.
+//!
+//! Values are actual positions, so the deviation is REF − TGT
+//! (`../shared/spec/iso230-2.md`, "Independent check values"). FWD runs are ↑,
+//! BWD runs ↓; the ecmc report script swaps the two labels (a known bug), we do
+//! not. `CYCLES` and `POSITIONS`, when given, must agree with the data; when
+//! absent they are taken from the data. The file names no axis; it is `X`
+//! unless the caller renames it.
+
+use crate::error::{ParseError, Warning};
+use crate::measurement::{Direction, Environment, Measurement, Metadata, Run, SourceFormat};
+use crate::read::missing_readings_warning;
+use crate::read::text::{self, Line, end_of_file_line, split_key};
+use crate::units::LengthUnit;
+
+/// Parses the text of an ecmc ISO 230-2 data file.
+pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
+    let mut file = EcmcFile::default();
+    for line in text::lines(input) {
+        let trimmed = line.text.trim();
+        if trimmed.is_empty() || trimmed.starts_with('#') {
+            continue;
+        }
+        file.line(&line)?;
+    }
+    file.finish(end_of_file_line(input))
+}
+
+/// A count given in the file, with where.
+#[derive(Clone, Copy, Debug)]
+struct Declared {
+    value: usize,
+    line: usize,
+    column: usize,
+}
+
+/// A value at an index, with where.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    position_index: usize,
+    cycle_index: usize,
+    value: f64,
+    line: usize,
+    column: usize,
+}
+
+#[derive(Default)]
+struct EcmcFile {
+    unit: Option<LengthUnit>,
+    cycles: Option<Declared>,
+    positions: Option<Declared>,
+    targets: Vec<Entry>,
+    forward: Vec<Entry>,
+    backward: Vec<Entry>,
+    metadata: Metadata,
+    warnings: Vec<Warning>,
+}
+
+/// The key of a line, split into its name and its bracketed indices.
+struct Key<'a> {
+    name: &'a str,
+    indices: Vec<(usize, &'a str)>,
+}
+
+impl EcmcFile {
+    fn line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        let Some((key_text, value)) = split_key(line.text, '=') else {
+            return Err(line.expected_at(line.text.trim_start(), "KEY=VALUE or a # comment"));
+        };
+        let key = parse_key(line, key_text)?;
+        match (key.name.to_ascii_uppercase().as_str(), key.indices.len()) {
+            ("TEST_DATA", 0) => self.keep("TEST_DATA", value.trim_start_matches('#').trim()),
+            ("REF_PV" | "TEST_PV" | "TGT_SET_PV", 0) => self.keep(key.name, value),
+            ("UNIT", 0) => self.unit = Some(unit(line, value)?),
+            ("CYCLES", 0) => self.cycles = Some(declared(line, value, "cycle count")?),
+            ("POSITIONS", 0) => self.positions = Some(declared(line, value, "position count")?),
+            ("DEC", 0) => {
+                text::integer(line, value, "decimal count")?;
+            }
+            ("TGT_DATA", 1) => {
+                let entry = entry(line, &key, value, "target position")?;
+                self.targets.push(entry);
+            }
+            ("REF_DATA_FWD", 2) => {
+                let entry = entry(line, &key, value, "actual position")?;
+                self.forward.push(entry);
+            }
+            ("REF_DATA_BWD", 2) => {
+                let entry = entry(line, &key, value, "actual position")?;
+                self.backward.push(entry);
+            }
+            ("TGT_DATA" | "REF_DATA_FWD" | "REF_DATA_BWD", found) => {
+                let expected = if key.name.eq_ignore_ascii_case("TGT_DATA") {
+                    1
+                } else {
+                    2
+                };
+                let at = key_text.trim_start();
+                return Err(line.error_at(
+                    at,
+                    format!(
+                        "{} takes {expected} index(es) in brackets, found {found}",
+                        key.name.to_ascii_uppercase()
+                    ),
+                ));
+            }
+            _ => self.warnings.push(Warning::UnknownKey {
+                line: line.number,
+                key: key_text.trim().to_string(),
+            }),
+        }
+        Ok(())
+    }
+
+    fn keep(&mut self, key: &str, value: &str) {
+        self.metadata
+            .extra
+            .push((key.to_string(), value.to_string()));
+    }
+
+    fn finish(mut self, end_line: usize) -> Result<(Measurement, Vec<Warning>), ParseError> {
+        if self.targets.is_empty() {
+            return Err(ParseError::new(
+                end_line,
+                1,
+                "expected TGT_DATA[i]= lines, found none",
+            ));
+        }
+        let position_count = declared_count(self.positions, &self.targets, "POSITIONS")?;
+        let cycle_count = match self.cycles {
+            Some(declared) => declared.value,
+            None => self
+                .forward
+                .iter()
+                .chain(&self.backward)
+                .map(|e| e.cycle_index)
+                .max()
+                .unwrap_or(0),
+        };
+        for entry in self.forward.iter().chain(&self.backward) {
+            check_range(entry, position_count, cycle_count)?;
+        }
+        let unit = self.unit.unwrap_or_default();
+        let mut target_of_position = vec![None; position_count];
+        for entry in &self.targets {
+            if let Some(first) = target_of_position[entry.position_index - 1].replace(*entry) {
+                return Err(ParseError::new(
+                    entry.line,
+                    entry.column,
+                    format!(
+                        "TGT_DATA[{}] is given twice (first at line {})",
+                        entry.position_index, first.line
+                    ),
+                ));
+            }
+        }
+        let mut targets: Vec<Entry> = Vec::with_capacity(position_count);
+        for (index, target) in target_of_position.iter().enumerate() {
+            match target {
+                Some(target) => targets.push(*target),
+                None => {
+                    let (line, column) =
+                        self.positions.map_or((end_line, 1), |p| (p.line, p.column));
+                    return Err(ParseError::new(
+                        line,
+                        column,
+                        format!(
+                            "expected TGT_DATA[{}], found none: every position 1..{position_count} needs a target",
+                            index + 1
+                        ),
+                    ));
+                }
+            }
+        }
+        let mut order: Vec<usize> = (0..position_count).collect();
+        order.sort_by(|&a, &b| targets[a].value.total_cmp(&targets[b].value));
+        for pair in order.windows(2) {
+            let (first, second) = (targets[pair[0]], targets[pair[1]]);
+            if first.value == second.value {
+                let later = if second.line > first.line {
+                    second
+                } else {
+                    first
+                };
+                let earlier = if second.line > first.line {
+                    first
+                } else {
+                    second
+                };
+                return Err(ParseError::new(
+                    later.line,
+                    later.column,
+                    format!(
+                        "duplicate target {} (also TGT_DATA[{}] at line {})",
+                        later.value, earlier.position_index, earlier.line
+                    ),
+                ));
+            }
+        }
+        let targets_mm: Vec<f64> = order
+            .iter()
+            .map(|&i| unit.to_mm(targets[i].value))
+            .collect();
+        let grid = |entries: &[Entry], name: &str| -> Result<Vec<Vec<Option<f64>>>, ParseError> {
+            let mut grid = vec![vec![None; position_count]; cycle_count];
+            let mut lines = vec![vec![0usize; position_count]; cycle_count];
+            for entry in entries {
+                let (cycle, position) = (entry.cycle_index - 1, entry.position_index - 1);
+                if grid[cycle][position].is_some() {
+                    return Err(ParseError::new(
+                        entry.line,
+                        entry.column,
+                        format!(
+                            "{name}[{},{}] is given twice (first at line {})",
+                            entry.position_index, entry.cycle_index, lines[cycle][position]
+                        ),
+                    ));
+                }
+                let deviation = unit.to_mm(entry.value - targets[position].value);
+                grid[cycle][position] = Some(deviation);
+                lines[cycle][position] = entry.line;
+            }
+            Ok(grid)
+        };
+        let forward = grid(&self.forward, "REF_DATA_FWD")?;
+        let backward = grid(&self.backward, "REF_DATA_BWD")?;
+        // Runs in the order measured: each cycle goes forward, then backward.
+        let mut runs = Vec::with_capacity(2 * cycle_count);
+        let mut numbers = [0u32; 2];
+        for cycle in 0..cycle_count {
+            for (direction, grid) in [(Direction::Up, &forward), (Direction::Down, &backward)] {
+                let by_position = &grid[cycle];
+                if by_position.iter().all(Option::is_none) {
+                    continue;
+                }
+                let slot = usize::from(direction == Direction::Down);
+                numbers[slot] += 1;
+                runs.push(Run {
+                    direction,
+                    number: numbers[slot],
+                    start_time_s: None,
+                    deviations_mm: order.iter().map(|&p| by_position[p]).collect(),
+                });
+            }
+        }
+        if runs.is_empty() {
+            return Err(ParseError::new(
+                end_line,
+                1,
+                "expected REF_DATA_FWD[i,j]= or REF_DATA_BWD[i,j]= lines, found none",
+            ));
+        }
+        if let Some(warning) = missing_readings_warning(&runs, &targets_mm) {
+            self.warnings.push(warning);
+        }
+        self.metadata.source_format = Some(SourceFormat::Ecmc);
+        self.metadata.length_unit = unit;
+        let measurement =
+            Measurement::new("X", targets_mm, runs, Environment::default(), self.metadata)
+                .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
+        Ok((measurement, self.warnings))
+    }
+}
+
+/// The number of positions: as declared (checked against the data) or as found.
+fn declared_count(
+    declared: Option<Declared>,
+    entries: &[Entry],
+    name: &str,
+) -> Result<usize, ParseError> {
+    let found = entries.iter().map(|e| e.position_index).max().unwrap_or(0);
+    let Some(declared) = declared else {
+        return Ok(found);
+    };
+    if let Some(beyond) = entries.iter().find(|e| e.position_index > declared.value) {
+        return Err(ParseError::new(
+            beyond.line,
+            beyond.column,
+            format!(
+                "index {} is beyond {name}={} (line {})",
+                beyond.position_index, declared.value, declared.line
+            ),
+        ));
+    }
+    Ok(declared.value)
+}
+
+fn check_range(entry: &Entry, position_count: usize, cycle_count: usize) -> Result<(), ParseError> {
+    if entry.position_index > position_count {
+        return Err(ParseError::new(
+            entry.line,
+            entry.column,
+            format!(
+                "position index {} is beyond the {position_count} targets",
+                entry.position_index
+            ),
+        ));
+    }
+    if entry.cycle_index > cycle_count {
+        return Err(ParseError::new(
+            entry.line,
+            entry.column,
+            format!(
+                "cycle index {} is beyond CYCLES={cycle_count}",
+                entry.cycle_index
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `NAME`, `NAME[i]` or `NAME[i,j]`, with optional spaces inside.
+fn parse_key<'a>(line: &Line<'a>, key: &'a str) -> Result<Key<'a>, ParseError> {
+    let Some(open) = key.find('[') else {
+        if key.is_empty() || !key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(line.expected_at(key.trim_start(), "a key name (letters, digits, _)"));
+        }
+        return Ok(Key {
+            name: key,
+            indices: Vec::new(),
+        });
+    };
+    let name = key[..open].trim();
+    let inner_and_rest = &key[open + 1..];
+    let Some(close) = inner_and_rest.find(']') else {
+        return Err(line.error_at(&key[open..], "expected ']' after the index"));
+    };
+    let trailing = inner_and_rest[close + 1..].trim();
+    if !trailing.is_empty() {
+        return Err(line.expected_at(trailing, "'=' after ']'"));
+    }
+    let mut indices = Vec::new();
+    for part in inner_and_rest[..close].split(',') {
+        let token = part.trim();
+        let index = text::integer(line, token, "index")?;
+        if index == 0 {
+            return Err(line.error_at(token, "expected an index from 1, found 0"));
+        }
+        indices.push((index as usize, token));
+    }
+    Ok(Key { name, indices })
+}
+
+fn entry(line: &Line<'_>, key: &Key<'_>, value: &str, what: &str) -> Result<Entry, ParseError> {
+    let number = text::number(line, value, what)?;
+    Ok(Entry {
+        position_index: key.indices[0].0,
+        cycle_index: key.indices.get(1).map_or(0, |i| i.0),
+        value: number,
+        line: line.number,
+        column: line.column_of(key.indices[0].1),
+    })
+}
+
+fn declared(line: &Line<'_>, value: &str, what: &str) -> Result<Declared, ParseError> {
+    let count = text::integer(line, value, what)?;
+    if count == 0 || count > 100_000 {
+        return Err(line.error_at(
+            value,
+            format!("expected a {what} from 1 to 100000, found {count}"),
+        ));
+    }
+    Ok(Declared {
+        value: count as usize,
+        line: line.number,
+        column: line.column_of(value),
+    })
+}
+
+fn unit(line: &Line<'_>, value: &str) -> Result<LengthUnit, ParseError> {
+    match value.to_ascii_lowercase().as_str() {
+        "mm" => Ok(LengthUnit::Millimetre),
+        "inch" | "in" => Ok(LengthUnit::Inch),
+        _ => Err(line.error_at(
+            value,
+            format!(
+                "expected UNIT=mm or UNIT=inch, found {value:?} (rotary axes are not supported)"
+            ),
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SMALL: &str = "TEST_DATA=# Input data file\n\
+        UNIT=mm\nCYCLES=2\nPOSITIONS=2\nDEC=5\n\
+        TGT_DATA[1]=10\n REF_DATA_FWD[1,1] = 10.001\nTGT_DATA[2] =20\n\
+        REF_DATA_FWD[2,1]=20.002 \nREF_DATA_FWD[1,2]=10.003\nREF_DATA_FWD[2,2]=20.004\n\
+        REF_DATA_BWD[1,1]=9.999\nREF_DATA_BWD[2,1]=19.998\nREF_DATA_BWD[1,2]=9.997\nREF_DATA_BWD[2,2]=19.996\n  \n";
+
+    fn parse_ok(text: &str) -> Measurement {
+        parse(text).unwrap_or_else(|e| panic!("{e}")).0
+    }
+
+    #[test]
+    fn values_are_actual_positions_and_fwd_is_up() {
+        let m = parse_ok(SMALL);
+        assert_eq!(m.targets_mm(), &[10.0, 20.0]);
+        let labels: Vec<String> = m.runs().iter().map(|r| r.label()).collect();
+        assert_eq!(labels, ["1↑", "1↓", "2↑", "2↓"]);
+        let first = m.runs()[0].deviations_mm[0].unwrap();
+        assert!((first - 0.001).abs() < 1e-12);
+        let down = m.runs()[3].deviations_mm[1].unwrap();
+        assert!((down + 0.004).abs() < 1e-12);
+    }
+
+    #[test]
+    fn counts_are_inferred_when_absent() {
+        let text = "TGT_DATA[1]=0\nTGT_DATA[2]=5\nREF_DATA_FWD[1,1]=0\nREF_DATA_FWD[2,1]=5.001\n";
+        let m = parse_ok(text);
+        assert_eq!(m.runs().len(), 1);
+        assert_eq!(m.run_count(Direction::Down), 0);
+    }
+
+    #[test]
+    fn positioned_errors() {
+        let cases = [
+            ("TGT_DATA[1]=1,5\n", (1, 13), "decimal comma"),
+            (
+                "POSITIONS=1\nTGT_DATA[2]=1\nREF_DATA_FWD[2,1]=1\n",
+                (2, 10),
+                "beyond POSITIONS=1",
+            ),
+            (
+                "TGT_DATA[1]=1\nTGT_DATA[1]=2\nREF_DATA_FWD[1,1]=1\n",
+                (2, 10),
+                "given twice",
+            ),
+            (
+                "TGT_DATA[1]=1\nTGT_DATA[2]=1\nREF_DATA_FWD[1,1]=1\n",
+                (2, 10),
+                "duplicate target",
+            ),
+            ("UNIT=deg\n", (1, 6), "rotary"),
+            ("TGT_DATA[1,2]=1\n", (1, 1), "takes 1 index"),
+            ("TGT_DATA[x]=1\n", (1, 10), "whole number"),
+            ("just words\n", (1, 1), "KEY=VALUE"),
+            ("TGT_DATA[1]=nan\n", (1, 13), "expected a number"),
+            (
+                "CYCLES=1\nTGT_DATA[1]=1\nREF_DATA_BWD[1,2]=1\n",
+                (3, 14),
+                "beyond CYCLES=1",
+            ),
+        ];
+        for (text, (line, column), needle) in cases {
+            let error = parse(text).unwrap_err();
+            assert_eq!(
+                (error.position.line, error.position.column),
+                (line, column),
+                "{text:?}: {error}"
+            );
+            assert!(error.message.contains(needle), "{text:?}: {error}");
+        }
+    }
+}

@@ -1,0 +1,319 @@
+//! Reading measurement files: the only place that opens inputs.
+//!
+//! The front end ([`read_path`], [`read_paths`]) reads bytes, decodes them
+//! ([`decode`]: UTF-8 with or without BOM, else Latin-1; UTF-16 and binary
+//! data are refused with a position), detects the format from the content
+//! ([`detect`]) unless the caller names it, hands the text to that format's
+//! pure parser, and adds the path to any error. The parsers take `&str` and
+//! never see a path, so they are tested and fuzzed on strings.
+//!
+//! One module per format, each with its parser and, where axcomp writes the
+//! format too, its writer: [`rtl`], [`ecmc`], [`api_pos`], [`csv`].
+
+pub mod api_pos;
+pub mod csv;
+pub mod ecmc;
+pub mod rtl;
+pub mod text;
+
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+
+use chrono::NaiveDateTime;
+
+use crate::error::{ParseError, ReadError, Warning};
+use crate::measurement::{Measurement, Run, SourceFormat};
+
+/// A measurement read from one or more files, with what the readers noticed.
+#[derive(Clone, Debug)]
+pub struct ReadResult {
+    /// The measurement.
+    pub measurement: Measurement,
+    /// Non-fatal findings, for the user.
+    pub warnings: Vec<Warning>,
+}
+
+/// Reads one measurement file. `format` overrides detection.
+pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult, ReadError> {
+    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let located = |error: ParseError| ReadError::Parse {
+        path: path.to_path_buf(),
+        error,
+    };
+    let text = decode(&bytes).map_err(located)?;
+    let format = match format {
+        Some(format) => format,
+        None => detect(&text).ok_or_else(|| located(unknown_format_error()))?,
+    };
+    let (mut measurement, warnings) = parse_str(&text, format).map_err(located)?;
+    measurement.metadata.source_file = Some(path.to_path_buf());
+    Ok(ReadResult {
+        measurement,
+        warnings,
+    })
+}
+
+/// Reads one file, or two files of one axis that together make one
+/// bidirectional measurement (e.g. the forward and reverse `.pos` files).
+pub fn read_paths(
+    paths: &[PathBuf],
+    format: Option<SourceFormat>,
+) -> Result<ReadResult, ReadError> {
+    let Some((first, rest)) = paths.split_first() else {
+        return Err(ReadError::Merge {
+            path: PathBuf::from("-"),
+            message: "no input file given".to_string(),
+        });
+    };
+    let mut result = read_path(first, format)?;
+    for path in rest {
+        let next = read_path(path, format)?;
+        let merged = result
+            .measurement
+            .merge(&next.measurement)
+            .map_err(|message| ReadError::Merge {
+                path: path.clone(),
+                message,
+            })?;
+        result.measurement = merged;
+        result.warnings.extend(next.warnings);
+    }
+    Ok(result)
+}
+
+/// Parses decoded text in a known format (no I/O).
+pub fn parse_str(
+    text: &str,
+    format: SourceFormat,
+) -> Result<(Measurement, Vec<Warning>), ParseError> {
+    match format {
+        SourceFormat::Rtl => rtl::parse(text),
+        SourceFormat::Ecmc => ecmc::parse(text),
+        SourceFormat::ApiPos => api_pos::parse(text),
+        SourceFormat::Csv => csv::parse(text),
+    }
+}
+
+/// Guesses the format from the content, or `None` if nothing fits.
+pub fn detect(text: &str) -> Option<SourceFormat> {
+    let first = text.lines().map(str::trim).find(|line| !line.is_empty())?;
+    if first.eq_ignore_ascii_case("HEADER::") {
+        return Some(SourceFormat::Rtl);
+    }
+    if first.starts_with("API ") && first.contains("Laser") {
+        return Some(SourceFormat::ApiPos);
+    }
+    let first_data = text
+        .lines()
+        .map(str::trim)
+        .find(|line| !line.is_empty() && !line.starts_with('#'));
+    if let Some(line) = first_data {
+        let compact: String = line.chars().filter(|c| !c.is_whitespace()).collect();
+        if compact.to_ascii_lowercase().starts_with(csv::HEADER) {
+            return Some(SourceFormat::Csv);
+        }
+    }
+    if text.contains("TGT_DATA[")
+        || text.contains("REF_DATA_FWD[")
+        || text.contains("REF_DATA_BWD[")
+    {
+        return Some(SourceFormat::Ecmc);
+    }
+    if text
+        .lines()
+        .any(|line| line.trim_start().starts_with("API Linear"))
+    {
+        return Some(SourceFormat::ApiPos);
+    }
+    None
+}
+
+/// The error for content that matches no format: it lists what is supported.
+pub fn unknown_format_error() -> ParseError {
+    let list: Vec<String> = SourceFormat::ALL
+        .iter()
+        .map(|format| format!("{} ({})", format.name(), format.description()))
+        .collect();
+    ParseError::new(
+        1,
+        1,
+        format!(
+            "unknown format: expected one of: {}; name one with --format",
+            list.join("; ")
+        ),
+    )
+}
+
+/// Decodes file bytes to text.
+///
+/// UTF-8 (a BOM is dropped) is taken as is; other bytes are read as Latin-1,
+/// which older Windows laser software writes. UTF-16 and binary data are
+/// refused: the error names the line and column of the first offending byte.
+pub fn decode(bytes: &[u8]) -> Result<Cow<'_, str>, ParseError> {
+    if bytes.starts_with(&[0xFF, 0xFE])
+        || bytes.starts_with(&[0xFE, 0xFF])
+        || looks_like_utf16(bytes)
+    {
+        return Err(ParseError::new(
+            1,
+            1,
+            "expected UTF-8, ASCII or Latin-1 text, found UTF-16: convert the file first (e.g. iconv -f UTF-16 -t UTF-8)",
+        ));
+    }
+    let bytes = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(bytes);
+    if let Some(offset) = bytes.iter().position(|&b| is_binary_byte(b)) {
+        let (line, column) = line_column_of_byte(bytes, offset);
+        return Err(ParseError::new(
+            line,
+            column,
+            format!(
+                "expected text, found byte 0x{:02X}: this looks like a binary file, not a measurement",
+                bytes[offset]
+            ),
+        ));
+    }
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(ParseError::expected(1, 1, "a measurement", "an empty file"));
+    }
+    Ok(match std::str::from_utf8(bytes) {
+        Ok(text) => Cow::Borrowed(text),
+        Err(_) => Cow::Owned(bytes.iter().map(|&b| char::from(b)).collect()),
+    })
+}
+
+/// UTF-16 without a BOM: ASCII text in which every other byte is zero.
+fn looks_like_utf16(bytes: &[u8]) -> bool {
+    let head = &bytes[..bytes.len().min(64) & !1];
+    if head.len() < 4 {
+        return false;
+    }
+    let all_zero = |parity: usize| head.iter().skip(parity).step_by(2).all(|&b| b == 0);
+    let none_zero = |parity: usize| head.iter().skip(parity).step_by(2).all(|&b| b != 0);
+    (all_zero(1) && none_zero(0)) || (all_zero(0) && none_zero(1))
+}
+
+/// Control characters that never occur in the text formats axcomp reads.
+fn is_binary_byte(byte: u8) -> bool {
+    matches!(byte, 0x00..=0x08 | 0x0E..=0x1A | 0x1C..=0x1F | 0x7F)
+}
+
+/// 1-based line and column (in bytes, as the text is not yet decoded) of a byte offset.
+fn line_column_of_byte(bytes: &[u8], offset: usize) -> (usize, usize) {
+    let before = &bytes[..offset];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |p| p + 1);
+    (line, offset - line_start + 1)
+}
+
+/// Parses the date patterns seen in `.rtl` files (`../shared/spec/renishaw-rtl.md`,
+/// USER-TEXT); `None` for anything else, which stays as raw text.
+pub fn parse_date(raw: &str) -> Option<NaiveDateTime> {
+    const PATTERNS: [&str; 4] = [
+        "%Y-%m-%d %H:%M:%S",
+        "%H:%M %b %d %Y",
+        "%d/%m/%Y %H:%M:%S",
+        "%Y-%m-%dT%H:%M:%S",
+    ];
+    let raw = raw.trim();
+    PATTERNS
+        .iter()
+        .find_map(|pattern| NaiveDateTime::parse_from_str(raw, pattern).ok())
+        .or_else(|| {
+            chrono::NaiveDate::parse_from_str(raw, "%Y-%m-%d")
+                .ok()
+                .and_then(|date| date.and_hms_opt(0, 0, 0))
+        })
+}
+
+/// A warning listing missing readings, or `None` when every reading is there.
+pub(crate) fn missing_readings_warning(runs: &[Run], targets_mm: &[f64]) -> Option<Warning> {
+    let mut count = 0;
+    let mut examples = Vec::new();
+    for run in runs {
+        for (target_mm, value) in targets_mm.iter().zip(&run.deviations_mm) {
+            if value.is_none() {
+                count += 1;
+                if examples.len() < 3 {
+                    examples.push(format!("run {} at {target_mm} mm", run.label()));
+                }
+            }
+        }
+    }
+    (count > 0).then_some(Warning::MissingReadings { count, examples })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decoding_accepts_utf8_bom_and_latin1() {
+        assert_eq!(decode(b"\xEF\xBB\xBFHEADER::\n").unwrap(), "HEADER::\n");
+        assert_eq!(
+            decode(b"Machine: Kovosvit \xB5\n").unwrap(),
+            "Machine: Kovosvit µ\n"
+        );
+    }
+
+    #[test]
+    fn decoding_refuses_utf16_binary_and_empty() {
+        let utf16: Vec<u8> = "HEADER::\r\n"
+            .encode_utf16()
+            .flat_map(u16::to_le_bytes)
+            .collect();
+        assert!(decode(&utf16).unwrap_err().message.contains("UTF-16"));
+        let mut with_bom = vec![0xFF, 0xFE];
+        with_bom.extend(&utf16);
+        assert!(decode(&with_bom).unwrap_err().message.contains("UTF-16"));
+        let binary = decode(b"HEADER::\nab\x00c").unwrap_err();
+        assert_eq!((binary.position.line, binary.position.column), (2, 3));
+        assert!(
+            decode(b"  \n\r\n")
+                .unwrap_err()
+                .message
+                .contains("empty file")
+        );
+    }
+
+    #[test]
+    fn formats_are_detected_from_content() {
+        assert_eq!(
+            detect("\n  HEADER::\r\nFile type : rtl"),
+            Some(SourceFormat::Rtl)
+        );
+        assert_eq!(
+            detect("TEST_DATA=# x\nTGT_DATA[1]=15\n"),
+            Some(SourceFormat::Ecmc)
+        );
+        assert_eq!(
+            detect("API X-D Laser Measurement Linear Data Table (Company Name: )\n"),
+            Some(SourceFormat::ApiPos)
+        );
+        assert_eq!(
+            detect("# axis: X\ntarget_mm, run, direction, deviation_um\n"),
+            Some(SourceFormat::Csv)
+        );
+        assert_eq!(detect("hello\nworld\n"), None);
+    }
+
+    #[test]
+    fn dates_in_known_patterns() {
+        let parsed = parse_date("10:46 Dec 12 2016").unwrap();
+        assert_eq!(parsed.to_string(), "2016-12-12 10:46:00");
+        assert_eq!(
+            parse_date("2021-11-10 13:45:57").unwrap().to_string(),
+            "2021-11-10 13:45:57"
+        );
+        assert_eq!(
+            parse_date("12/12/2016 10:46:00").unwrap().to_string(),
+            "2016-12-12 10:46:00"
+        );
+        assert_eq!(parse_date("sometime"), None);
+    }
+}

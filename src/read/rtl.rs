@@ -1,0 +1,808 @@
+//! Renishaw LaserXL / Laser10 `.rtl` linear data: parser and writer.
+//!
+//! Implements `../shared/spec/renishaw-rtl.md`. No Renishaw specification is
+//! public; the layout is the one five independent third-party programs agree
+//! on (`../shared/notes/rtl-and-com-search.md`). What the spec calls lenient
+//! is lenient here, each with a test:
+//! - section names and keys match case-insensitively after trimming padding;
+//! - LF or CRLF, blank lines anywhere (Latin-1 is handled by `read::decode`);
+//! - an unknown section is skipped with a warning;
+//! - targets may be negative, unsorted, several per line, or start on the
+//!   `Targets :` line itself;
+//! - deviation rows are split on any whitespace and keyed on their
+//!   (run, target number) columns, never on row position; a missing pair is a
+//!   missing reading, not zero.
+//!
+//! Everything else is an error with line and column: a row with the wrong
+//! number of fields, a run or target number out of range, a pair listed twice,
+//! a count that does not match, a run whose rows go neither up nor down, a
+//! file without `EOF::` (truncated), an `Owner` other than `Linear`.
+//!
+//! A run's direction is inferred from the order its rows visit the targets:
+//! towards larger target positions is ↑. A run with a single row falls back to
+//! odd = ↑, even = ↓, as every known reader assumes.
+//!
+//! Deviations in the file are µm, actual minus target; targets are mm.
+
+use std::collections::HashMap;
+
+use nom::bytes::complete::{tag, take_while1};
+use nom::character::complete::space0;
+use nom::combinator::all_consuming;
+use nom::sequence::terminated;
+use nom::{IResult, Parser};
+
+use crate::error::{ParseError, Warning, describe_found};
+use crate::measurement::{
+    Direction, Environment, Measurement, Metadata, Run, SourceFormat, StartEnd, TestDate,
+};
+use crate::read::text::{self, Line, end_of_file_line, split_key};
+use crate::read::{missing_readings_warning, parse_date};
+use crate::units::{LengthUnit, mm_to_um, um_to_mm};
+
+/// Material temperature Renishaw writes when no sensor is fitted (°C).
+const NO_SENSOR_C: f64 = -10.0;
+
+/// Parses the text of an `.rtl` file.
+pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
+    let mut parser = RtlParser::default();
+    parser.run(input)?;
+    parser.finish(input)
+}
+
+/// Writes a measurement as an `.rtl` file (CRLF line ends, as Renishaw's software writes).
+///
+/// Runs are written in the order measured, one file run per direction pass;
+/// rows go in the order the run visited the targets. Numbers use the shortest
+/// text that reads back to the same value, so `parse(write(m))` gives `m` back.
+pub fn write(measurement: &Measurement) -> String {
+    let mut out = String::new();
+    let mut line = |text: &str| {
+        out.push_str(text);
+        out.push_str("\r\n");
+    };
+    let metadata = &measurement.metadata;
+    let field = |value: &Option<String>| value.clone().unwrap_or_default();
+    let unidirectional =
+        measurement.run_count(Direction::Up) == 0 || measurement.run_count(Direction::Down) == 0;
+
+    line("HEADER::");
+    line("File type  : rtl");
+    line("Owner      : Linear");
+    line("Version no : axcomp");
+    line("");
+    line("TARGET DATA::");
+    line("Filetype  : ISO");
+    line(&format!("Target-count: {}", measurement.targets_mm().len()));
+    line("Targets :");
+    for chunk in measurement.targets_mm().chunks(5) {
+        let texts: Vec<String> = chunk.iter().map(|t| format!("{t}")).collect();
+        line(&texts.join("  "));
+    }
+    line(if unidirectional {
+        "Flags: 0 1 2 0"
+    } else {
+        "Flags: 0 0 2 0"
+    });
+    line("");
+    line("USER-TEXT::");
+    line(&format!("Machine: {}", field(&metadata.machine)));
+    line(&format!("Serial No: {}", field(&metadata.serial_number)));
+    let date = metadata
+        .date
+        .as_ref()
+        .map(|d| d.raw.clone())
+        .unwrap_or_default();
+    line(&format!("Date: {date}"));
+    line(&format!("By: {}", field(&metadata.operator)));
+    line(&format!("Axis: {}", measurement.axis()));
+    line(&format!("Location: {}", field(&metadata.location)));
+    line(&format!("TITLE: {}", field(&metadata.description)));
+    line("");
+    line("RUNS::");
+    line(&format!("Run-count:{}", measurement.runs().len()));
+    line("");
+    line("DEVIATIONS::");
+    line("Run Target Data:");
+    for (run_index, run) in measurement.runs().iter().enumerate() {
+        let order: Vec<usize> = match run.direction {
+            Direction::Up => (0..measurement.targets_mm().len()).collect(),
+            Direction::Down => (0..measurement.targets_mm().len()).rev().collect(),
+        };
+        for target_index in order {
+            if let Some(deviation_mm) = run.deviations_mm[target_index] {
+                line(&format!(
+                    "{:<3} {:<6} {}",
+                    run_index + 1,
+                    target_index + 1,
+                    mm_to_um(deviation_mm)
+                ));
+            }
+        }
+    }
+    line("");
+    line("ENVIRONMENT::");
+    write_environment(&measurement.environment, &mut line);
+    line("");
+    line("EOF::");
+    out
+}
+
+fn write_environment(environment: &Environment, line: &mut impl FnMut(&str)) {
+    let pair = |value: StartEnd, missing: f64| {
+        format!(
+            "{:.6} {:.6}",
+            value.start.unwrap_or(missing),
+            value.end.unwrap_or(missing)
+        )
+    };
+    if !environment.air_temperature_c.is_empty() {
+        line(&format!(
+            "Air temp   : {}",
+            pair(environment.air_temperature_c, 0.0)
+        ));
+    }
+    if !environment.air_pressure_kpa.is_empty() {
+        line(&format!(
+            "Air press  : {}",
+            pair(environment.air_pressure_kpa, 0.0)
+        ));
+    }
+    if !environment.air_humidity_pct.is_empty() {
+        line(&format!(
+            "Air humid  : {}",
+            pair(environment.air_humidity_pct, 0.0)
+        ));
+    }
+    for (index, sensor) in environment.material_temperature_c.iter().enumerate() {
+        line(&format!(
+            "Mat temp {} : {}",
+            index + 1,
+            pair(*sensor, NO_SENSOR_C)
+        ));
+    }
+    if !environment.environmental_factor_um.is_empty() {
+        let factor = environment.environmental_factor_um;
+        line(&format!(
+            "Env factor : {:.8} {:.8}",
+            factor.start.unwrap_or(0.0),
+            factor.end.unwrap_or(0.0)
+        ));
+    }
+    if let Some(coefficient) = environment.expansion_coefficient_ppm_per_k {
+        line(&format!("Exp coeff  : {coefficient:.6} {coefficient:.6}"));
+    }
+}
+
+/// The sections of an `.rtl` file, in the order the spec gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Section {
+    Header,
+    TargetData,
+    UserText,
+    Runs,
+    Deviations,
+    Environment,
+    Eof,
+    /// A section the reader does not know; its lines are skipped.
+    Unknown,
+}
+
+impl Section {
+    fn from_name(name: &str) -> Section {
+        let normalised = name.trim().to_ascii_uppercase().replace('_', " ");
+        match normalised.as_str() {
+            "HEADER" => Section::Header,
+            "TARGET DATA" => Section::TargetData,
+            "USER-TEXT" | "USER TEXT" => Section::UserText,
+            "RUNS" => Section::Runs,
+            "DEVIATIONS" => Section::Deviations,
+            "ENVIRONMENT" => Section::Environment,
+            "EOF" => Section::Eof,
+            _ => Section::Unknown,
+        }
+    }
+}
+
+/// `NAME::` with optional surrounding blanks: a section header line.
+fn section_header(input: &str) -> IResult<&str, &str> {
+    let name = take_while1(|c: char| c.is_ascii_alphanumeric() || c == ' ' || c == '-' || c == '_');
+    all_consuming((space0, terminated(name, tag("::")), space0))
+        .map(|(_, name, _)| name)
+        .parse(input)
+}
+
+/// One deviation row as read, before runs are assembled.
+#[derive(Clone, Copy, Debug)]
+struct DeviationRow {
+    line: usize,
+    column: usize,
+    file_run: u32,
+    target_number: usize,
+    deviation_um: f64,
+}
+
+/// A number with the line and column it came from.
+#[derive(Clone, Copy, Debug)]
+struct Located<T> {
+    value: T,
+    line: usize,
+    column: usize,
+}
+
+#[derive(Default)]
+struct RtlParser {
+    section: Option<Section>,
+    seen: HashMap<&'static str, usize>,
+    collecting_targets: bool,
+    target_count: Option<Located<usize>>,
+    targets: Vec<Located<f64>>,
+    /// Target value (as bits, -0 folded into +0) → index into `targets`.
+    target_lookup: HashMap<u64, usize>,
+    run_count: Option<Located<u32>>,
+    rows: Vec<DeviationRow>,
+    /// (file run, target number) → line, to find a pair listed twice.
+    row_lookup: HashMap<(u32, usize), usize>,
+    metadata: Metadata,
+    axis: Option<String>,
+    last_user_key: Option<String>,
+    environment: Environment,
+    capture_start: Option<String>,
+    saw_eof: Option<usize>,
+    warnings: Vec<Warning>,
+}
+
+impl RtlParser {
+    fn run(&mut self, input: &str) -> Result<(), ParseError> {
+        for line in text::lines(input) {
+            if line.is_blank() {
+                continue;
+            }
+            if let Some(eof_line) = self.saw_eof {
+                return Err(line.error_at(
+                    line.text.trim_start(),
+                    format!(
+                        "expected nothing after EOF:: (line {eof_line}), found {}",
+                        describe_found(line.text.trim())
+                    ),
+                ));
+            }
+            if let Ok((_, name)) = section_header(line.text) {
+                self.enter_section(&line, name)?;
+                continue;
+            }
+            let Some(section) = self.section else {
+                return Err(line.expected_at(
+                    line.text.trim_start(),
+                    "HEADER:: as the first line of an .rtl file",
+                ));
+            };
+            match section {
+                Section::Header => self.header_line(&line)?,
+                Section::TargetData => self.target_data_line(&line)?,
+                Section::UserText => self.user_text_line(&line),
+                Section::Runs => self.runs_line(&line)?,
+                Section::Deviations => self.deviation_line(&line)?,
+                Section::Environment => self.environment_line(&line)?,
+                Section::Eof | Section::Unknown => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn enter_section(&mut self, line: &Line<'_>, name: &str) -> Result<(), ParseError> {
+        let section = Section::from_name(name);
+        let name_at = line.text.trim_start();
+        if self.section.is_none() && section != Section::Header {
+            return Err(line.expected_at(name_at, "HEADER:: as the first line of an .rtl file"));
+        }
+        self.collecting_targets = false;
+        if section == Section::Unknown {
+            self.warnings.push(Warning::UnknownSection {
+                line: line.number,
+                name: name.trim().to_string(),
+            });
+            self.section = Some(section);
+            return Ok(());
+        }
+        let key = section_key(section);
+        if let Some(first) = self.seen.insert(key, line.number) {
+            return Err(line.error_at(
+                name_at,
+                format!("section {key}:: appears twice (first at line {first})"),
+            ));
+        }
+        if section == Section::Eof {
+            self.saw_eof = Some(line.number);
+        }
+        self.section = Some(section);
+        Ok(())
+    }
+
+    fn header_line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        let (key, value) = key_value(line)?;
+        match key.to_ascii_lowercase().as_str() {
+            "owner" => {
+                if !value.eq_ignore_ascii_case("linear") {
+                    return Err(line.error_at(
+                        value,
+                        format!(
+                            "expected Owner : Linear, found {}: only linear measurements are supported (angular and straightness files are not)",
+                            describe_found(value)
+                        ),
+                    ));
+                }
+            }
+            "file type" | "version no" => self.keep(key, value),
+            _ => self.unknown_key(line, key),
+        }
+        Ok(())
+    }
+
+    fn target_data_line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        // A target value line has no colon; any `Key:` line ends the target list.
+        let Some((key, value)) = split_key(line.text, ':') else {
+            if !self.collecting_targets {
+                return Err(
+                    line.expected_at(line.text.trim_start(), "Key : value in TARGET DATA::")
+                );
+            }
+            return self.target_values(line, line.text);
+        };
+        self.collecting_targets = false;
+        match key.to_ascii_lowercase().as_str() {
+            "target-count" => {
+                let count = text::integer(line, value, "target count")?;
+                self.target_count = Some(Located {
+                    value: count as usize,
+                    line: line.number,
+                    column: line.column_of(value),
+                });
+            }
+            "targets" => {
+                self.collecting_targets = true;
+                self.target_values(line, value)?;
+            }
+            "filetype" | "flags" => self.keep(key, value),
+            _ => self.unknown_key(line, key),
+        }
+        Ok(())
+    }
+
+    fn target_values(&mut self, line: &Line<'_>, values: &str) -> Result<(), ParseError> {
+        for token in values.split_whitespace() {
+            let value = text::number(line, token, "target position in mm")?;
+            let column = line.column_of(token);
+            let key = (value + 0.0).to_bits();
+            if let Some(&index) = self.target_lookup.get(&key) {
+                let first = self.targets[index];
+                return Err(ParseError::new(
+                    line.number,
+                    column,
+                    format!(
+                        "duplicate target {value} mm (first listed at line {}, column {})",
+                        first.line, first.column
+                    ),
+                ));
+            }
+            self.target_lookup.insert(key, self.targets.len());
+            self.targets.push(Located {
+                value,
+                line: line.number,
+                column,
+            });
+        }
+        Ok(())
+    }
+
+    fn user_text_line(&mut self, line: &Line<'_>) {
+        let Some((key, value)) = split_key(line.text, ':') else {
+            // USER-TEXT is free text: a line without a key continues the previous value.
+            if let Some(key) = self.last_user_key.clone() {
+                self.append_user_text(&key, line.text.trim());
+            }
+            return;
+        };
+        let key = key.to_ascii_lowercase();
+        self.set_user_text(line, &key, value);
+        self.last_user_key = Some(key);
+    }
+
+    fn set_user_text(&mut self, line: &Line<'_>, key: &str, value: &str) {
+        let value = (!value.is_empty()).then(|| value.to_string());
+        match key {
+            "machine" => self.metadata.machine = value,
+            "serial no" => self.metadata.serial_number = value,
+            "by" => self.metadata.operator = value,
+            "axis" => self.axis = value,
+            "location" => self.metadata.location = value,
+            "title" => self.metadata.description = value,
+            "date" => {
+                self.metadata.date = value.map(|raw| TestDate {
+                    parsed: parse_date(&raw),
+                    raw,
+                })
+            }
+            _ => self.unknown_key(line, key),
+        }
+    }
+
+    fn append_user_text(&mut self, key: &str, more: &str) {
+        let target = match key {
+            "machine" => &mut self.metadata.machine,
+            "location" => &mut self.metadata.location,
+            "title" => &mut self.metadata.description,
+            _ => return,
+        };
+        let joined = match target.take() {
+            Some(previous) => format!("{previous} {more}"),
+            None => more.to_string(),
+        };
+        *target = Some(joined);
+    }
+
+    fn runs_line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        let (key, value) = key_value(line)?;
+        if !key.eq_ignore_ascii_case("run-count") {
+            self.unknown_key(line, key);
+            return Ok(());
+        }
+        let count = text::integer(line, value, "run count")?;
+        let Ok(count) = u32::try_from(count) else {
+            return Err(line.error_at(value, format!("run count {count} is too large")));
+        };
+        self.run_count = Some(Located {
+            value: count,
+            line: line.number,
+            column: line.column_of(value),
+        });
+        Ok(())
+    }
+
+    fn deviation_line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        if line.text.contains(':') {
+            let (key, _) = key_value(line)?;
+            if !key.eq_ignore_ascii_case("run target data") {
+                self.unknown_key(line, key);
+            }
+            return Ok(());
+        }
+        let fields: Vec<&str> = line.fields().collect();
+        if fields.len() != 3 {
+            let at = fields.get(3).copied().unwrap_or(line.text.trim_start());
+            return Err(line.error_at(
+                at,
+                format!(
+                    "deviation row has {} field(s), expected run, target number, value",
+                    fields.len()
+                ),
+            ));
+        }
+        let (run, target, value) = (fields[0], fields[1], fields[2]);
+        let file_run = text::integer(line, run, "run number")?;
+        let Some(run_count) = self.run_count else {
+            return Err(line.error_at(run, "deviation row before RUNS:: Run-count"));
+        };
+        if file_run == 0 || file_run > u64::from(run_count.value) {
+            return Err(line.error_at(
+                run,
+                format!(
+                    "run {file_run} is out of range: Run-count is {} (line {})",
+                    run_count.value, run_count.line
+                ),
+            ));
+        }
+        let target_number = text::integer(line, target, "target number")?;
+        let listed = self.targets.len() as u64;
+        if target_number == 0 || target_number > listed {
+            return Err(line.error_at(
+                target,
+                format!(
+                    "target number {target_number} is out of range: {listed} targets are listed"
+                ),
+            ));
+        }
+        let deviation_um = text::number(line, value, "deviation in µm")?;
+        let file_run = file_run as u32;
+        let target_number = target_number as usize;
+        if let Some(first_line) = self
+            .row_lookup
+            .insert((file_run, target_number), line.number)
+        {
+            return Err(line.error_at(
+                target,
+                format!(
+                    "run {file_run} lists target {target_number} twice (first at line {first_line})"
+                ),
+            ));
+        }
+        self.rows.push(DeviationRow {
+            line: line.number,
+            column: line.column_of(run),
+            file_run,
+            target_number,
+            deviation_um,
+        });
+        Ok(())
+    }
+
+    fn environment_line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        let (key, value) = key_value(line)?;
+        let key_normalised = key
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+            .to_ascii_lowercase();
+        let environment = &mut self.environment;
+        match key_normalised.as_str() {
+            "air temp" => environment.air_temperature_c = start_end(line, value, None)?,
+            "air press" => environment.air_pressure_kpa = start_end(line, value, None)?,
+            "air humid" => environment.air_humidity_pct = start_end(line, value, None)?,
+            "mat temp 1" | "mat temp 2" | "mat temp 3" => {
+                let index = usize::from(key_normalised.as_bytes()[9] - b'1');
+                environment.material_temperature_c[index] =
+                    start_end(line, value, Some(NO_SENSOR_C))?;
+            }
+            "env factor" => environment.environmental_factor_um = start_end(line, value, None)?,
+            "exp coeff" => {
+                environment.expansion_coefficient_ppm_per_k = start_end(line, value, None)?.start
+            }
+            "date time" => {
+                let quoted: Vec<&str> = value.split('"').skip(1).step_by(2).collect();
+                self.capture_start = quoted.first().map(|s| s.to_string());
+            }
+            "final data" => self.keep(key, value),
+            _ => self.unknown_key(line, key),
+        }
+        Ok(())
+    }
+
+    fn keep(&mut self, key: &str, value: &str) {
+        self.metadata
+            .extra
+            .push((key.to_string(), value.to_string()));
+    }
+
+    fn unknown_key(&mut self, line: &Line<'_>, key: &str) {
+        self.warnings.push(Warning::UnknownKey {
+            line: line.number,
+            key: key.to_string(),
+        });
+    }
+
+    fn finish(mut self, input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
+        let end_line = end_of_file_line(input);
+        if self.section.is_none() {
+            return Err(ParseError::expected(
+                1,
+                1,
+                "HEADER:: as the first line of an .rtl file",
+                "an empty file",
+            ));
+        }
+        if self.saw_eof.is_none() {
+            return Err(ParseError::new(
+                end_line,
+                1,
+                "expected EOF:: at the end of the file, found end of file: the file is truncated",
+            ));
+        }
+        for (key, name) in [
+            ("TARGET DATA", "TARGET DATA::"),
+            ("RUNS", "RUNS::"),
+            ("DEVIATIONS", "DEVIATIONS::"),
+        ] {
+            if !self.seen.contains_key(key) {
+                return Err(ParseError::new(
+                    end_line,
+                    1,
+                    format!("expected a {name} section, found none"),
+                ));
+            }
+        }
+        let Some(target_count) = self.target_count else {
+            let line = self.seen["TARGET DATA"];
+            return Err(ParseError::new(
+                line,
+                1,
+                "expected Target-count: in TARGET DATA::, found none",
+            ));
+        };
+        if target_count.value != self.targets.len() {
+            return Err(ParseError::new(
+                target_count.line,
+                target_count.column,
+                format!(
+                    "Target-count is {} but {} target(s) are listed",
+                    target_count.value,
+                    self.targets.len()
+                ),
+            ));
+        }
+        let Some(run_count) = self.run_count else {
+            let line = self.seen["RUNS"];
+            return Err(ParseError::new(
+                line,
+                1,
+                "expected Run-count: in RUNS::, found none",
+            ));
+        };
+        if run_count.value == 0 {
+            return Err(ParseError::new(
+                run_count.line,
+                run_count.column,
+                "expected at least one run, found Run-count:0",
+            ));
+        }
+        let runs = self.assemble_runs(run_count)?;
+        let axis = match self.axis.take() {
+            Some(axis) => axis,
+            None => {
+                self.warnings.push(Warning::InconsistentMetadata {
+                    message:
+                        "no Axis: in USER-TEXT::; the axis is called X (use --axis to name it)"
+                            .to_string(),
+                });
+                "X".to_string()
+            }
+        };
+        if self.metadata.date.is_none() {
+            self.metadata.date = self.capture_start.take().map(|raw| TestDate {
+                parsed: parse_date(&raw),
+                raw,
+            });
+        }
+        self.metadata.source_format = Some(SourceFormat::Rtl);
+        self.metadata.length_unit = LengthUnit::Millimetre;
+        let targets_mm: Vec<f64> = sorted_targets(&self.targets)
+            .iter()
+            .map(|t| t.value)
+            .collect();
+        if let Some(warning) = missing_readings_warning(&runs, &targets_mm) {
+            self.warnings.push(warning);
+        }
+        let measurement = Measurement::new(axis, targets_mm, runs, self.environment, self.metadata)
+            .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
+        Ok((measurement, self.warnings))
+    }
+
+    /// Groups the rows by file run, infers each run's direction and numbers the
+    /// runs per direction in the order measured.
+    fn assemble_runs(&self, run_count: Located<u32>) -> Result<Vec<Run>, ParseError> {
+        let sorted = sorted_targets(&self.targets);
+        // Target number (1-based, as listed) → index into the sorted targets.
+        let mut sorted_index = vec![0; self.targets.len()];
+        for (index, target) in sorted.iter().enumerate() {
+            sorted_index[target.original_index] = index;
+        }
+        let mut runs = Vec::with_capacity(run_count.value as usize);
+        let mut numbers = [0u32; 2];
+        let mut rows_by_run: Vec<Vec<&DeviationRow>> = vec![Vec::new(); run_count.value as usize];
+        for row in &self.rows {
+            rows_by_run[row.file_run as usize - 1].push(row);
+        }
+        for (file_run, rows) in (1..=run_count.value).zip(rows_by_run) {
+            if rows.is_empty() {
+                return Err(ParseError::new(
+                    run_count.line,
+                    run_count.column,
+                    format!(
+                        "Run-count is {} but run {file_run} has no deviation rows",
+                        run_count.value
+                    ),
+                ));
+            }
+            let direction = run_direction(&rows, &sorted_index, file_run)?;
+            let slot = usize::from(direction == Direction::Down);
+            numbers[slot] += 1;
+            let mut deviations_mm = vec![None; self.targets.len()];
+            for row in &rows {
+                deviations_mm[sorted_index[row.target_number - 1]] =
+                    Some(um_to_mm(row.deviation_um));
+            }
+            runs.push(Run {
+                direction,
+                number: numbers[slot],
+                start_time_s: None,
+                deviations_mm,
+            });
+        }
+        Ok(runs)
+    }
+}
+
+/// The direction of one run from the order of its rows (see the module doc).
+fn run_direction(
+    rows: &[&DeviationRow],
+    sorted_index: &[usize],
+    file_run: u32,
+) -> Result<Direction, ParseError> {
+    if rows.len() == 1 {
+        return Ok(if file_run % 2 == 1 {
+            Direction::Up
+        } else {
+            Direction::Down
+        });
+    }
+    let position = |row: &DeviationRow| sorted_index[row.target_number - 1];
+    let direction = if position(rows[1]) > position(rows[0]) {
+        Direction::Up
+    } else {
+        Direction::Down
+    };
+    for pair in rows.windows(2) {
+        let forward = position(pair[1]) > position(pair[0]);
+        if forward != (direction == Direction::Up) {
+            return Err(ParseError::new(
+                pair[1].line,
+                pair[1].column,
+                format!(
+                    "run {file_run} visits the targets out of order (target {} after target {}): expected the rows of a run to go all up or all down",
+                    pair[1].target_number, pair[0].target_number
+                ),
+            ));
+        }
+    }
+    Ok(direction)
+}
+
+#[derive(Clone, Copy)]
+struct SortedTarget {
+    value: f64,
+    original_index: usize,
+}
+
+fn sorted_targets(targets: &[Located<f64>]) -> Vec<SortedTarget> {
+    let mut sorted: Vec<SortedTarget> = targets
+        .iter()
+        .enumerate()
+        .map(|(original_index, t)| SortedTarget {
+            value: t.value,
+            original_index,
+        })
+        .collect();
+    sorted.sort_by(|a, b| a.value.total_cmp(&b.value));
+    sorted
+}
+
+fn section_key(section: Section) -> &'static str {
+    match section {
+        Section::Header => "HEADER",
+        Section::TargetData => "TARGET DATA",
+        Section::UserText => "USER-TEXT",
+        Section::Runs => "RUNS",
+        Section::Deviations => "DEVIATIONS",
+        Section::Environment => "ENVIRONMENT",
+        Section::Eof => "EOF",
+        Section::Unknown => "?",
+    }
+}
+
+/// `Key : value`, or an error saying a key was expected.
+fn key_value<'a>(line: &Line<'a>) -> Result<(&'a str, &'a str), ParseError> {
+    split_key(line.text, ':').ok_or_else(|| line.expected_at(line.text.trim_start(), "Key : value"))
+}
+
+/// `start end [flag]`: two numbers and an optional third of unknown meaning.
+/// `sentinel` is the value that means "no sensor"; it becomes `None`.
+fn start_end(line: &Line<'_>, value: &str, sentinel: Option<f64>) -> Result<StartEnd, ParseError> {
+    let tokens: Vec<&str> = value.split_whitespace().collect();
+    if tokens.len() < 2 {
+        let at = tokens.first().copied().unwrap_or(value);
+        return Err(line.error_at(
+            at,
+            format!(
+                "expected start and end values, found {} value(s)",
+                tokens.len()
+            ),
+        ));
+    }
+    let read = |token: &str| -> Result<Option<f64>, ParseError> {
+        let number = text::number(line, token, "environment value")?;
+        Ok((Some(number) != sentinel).then_some(number))
+    };
+    Ok(StartEnd::new(read(tokens[0])?, read(tokens[1])?))
+}
+
+#[cfg(test)]
+mod tests;

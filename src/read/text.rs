@@ -1,0 +1,252 @@
+//! Building blocks for the line-oriented formats: numbered lines, fields with
+//! their columns, and strict numbers.
+//!
+//! Every format axcomp reads is line-oriented, so the parsers first number
+//! the lines and then parse each line; the line number in an error is then
+//! exact (`../shared/spec/style.md` §4). Columns count characters from 1.
+//!
+//! Numbers are strict: a plain decimal (`-12.5`, `+0.0012`, `.5`, `1e-3`).
+//! nom's `double` would accept `nan`, `inf` and `infinity`, and `1e400` parses
+//! to infinity; here a token is first *recognised* as a decimal with nom, then
+//! parsed, and anything non-finite is refused. A decimal comma is refused with
+//! a message that says so.
+
+use nom::branch::alt;
+use nom::character::complete::{char, digit0, digit1, one_of};
+use nom::combinator::opt;
+use nom::sequence::pair;
+use nom::{IResult, Parser};
+
+use crate::error::{ParseError, describe_found};
+
+/// One line of a file: its 1-based number and its text without the line end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Line<'a> {
+    /// Line number, from 1.
+    pub number: usize,
+    /// The text, without `\n` or `\r\n`.
+    pub text: &'a str,
+}
+
+impl<'a> Line<'a> {
+    /// The 1-based character column of `part`, which must be a sub-slice of this line.
+    pub fn column_of(&self, part: &str) -> usize {
+        let offset = (part.as_ptr() as usize).saturating_sub(self.text.as_ptr() as usize);
+        let offset = offset.min(self.text.len());
+        self.text[..offset].chars().count() + 1
+    }
+
+    /// The column just after the last character (for "found end of line").
+    pub fn end_column(&self) -> usize {
+        self.text.chars().count() + 1
+    }
+
+    /// An error at the start of `part`.
+    pub fn error_at(&self, part: &str, message: impl Into<String>) -> ParseError {
+        ParseError::new(self.number, self.column_of(part), message)
+    }
+
+    /// An `expected …, found …` error at the start of `part`.
+    pub fn expected_at(&self, part: &str, expected: &str) -> ParseError {
+        ParseError::expected(
+            self.number,
+            self.column_of(part),
+            expected,
+            &describe_found(part),
+        )
+    }
+
+    /// The whitespace-separated fields of the line.
+    pub fn fields(&self) -> impl Iterator<Item = &'a str> {
+        self.text.split_whitespace()
+    }
+
+    /// Whether the line holds nothing but whitespace.
+    pub fn is_blank(&self) -> bool {
+        self.text.trim().is_empty()
+    }
+}
+
+/// Splits text into numbered lines, accepting LF and CRLF line ends.
+pub fn lines(text: &str) -> impl Iterator<Item = Line<'_>> {
+    text.split('\n').enumerate().map(|(index, raw)| Line {
+        number: index + 1,
+        text: raw.strip_suffix('\r').unwrap_or(raw),
+    })
+}
+
+/// The line just past the end of the text, for "expected …, found end of file".
+pub fn end_of_file_line(text: &str) -> usize {
+    let count = text.split('\n').count();
+    if text.ends_with('\n') {
+        count
+    } else {
+        count + 1
+    }
+}
+
+/// Recognises a plain decimal number: sign, digits, optional fraction, optional exponent.
+///
+/// The matched text is taken from the length of what remains, not with
+/// `nom::combinator::recognize`: in nom 8.0.0 `recognize` returns a short slice
+/// when a `digit0`-style parser consumes to the end of a `&str`
+/// (rust-bakery/nom#1808, #1887; fixed on nom's main branch, not released).
+fn decimal(input: &str) -> IResult<&str, &str> {
+    let (rest, _) = (
+        opt(one_of("+-")),
+        alt((
+            pair(digit1, opt(pair(char('.'), digit0))).map(|_| ()),
+            pair(char('.'), digit1).map(|_| ()),
+        )),
+        opt((one_of("eE"), opt(one_of("+-")), digit1)),
+    )
+        .parse(input)?;
+    Ok((rest, consumed(input, rest)))
+}
+
+/// The part of `input` a parser consumed, given what it left.
+pub fn consumed<'a>(input: &'a str, rest: &str) -> &'a str {
+    &input[..input.len() - rest.len()]
+}
+
+/// Parses a whole token as a finite decimal number, or says what is wrong with it.
+///
+/// `what` names the quantity for the message ("target", "deviation").
+pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseError> {
+    let expected = format!("a number ({what})");
+    let Ok((rest, digits)) = decimal(token) else {
+        return Err(line.expected_at(token, &expected));
+    };
+    if !rest.is_empty() {
+        if rest.starts_with(',') && rest[1..].starts_with(|c: char| c.is_ascii_digit()) {
+            return Err(line.error_at(
+                token,
+                format!(
+                    "expected a number ({what}) with '.' as decimal point, found decimal comma in {}",
+                    describe_found(token)
+                ),
+            ));
+        }
+        return Err(line.expected_at(token, &expected));
+    }
+    let value: f64 = digits
+        .parse()
+        .map_err(|_| line.expected_at(token, &expected))?;
+    if !value.is_finite() {
+        return Err(line.error_at(
+            token,
+            format!("expected a finite number ({what}), found {token:?}, which overflows"),
+        ));
+    }
+    Ok(value)
+}
+
+/// Parses a whole token as a non-negative integer.
+pub fn integer(line: &Line<'_>, token: &str, what: &str) -> Result<u64, ParseError> {
+    let all_digits = !token.is_empty() && token.bytes().all(|b| b.is_ascii_digit());
+    if !all_digits {
+        return Err(line.expected_at(token, &format!("a whole number ({what})")));
+    }
+    token
+        .parse()
+        .map_err(|_| line.error_at(token, format!("{what} {token} is too large")))
+}
+
+/// Splits `key<sep>value` at the first `sep`; the key is trimmed, the value is
+/// trimmed and still a slice of the line (so columns stay right).
+pub fn split_key(text: &str, sep: char) -> Option<(&str, &str)> {
+    let at = text.find(sep)?;
+    Some((text[..at].trim(), text[at + sep.len_utf8()..].trim()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(text: &str) -> Line<'_> {
+        Line { number: 7, text }
+    }
+
+    #[test]
+    fn numbered_lines_strip_crlf() {
+        let all: Vec<_> = lines("a\r\nb\n\nc").collect();
+        assert_eq!(all.len(), 4);
+        assert_eq!(all[0].text, "a");
+        assert_eq!(all[1].number, 2);
+        assert_eq!(all[3].text, "c");
+        assert_eq!(end_of_file_line("a\nb\n"), 3);
+        assert_eq!(end_of_file_line("a\nb"), 3);
+    }
+
+    #[test]
+    fn columns_count_characters() {
+        let l = line("µm  12.5");
+        let token = l.fields().nth(1).unwrap();
+        assert_eq!(l.column_of(token), 5);
+        assert_eq!(l.end_column(), 9);
+    }
+
+    #[test]
+    fn strict_numbers() {
+        let l = line("x");
+        for (text, value) in [
+            ("12.5", 12.5),
+            ("-0.0012", -0.0012),
+            ("+3", 3.0),
+            (".5", 0.5),
+            ("5.", 5.0),
+            ("1e-3", 0.001),
+            ("-2.5E+2", -250.0),
+        ] {
+            assert_eq!(number(&l, text, "value").unwrap(), value, "{text}");
+        }
+        for bad in [
+            "nan",
+            "NaN",
+            "inf",
+            "-infinity",
+            "",
+            "1.2.3",
+            "12a",
+            "--1",
+            "e5",
+            "0x10",
+        ] {
+            let error = number(&l, bad, "value").unwrap_err();
+            assert!(
+                error.message.starts_with("expected a number (value)"),
+                "{bad}: {error}"
+            );
+        }
+        let comma = number(&l, "1,5", "deviation").unwrap_err();
+        assert!(comma.message.contains("decimal comma"), "{comma}");
+        let huge = number(&l, "1e400", "target").unwrap_err();
+        assert!(huge.message.contains("overflows"), "{huge}");
+    }
+
+    #[test]
+    fn decimal_recognises_up_to_the_end_of_input() {
+        // Regression guard for rust-bakery/nom#1808 (see `decimal`).
+        assert_eq!(decimal("1.270"), Ok(("", "1.270")));
+        assert_eq!(decimal("12 x"), Ok((" x", "12")));
+    }
+
+    #[test]
+    fn strict_integers() {
+        let l = line("x");
+        assert_eq!(integer(&l, "42", "run").unwrap(), 42);
+        assert!(integer(&l, "-1", "run").is_err());
+        assert!(integer(&l, "1.0", "run").is_err());
+        assert!(integer(&l, "99999999999999999999999", "run").is_err());
+    }
+
+    #[test]
+    fn keys_split_and_trim() {
+        assert_eq!(
+            split_key("Air temp   : 20.3 20.4", ':'),
+            Some(("Air temp", "20.3 20.4"))
+        );
+        assert_eq!(split_key("UNIT=mm", '='), Some(("UNIT", "mm")));
+        assert_eq!(split_key("no separator", ':'), None);
+    }
+}

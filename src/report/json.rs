@@ -1,0 +1,314 @@
+//! The `--json` wire format of `axcomp evaluate`.
+//!
+//! # Wire format
+//!
+//! One object; keys may be added, never renamed or removed. Lengths carry
+//! their unit in the key; not-evaluated figures are `null`, never 0.
+//!
+//! ```text
+//! { "format": "ecmc", "axis": "X", "source_file": "…", "length_unit": "mm",
+//!   "targets_mm": [15.0, …],
+//!   "runs": {"up": 5, "down": 5}, "excluded_runs": ["1:down"],
+//!   "figures_um": {"A": …, "A_up": …, "A_down": …, "E": …, "E_up": …, "E_down": …,
+//!                  "M": …, "R": …, "R_up": …, "R_down": …, "B": …, "B_mean": …},
+//!   "per_target": [{"target_mm": …, "n_up": 5, "n_down": 5,
+//!                   "mean_up_um": …, "mean_down_um": …, "mean_um": …,
+//!                   "s_up_um": …, "s_down_um": …, "B_um": …,
+//!                   "R_up_um": …, "R_down_um": …, "R_um": …}, …],
+//!   "outliers": [{"run": 1, "direction": "down", "score": 48.2,
+//!                 "worst_target_mm": 15.0, "offset_um": 101.4}],
+//!   "environment": {…}, "metadata": {…}, "warnings": ["…"] }
+//! ```
+//!
+//! `B` is max |B_i| (unsigned); `B_mean` (B̄) and `B_um` are signed, ↑ minus ↓.
+
+use serde::Serialize;
+
+use crate::error::Warning;
+use crate::evaluate::{AxisFigures, Evaluation, SuspectedOutlier, TargetStats};
+use crate::measurement::{Environment, Measurement, RunSelector, StartEnd};
+use crate::units::{mm_to_um, opt_mm_to_um};
+
+/// The whole `evaluate --json` object.
+#[derive(Clone, Debug, Serialize)]
+pub struct EvaluationJson {
+    /// Input format name (`rtl`, `ecmc`, `api-pos`, `csv`).
+    pub format: Option<&'static str>,
+    /// Axis name.
+    pub axis: String,
+    /// The file read (the first, when two were joined).
+    pub source_file: Option<String>,
+    /// Length unit of the source file (`mm` or `inch`); all values here are mm or µm.
+    pub length_unit: &'static str,
+    /// Targets, mm.
+    pub targets_mm: Vec<f64>,
+    /// Runs per direction, after exclusions.
+    pub runs: RunCountsJson,
+    /// Runs left out by `--exclude-run`, as `3`, `3:up` or `3:down`.
+    pub excluded_runs: Vec<String>,
+    /// Axis figures, µm.
+    pub figures_um: FiguresJson,
+    /// Per-target statistics.
+    pub per_target: Vec<PerTargetJson>,
+    /// Suspected outlier runs (included in the figures).
+    pub outliers: Vec<OutlierJson>,
+    /// Test conditions.
+    pub environment: EnvironmentJson,
+    /// Who, what, where, when.
+    pub metadata: MetadataJson,
+    /// Reader and evaluator warnings, as sentences.
+    pub warnings: Vec<String>,
+}
+
+/// Run counts.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct RunCountsJson {
+    /// ↑ runs.
+    pub up: usize,
+    /// ↓ runs.
+    pub down: usize,
+}
+
+/// ISO 230-2 axis figures, µm.
+#[allow(non_snake_case, missing_docs)]
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct FiguresJson {
+    pub A: Option<f64>,
+    pub A_up: Option<f64>,
+    pub A_down: Option<f64>,
+    pub E: Option<f64>,
+    pub E_up: Option<f64>,
+    pub E_down: Option<f64>,
+    pub M: Option<f64>,
+    pub R: Option<f64>,
+    pub R_up: Option<f64>,
+    pub R_down: Option<f64>,
+    pub B: Option<f64>,
+    pub B_mean: Option<f64>,
+}
+
+impl FiguresJson {
+    /// Converts axis figures (mm) to µm.
+    pub fn from_figures(f: &AxisFigures) -> FiguresJson {
+        FiguresJson {
+            A: opt_mm_to_um(f.a_mm),
+            A_up: opt_mm_to_um(f.a_up_mm),
+            A_down: opt_mm_to_um(f.a_down_mm),
+            E: opt_mm_to_um(f.e_mm),
+            E_up: opt_mm_to_um(f.e_up_mm),
+            E_down: opt_mm_to_um(f.e_down_mm),
+            M: opt_mm_to_um(f.m_mm),
+            R: opt_mm_to_um(f.r_mm),
+            R_up: opt_mm_to_um(f.r_up_mm),
+            R_down: opt_mm_to_um(f.r_down_mm),
+            B: opt_mm_to_um(f.b_mm),
+            B_mean: opt_mm_to_um(f.b_mean_mm),
+        }
+    }
+}
+
+/// Statistics at one target, µm.
+#[allow(non_snake_case)]
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct PerTargetJson {
+    /// Target, mm.
+    pub target_mm: f64,
+    /// Readings ↑.
+    pub n_up: usize,
+    /// Readings ↓.
+    pub n_down: usize,
+    /// x̄_i↑.
+    pub mean_up_um: Option<f64>,
+    /// x̄_i↓.
+    pub mean_down_um: Option<f64>,
+    /// x̄_i.
+    pub mean_um: Option<f64>,
+    /// s_i↑.
+    pub s_up_um: Option<f64>,
+    /// s_i↓.
+    pub s_down_um: Option<f64>,
+    /// B_i (signed).
+    pub B_um: Option<f64>,
+    /// R_i↑.
+    pub R_up_um: Option<f64>,
+    /// R_i↓.
+    pub R_down_um: Option<f64>,
+    /// R_i.
+    pub R_um: Option<f64>,
+}
+
+impl PerTargetJson {
+    /// Converts one target's statistics to µm.
+    pub fn from_stats(t: &TargetStats) -> PerTargetJson {
+        PerTargetJson {
+            target_mm: t.target_mm,
+            n_up: t.up.n,
+            n_down: t.down.n,
+            mean_up_um: opt_mm_to_um(t.up.mean_mm),
+            mean_down_um: opt_mm_to_um(t.down.mean_mm),
+            mean_um: opt_mm_to_um(t.mean_mm),
+            s_up_um: opt_mm_to_um(t.up.s_mm),
+            s_down_um: opt_mm_to_um(t.down.s_mm),
+            B_um: opt_mm_to_um(t.reversal_mm),
+            R_up_um: opt_mm_to_um(t.repeatability_up_mm),
+            R_down_um: opt_mm_to_um(t.repeatability_down_mm),
+            R_um: opt_mm_to_um(t.repeatability_mm),
+        }
+    }
+}
+
+/// A suspected outlier run.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct OutlierJson {
+    /// Run number within its direction.
+    pub run: u32,
+    /// `up` or `down`.
+    pub direction: &'static str,
+    /// Largest standardised difference from the other runs.
+    pub score: f64,
+    /// Where it differs most, mm.
+    pub worst_target_mm: f64,
+    /// How much it differs there from the mean of the other runs, µm.
+    pub offset_um: f64,
+}
+
+impl OutlierJson {
+    /// Converts a flagged run.
+    pub fn from_outlier(o: &SuspectedOutlier) -> OutlierJson {
+        OutlierJson {
+            run: o.run,
+            direction: o.direction.as_str(),
+            score: o.score,
+            worst_target_mm: o.worst_target_mm,
+            offset_um: mm_to_um(o.offset_mm),
+        }
+    }
+}
+
+/// A start/end pair.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct StartEndJson {
+    /// At the start.
+    pub start: Option<f64>,
+    /// At the end.
+    pub end: Option<f64>,
+}
+
+impl From<StartEnd> for StartEndJson {
+    fn from(value: StartEnd) -> StartEndJson {
+        StartEndJson {
+            start: value.start,
+            end: value.end,
+        }
+    }
+}
+
+/// Test conditions in °C, kPa, %, ppm/K and µm.
+#[derive(Clone, Debug, Serialize)]
+pub struct EnvironmentJson {
+    /// Air temperature, °C.
+    pub air_temperature_c: StartEndJson,
+    /// Air pressure, kPa.
+    pub air_pressure_kpa: StartEndJson,
+    /// Relative humidity, %.
+    pub air_humidity_pct: StartEndJson,
+    /// Material sensors 1–3, °C (`null` where none is fitted).
+    pub material_temperature_c: Vec<StartEndJson>,
+    /// Expansion coefficient, µm/(m·K).
+    pub expansion_coefficient_ppm_per_k: Option<f64>,
+    /// λ_vac / (2·n_air) as the laser used it, µm.
+    pub environmental_factor_um: StartEndJson,
+    /// The laser's vacuum wavelength, µm.
+    pub vacuum_wavelength_um: Option<f64>,
+}
+
+impl EnvironmentJson {
+    /// Copies the environment record.
+    pub fn from_environment(e: &Environment) -> EnvironmentJson {
+        EnvironmentJson {
+            air_temperature_c: e.air_temperature_c.into(),
+            air_pressure_kpa: e.air_pressure_kpa.into(),
+            air_humidity_pct: e.air_humidity_pct.into(),
+            material_temperature_c: e
+                .material_temperature_c
+                .iter()
+                .map(|s| (*s).into())
+                .collect(),
+            expansion_coefficient_ppm_per_k: e.expansion_coefficient_ppm_per_k,
+            environmental_factor_um: e.environmental_factor_um.into(),
+            vacuum_wavelength_um: e.vacuum_wavelength_um,
+        }
+    }
+}
+
+/// Metadata as text.
+#[derive(Clone, Debug, Serialize)]
+pub struct MetadataJson {
+    /// Machine.
+    pub machine: Option<String>,
+    /// Serial number.
+    pub serial_number: Option<String>,
+    /// Operator.
+    pub operator: Option<String>,
+    /// The date as written in the file.
+    pub date: Option<String>,
+    /// The date parsed, ISO 8601, when the pattern is known.
+    pub date_iso: Option<String>,
+    /// Location.
+    pub location: Option<String>,
+    /// Title or description.
+    pub description: Option<String>,
+}
+
+impl EvaluationJson {
+    /// Builds the wire object from a measurement, its evaluation and all warnings.
+    pub fn new(
+        measurement: &Measurement,
+        evaluation: &Evaluation,
+        excluded: &[RunSelector],
+        warnings: &[Warning],
+    ) -> EvaluationJson {
+        let metadata = &measurement.metadata;
+        EvaluationJson {
+            format: metadata.source_format.map(|f| f.name()),
+            axis: measurement.axis().to_string(),
+            source_file: metadata
+                .source_file
+                .as_ref()
+                .map(|p| p.display().to_string()),
+            length_unit: metadata.length_unit.as_str(),
+            targets_mm: measurement.targets_mm().to_vec(),
+            runs: RunCountsJson {
+                up: evaluation.runs_up,
+                down: evaluation.runs_down,
+            },
+            excluded_runs: excluded.iter().map(ToString::to_string).collect(),
+            figures_um: FiguresJson::from_figures(&evaluation.figures),
+            per_target: evaluation
+                .per_target
+                .iter()
+                .map(PerTargetJson::from_stats)
+                .collect(),
+            outliers: evaluation
+                .outliers
+                .iter()
+                .map(OutlierJson::from_outlier)
+                .collect(),
+            environment: EnvironmentJson::from_environment(&measurement.environment),
+            metadata: MetadataJson {
+                machine: metadata.machine.clone(),
+                serial_number: metadata.serial_number.clone(),
+                operator: metadata.operator.clone(),
+                date: metadata.date.as_ref().map(|d| d.raw.clone()),
+                date_iso: metadata
+                    .date
+                    .as_ref()
+                    .and_then(|d| d.parsed)
+                    .map(|d| d.format("%Y-%m-%dT%H:%M:%S").to_string()),
+                location: metadata.location.clone(),
+                description: metadata.description.clone(),
+            },
+            warnings: warnings.iter().map(ToString::to_string).collect(),
+        }
+    }
+}

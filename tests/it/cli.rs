@@ -1,0 +1,133 @@
+//! The `evaluate` command end to end: the report (golden file), flags, errors.
+
+use crate::util::{assert_golden, axcomp, test_data};
+
+const SAMPLE: &str = "fixtures/sample-x.rtl";
+
+#[test]
+fn terminal_report_of_the_bundled_sample() {
+    let run = axcomp(["evaluate", SAMPLE]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert_golden(&run.stdout, &test_data("golden/evaluate-sample-x.txt"));
+}
+
+#[test]
+fn json_report_of_the_bundled_sample() {
+    let run = axcomp(["evaluate", "--json", SAMPLE]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    for key in [
+        "format",
+        "axis",
+        "targets_mm",
+        "runs",
+        "figures_um",
+        "per_target",
+        "outliers",
+    ] {
+        assert!(json.get(key).is_some(), "missing key {key}");
+    }
+    assert_eq!(json["format"], "rtl");
+    assert_eq!(json["runs"]["up"], 5);
+    let target = &json["per_target"][0];
+    for key in [
+        "target_mm",
+        "mean_up_um",
+        "mean_down_um",
+        "mean_um",
+        "s_up_um",
+        "s_down_um",
+        "B_um",
+        "R_up_um",
+        "R_down_um",
+        "R_um",
+    ] {
+        assert!(target.get(key).is_some(), "missing per-target key {key}");
+    }
+    assert_golden(&run.stdout, &test_data("golden/evaluate-sample-x.json"));
+}
+
+#[test]
+fn excluding_a_run_changes_the_counts_and_is_recorded() {
+    let run = axcomp([
+        "evaluate",
+        "--json",
+        SAMPLE,
+        "--exclude-run",
+        "1:down",
+        "--exclude-run",
+        "5",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(
+        (json["runs"]["up"].as_u64(), json["runs"]["down"].as_u64()),
+        (Some(4), Some(3))
+    );
+    assert_eq!(json["excluded_runs"], serde_json::json!(["1:down", "5"]));
+}
+
+#[test]
+fn excluding_a_run_that_does_not_exist_is_an_error() {
+    let run = axcomp(["evaluate", SAMPLE, "--exclude-run", "6:up"]);
+    assert_eq!(run.code, 2);
+    assert!(
+        run.stderr
+            .contains("--exclude-run 6:up: no such run (the file has runs 1–5 ↑ and 1–5 ↓)"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn format_override_and_axis_rename() {
+    let forced = axcomp(["evaluate", "--format", "csv", SAMPLE]);
+    assert_eq!(forced.code, 2);
+    assert!(
+        forced
+            .stderr
+            .contains("sample-x.rtl:1:1: expected the header target_mm,run,direction,deviation_um"),
+        "{}",
+        forced.stderr
+    );
+    let unknown = axcomp(["evaluate", "--format", "xls", SAMPLE]);
+    assert_eq!(unknown.code, 2);
+    assert!(
+        unknown
+            .stderr
+            .contains("supported: rtl, ecmc, api-pos, csv"),
+        "{}",
+        unknown.stderr
+    );
+    let renamed = axcomp(["evaluate", "--json", "--axis", "U", SAMPLE]);
+    assert!(renamed.stdout.contains("\"axis\": \"U\""));
+}
+
+#[test]
+fn warnings_go_to_stderr_unless_quiet() {
+    let pos = crate::util::shared_data("api-xd/example__8055__X Axis Forward.pos");
+    let loud = axcomp(["evaluate".as_ref(), pos.as_os_str()]);
+    assert!(
+        loud.stderr.contains("warning: unidirectional test"),
+        "{}",
+        loud.stderr
+    );
+    let quiet = axcomp(["evaluate".as_ref(), "--quiet".as_ref(), pos.as_os_str()]);
+    assert_eq!((quiet.code, quiet.stderr.as_str()), (0, ""));
+}
+
+#[test]
+fn usage_errors_exit_2_and_help_exits_0() {
+    assert_eq!(axcomp(["evaluate"]).code, 2);
+    assert_eq!(axcomp(["frobnicate"]).code, 2);
+    let help = axcomp(["evaluate", "--help"]);
+    assert_eq!(help.code, 0);
+    assert!(help.stdout.contains("--exclude-run"));
+    let missing = axcomp(["evaluate", "no-such-file.rtl"]);
+    assert_eq!(missing.code, 2);
+    assert!(
+        missing.stderr.contains("no-such-file.rtl: No such file"),
+        "{}",
+        missing.stderr
+    );
+}

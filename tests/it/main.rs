@@ -1,0 +1,10 @@
+//! axcomp integration tests: one binary (see Cargo.toml `autotests = false`).
+//!
+//! Real third-party data is read by path from `../shared/data` (never copied
+//! into the repository); small inputs and expected outputs live in `tests/data`.
+
+mod bad_input;
+mod cli;
+mod evaluate_ecmc;
+mod read_api_pos;
+mod util;

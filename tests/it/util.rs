@@ -1,0 +1,91 @@
+//! Test harness: paths to shared data, running the binary, comparing text.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A file under `../shared/data` (the real third-party measurements).
+pub fn shared_data(relative: &str) -> PathBuf {
+    let path = root().join("../shared/data").join(relative);
+    assert!(
+        path.exists(),
+        "shared test data missing: {}",
+        path.display()
+    );
+    path
+}
+
+/// Every file in a `../shared/data` folder whose name ends with `suffix`.
+pub fn shared_files(folder: &str, suffix: &str) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(shared_data(folder))
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.to_string_lossy().ends_with(suffix))
+        .collect();
+    files.sort();
+    files
+}
+
+/// A file under `tests/data`.
+pub fn test_data(relative: &str) -> PathBuf {
+    root().join("tests/data").join(relative)
+}
+
+/// What the binary did.
+pub struct Run {
+    pub code: i32,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+/// Runs `axcomp` with arguments.
+pub fn axcomp<I, S>(args: I) -> Run
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let output = Command::new(env!("CARGO_BIN_EXE_axcomp"))
+        .args(args)
+        .output()
+        .expect("run axcomp");
+    Run {
+        code: output.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
+    }
+}
+
+/// Runs `axcomp evaluate --json FILE…` and parses the object.
+pub fn evaluate_json(files: &[&Path]) -> serde_json::Value {
+    let mut args: Vec<&std::ffi::OsStr> = vec!["evaluate".as_ref(), "--json".as_ref()];
+    args.extend(files.iter().map(|f| f.as_os_str()));
+    let run = axcomp(args);
+    assert_eq!(run.code, 0, "stderr: {}", run.stderr);
+    serde_json::from_str(&run.stdout).expect("evaluate --json prints one JSON object")
+}
+
+/// Compares a text with a golden file; `AXCOMP_UPDATE_GOLDEN=1` rewrites it.
+/// A missing golden file is a failure, not a silent pass.
+pub fn assert_golden(actual: &str, golden: &Path) {
+    if std::env::var_os("AXCOMP_UPDATE_GOLDEN").is_some() {
+        std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
+        std::fs::write(golden, actual).unwrap();
+        return;
+    }
+    let expected = std::fs::read_to_string(golden).unwrap_or_else(|_| {
+        panic!(
+            "golden file {} missing; run with AXCOMP_UPDATE_GOLDEN=1 and review it",
+            golden.display()
+        )
+    });
+    if expected != actual {
+        panic!(
+            "{} differs from the output.\n--- expected\n{expected}\n--- actual\n{actual}\n(rerun with AXCOMP_UPDATE_GOLDEN=1 to accept a deliberate change)",
+            golden.display()
+        );
+    }
+}
