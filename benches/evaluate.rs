@@ -1,0 +1,55 @@
+//! Reading and evaluating a large test: 10,000 targets × 10 runs (5 each way).
+//!
+//! The issue asks that `axcomp evaluate` on such a file take "well under a
+//! second"; this measures the parts (parse, evaluate) without process start-up.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+
+use axcomp::evaluate::evaluate;
+use axcomp::measurement::{Direction, Environment, Measurement, Metadata, Run, SourceFormat};
+use axcomp::read::{self, rtl};
+
+/// A deterministic 10,000-target measurement (no RNG: a sine plus a
+/// run-dependent wobble is enough to exercise every code path).
+fn large_measurement() -> Measurement {
+    let targets: Vec<f64> = (0..10_000).map(|i| f64::from(i) * 0.1).collect();
+    let runs = (0..10u32)
+        .map(|k| Run {
+            direction: if k % 2 == 0 {
+                Direction::Up
+            } else {
+                Direction::Down
+            },
+            number: k / 2 + 1,
+            start_time_s: None,
+            deviations_mm: targets
+                .iter()
+                .map(|x| Some(0.005 * (x / 50.0).sin() + 1e-4 * f64::from(k) * (x * 7.0).cos()))
+                .collect(),
+        })
+        .collect();
+    Measurement::new(
+        "X",
+        targets,
+        runs,
+        Environment::default(),
+        Metadata::default(),
+    )
+    .unwrap()
+}
+
+fn bench(c: &mut Criterion) {
+    let measurement = large_measurement();
+    let text = rtl::write(&measurement);
+    let mut group = c.benchmark_group("evaluate_10k_targets_10_runs");
+    group.sample_size(20);
+    group.bench_function("parse_rtl", |b| {
+        b.iter(|| read::parse_str(black_box(&text), SourceFormat::Rtl).unwrap())
+    });
+    group.bench_function("evaluate", |b| b.iter(|| evaluate(black_box(&measurement))));
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
