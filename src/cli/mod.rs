@@ -1,20 +1,43 @@
 //! The command line: a thin layer over the library (binary only).
 //!
-//! [`args`] mirrors the flags with clap and validates them; [`run`] turns them
-//! into library calls and prints. Errors are printed once, with their chain,
-//! and give exit code 2. A closed pipe (`axcomp evaluate x | head`) is success.
+//! Each subcommand lives in its own file with its flags (clap derive, each
+//! flag documented where it is defined) and its `run` function, which turns
+//! the flags into library calls and prints. Errors are printed once, with
+//! their chain, and give exit code 2. A closed pipe (`axcomp … | head`) is
+//! success.
 
-mod args;
-mod run;
+mod common;
+mod evaluate;
+mod progress;
 
-use std::io::IsTerminal;
 use std::process::ExitCode;
 
-use clap::Parser;
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+
+/// axcomp: laser measurements to ISO 230-2 figures and compensation tables.
+#[derive(Debug, Parser)]
+#[command(name = "axcomp", version, about, long_about = None, propagate_version = true)]
+pub struct Args {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Read a laser measurement and evaluate it per ISO 230-2.
+    ///
+    /// Prints the per-target table and the axis figures A, E, M, R, B in µm.
+    /// Give two files to join the forward and reverse files of one axis (API
+    /// XD .pos) into one bidirectional measurement.
+    Evaluate(evaluate::EvaluateArgs),
+}
 
 /// Parses, runs, and maps the outcome to an exit code.
 pub fn main() -> ExitCode {
-    let args = match args::Args::try_parse() {
+    let args = match Args::try_parse() {
         Ok(args) => args,
         Err(error) => {
             // clap prints help and version to stdout with exit 0, usage errors to stderr.
@@ -26,13 +49,19 @@ pub fn main() -> ExitCode {
             };
         }
     };
-    match run::run(args) {
+    match run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) if is_broken_pipe(&error) => ExitCode::SUCCESS,
         Err(error) => {
             eprintln!("axcomp: error: {error:#}");
             ExitCode::from(2)
         }
+    }
+}
+
+fn run(args: Args) -> Result<()> {
+    match args.command {
+        Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
     }
 }
 
@@ -44,8 +73,13 @@ fn is_broken_pipe(error: &anyhow::Error) -> bool {
     })
 }
 
-/// Whether progress bars and colour may be shown: stdout is a terminal and not `--quiet`.
-#[allow(dead_code)]
-pub fn interactive(quiet: bool) -> bool {
-    !quiet && std::io::stdout().is_terminal()
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn flag_definitions_are_consistent() {
+        Args::command().debug_assert();
+    }
 }

@@ -1,0 +1,114 @@
+//! `axcomp evaluate`: read a measurement and print its ISO 230-2 figures.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+
+use axcomp::evaluate::evaluate;
+use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
+use axcomp::read;
+use axcomp::report::{json::EvaluationJson, terminal};
+
+use super::common::{parse_format, parse_run_selector, print_json, print_text, print_warnings};
+
+/// Flags of `axcomp evaluate`.
+#[derive(Debug, clap::Args)]
+pub struct EvaluateArgs {
+    /// Measurement file(s): .rtl, ecmc .dat, API .pos or axcomp CSV.
+    ///
+    /// The format is detected from the content. Two files of one axis (e.g.
+    /// forward and reverse .pos) are joined into one measurement.
+    #[arg(required = true, num_args = 1..=2, value_name = "FILE")]
+    pub files: Vec<PathBuf>,
+
+    /// Input format, instead of detecting it: rtl, ecmc, api-pos, csv.
+    #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
+    pub format: Option<SourceFormat>,
+
+    /// Name of the axis, instead of the one in the file.
+    ///
+    /// Some files name no axis (ecmc) or the wrong one (API files copied
+    /// from another axis).
+    #[arg(long, value_name = "NAME", help_heading = "Input")]
+    pub axis: Option<String>,
+
+    /// Leave a run out of the evaluation: RUN (both directions), RUN:up or RUN:down.
+    ///
+    /// Runs are numbered 1, 2, 3, … per direction in the order measured, as the
+    /// report names them. Repeat the flag to leave out several. Only do this
+    /// for a run you know is faulty (e.g. flagged as a suspected outlier and
+    /// explained).
+    #[arg(long = "exclude-run", value_name = "RUN[:DIR]", value_parser = parse_run_selector, help_heading = "Evaluation")]
+    pub exclude_runs: Vec<RunSelector>,
+
+    /// Print one JSON object (units in the keys) instead of the report.
+    #[arg(long, help_heading = "Output")]
+    pub json: bool,
+
+    /// Do not print warnings.
+    #[arg(long, short = 'q', help_heading = "Output")]
+    pub quiet: bool,
+}
+
+/// Runs `axcomp evaluate`.
+pub fn run(args: &EvaluateArgs) -> Result<()> {
+    let read::ReadResult {
+        mut measurement,
+        mut warnings,
+    } = read::read_paths(&args.files, args.format)?;
+    if let Some(axis) = &args.axis {
+        measurement.set_axis(axis.clone());
+    }
+    check_selectors(&measurement, &args.exclude_runs)?;
+    let measurement = measurement
+        .without_runs(&args.exclude_runs)
+        .context("after excluding runs")?;
+    let evaluation = evaluate(&measurement);
+    warnings.extend(evaluation.warnings.iter().cloned());
+    let report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
+    print_warnings(&warnings, args.quiet);
+    if args.json {
+        print_json(&report)
+    } else {
+        print_text(&terminal::evaluation_report(&report))
+    }
+}
+
+/// Refuses selectors that pick no run: a typo must not pass silently.
+pub fn check_selectors(measurement: &Measurement, selectors: &[RunSelector]) -> Result<()> {
+    for selector in selectors {
+        if measurement.runs().iter().any(|run| selector.selects(run)) {
+            continue;
+        }
+        let up = measurement.run_count(Direction::Up);
+        let down = measurement.run_count(Direction::Down);
+        bail!("--exclude-run {selector}: no such run (the file has runs 1–{up} ↑ and 1–{down} ↓)");
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Args, Command};
+    use clap::Parser;
+
+    #[test]
+    fn evaluate_takes_one_or_two_files() {
+        assert!(Args::try_parse_from(["axcomp", "evaluate"]).is_err());
+        assert!(Args::try_parse_from(["axcomp", "evaluate", "a", "b", "c"]).is_err());
+        let args = Args::try_parse_from([
+            "axcomp",
+            "evaluate",
+            "a.pos",
+            "b.pos",
+            "--exclude-run",
+            "1:down",
+            "--json",
+        ])
+        .unwrap();
+        let Command::Evaluate(evaluate) = args.command;
+        assert_eq!(evaluate.files.len(), 2);
+        assert!(evaluate.json);
+        assert_eq!(evaluate.exclude_runs.len(), 1);
+    }
+}
