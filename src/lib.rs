@@ -37,6 +37,8 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod compensate;
+pub mod emit;
 pub mod error;
 pub mod evaluate;
 pub mod measurement;

@@ -39,6 +39,15 @@ impl LengthUnit {
         }
     }
 
+    /// Looks a unit up by name (`mm`, `inch`, `in`).
+    pub fn from_name(name: &str) -> Option<LengthUnit> {
+        match name.to_ascii_lowercase().as_str() {
+            "mm" => Some(LengthUnit::Millimetre),
+            "inch" | "in" => Some(LengthUnit::Inch),
+            _ => None,
+        }
+    }
+
     /// Converts a length in this unit to millimetres.
     pub fn to_mm(self, value: f64) -> Mm {
         match self {

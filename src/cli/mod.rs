@@ -7,6 +7,7 @@
 //! success.
 
 mod common;
+mod convert;
 mod evaluate;
 mod progress;
 
@@ -33,6 +34,12 @@ pub enum Command {
     /// Give two files to join the forward and reverse files of one axis (API
     /// XD .pos) into one bidirectional measurement.
     Evaluate(evaluate::EvaluateArgs),
+    /// Write a compensation table a controller loads as is.
+    ///
+    /// Heidenhain iTNC 530 and TNC 640 .COM, Siemens Sinumerik 840D .MPF (LEC,
+    /// or CEC for bidirectional tables) and LinuxCNC COMP_FILE, from the
+    /// per-target mean deviations of a measurement.
+    Convert(convert::ConvertArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -62,6 +69,7 @@ pub fn main() -> ExitCode {
 fn run(args: Args) -> Result<()> {
     match args.command {
         Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
+        Command::Convert(convert_args) => convert::run(&convert_args),
     }
 }
 

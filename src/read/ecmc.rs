@@ -23,6 +23,9 @@ use crate::read::missing_readings_warning;
 use crate::read::text::{self, Line, end_of_file_line, split_key};
 use crate::units::LengthUnit;
 
+/// Largest number of positions or cycles, and so largest index, accepted.
+const MAX_COUNT: u64 = 100_000;
+
 /// Parses the text of an ecmc ISO 230-2 data file.
 pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
     let mut file = EcmcFile::default();
@@ -345,6 +348,13 @@ fn parse_key<'a>(line: &Line<'a>, key: &'a str) -> Result<Key<'a>, ParseError> {
         let index = text::integer(line, token, "index")?;
         if index == 0 {
             return Err(line.error_at(token, "expected an index from 1, found 0"));
+        }
+        // Indices size the tables built from them: bound them like the declared counts.
+        if index > MAX_COUNT {
+            return Err(line.error_at(
+                token,
+                format!("index {index} is too large (at most {MAX_COUNT})"),
+            ));
         }
         indices.push((index as usize, token));
     }

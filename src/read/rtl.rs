@@ -669,6 +669,18 @@ impl RtlParser {
     /// Groups the rows by file run, infers each run's direction and numbers the
     /// runs per direction in the order measured.
     fn assemble_runs(&self, run_count: Located<u32>) -> Result<Vec<Run>, ParseError> {
+        // Every run needs a row: refuse an impossible count before sizing anything by it.
+        if run_count.value as usize > self.rows.len() {
+            return Err(ParseError::new(
+                run_count.line,
+                run_count.column,
+                format!(
+                    "Run-count is {} but there are only {} deviation rows",
+                    run_count.value,
+                    self.rows.len()
+                ),
+            ));
+        }
         let sorted = sorted_targets(&self.targets);
         // Target number (1-based, as listed) → index into the sorted targets.
         let mut sorted_index = vec![0; self.targets.len()];

@@ -6,5 +6,6 @@
 //! terminal report. Both convert mm to µm through `crate::units`; nothing
 //! else in the crate depends on this module.
 
+pub mod convert;
 pub mod json;
 pub mod terminal;

@@ -1,0 +1,266 @@
+//! `axcomp convert`: a measurement to a compensation file the controller loads as is.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use axcomp::compensate::{self, Extrapolate, GridSpec, TableMode, TableOptions};
+use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
+use axcomp::evaluate::evaluate;
+use axcomp::measurement::{RunSelector, SourceFormat};
+use axcomp::output::write_new;
+use axcomp::read;
+use axcomp::report::convert::ConvertJson;
+
+use super::common::{parse_format, parse_run_selector, print_json, print_text, print_warnings};
+use super::evaluate::check_selectors;
+
+/// Flags of `axcomp convert`.
+#[derive(Debug, clap::Args)]
+pub struct ConvertArgs {
+    /// Measurement file(s): .rtl, ecmc .dat, API .pos or axcomp CSV.
+    #[arg(required = true, num_args = 1..=2, value_name = "FILE")]
+    pub files: Vec<PathBuf>,
+
+    /// The controller: itnc530, tnc640, sinumerik840d or linuxcnc.
+    #[arg(long, value_name = "CONTROLLER", value_parser = parse_controller, help_heading = "Table")]
+    pub controller: Controller,
+
+    /// Output file (refused if it exists, unless --force).
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "OUT",
+        help_heading = "Output"
+    )]
+    pub output: PathBuf,
+
+    /// Replace an existing output file.
+    #[arg(long, help_heading = "Output")]
+    pub force: bool,
+
+    /// The compensated axis, instead of the one the file names.
+    #[arg(long, value_name = "NAME", help_heading = "Table")]
+    pub axis: Option<String>,
+
+    /// mean: one table from the bidirectional mean (plus a suggested backlash);
+    /// bidirectional: separate ↑ and ↓ tables.
+    ///
+    /// Bidirectional tables go into the TNC 640 BACKLASH column, two Sinumerik
+    /// CEC tables ($AN_CEC_DIRECTION 1 and -1) and the LinuxCNC forward and
+    /// reverse columns; the iTNC 530 has no place for them.
+    #[arg(long, value_name = "MODE", default_value = "mean", value_parser = parse_mode, help_heading = "Table")]
+    pub mode: TableMode,
+
+    /// First compensation point, mm (default: the first target).
+    #[arg(long, value_name = "MM", requires = "step", help_heading = "Grid")]
+    pub start: Option<f64>,
+
+    /// Spacing of the compensation points, mm.
+    ///
+    /// Without it the points are the measured targets, which iTNC 530 and
+    /// Sinumerik accept only when they are evenly spaced.
+    #[arg(long, value_name = "MM", help_heading = "Grid")]
+    pub step: Option<f64>,
+
+    /// Number of compensation points (default: as many as fit in the measured range).
+    #[arg(long, value_name = "N", requires = "step", help_heading = "Grid")]
+    pub count: Option<usize>,
+
+    /// Position where the table is zero, mm (default: the first point).
+    ///
+    /// Controllers reference the axis there; seed 001 zeroes the first point.
+    #[arg(long, value_name = "MM", help_heading = "Table")]
+    pub reference: Option<f64>,
+
+    /// Points outside the measured range: hold the end value, or zero.
+    /// Without it such points are refused.
+    #[arg(long, value_name = "RULE", value_parser = parse_extrapolate, help_heading = "Grid")]
+    pub extrapolate: Option<Extrapolate>,
+
+    /// The table that was active during the measurement (any format convert writes).
+    ///
+    /// The measurement then shows the residual; the new table is the old one
+    /// plus that residual, on the new grid.
+    #[arg(long, value_name = "TABLE", help_heading = "Table")]
+    pub existing: Option<PathBuf>,
+
+    /// Write the same table for a coupled axis too (gantry slave); repeatable.
+    #[arg(long = "also", value_name = "AXIS", help_heading = "Table")]
+    pub also: Vec<String>,
+
+    /// Machine profile (TOML): axis names and numbers per controller, units, limits.
+    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
+    pub machine: Option<PathBuf>,
+
+    /// Most compensation points the machine takes (Sinumerik MD38000 / MD18342).
+    #[arg(long = "max-points", value_name = "N", help_heading = "Machine")]
+    pub max_points: Option<usize>,
+
+    /// LinuxCNC COMP_FILE_TYPE: 0 (actual positions) or 1 (offsets).
+    #[arg(long = "linuxcnc-type", value_name = "0|1", default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Machine")]
+    pub linuxcnc_type: u8,
+
+    /// Input format, instead of detecting it: rtl, ecmc, api-pos, csv.
+    #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
+    pub format: Option<SourceFormat>,
+
+    /// Leave a run out: RUN, RUN:up or RUN:down (as in evaluate).
+    #[arg(long = "exclude-run", value_name = "RUN[:DIR]", value_parser = parse_run_selector, help_heading = "Input")]
+    pub exclude_runs: Vec<RunSelector>,
+
+    /// Print the table as one JSON object instead of the summary.
+    #[arg(long, help_heading = "Output")]
+    pub json: bool,
+
+    /// Do not print warnings.
+    #[arg(long, short = 'q', help_heading = "Output")]
+    pub quiet: bool,
+}
+
+fn parse_controller(name: &str) -> Result<Controller, String> {
+    Controller::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Controller::ALL.iter().map(|c| c.name()).collect();
+        format!(
+            "unknown controller {name:?}; supported: {}",
+            names.join(", ")
+        )
+    })
+}
+
+fn parse_mode(name: &str) -> Result<TableMode, String> {
+    match name {
+        "mean" => Ok(TableMode::Mean),
+        "bidirectional" => Ok(TableMode::Bidirectional),
+        _ => Err(format!("expected mean or bidirectional, found {name:?}")),
+    }
+}
+
+fn parse_extrapolate(name: &str) -> Result<Extrapolate, String> {
+    match name {
+        "hold" => Ok(Extrapolate::Hold),
+        "zero" => Ok(Extrapolate::Zero),
+        _ => Err(format!("expected hold or zero, found {name:?}")),
+    }
+}
+
+/// Runs `axcomp convert`.
+pub fn run(args: &ConvertArgs) -> Result<()> {
+    let profile = match &args.machine {
+        Some(path) => {
+            let text =
+                std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+            MachineProfile::from_toml_str(&text)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
+        }
+        None => MachineProfile::default(),
+    };
+    let read::ReadResult {
+        mut measurement,
+        mut warnings,
+    } = read::read_paths(&args.files, args.format)?;
+    if let Some(axis) = &args.axis {
+        measurement.set_axis(axis.clone());
+    }
+    check_selectors(&measurement, &args.exclude_runs)?;
+    let mut measurement = measurement.without_runs(&args.exclude_runs)?;
+    let mut axes = vec![
+        profile
+            .axis(measurement.axis())
+            .map_err(anyhow::Error::msg)?,
+    ];
+    for also in &args.also {
+        axes.push(profile.axis(also).map_err(anyhow::Error::msg)?);
+    }
+    let options = EmitOptions {
+        axes,
+        table_name: table_name(&args.output),
+        machine_unit: profile.machine_unit(),
+        linuxcnc_type: args.linuxcnc_type,
+        max_points: args.max_points.or(profile.controller.max_points),
+        max_value_mm: profile.controller.max_value_mm,
+        cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
+        cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
+        tnc640_columns: profile
+            .controller
+            .tnc640_columns
+            .clone()
+            .unwrap_or_default(),
+    };
+    if let Some(existing) = &args.existing {
+        let text =
+            std::fs::read_to_string(existing).with_context(|| format!("{}", existing.display()))?;
+        // A LinuxCNC table's type is told from its numbers; --linuxcnc-type decides when they do not.
+        let (_, active) = emit::read_any(&text, &options, None)
+            .or_else(|_| emit::read_any(&text, &options, Some(args.linuxcnc_type)))
+            .map_err(|error| anyhow::anyhow!("{}:{error}", existing.display()))?;
+        measurement = compensate::add_existing_table(&measurement, &active)?;
+    }
+    let evaluation = evaluate(&measurement);
+    warnings.extend(evaluation.warnings.iter().cloned());
+    let table_options = TableOptions {
+        mode: args.mode,
+        grid: grid(args, measurement.targets_mm())?,
+        reference_mm: args.reference,
+        extrapolate: args.extrapolate.unwrap_or(Extrapolate::Refuse),
+    };
+    let table = compensate::build_table(&measurement, &evaluation, &table_options)?;
+    let text = emit::write(args.controller, &table, &options)?;
+    write_new(&args.output, text.as_bytes(), args.force)?;
+    let file_name = args.output.file_name().map_or_else(
+        || args.output.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let activation = emit::activation(args.controller, &table, &file_name, &options);
+    let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    let report = ConvertJson::new(
+        args.controller.name(),
+        args.output.display().to_string(),
+        &table,
+        args.also.clone(),
+        activation,
+        warning_texts,
+    );
+    print_warnings(&warnings, args.quiet);
+    if args.json {
+        print_json(&report)
+    } else {
+        print_text(&report.summary())
+    }
+}
+
+/// The grid: `--step` (with `--start`, `--count`), else the measured targets
+/// when the controller takes them.
+fn grid(args: &ConvertArgs, targets_mm: &[f64]) -> Result<GridSpec> {
+    let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
+    let Some(step_mm) = args.step else {
+        if args.controller.accepts_free_positions()
+            || compensate::regular_step(targets_mm).is_some()
+        {
+            return Ok(GridSpec::Targets);
+        }
+        bail!(
+            "the targets are unevenly spaced ({} targets from {first} to {last} mm) and {} needs one step: give --step (and optionally --start, --count)",
+            targets_mm.len(),
+            args.controller.name()
+        );
+    };
+    let start_mm = args.start.unwrap_or(first);
+    let count = match args.count {
+        Some(count) => count,
+        None => ((last - start_mm) / step_mm + 1e-9).floor().max(0.0) as usize + 1,
+    };
+    Ok(GridSpec::Regular {
+        start_mm,
+        step_mm,
+        count,
+    })
+}
+
+/// The name inside Heidenhain files: the output file name, upper case.
+fn table_name(output: &Path) -> String {
+    output
+        .file_name()
+        .map(|name| name.to_string_lossy().to_uppercase())
+        .unwrap_or_else(|| "AXIS.COM".to_string())
+}

@@ -1,0 +1,474 @@
+//! Compensation tables from an evaluated measurement.
+//!
+//! A [`CompensationTable`] is what every controller format is written from
+//! and read into: compensation points (mm, strictly increasing) and, per
+//! point, the axis error to compensate, in mm, in axcomp's one sign
+//! convention: **the positional deviation actual − target** (ISO 230-2's
+//! x̄), shifted so the value at the reference point is zero. Each emitter in
+//! `emit/` converts that to its controller's own convention (an error for
+//! Heidenhain and Siemens LEC, a correction for Siemens CEC, actual positions
+//! or trims for LinuxCNC) and back.
+//!
+//! Building a table ([`build_table`]):
+//! 1. the source curve per direction is the per-target mean deviation
+//!    (`mean` mode: the bidirectional mean x̄_i; `bidirectional` mode: x̄_i↑
+//!    and x̄_i↓), a unidirectional test giving its one direction;
+//! 2. it is linearly interpolated onto the compensation points (the measured
+//!    targets, or a regular grid `start + k·step`); a point outside the
+//!    measured range is refused unless extrapolation is asked for (hold the
+//!    end value, or write zero);
+//! 3. the table is shifted so its value at the reference point is zero
+//!    (controllers reference there; default the first point, as seed 001's
+//!    tool does);
+//! 4. in `mean` mode the suggested backlash parameter is −B̄ = mean(x̄↓ − x̄↑).
+//!
+//! A measurement taken with a table already active measures the residual;
+//! [`add_existing_table`] turns it back into the uncompensated deviations
+//! (residual + the active table, applied as the controller applies it) before
+//! a new table is built.
+//!
+//! Pure: no I/O. Lengths in mm.
+
+use crate::evaluate::Evaluation;
+use crate::measurement::{Direction, Measurement, MeasurementError, Run};
+
+/// Whether the table has one column or one per direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TableMode {
+    /// One table from the bidirectional mean x̄_i (plus a suggested backlash).
+    Mean,
+    /// Separate ↑ and ↓ tables from x̄_i↑ and x̄_i↓.
+    Bidirectional,
+}
+
+impl TableMode {
+    /// `mean` or `bidirectional`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TableMode::Mean => "mean",
+            TableMode::Bidirectional => "bidirectional",
+        }
+    }
+}
+
+/// What to do with a compensation point outside the measured range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Extrapolate {
+    /// Refuse the table.
+    Refuse,
+    /// Hold the value of the nearest measured end.
+    Hold,
+    /// Write zero (no compensation there).
+    Zero,
+}
+
+/// Where the compensation points go.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GridSpec {
+    /// At the measured targets.
+    Targets,
+    /// At `start_mm + k·step_mm`, k = 0 … count − 1.
+    Regular {
+        /// First point, mm.
+        start_mm: f64,
+        /// Spacing, mm (> 0).
+        step_mm: f64,
+        /// Number of points (≥ 2).
+        count: usize,
+    },
+}
+
+/// How to build a table. No `Default`: the caller states every choice.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableOptions {
+    /// One table or one per direction.
+    pub mode: TableMode,
+    /// Where the points go.
+    pub grid: GridSpec,
+    /// Position where the table is zero; `None` for the first point.
+    pub reference_mm: Option<f64>,
+    /// Points outside the measured range.
+    pub extrapolate: Extrapolate,
+}
+
+/// The values of a table: one column, or one per direction. Axis error in mm
+/// (actual − target), zero at the reference.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TableValues {
+    /// One value per point, for both directions.
+    Mean(Vec<f64>),
+    /// ↑ and ↓ values per point.
+    Bidirectional {
+        /// Moving in the positive direction.
+        up: Vec<f64>,
+        /// Moving in the negative direction.
+        down: Vec<f64>,
+    },
+}
+
+impl TableValues {
+    /// The values for one direction.
+    pub fn for_direction(&self, direction: Direction) -> &[f64] {
+        match (self, direction) {
+            (TableValues::Mean(values), _) => values,
+            (TableValues::Bidirectional { up, .. }, Direction::Up) => up,
+            (TableValues::Bidirectional { down, .. }, Direction::Down) => down,
+        }
+    }
+
+    /// `mean` or `bidirectional`.
+    pub fn mode(&self) -> TableMode {
+        match self {
+            TableValues::Mean(_) => TableMode::Mean,
+            TableValues::Bidirectional { .. } => TableMode::Bidirectional,
+        }
+    }
+
+    fn map(&self, f: impl Fn(&[f64]) -> Vec<f64>) -> TableValues {
+        match self {
+            TableValues::Mean(values) => TableValues::Mean(f(values)),
+            TableValues::Bidirectional { up, down } => TableValues::Bidirectional {
+                up: f(up),
+                down: f(down),
+            },
+        }
+    }
+}
+
+/// A compensation table in axcomp's convention (see the module doc).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompensationTable {
+    /// The compensated axis.
+    pub axis: String,
+    /// Compensation points, mm, strictly increasing.
+    pub positions_mm: Vec<f64>,
+    /// Axis error at each point, mm, zero at the reference.
+    pub values: TableValues,
+    /// Where the table is zero, mm.
+    pub reference_mm: f64,
+    /// Suggested backlash parameter, mm (mean mode): −B̄, positive for the usual
+    /// lost motion (the axis falls short in the direction it moves).
+    pub suggested_backlash_mm: Option<f64>,
+}
+
+impl CompensationTable {
+    /// The axis error the table holds at `position_mm` when moving in
+    /// `direction`, as controllers apply tables: linear between points, the
+    /// end values held outside (Siemens K3 §4.4, LinuxCNC `control.c`,
+    /// Heidenhain).
+    pub fn value_at(&self, position_mm: f64, direction: Direction) -> f64 {
+        interpolate_hold(
+            &self.positions_mm,
+            self.values.for_direction(direction),
+            position_mm,
+        )
+    }
+
+    /// The spacing if the points are evenly spaced (within 1 nm), else `None`.
+    pub fn regular_step_mm(&self) -> Option<f64> {
+        regular_step(&self.positions_mm)
+    }
+
+    /// The largest |value| of the table, mm.
+    pub fn max_abs_mm(&self) -> f64 {
+        let all = match &self.values {
+            TableValues::Mean(values) => values.clone(),
+            TableValues::Bidirectional { up, down } => up.iter().chain(down).copied().collect(),
+        };
+        all.iter().fold(0.0, |max: f64, v| max.max(v.abs()))
+    }
+}
+
+/// Why a table cannot be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CompensateError {
+    /// Bidirectional mode needs both directions.
+    #[error(
+        "bidirectional tables need runs in both directions; this test has only {0} runs (use --mode mean)"
+    )]
+    OneDirectionOnly(Direction),
+    /// No target has a mean deviation.
+    #[error("no target has a mean deviation to compensate")]
+    NoData,
+    /// A compensation point lies outside the measured range.
+    #[error(
+        "compensation point {position_mm} mm is outside the measured range {first_mm} … {last_mm} mm; use --extrapolate hold or --extrapolate zero, or a grid inside the range"
+    )]
+    OutsideMeasuredRange {
+        /// The point.
+        position_mm: f64,
+        /// First measured target.
+        first_mm: f64,
+        /// Last measured target.
+        last_mm: f64,
+    },
+    /// The reference position lies outside the table.
+    #[error("reference position {reference_mm} mm is outside the table {first_mm} … {last_mm} mm")]
+    ReferenceOutside {
+        /// The reference.
+        reference_mm: f64,
+        /// First point.
+        first_mm: f64,
+        /// Last point.
+        last_mm: f64,
+    },
+    /// The grid is not usable.
+    #[error("invalid grid: {0}")]
+    Grid(String),
+}
+
+/// The spacing of evenly spaced positions (within 1 nm), or `None`.
+pub fn regular_step(positions_mm: &[f64]) -> Option<f64> {
+    const SAME_STEP_MM: f64 = 1e-6;
+    if positions_mm.len() < 2 {
+        return None;
+    }
+    let step =
+        (positions_mm[positions_mm.len() - 1] - positions_mm[0]) / (positions_mm.len() - 1) as f64;
+    let even = positions_mm
+        .windows(2)
+        .all(|pair| ((pair[1] - pair[0]) - step).abs() <= SAME_STEP_MM);
+    (even && step > 0.0).then_some(step)
+}
+
+/// Linear interpolation with the end values held outside `[x0, xn]`.
+/// `xs` strictly increasing, same length as `ys`, not empty.
+pub fn interpolate_hold(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+    debug_assert_eq!(xs.len(), ys.len());
+    let last = xs.len() - 1;
+    if x <= xs[0] {
+        return ys[0];
+    }
+    if x >= xs[last] {
+        return ys[last];
+    }
+    // First index with xs[i] > x; x lies in [xs[i-1], xs[i]).
+    let i = xs.partition_point(|&p| p <= x);
+    let (x0, x1, y0, y1) = (xs[i - 1], xs[i], ys[i - 1], ys[i]);
+    y0 + (y1 - y0) * (x - x0) / (x1 - x0)
+}
+
+/// The source curve of one direction (or of the mean): positions and mean
+/// deviations of the targets where it is defined.
+fn source_curve(
+    evaluation: &Evaluation,
+    pick: impl Fn(&crate::evaluate::TargetStats) -> Option<f64>,
+) -> (Vec<f64>, Vec<f64>) {
+    evaluation
+        .per_target
+        .iter()
+        .filter_map(|t| pick(t).map(|value| (t.target_mm, value)))
+        .unzip()
+}
+
+/// Builds a compensation table from a measurement and its evaluation.
+///
+/// # Example
+/// ```
+/// use axcomp::compensate::{build_table, Extrapolate, GridSpec, TableMode, TableOptions, TableValues};
+/// use axcomp::evaluate::evaluate;
+/// use axcomp::read::parse_str;
+/// use axcomp::measurement::SourceFormat;
+/// let csv = "target_mm,run,direction,deviation_um\n0,1,up,1\n100,1,up,-2\n0,1,down,3\n100,1,down,0\n";
+/// let (m, _) = parse_str(csv, SourceFormat::Csv).unwrap();
+/// let options = TableOptions { mode: TableMode::Mean, grid: GridSpec::Targets,
+///                              reference_mm: None, extrapolate: Extrapolate::Refuse };
+/// let table = build_table(&m, &evaluate(&m), &options).unwrap();
+/// // x̄ = 2, −1 µm; shifted to zero at 0 mm: 0, −3 µm.
+/// assert_eq!(table.values, TableValues::Mean(vec![0.0, -0.003]));
+/// // −B̄ = mean(x̄↓ − x̄↑) = mean(2, 2) µm.
+/// assert!((table.suggested_backlash_mm.unwrap() - 0.002).abs() < 1e-15);
+/// ```
+pub fn build_table(
+    measurement: &Measurement,
+    evaluation: &Evaluation,
+    options: &TableOptions,
+) -> Result<CompensationTable, CompensateError> {
+    let positions_mm = grid_positions(measurement.targets_mm(), options.grid)?;
+    let has = |d: Direction| measurement.run_count(d) > 0;
+    let (raw, suggested_backlash_mm) = match options.mode {
+        TableMode::Mean => {
+            let curve = match (has(Direction::Up), has(Direction::Down)) {
+                (true, true) => source_curve(evaluation, |t| t.mean_mm),
+                (true, false) => source_curve(evaluation, |t| t.up.mean_mm),
+                _ => source_curve(evaluation, |t| t.down.mean_mm),
+            };
+            let column = resample(&curve, &positions_mm, options.extrapolate)?;
+            let backlash = evaluation.figures.b_mean_mm.map(|b| -b);
+            (TableValues::Mean(column), backlash)
+        }
+        TableMode::Bidirectional => {
+            for direction in Direction::BOTH {
+                if !has(direction) {
+                    return Err(CompensateError::OneDirectionOnly(direction.reversed()));
+                }
+            }
+            let up = resample(
+                &source_curve(evaluation, |t| t.up.mean_mm),
+                &positions_mm,
+                options.extrapolate,
+            )?;
+            let down = resample(
+                &source_curve(evaluation, |t| t.down.mean_mm),
+                &positions_mm,
+                options.extrapolate,
+            )?;
+            (TableValues::Bidirectional { up, down }, None)
+        }
+    };
+    let reference_mm = options.reference_mm.unwrap_or(positions_mm[0]);
+    let (first_mm, last_mm) = (positions_mm[0], positions_mm[positions_mm.len() - 1]);
+    if reference_mm < first_mm - 1e-9 || reference_mm > last_mm + 1e-9 {
+        return Err(CompensateError::ReferenceOutside {
+            reference_mm,
+            first_mm,
+            last_mm,
+        });
+    }
+    let values = shift_to_reference(
+        &raw,
+        &positions_mm,
+        reference_mm,
+        options.extrapolate == Extrapolate::Zero,
+        measurement,
+    );
+    Ok(CompensationTable {
+        axis: measurement.axis().to_string(),
+        positions_mm,
+        values,
+        reference_mm,
+        suggested_backlash_mm,
+    })
+}
+
+/// Subtracts the value at the reference. Zero-extrapolated points (marked by
+/// lying outside the measured range) stay zero: "no compensation there".
+/// In bidirectional mode both columns are shifted by the same amount, their
+/// mean at the reference, so the reversal between them is kept and the table
+/// does not depend on the direction the controller references in.
+fn shift_to_reference(
+    raw: &TableValues,
+    positions_mm: &[f64],
+    reference_mm: f64,
+    zero_outside: bool,
+    measurement: &Measurement,
+) -> TableValues {
+    let targets = measurement.targets_mm();
+    let (first, last) = (targets[0], targets[targets.len() - 1]);
+    let at_reference =
+        |d: Direction| interpolate_hold(positions_mm, raw.for_direction(d), reference_mm);
+    let offset = (at_reference(Direction::Up) + at_reference(Direction::Down)) / 2.0;
+    raw.map(|column| {
+        column
+            .iter()
+            .zip(positions_mm)
+            .map(|(value, &p)| {
+                let outside = p < first - 1e-9 || p > last + 1e-9;
+                if zero_outside && outside {
+                    0.0
+                } else {
+                    value - offset
+                }
+            })
+            .collect()
+    })
+}
+
+/// The compensation points of a grid spec.
+fn grid_positions(targets_mm: &[f64], grid: GridSpec) -> Result<Vec<f64>, CompensateError> {
+    match grid {
+        GridSpec::Targets => {
+            if targets_mm.len() < 2 {
+                return Err(CompensateError::Grid(
+                    "a table needs at least 2 points; the test has 1 target".into(),
+                ));
+            }
+            Ok(targets_mm.to_vec())
+        }
+        GridSpec::Regular {
+            start_mm,
+            step_mm,
+            count,
+        } => {
+            if !(step_mm.is_finite() && step_mm > 0.0) {
+                return Err(CompensateError::Grid(format!(
+                    "step must be positive, found {step_mm} mm"
+                )));
+            }
+            if count < 2 {
+                return Err(CompensateError::Grid(format!(
+                    "a table needs at least 2 points, found {count}"
+                )));
+            }
+            if !start_mm.is_finite() {
+                return Err(CompensateError::Grid(format!(
+                    "start must be a number, found {start_mm}"
+                )));
+            }
+            // start + k·step, rounded to 1e-9 mm so that e.g. 0.1·3 prints as 0.3.
+            Ok((0..count)
+                .map(|k| ((start_mm + k as f64 * step_mm) * 1e9).round() / 1e9)
+                .collect())
+        }
+    }
+}
+
+/// Interpolates a source curve onto the points, applying the extrapolation rule.
+fn resample(
+    curve: &(Vec<f64>, Vec<f64>),
+    positions_mm: &[f64],
+    extrapolate: Extrapolate,
+) -> Result<Vec<f64>, CompensateError> {
+    let (xs, ys) = curve;
+    if xs.is_empty() {
+        return Err(CompensateError::NoData);
+    }
+    let (first_mm, last_mm) = (xs[0], xs[xs.len() - 1]);
+    positions_mm
+        .iter()
+        .map(|&p| {
+            let outside = p < first_mm - 1e-9 || p > last_mm + 1e-9;
+            match (outside, extrapolate) {
+                (true, Extrapolate::Refuse) => Err(CompensateError::OutsideMeasuredRange {
+                    position_mm: p,
+                    first_mm,
+                    last_mm,
+                }),
+                _ => Ok(interpolate_hold(xs, ys, p)),
+            }
+        })
+        .collect()
+}
+
+/// Turns a measurement taken with `active` compensation on into the deviations
+/// the axis would show without it: each reading plus the active table's value
+/// there, in its direction (the controller subtracted that value).
+pub fn add_existing_table(
+    measurement: &Measurement,
+    active: &CompensationTable,
+) -> Result<Measurement, MeasurementError> {
+    let targets = measurement.targets_mm().to_vec();
+    let runs: Vec<Run> = measurement
+        .runs()
+        .iter()
+        .map(|run| Run {
+            deviations_mm: run
+                .deviations_mm
+                .iter()
+                .zip(&targets)
+                .map(|(value, &p)| value.map(|v| v + active.value_at(p, run.direction)))
+                .collect(),
+            ..run.clone()
+        })
+        .collect();
+    Measurement::new(
+        measurement.axis(),
+        targets,
+        runs,
+        measurement.environment.clone(),
+        measurement.metadata.clone(),
+    )
+}
+
+#[cfg(test)]
+mod tests;

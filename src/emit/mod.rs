@@ -1,0 +1,432 @@
+//! Controller compensation files: one module per format, each writes AND reads it.
+//!
+//! `write` turns a [`CompensationTable`] (axcomp's convention: axis error
+//! actual − target, mm, zero at the reference) into the bytes the controller
+//! loads; `read` turns such a file back into a table, to the format's
+//! resolution. The formats, their sources and what is reconstructed are in
+//! `formats/<controller>/README.md` next to their golden files.
+//!
+//! This module holds what they share: the [`Controller`] enum, the options
+//! every writer takes ([`EmitOptions`]), the refusal rules that stop a table
+//! the controller would reject ([`check_table`]), the number formats, and
+//! format detection for reading an existing table ([`read_any`]).
+
+mod heidenhain;
+pub mod itnc530;
+pub mod linuxcnc;
+pub mod profile;
+pub mod sinumerik840d;
+pub mod tnc640;
+
+use crate::compensate::{CompensationTable, TableMode};
+use crate::error::ParseError;
+use crate::units::LengthUnit;
+pub use profile::{AxisProfile, MachineProfile};
+
+/// The controllers axcomp writes tables for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Controller {
+    /// Heidenhain iTNC 530 nonlinear axis error compensation (`.COM`).
+    Itnc530,
+    /// Heidenhain TNC 640 (`.COM` + a `config.cma` line).
+    Tnc640,
+    /// Siemens Sinumerik 840D: LEC (`$AA_ENC_COMP`) or, bidirectional, CEC (`$AN_CEC`).
+    Sinumerik840d,
+    /// LinuxCNC `[JOINT_n] COMP_FILE` (type 0 or 1).
+    LinuxCnc,
+}
+
+impl Controller {
+    /// Every controller, in the order they are listed to users.
+    pub const ALL: [Controller; 4] = [
+        Controller::Itnc530,
+        Controller::Tnc640,
+        Controller::Sinumerik840d,
+        Controller::LinuxCnc,
+    ];
+
+    /// The `--controller` name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Controller::Itnc530 => "itnc530",
+            Controller::Tnc640 => "tnc640",
+            Controller::Sinumerik840d => "sinumerik840d",
+            Controller::LinuxCnc => "linuxcnc",
+        }
+    }
+
+    /// Looks a controller up by name.
+    pub fn from_name(name: &str) -> Option<Controller> {
+        Controller::ALL
+            .into_iter()
+            .find(|c| c.name().eq_ignore_ascii_case(name))
+    }
+
+    /// Whether the format takes free (uneven) compensation points.
+    pub fn accepts_free_positions(self) -> bool {
+        matches!(self, Controller::Tnc640 | Controller::LinuxCnc)
+    }
+
+    /// Whether the format holds separate ↑ and ↓ values.
+    pub fn supports_bidirectional(self) -> bool {
+        !matches!(self, Controller::Itnc530)
+    }
+
+    /// The most points the controller takes, when known.
+    pub fn max_points(self) -> Option<usize> {
+        match self {
+            // TNC 407 technical manual p.622: "Compensation value table (.COM) has more than 256 entries".
+            Controller::Itnc530 => Some(256),
+            // LinuxCNC motion.h: EMCMOT_COMP_SIZE 256.
+            Controller::LinuxCnc => Some(256),
+            // TNC 640: not documented publicly; Sinumerik: MD38000, machine-specific.
+            Controller::Tnc640 | Controller::Sinumerik840d => None,
+        }
+    }
+}
+
+/// What every writer needs besides the table. Filled by the caller from the
+/// command line and the machine profile; no `Default`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EmitOptions {
+    /// The axes that get the table: the compensated axis first, then coupled
+    /// axes (a gantry slave) that get the same values.
+    pub axes: Vec<AxisProfile>,
+    /// Table name written inside the file where the format has one (Heidenhain `BEGIN …`).
+    pub table_name: String,
+    /// Length unit of the machine (LinuxCNC writes machine units).
+    pub machine_unit: LengthUnit,
+    /// LinuxCNC `COMP_FILE_TYPE`: 0 (actual positions) or 1 (offsets).
+    pub linuxcnc_type: u8,
+    /// Largest number of points the machine takes (Sinumerik MD38000/MD18342, or a profile limit).
+    pub max_points: Option<usize>,
+    /// Largest |value| the machine builder allows, mm.
+    pub max_value_mm: Option<f64>,
+    /// Sinumerik CEC: index of the first table (the ↑ table; ↓ is the next).
+    pub cec_first_table: usize,
+    /// Sinumerik CEC sign: `true` writes the correction (−error), the
+    /// reconstructed convention; `false` writes the error.
+    pub cec_values_are_corrections: bool,
+    /// TNC 640: the machine's axis columns (CfgAxes/axisList); empty for just
+    /// the written axes.
+    pub tnc640_columns: Vec<String>,
+}
+
+/// Why a table is refused for a controller.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EmitError {
+    /// More points than the controller takes.
+    #[error(
+        "{controller} takes at most {max} compensation points, the table has {count}; use a larger --step"
+    )]
+    TooManyPoints {
+        /// The controller.
+        controller: &'static str,
+        /// The limit.
+        max: usize,
+        /// The table's points.
+        count: usize,
+    },
+    /// Points not strictly increasing.
+    #[error(
+        "compensation positions must be strictly increasing: {position_mm} mm follows {previous_mm} mm"
+    )]
+    NotIncreasing {
+        /// The offending point.
+        position_mm: f64,
+        /// The one before.
+        previous_mm: f64,
+    },
+    /// Uneven spacing where the format has one step.
+    #[error(
+        "{controller} needs evenly spaced points (one step for the whole table); give --step (and --start, --count)"
+    )]
+    UnevenSpacing {
+        /// The controller.
+        controller: &'static str,
+    },
+    /// A value beyond the format's or the machine's range.
+    #[error("value {value_mm} mm at {position_mm} mm is beyond the {what} range of ±{limit_mm} mm")]
+    ValueOutOfRange {
+        /// The value.
+        value_mm: f64,
+        /// Where.
+        position_mm: f64,
+        /// Whose range.
+        what: &'static str,
+        /// The limit.
+        limit_mm: f64,
+    },
+    /// The format has one column only.
+    #[error(
+        "{controller} tables hold one value per point; use --mode mean (and set the backlash parameter to the suggested value)"
+    )]
+    NoBidirectional {
+        /// The controller.
+        controller: &'static str,
+    },
+    /// The format needs zero at its first point.
+    #[error(
+        "{controller} needs the value 0 at the first point (the datum); the table is {value_mm} mm there: use --reference at the first point"
+    )]
+    NotZeroAtDatum {
+        /// The controller.
+        controller: &'static str,
+        /// The value at the first point.
+        value_mm: f64,
+    },
+    /// A profile value the format cannot use.
+    #[error("{0}")]
+    Profile(String),
+    /// A bug: the written text does not read back to the table.
+    #[error("internal error, please report: {0}")]
+    Internal(String),
+}
+
+/// Checks what the controller would reject, before anything is written.
+pub fn check_table(
+    controller: Controller,
+    table: &CompensationTable,
+    options: &EmitOptions,
+) -> Result<(), EmitError> {
+    let name = controller.name();
+    let count = table.positions_mm.len();
+    let limit = match (controller.max_points(), options.max_points) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
+    if let Some(max) = limit
+        && count > max
+    {
+        return Err(EmitError::TooManyPoints {
+            controller: name,
+            max,
+            count,
+        });
+    }
+    for pair in table.positions_mm.windows(2) {
+        if pair[1] <= pair[0] {
+            return Err(EmitError::NotIncreasing {
+                position_mm: pair[1],
+                previous_mm: pair[0],
+            });
+        }
+    }
+    if !controller.accepts_free_positions() && table.regular_step_mm().is_none() {
+        return Err(EmitError::UnevenSpacing { controller: name });
+    }
+    if table.values.mode() == TableMode::Bidirectional && !controller.supports_bidirectional() {
+        return Err(EmitError::NoBidirectional { controller: name });
+    }
+    // TNC 335/407 manuals: "The error curve must always start with correction value = 0 at the datum point."
+    let first_value = table
+        .values
+        .for_direction(crate::measurement::Direction::Up)[0];
+    if controller == Controller::Itnc530 && first_value.abs() >= 0.5e-4 {
+        return Err(EmitError::NotZeroAtDatum {
+            controller: name,
+            value_mm: first_value,
+        });
+    }
+    let format_limit = match controller {
+        // [reconstructed] ±9.9999 mm: the range of the iTNC 530 backlash
+        // parameter MP750 and of a 4-decimal signed field; no COM-specific limit is public.
+        Controller::Itnc530 | Controller::Tnc640 => Some(("Heidenhain", 9.9999)),
+        Controller::Sinumerik840d | Controller::LinuxCnc => None,
+    };
+    let machine_limit = options.max_value_mm.map(|limit| ("machine profile", limit));
+    for (what, limit_mm) in format_limit.into_iter().chain(machine_limit) {
+        for direction in crate::measurement::Direction::BOTH {
+            let column = table.values.for_direction(direction);
+            if let Some((value, position)) = column
+                .iter()
+                .zip(&table.positions_mm)
+                .find(|(value, _)| value.abs() > limit_mm)
+            {
+                return Err(EmitError::ValueOutOfRange {
+                    value_mm: *value,
+                    position_mm: *position,
+                    what,
+                    limit_mm,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes a table in a controller's format: checks it first ([`check_table`]),
+/// then reads the text back with the same module and compares it with the
+/// table to the format's resolution, so a file that would not round-trip is
+/// never handed out.
+pub fn write(
+    controller: Controller,
+    table: &CompensationTable,
+    options: &EmitOptions,
+) -> Result<String, EmitError> {
+    check_table(controller, table, options)?;
+    let text = match controller {
+        Controller::Itnc530 => itnc530::write(table, options),
+        Controller::Tnc640 => tnc640::write(table, options),
+        Controller::Sinumerik840d => sinumerik840d::write(table, options),
+        Controller::LinuxCnc => linuxcnc::write(table, options),
+    }?;
+    let (_, back) = read_any(&text, options, Some(options.linuxcnc_type)).map_err(|error| {
+        EmitError::Internal(format!(
+            "the written {} table does not read back: {error}",
+            controller.name()
+        ))
+    })?;
+    let tolerance_mm = resolution_mm(controller, options.machine_unit) / 2.0 + 1e-12;
+    let same_points = back.positions_mm.len() == table.positions_mm.len()
+        && back
+            .positions_mm
+            .iter()
+            .zip(&table.positions_mm)
+            .all(|(a, b)| (a - b).abs() <= tolerance_mm);
+    let same_values = crate::measurement::Direction::BOTH.iter().all(|d| {
+        back.values
+            .for_direction(*d)
+            .iter()
+            .zip(table.values.for_direction(*d))
+            .all(|(a, b)| (a - b).abs() <= tolerance_mm)
+    });
+    if !(same_points && same_values) {
+        return Err(EmitError::Internal(format!(
+            "the written {} table reads back different values",
+            controller.name()
+        )));
+    }
+    Ok(text)
+}
+
+/// The smallest step a format writes, mm.
+pub fn resolution_mm(controller: Controller, machine_unit: LengthUnit) -> f64 {
+    match controller {
+        Controller::Itnc530 | Controller::Tnc640 => 1e-4,
+        Controller::Sinumerik840d => 1e-6,
+        Controller::LinuxCnc => match machine_unit {
+            LengthUnit::Millimetre => 1e-6,
+            LengthUnit::Inch => crate::units::inch_to_mm(1e-7),
+        },
+    }
+}
+
+/// Reads a table written by any supported controller format, detected from
+/// the content: the table of `options.axes[0]`, in machine units
+/// `options.machine_unit` (LinuxCNC) and with the profile's CEC sign.
+/// `linuxcnc_type` must be given for LinuxCNC files whose type the numbers
+/// do not tell.
+pub fn read_any(
+    text: &str,
+    options: &EmitOptions,
+    linuxcnc_type: Option<u8>,
+) -> Result<(Controller, CompensationTable), ParseError> {
+    let Some(axis) = options.axes.first() else {
+        return Err(ParseError::new(1, 1, "no axis given to read the table of"));
+    };
+    let first = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty())
+        .unwrap_or("");
+    let (controller, mut table) = if first.starts_with("BEGIN") && first.contains("DATUM") {
+        (
+            Controller::Itnc530,
+            itnc530::read(text, axis.itnc530_column)?,
+        )
+    } else if first.starts_with("BEGIN") {
+        (Controller::Tnc640, tnc640::read(text, &axis.tnc640_column)?)
+    } else if first.starts_with('%') || text.contains("$AA_ENC_COMP") || text.contains("$AN_CEC") {
+        let table = sinumerik840d::read(
+            text,
+            &axis.sinumerik_axis,
+            options.cec_values_are_corrections,
+        )?;
+        (Controller::Sinumerik840d, table)
+    } else if first.split_whitespace().count() == 3 {
+        let table = linuxcnc::read(text, &axis.axis, linuxcnc_type, options.machine_unit)?;
+        (Controller::LinuxCnc, table)
+    } else {
+        return Err(ParseError::new(
+            1,
+            1,
+            "unknown compensation table format: expected a Heidenhain .COM (BEGIN …), a Sinumerik .MPF (%_N_…) or a LinuxCNC COMP_FILE (nominal forward reverse)",
+        ));
+    };
+    table.axis = axis.axis.clone();
+    Ok((controller, table))
+}
+
+/// How to activate a written table on its controller, in one or a few lines.
+pub fn activation(
+    controller: Controller,
+    table: &CompensationTable,
+    file_name: &str,
+    options: &EmitOptions,
+) -> String {
+    match controller {
+        Controller::Itnc530 => itnc530::activation(file_name, options),
+        Controller::Tnc640 => tnc640::activation(file_name, options),
+        Controller::Sinumerik840d => sinumerik840d::activation(table, options),
+        Controller::LinuxCnc => linuxcnc::activation(file_name, options),
+    }
+}
+
+/// `+0.0023` / `-0.0023` with a fixed number of decimals; never `-0.0000`.
+pub fn signed_fixed(value: f64, decimals: usize) -> String {
+    let text = format!("{value:+.decimals$}");
+    if text.starts_with('-') && text[1..].chars().all(|c| c == '0' || c == '.') {
+        return format!("+{}", &text[1..]);
+    }
+    text
+}
+
+/// Minimal digits, up to `max_decimals`, with an explicit sign: `+100`, `+12.5`, `-0.25`.
+pub fn signed_minimal(value: f64, max_decimals: usize) -> String {
+    let unsigned = minimal(value.abs(), max_decimals);
+    let negative = value < 0.0 && unsigned.chars().any(|c| c.is_ascii_digit() && c != '0');
+    format!("{}{unsigned}", if negative { '-' } else { '+' })
+}
+
+/// Minimal digits, up to `max_decimals`, no sign for positives: `100`, `12.5`, `-0.25`.
+pub fn minimal(value: f64, max_decimals: usize) -> String {
+    let text = format!("{value:.max_decimals$}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &text
+    };
+    if text == "-0" {
+        "0".to_string()
+    } else {
+        text.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn number_formats() {
+        assert_eq!(signed_fixed(-0.0023, 4), "-0.0023");
+        assert_eq!(signed_fixed(0.0, 4), "+0.0000");
+        assert_eq!(signed_fixed(-0.00004, 4), "+0.0000");
+        assert_eq!(signed_fixed(0.00005001, 4), "+0.0001");
+        assert_eq!(signed_minimal(100.0, 4), "+100");
+        assert_eq!(signed_minimal(-12.5, 4), "-12.5");
+        assert_eq!(signed_minimal(-0.00001, 4), "+0");
+        assert_eq!(minimal(-200.0, 6), "-200");
+        assert_eq!(minimal(0.0030000001, 6), "0.003");
+        assert_eq!(minimal(-0.0000001, 6), "0");
+    }
+
+    #[test]
+    fn controller_names() {
+        for controller in Controller::ALL {
+            assert_eq!(Controller::from_name(controller.name()), Some(controller));
+        }
+        assert_eq!(Controller::from_name("fanuc"), None);
+    }
+}

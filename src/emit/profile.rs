@@ -1,0 +1,200 @@
+//! Machine profiles: how one machine names its axes for each controller, its
+//! units and its limits. One TOML file per machine, an example in
+//! `fixtures/machines/`. Everything lives under a `[controller]` table, so the
+//! same file can also hold the machine's kinematic description for `model`.
+//!
+//! ```toml
+//! [controller]
+//! units = "mm"              # machine units (LinuxCNC writes these)
+//! max_points = 200          # Sinumerik MD38000 / MD18342, or any stricter limit
+//! max_value_mm = 0.1        # refuse tables with larger |values|
+//! cec_first_table = 0       # Sinumerik CEC table index for ↑ (↓ is the next)
+//! cec_values = "correction" # or "error": the CEC sign, see formats/sinumerik840d
+//! tnc640_columns = ["X", "Y", "Z"]  # the machine's CfgAxes/axisList
+//!
+//! [controller.axes.X]
+//! itnc530_column = 1        # iTNC 530: the N of the N=F() column
+//! tnc640_column = "X"       # TNC 640: the axis column name
+//! sinumerik_axis = "X1"     # Sinumerik machine axis name (or AX1)
+//! sinumerik_encoder = 0     # 0 = first measuring system
+//! linuxcnc_joint = 0        # LinuxCNC [JOINT_n]
+//! ```
+//!
+//! Axes missing from the profile get defaults from their letter (X, Y, Z, A,
+//! B, C, U, V, W → iTNC columns 1–9, TNC 640 column = the letter, Sinumerik
+//! `X1`…, LinuxCNC joints 0–8), documented in README.md.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+use crate::units::LengthUnit;
+
+/// A machine profile as read from TOML (only the `[controller]` part).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+pub struct MachineProfile {
+    /// Controller settings.
+    #[serde(default)]
+    pub controller: ControllerProfile,
+}
+
+/// The `[controller]` table.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerProfile {
+    /// Machine units: `mm` or `inch`.
+    pub units: Option<String>,
+    /// Largest number of compensation points the machine takes.
+    pub max_points: Option<usize>,
+    /// Largest |value| allowed, mm.
+    pub max_value_mm: Option<f64>,
+    /// Sinumerik CEC: first table index.
+    pub cec_first_table: Option<usize>,
+    /// Sinumerik CEC sign: `correction` or `error`.
+    pub cec_values: Option<String>,
+    /// TNC 640: the machine's axis columns, in order.
+    pub tnc640_columns: Option<Vec<String>>,
+    /// Per-axis names and numbers.
+    #[serde(default)]
+    pub axes: BTreeMap<String, AxisProfileToml>,
+}
+
+/// One axis as written in the profile; every field optional.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisProfileToml {
+    /// iTNC 530 column number (the N of `N=F()`).
+    pub itnc530_column: Option<u32>,
+    /// TNC 640 column name.
+    pub tnc640_column: Option<String>,
+    /// Sinumerik machine axis name.
+    pub sinumerik_axis: Option<String>,
+    /// Sinumerik measuring system (0 = first).
+    pub sinumerik_encoder: Option<u32>,
+    /// LinuxCNC joint number.
+    pub linuxcnc_joint: Option<u32>,
+}
+
+/// One axis with every name resolved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisProfile {
+    /// The axis letter as the measurement names it.
+    pub axis: String,
+    /// iTNC 530 column number.
+    pub itnc530_column: u32,
+    /// TNC 640 column name.
+    pub tnc640_column: String,
+    /// Sinumerik machine axis name.
+    pub sinumerik_axis: String,
+    /// Sinumerik measuring system.
+    pub sinumerik_encoder: u32,
+    /// LinuxCNC joint number.
+    pub linuxcnc_joint: u32,
+}
+
+/// The letters whose position gives the default numbers.
+const AXIS_LETTERS: [&str; 9] = ["X", "Y", "Z", "A", "B", "C", "U", "V", "W"];
+
+impl MachineProfile {
+    /// Parses a profile; unknown keys under `[controller]` are errors (a typo
+    /// must not silently fall back to a default), other top-level tables are
+    /// left to their own readers.
+    pub fn from_toml_str(text: &str) -> Result<MachineProfile, String> {
+        let profile: MachineProfile = toml::from_str(text).map_err(|e| e.to_string())?;
+        if let Some(units) = &profile.controller.units {
+            LengthUnit::from_name(units).ok_or_else(|| {
+                format!("controller.units must be \"mm\" or \"inch\", found {units:?}")
+            })?;
+        }
+        if let Some(sign) = &profile.controller.cec_values
+            && sign != "correction"
+            && sign != "error"
+        {
+            return Err(format!(
+                "controller.cec_values must be \"correction\" or \"error\", found {sign:?}"
+            ));
+        }
+        Ok(profile)
+    }
+
+    /// The machine unit (default mm).
+    pub fn machine_unit(&self) -> LengthUnit {
+        self.controller
+            .units
+            .as_deref()
+            .and_then(LengthUnit::from_name)
+            .unwrap_or(LengthUnit::Millimetre)
+    }
+
+    /// The resolved names of an axis: profile entries first, defaults from the letter.
+    pub fn axis(&self, axis: &str) -> Result<AxisProfile, String> {
+        let entry = self.controller.axes.get(axis).cloned().unwrap_or_default();
+        let index = AXIS_LETTERS
+            .iter()
+            .position(|l| l.eq_ignore_ascii_case(axis));
+        let need = |what: &str| {
+            format!(
+                "axis {axis:?} has no default {what}; give it in the machine profile under [controller.axes.{axis}]"
+            )
+        };
+        Ok(AxisProfile {
+            axis: axis.to_string(),
+            itnc530_column: match entry.itnc530_column {
+                Some(column) => column,
+                None => index
+                    .map(|i| i as u32 + 1)
+                    .ok_or_else(|| need("itnc530_column"))?,
+            },
+            tnc640_column: entry.tnc640_column.unwrap_or_else(|| axis.to_string()),
+            sinumerik_axis: entry
+                .sinumerik_axis
+                .unwrap_or_else(|| format!("{}1", axis.to_ascii_uppercase())),
+            sinumerik_encoder: entry.sinumerik_encoder.unwrap_or(0),
+            linuxcnc_joint: match entry.linuxcnc_joint {
+                Some(joint) => joint,
+                None => index
+                    .map(|i| i as u32)
+                    .ok_or_else(|| need("linuxcnc_joint"))?,
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_come_from_the_axis_letter() {
+        let profile = MachineProfile::default();
+        let x = profile.axis("X").unwrap();
+        assert_eq!(
+            (
+                x.itnc530_column,
+                x.tnc640_column.as_str(),
+                x.sinumerik_axis.as_str(),
+                x.linuxcnc_joint
+            ),
+            (1, "X", "X1", 0)
+        );
+        let u = profile.axis("U").unwrap();
+        assert_eq!((u.itnc530_column, u.linuxcnc_joint), (7, 6));
+        assert!(
+            profile
+                .axis("Q")
+                .unwrap_err()
+                .contains("[controller.axes.Q]")
+        );
+    }
+
+    #[test]
+    fn profile_entries_override_and_typos_are_errors() {
+        let text = "[kinematics]\nchain = \"ZFYX\"\n\n[controller]\nunits = \"inch\"\nmax_points = 200\n\n[controller.axes.X]\nsinumerik_axis = \"AX1\"\nlinuxcnc_joint = 3\n";
+        let profile = MachineProfile::from_toml_str(text).unwrap();
+        assert_eq!(profile.machine_unit(), LengthUnit::Inch);
+        let x = profile.axis("X").unwrap();
+        assert_eq!((x.sinumerik_axis.as_str(), x.linuxcnc_joint), ("AX1", 3));
+        assert!(MachineProfile::from_toml_str("[controller]\nmax_pionts = 3\n").is_err());
+        assert!(MachineProfile::from_toml_str("[controller]\nunits = \"furlong\"\n").is_err());
+    }
+}

@@ -1,0 +1,433 @@
+//! Siemens Sinumerik 840D compensation programs (`.MPF`): LEC writer/reader
+//! (`%_N_AX_EEC_INI`, `$AA_ENC_COMP`) for one table, CEC (`%_N_NC_CEC_INI`,
+//! `$AN_CEC`) for direction-dependent tables.
+//!
+//! Spec and sources: `formats/sinumerik840d/README.md`. [seen] the Siemens
+//! Function Manual Extended Functions K3 (03/2013) examples: the LEC program
+//! skeleton, index order `[encoder, point, axis]`, points N = 0…(MAX−MIN)/STEP,
+//! end values held outside MIN…MAX, "a positive compensation value causes the
+//! machine axis to move in the negative direction" (so an LEC value is the
+//! measured error with its own sign); the CEC table parameters with
+//! `$AN_CEC_DIRECTION` = 1 / −1 for position-dependent backlash with two
+//! tables. [reconstructed] the CEC sign: the K3 sag examples enter the value
+//! that moves the compensation axis (a correction, −error); it is a profile
+//! setting (`cec_values`) because no public page states it outright.
+//!
+//! Numbers: mm, minimal digits with at least one decimal (`0.0023`,
+//! `100.0`), as the manual's examples; 1 nm resolution.
+
+use std::collections::BTreeMap;
+
+use crate::compensate::{CompensationTable, TableValues};
+use crate::emit::{EmitError, EmitOptions, minimal};
+use crate::error::ParseError;
+use crate::read::text::{self, Line};
+
+/// Decimals written (1 nm).
+const DECIMALS: usize = 6;
+
+/// A Siemens number: minimal digits, at least one decimal.
+fn number(value: f64) -> String {
+    let text = minimal(value, DECIMALS);
+    if text.contains('.') {
+        text
+    } else {
+        format!("{text}.0")
+    }
+}
+
+/// Writes LEC for a mean table, CEC for a bidirectional one.
+pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String, EmitError> {
+    let step = table.regular_step_mm().ok_or(EmitError::UnevenSpacing {
+        controller: "sinumerik840d",
+    })?;
+    let first = table.positions_mm[0];
+    let last = table.positions_mm[table.positions_mm.len() - 1];
+    let mut out = String::new();
+    let mut line = |text: String| {
+        out.push_str(&text);
+        out.push('\n');
+    };
+    match &table.values {
+        TableValues::Mean(values) => {
+            line("%_N_AX_EEC_INI".to_string());
+            line("CHANDATA(1)".to_string());
+            for axis in &options.axes {
+                let (e, name) = (axis.sinumerik_encoder, &axis.sinumerik_axis);
+                for (n, value) in values.iter().enumerate() {
+                    line(format!("$AA_ENC_COMP[{e},{n},{name}]={}", number(*value)));
+                }
+                line(format!("$AA_ENC_COMP_STEP[{e},{name}]={}", number(step)));
+                line(format!("$AA_ENC_COMP_MIN[{e},{name}]={}", number(first)));
+                line(format!("$AA_ENC_COMP_MAX[{e},{name}]={}", number(last)));
+                line(format!("$AA_ENC_COMP_IS_MODULO[{e},{name}]=0"));
+            }
+        }
+        TableValues::Bidirectional { up, down } => {
+            line("%_N_NC_CEC_INI".to_string());
+            line("CHANDATA(1)".to_string());
+            let sign = if options.cec_values_are_corrections {
+                -1.0
+            } else {
+                1.0
+            };
+            let mut t = options.cec_first_table;
+            for axis in &options.axes {
+                for (direction, values) in [(1, up), (-1, down)] {
+                    for (n, value) in values.iter().enumerate() {
+                        line(format!("$AN_CEC[{t},{n}]={}", number(sign * value)));
+                    }
+                    let name = &axis.sinumerik_axis;
+                    line(format!("$AN_CEC_INPUT_AXIS[{t}]=({name})"));
+                    line(format!("$AN_CEC_OUTPUT_AXIS[{t}]=({name})"));
+                    line(format!("$AN_CEC_STEP[{t}]={}", number(step)));
+                    line(format!("$AN_CEC_MIN[{t}]={}", number(first)));
+                    line(format!("$AN_CEC_MAX[{t}]={}", number(last)));
+                    line(format!("$AN_CEC_DIRECTION[{t}]={direction}"));
+                    line(format!("$AN_CEC_MULT_BY_TABLE[{t}]=0"));
+                    line(format!("$AN_CEC_IS_MODULO[{t}]=0"));
+                    t += 1;
+                }
+            }
+        }
+    }
+    line("M17".to_string());
+    Ok(out)
+}
+
+/// What the machine needs before the program loads, and how to activate it.
+pub fn activation(table: &CompensationTable, options: &EmitOptions) -> String {
+    let points = table.positions_mm.len();
+    match table.values {
+        TableValues::Mean(_) => {
+            let axes: Vec<String> = options
+                .axes
+                .iter()
+                .map(|a| a.sinumerik_axis.clone())
+                .collect();
+            format!(
+                "needs MD38000 $MA_MM_ENC_COMP_MAX_POINTS ≥ {points} for {}; load with MD32700 $MA_ENC_COMP_ENABLE = 0, then set it to 1 and reference the axis",
+                axes.join(", ")
+            )
+        }
+        TableValues::Bidirectional { .. } => {
+            let last = options.cec_first_table + 2 * options.axes.len() - 1;
+            format!(
+                "needs the CEC option and MD18342 $MN_MM_CEC_MAX_POINTS[{}…{last}] ≥ {points}; load with MD32710 $MA_CEC_ENABLE = 0, then set $MA_CEC_TABLE_ENABLE for the tables and MD32710 to 1. Check the sign with one test move first (formats/sinumerik840d/README.md)",
+                options.cec_first_table
+            )
+        }
+    }
+}
+
+/// One `$NAME[indices]=value` assignment.
+struct Assignment<'a> {
+    line: Line<'a>,
+    name: String,
+    indices: Vec<&'a str>,
+    value: &'a str,
+}
+
+fn assignment<'a>(line: &Line<'a>) -> Result<Option<Assignment<'a>>, ParseError> {
+    let code = line.text.split(';').next().unwrap_or("").trim();
+    if code.is_empty() || !code.starts_with('$') {
+        return Ok(None);
+    }
+    let (Some(open), Some(close), Some(equals)) = (code.find('['), code.find(']'), code.find('='))
+    else {
+        return Err(line.expected_at(code, "$NAME[indices]=value"));
+    };
+    if !(open < close && close < equals) {
+        return Err(line.expected_at(code, "$NAME[indices]=value"));
+    }
+    Ok(Some(Assignment {
+        line: *line,
+        name: code[1..open].trim().to_ascii_uppercase(),
+        indices: code[open + 1..close].split(',').map(str::trim).collect(),
+        value: code[equals + 1..].trim(),
+    }))
+}
+
+/// The points and parameters of one table as read.
+#[derive(Default)]
+struct RawTable<'a> {
+    points: BTreeMap<usize, (f64, Line<'a>)>,
+    step: Option<f64>,
+    min: Option<f64>,
+    max: Option<f64>,
+    direction: i32,
+    output_axis: Option<String>,
+    first_line: Option<Line<'a>>,
+}
+
+/// Reads the table of `axis` (a Sinumerik machine axis name) from an LEC or a
+/// CEC program. `cec_values_are_corrections` as in [`EmitOptions`].
+pub fn read(
+    input: &str,
+    axis: &str,
+    cec_values_are_corrections: bool,
+) -> Result<CompensationTable, ParseError> {
+    let mut lec: BTreeMap<String, RawTable<'_>> = BTreeMap::new();
+    let mut cec: BTreeMap<usize, RawTable<'_>> = BTreeMap::new();
+    for line in text::lines(input) {
+        let Some(a) = assignment(&line)? else {
+            continue;
+        };
+        let number = |token: &str, what: &str| text::number(&a.line, token, what);
+        let index = |i: usize, what: &str| -> Result<usize, ParseError> {
+            let token = a.indices.get(i).copied().unwrap_or("");
+            Ok(text::integer(&a.line, token, what)? as usize)
+        };
+        match a.name.as_str() {
+            "AA_ENC_COMP" | "AA_ENC_COMP_STEP" | "AA_ENC_COMP_MIN" | "AA_ENC_COMP_MAX" => {
+                let axis_name = a.indices.last().copied().unwrap_or("").to_string();
+                let table = lec.entry(axis_name).or_default();
+                table.first_line.get_or_insert(a.line);
+                match a.name.as_str() {
+                    "AA_ENC_COMP" => {
+                        let n = index(1, "interpolation point")?;
+                        table
+                            .points
+                            .insert(n, (number(a.value, "compensation value")?, a.line));
+                    }
+                    "AA_ENC_COMP_STEP" => table.step = Some(number(a.value, "step")?),
+                    "AA_ENC_COMP_MIN" => table.min = Some(number(a.value, "start position")?),
+                    _ => table.max = Some(number(a.value, "end position")?),
+                }
+            }
+            name if name.starts_with("AN_CEC") => {
+                let t = index(0, "table index")?;
+                let table = cec.entry(t).or_default();
+                table.first_line.get_or_insert(a.line);
+                match name {
+                    "AN_CEC" => {
+                        let n = index(1, "interpolation point")?;
+                        table
+                            .points
+                            .insert(n, (number(a.value, "compensation value")?, a.line));
+                    }
+                    "AN_CEC_STEP" => table.step = Some(number(a.value, "step")?),
+                    "AN_CEC_MIN" => table.min = Some(number(a.value, "start position")?),
+                    "AN_CEC_MAX" => table.max = Some(number(a.value, "end position")?),
+                    "AN_CEC_DIRECTION" => {
+                        table.direction = match a.value {
+                            "0" => 0,
+                            "1" => 1,
+                            "-1" => -1,
+                            other => {
+                                return Err(a
+                                    .line
+                                    .expected_at(other, "$AN_CEC_DIRECTION 0, 1 or -1"));
+                            }
+                        }
+                    }
+                    "AN_CEC_OUTPUT_AXIS" => {
+                        table.output_axis =
+                            Some(a.value.trim_matches(|c| c == '(' || c == ')').to_string())
+                    }
+                    _ => {}
+                }
+            }
+            _ => {}
+        }
+    }
+    if let Some(table) = lec.get(axis) {
+        let (positions_mm, values) = columns(table)?;
+        return Ok(finished(axis, positions_mm, TableValues::Mean(values)));
+    }
+    let sign = if cec_values_are_corrections {
+        -1.0
+    } else {
+        1.0
+    };
+    let mut up = None;
+    let mut down = None;
+    for table in cec
+        .values()
+        .filter(|t| t.output_axis.as_deref() == Some(axis))
+    {
+        let (positions, values) = columns(table)?;
+        let values: Vec<f64> = values.iter().map(|v| sign * v).collect();
+        match table.direction {
+            1 => up = Some((positions, values)),
+            -1 => down = Some((positions, values)),
+            _ => {
+                up = Some((positions.clone(), values.clone()));
+                down = Some((positions, values));
+            }
+        }
+    }
+    match (up, down) {
+        (Some((positions, up)), Some((down_positions, down))) if positions == down_positions => {
+            let values = if up == down {
+                TableValues::Mean(up)
+            } else {
+                TableValues::Bidirectional { up, down }
+            };
+            Ok(finished(axis, positions, values))
+        }
+        (Some(_), Some(_)) => Err(ParseError::new(
+            1,
+            1,
+            format!("the ↑ and ↓ CEC tables of {axis} have different points"),
+        )),
+        _ => Err(ParseError::new(
+            1,
+            1,
+            format!(
+                "no $AA_ENC_COMP table and no complete pair of $AN_CEC tables (DIRECTION 1 and -1) for axis {axis}"
+            ),
+        )),
+    }
+}
+
+fn finished(axis: &str, positions_mm: Vec<f64>, values: TableValues) -> CompensationTable {
+    CompensationTable {
+        axis: axis.to_string(),
+        reference_mm: crate::emit::linuxcnc::reference_of(&positions_mm, &values),
+        positions_mm,
+        values,
+        suggested_backlash_mm: None,
+    }
+}
+
+/// Positions MIN + N·STEP and the values, checking the table is complete.
+fn columns(table: &RawTable<'_>) -> Result<(Vec<f64>, Vec<f64>), ParseError> {
+    let at = table.first_line.map_or((1, 1), |l| (l.number, 1));
+    let (Some(step), Some(min), Some(max)) = (table.step, table.min, table.max) else {
+        return Err(ParseError::new(
+            at.0,
+            at.1,
+            "expected STEP, MIN and MAX for the table, found only some",
+        ));
+    };
+    let count = table.points.len();
+    if count < 2 || table.points.keys().enumerate().any(|(i, n)| i != *n) {
+        return Err(ParseError::new(
+            at.0,
+            at.1,
+            "expected interpolation points 0, 1, 2, … without gaps",
+        ));
+    }
+    let expected_max = min + (count - 1) as f64 * step;
+    if step <= 0.0 || (expected_max - max).abs() > 1e-6 {
+        return Err(ParseError::new(
+            at.0,
+            at.1,
+            format!(
+                "MAX is {max} but MIN + {}·STEP is {expected_max}",
+                count - 1
+            ),
+        ));
+    }
+    let positions = (0..count).map(|n| min + n as f64 * step).collect();
+    let values = table.points.values().map(|(v, _)| *v).collect();
+    Ok((positions, values))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::profile::MachineProfile;
+    use crate::units::LengthUnit;
+
+    fn options() -> EmitOptions {
+        EmitOptions {
+            axes: vec![MachineProfile::default().axis("X").unwrap()],
+            table_name: String::new(),
+            machine_unit: LengthUnit::Millimetre,
+            linuxcnc_type: 0,
+            max_points: None,
+            max_value_mm: None,
+            cec_first_table: 0,
+            cec_values_are_corrections: true,
+            tnc640_columns: Vec::new(),
+        }
+    }
+
+    fn table(values: TableValues) -> CompensationTable {
+        CompensationTable {
+            axis: "X".into(),
+            positions_mm: vec![-200.0, -199.0, -198.0],
+            values,
+            reference_mm: -200.0,
+            suggested_backlash_mm: None,
+        }
+    }
+
+    #[test]
+    fn lec_as_the_manual_example() {
+        // K3 03/2013 p.240: +3 µm, +10 µm, +12 µm at −200, −199, −198 mm, step 1.0.
+        let lec = table(TableValues::Mean(vec![0.003, 0.01, 0.012]));
+        let text = write(&lec, &options()).unwrap();
+        assert_eq!(
+            text,
+            "%_N_AX_EEC_INI\nCHANDATA(1)\n$AA_ENC_COMP[0,0,X1]=0.003\n$AA_ENC_COMP[0,1,X1]=0.01\n$AA_ENC_COMP[0,2,X1]=0.012\n\
+             $AA_ENC_COMP_STEP[0,X1]=1.0\n$AA_ENC_COMP_MIN[0,X1]=-200.0\n$AA_ENC_COMP_MAX[0,X1]=-198.0\n$AA_ENC_COMP_IS_MODULO[0,X1]=0\nM17\n"
+        );
+        let back = read(&text, "X1", true).unwrap();
+        assert_eq!(
+            (back.positions_mm, back.values),
+            (lec.positions_mm, lec.values)
+        );
+    }
+
+    #[test]
+    fn cec_pair_round_trips_and_negates() {
+        let both = table(TableValues::Bidirectional {
+            up: vec![0.0, 0.001, 0.002],
+            down: vec![-0.004, -0.003, -0.002],
+        });
+        let text = write(&both, &options()).unwrap();
+        assert!(
+            text.starts_with(
+                "%_N_NC_CEC_INI\nCHANDATA(1)\n$AN_CEC[0,0]=0.0\n$AN_CEC[0,1]=-0.001\n"
+            ),
+            "{text}"
+        );
+        assert!(
+            text.contains("$AN_CEC_DIRECTION[0]=1\n") && text.contains("$AN_CEC_DIRECTION[1]=-1\n")
+        );
+        assert!(text.contains("$AN_CEC[1,0]=0.004\n"));
+        assert_eq!(read(&text, "X1", true).unwrap().values, both.values);
+        // Read with the other sign convention, every value flips.
+        let flipped = read(&text, "X1", false).unwrap();
+        assert_eq!(
+            flipped
+                .values
+                .for_direction(crate::measurement::Direction::Down)[0],
+            0.004
+        );
+    }
+
+    #[test]
+    fn incomplete_tables_are_refused() {
+        let text = "%_N_AX_EEC_INI\nCHANDATA(1)\n$AA_ENC_COMP[0,0,X1]=0.0\n$AA_ENC_COMP[0,2,X1]=0.0\n$AA_ENC_COMP_STEP[0,X1]=1.0\n$AA_ENC_COMP_MIN[0,X1]=0.0\n$AA_ENC_COMP_MAX[0,X1]=2.0\nM17\n";
+        assert!(
+            read(text, "X1", true)
+                .unwrap_err()
+                .message
+                .contains("without gaps")
+        );
+        let wrong_max = text.replace("[0,2,X1]", "[0,1,X1]");
+        assert!(
+            read(&wrong_max, "X1", true)
+                .unwrap_err()
+                .message
+                .contains("MAX is 2")
+        );
+        assert!(
+            read(&wrong_max, "Y1", true)
+                .unwrap_err()
+                .message
+                .contains("for axis Y1")
+        );
+        let bad = text.replace("=0.0\n$AA_ENC_COMP[0,2", "=0,5\n$AA_ENC_COMP[0,2");
+        assert!(
+            read(&bad, "X1", true)
+                .unwrap_err()
+                .message
+                .contains("decimal comma")
+        );
+    }
+}

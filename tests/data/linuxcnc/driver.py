@@ -1,0 +1,60 @@
+#!/usr/bin/python3
+"""The "display" of the LinuxCNC test: reset E-stop, switch on, home, then
+move X to each position of positions.json (MDI G1) and record, after each
+move, the correction LinuxCNC applies (sum2.0.out = motor-pos-cmd − pos-cmd),
+pos-cmd, motor-offset and the screw-comp pins backlash-corr (the correction
+computed) and backlash-filt (the correction applied), read with halcmd.
+Writes result.json next to itself and exits, which shuts LinuxCNC down."""
+import json
+import os
+import subprocess
+import time
+
+import linuxcnc
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+result = {"points": []}
+
+
+def getp(pin):
+    return float(subprocess.check_output(["halcmd", "getp", pin]).decode().strip())
+
+
+try:
+    positions = json.load(open(os.path.join(HERE, "positions.json")))
+    s = linuxcnc.stat()
+    c = linuxcnc.command()
+    c.state(linuxcnc.STATE_ESTOP_RESET)
+    c.wait_complete(20)
+    c.state(linuxcnc.STATE_ON)
+    c.wait_complete(20)
+    c.mode(linuxcnc.MODE_MANUAL)
+    c.wait_complete(20)
+    c.home(-1)
+    c.wait_complete(20)
+    for _ in range(400):
+        s.poll()
+        if all(s.homed[:3]):
+            break
+        time.sleep(0.05)
+    else:
+        raise RuntimeError("the joints did not home")
+    c.mode(linuxcnc.MODE_MDI)
+    c.wait_complete(20)
+    for x in positions:
+        c.mdi("G1 X%s F30000" % x)
+        if c.wait_complete(60) == -1:
+            raise RuntimeError("move to X%s timed out" % x)
+        time.sleep(0.05)  # let the backlash filter settle on the new correction
+        result["points"].append({
+            "x": x,
+            "correction": getp("sum2.0.out"),
+            "pos_cmd": getp("joint.0.pos-cmd"),
+            "motor_offset": getp("joint.0.motor-offset"),
+            "computed": getp("joint.0.backlash-corr"),
+            "applied": getp("joint.0.backlash-filt"),
+        })
+except Exception as error:  # reported to the Rust test, which fails on it
+    result["error"] = repr(error)
+with open(os.path.join(HERE, "result.json"), "w") as out:
+    json.dump(result, out)
