@@ -53,7 +53,13 @@ pub struct ConvertArgs {
     pub mode: TableMode,
 
     /// First compensation point, mm (default: the first target).
-    #[arg(long, value_name = "MM", requires = "step", help_heading = "Grid")]
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "step",
+        allow_negative_numbers = true,
+        help_heading = "Grid"
+    )]
     pub start: Option<f64>,
 
     /// Spacing of the compensation points, mm.
@@ -70,7 +76,12 @@ pub struct ConvertArgs {
     /// Position where the table is zero, mm (default: the first point).
     ///
     /// Controllers reference the axis there; seed 001 zeroes the first point.
-    #[arg(long, value_name = "MM", help_heading = "Table")]
+    #[arg(
+        long,
+        value_name = "MM",
+        allow_negative_numbers = true,
+        help_heading = "Table"
+    )]
     pub reference: Option<f64>,
 
     /// Points outside the measured range: hold the end value, or zero.

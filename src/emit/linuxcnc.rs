@@ -41,22 +41,27 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
             options.linuxcnc_type
         )));
     }
+    // Round nominal and errors to the written decimals first, so that a
+    // type-0 value (nominal + error) minus its nominal gives the error back exactly.
+    let scale = 10f64.powi(places as i32);
+    let rounded = |mm: f64| (unit.from_mm(mm) * scale).round() / scale;
+    let text = |value: f64| minimal(value, places);
     let mut out = String::new();
     for (index, &position_mm) in table.positions_mm.iter().enumerate() {
-        let error = |d: Direction| table.values.for_direction(d)[index];
+        let nominal = rounded(position_mm);
+        let error = |d: Direction| rounded(table.values.for_direction(d)[index]);
         let (forward, reverse) = match options.linuxcnc_type {
             0 => (
-                position_mm + error(Direction::Up),
-                position_mm + error(Direction::Down),
+                nominal + error(Direction::Up),
+                nominal + error(Direction::Down),
             ),
             _ => (-error(Direction::Up), -error(Direction::Down)),
         };
-        let number = |mm: f64| minimal(unit.from_mm(mm), places);
         out.push_str(&format!(
             "{} {} {}\n",
-            number(position_mm),
-            number(forward),
-            number(reverse)
+            text(nominal),
+            text(forward),
+            text(reverse)
         ));
     }
     Ok(out)

@@ -5,6 +5,7 @@
 
 mod bad_input;
 mod cli;
+mod convert;
 mod evaluate_ecmc;
 mod linuxcnc;
 mod read_api_pos;

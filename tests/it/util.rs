@@ -42,7 +42,7 @@ pub struct Run {
     pub stderr: String,
 }
 
-/// Runs `axcomp` with arguments.
+/// Runs `axcomp` with arguments, in the repository root.
 pub fn axcomp<I, S>(args: I) -> Run
 where
     I: IntoIterator<Item = S>,
