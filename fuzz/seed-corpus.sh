@@ -4,10 +4,11 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 shared=../../shared/data
-mkdir -p corpus/read_rtl corpus/read_ecmc corpus/read_api_pos corpus/read_csv
+mkdir -p corpus/read_rtl corpus/read_ecmc corpus/read_api_pos corpus/read_csv corpus/read_tables
 cp ../fixtures/*.rtl ../tests/data/bad/rtl-* corpus/read_rtl/
 cp "$shared"/ecmc/*/*.dat ../tests/data/bad/ecmc-* corpus/read_ecmc/
 for f in "$shared"/api-xd/*.pos; do cp "$f" "corpus/read_api_pos/$(basename "$f" | tr ' ' _)"; done
 cp ../tests/data/bad/pos-* corpus/read_api_pos/
 cp ../tests/data/bad/csv-* corpus/read_csv/
 printf 'target_mm,run,direction,deviation_um\n0,1,up,0\n100,1,up,2.5\n0,1,down,1\n100,1,down,\n' > corpus/read_csv/good.csv
+for f in ../formats/*/golden/*; do cp "$f" "corpus/read_tables/$(basename "$(dirname "$(dirname "$f")")")-$(basename "$f")"; done

@@ -145,6 +145,18 @@ pub enum EmitError {
         /// The controller.
         controller: &'static str,
     },
+    /// A step the format cannot write exactly.
+    #[error(
+        "{controller} writes the step to {resolution_mm} mm; a step of {step_mm} mm would shift the points along the table: give --step as a multiple of {resolution_mm} mm"
+    )]
+    StepNotRepresentable {
+        /// The controller.
+        controller: &'static str,
+        /// The step.
+        step_mm: f64,
+        /// The format's resolution.
+        resolution_mm: f64,
+    },
     /// A value beyond the format's or the machine's range.
     #[error("value {value_mm} mm at {position_mm} mm is beyond the {what} range of ±{limit_mm} mm")]
     ValueOutOfRange {
@@ -212,8 +224,20 @@ pub fn check_table(
             });
         }
     }
-    if !controller.accepts_free_positions() && table.regular_step_mm().is_none() {
-        return Err(EmitError::UnevenSpacing { controller: name });
+    if !controller.accepts_free_positions() {
+        let Some(step) = table.regular_step_mm() else {
+            return Err(EmitError::UnevenSpacing { controller: name });
+        };
+        // One step for the whole table, written to the format's resolution:
+        // a rounded step would shift point k by k times the rounding.
+        let resolution = resolution_mm(controller, options.machine_unit);
+        if ((step / resolution).round() * resolution - step).abs() > 1e-9 {
+            return Err(EmitError::StepNotRepresentable {
+                controller: name,
+                step_mm: step,
+                resolution_mm: resolution,
+            });
+        }
     }
     if table.values.mode() == TableMode::Bidirectional && !controller.supports_bidirectional() {
         return Err(EmitError::NoBidirectional { controller: name });
@@ -406,7 +430,10 @@ pub fn minimal(value: f64, max_decimals: usize) -> String {
 
 #[cfg(test)]
 mod tests {
+    use proptest::prelude::*;
+
     use super::*;
+    use crate::compensate::TableValues;
 
     #[test]
     fn number_formats() {
@@ -428,5 +455,101 @@ mod tests {
             assert_eq!(Controller::from_name(controller.name()), Some(controller));
         }
         assert_eq!(Controller::from_name("fanuc"), None);
+    }
+
+    fn options(controller: Controller, unit: LengthUnit) -> EmitOptions {
+        EmitOptions {
+            axes: vec![MachineProfile::default().axis("X").unwrap()],
+            table_name: "X.COM".into(),
+            machine_unit: unit,
+            linuxcnc_type: 0,
+            max_points: None,
+            max_value_mm: None,
+            cec_first_table: 0,
+            cec_values_are_corrections: controller == Controller::Sinumerik840d,
+            tnc640_columns: Vec::new(),
+        }
+    }
+
+    /// Tables every controller takes: an even grid, values within ±0.5 mm,
+    /// zero at the first point (the iTNC datum), mean or bidirectional.
+    fn arbitrary_table() -> impl Strategy<Value = (CompensationTable, bool)> {
+        (
+            -500_000i32..500_000,
+            500u32..100_000,
+            2usize..60,
+            any::<bool>(),
+        )
+            .prop_flat_map(|(start_um, step_um, count, both)| {
+                // Start and step on the 0.1 µm grid every format writes exactly.
+                let (start, step) = (f64::from(start_um) / 1000.0, f64::from(step_um) / 1000.0);
+                let column = || prop::collection::vec(-0.5f64..0.5, count);
+                (column(), column()).prop_map(move |(mut up, mut down)| {
+                    up[0] = 0.0;
+                    down[0] = 0.0;
+                    let positions_mm = (0..count).map(|k| start + k as f64 * step).collect();
+                    let values = if both {
+                        TableValues::Bidirectional { up, down }
+                    } else {
+                        TableValues::Mean(up)
+                    };
+                    let table = CompensationTable {
+                        axis: "X".into(),
+                        positions_mm,
+                        values,
+                        reference_mm: start,
+                        suggested_backlash_mm: None,
+                    };
+                    (table, both)
+                })
+            })
+    }
+
+    #[test]
+    fn a_step_the_format_would_round_is_refused() {
+        let table = CompensationTable {
+            axis: "X".into(),
+            positions_mm: vec![0.0, 31.70933479667853, 63.41866959335706],
+            values: TableValues::Mean(vec![0.0, 0.001, 0.002]),
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        };
+        let error = write(
+            Controller::Itnc530,
+            &table,
+            &options(Controller::Itnc530, LengthUnit::Millimetre),
+        )
+        .unwrap_err();
+        assert!(
+            matches!(error, EmitError::StepNotRepresentable { .. }),
+            "{error}"
+        );
+        // Free-position formats write each point and take it.
+        assert!(
+            write(
+                Controller::Tnc640,
+                &table,
+                &options(Controller::Tnc640, LengthUnit::Millimetre)
+            )
+            .is_ok()
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn every_controller_reads_back_what_it_writes((table, both) in arbitrary_table(), inch in any::<bool>()) {
+            for controller in Controller::ALL {
+                if both && !controller.supports_bidirectional() {
+                    continue;
+                }
+                let unit = if inch && controller == Controller::LinuxCnc { LengthUnit::Inch } else { LengthUnit::Millimetre };
+                let options = options(controller, unit);
+                // `write` itself reads the text back and compares within the resolution.
+                let text = write(controller, &table, &options).map_err(|e| TestCaseError::fail(format!("{controller:?}: {e}")))?;
+                let (detected, back) = read_any(&text, &options, Some(0)).map_err(|e| TestCaseError::fail(format!("{e}")))?;
+                prop_assert_eq!(detected, controller);
+                prop_assert_eq!(back.values.mode(), table.values.mode());
+            }
+        }
     }
 }
