@@ -38,6 +38,7 @@
 #![deny(missing_docs)]
 
 pub mod compensate;
+pub mod cycle;
 pub mod emit;
 pub mod error;
 pub mod evaluate;
@@ -45,4 +46,5 @@ pub mod measurement;
 pub mod output;
 pub mod read;
 pub mod report;
+pub mod synth;
 pub mod units;

@@ -188,8 +188,10 @@ pub struct Metadata {
     pub serial_number: Option<String>,
     /// Who measured.
     pub operator: Option<String>,
-    /// When.
+    /// When the test started.
     pub date: Option<TestDate>,
+    /// When the test ended, if the file records it.
+    pub end_date: Option<TestDate>,
     /// Where.
     pub location: Option<String>,
     /// Title or free description.
@@ -202,6 +204,16 @@ pub struct Metadata {
     pub length_unit: LengthUnit,
     /// Format-specific fields kept verbatim for the report (software version, flags, PV names).
     pub extra: Vec<(String, String)>,
+}
+
+impl Metadata {
+    /// Duration of the test, s, when both start and end are known and parsed.
+    pub fn duration_s(&self) -> Option<f64> {
+        let start = self.date.as_ref()?.parsed?;
+        let end = self.end_date.as_ref()?.parsed?;
+        let seconds = (end - start).num_seconds() as f64;
+        (seconds > 0.0).then_some(seconds)
+    }
 }
 
 /// Why a set of targets and runs is not a valid measurement.

@@ -75,6 +75,42 @@ pub fn um_to_mm(value_um: Um) -> Mm {
     value_um / UM_PER_MM
 }
 
+/// The shortest decimal text, in µm, that reads back (µm → mm with
+/// [`um_to_mm`]) to exactly `value_mm`. `mm_to_um` and `um_to_mm` are not
+/// exact inverses in binary floating point, so the nearest neighbours of
+/// `value_mm · 1000` are tried too; writers use this so that a file reads back
+/// to the very measurement that was written.
+pub fn um_text(value_mm: Mm) -> String {
+    let um = mm_to_um(value_mm);
+    let step = |x: f64, up: bool| {
+        // The adjacent f64 (f64::next_up/next_down, written out for rust-version 1.85).
+        if x == 0.0 {
+            return if up {
+                f64::from_bits(1)
+            } else {
+                -f64::from_bits(1)
+            };
+        }
+        let bits = x.to_bits();
+        let larger_magnitude = (x > 0.0) == up;
+        f64::from_bits(if larger_magnitude { bits + 1 } else { bits - 1 })
+    };
+    let mut candidates = vec![um];
+    let (mut above, mut below) = (um, um);
+    for _ in 0..4 {
+        above = step(above, true);
+        below = step(below, false);
+        candidates.push(above);
+        candidates.push(below);
+    }
+    candidates
+        .into_iter()
+        .filter(|candidate| um_to_mm(*candidate) == value_mm)
+        .map(|candidate| candidate.to_string())
+        .min_by_key(String::len)
+        .unwrap_or_else(|| um.to_string())
+}
+
 /// An optional length in millimetres to micrometres; `None` stays `None`.
 pub fn opt_mm_to_um(value_mm: Option<Mm>) -> Option<Um> {
     value_mm.map(mm_to_um)
@@ -113,6 +149,17 @@ mod tests {
         assert!((LengthUnit::Inch.from_mm(25.4) - 1.0).abs() < 1e-15);
         assert_eq!(LengthUnit::Millimetre.to_mm(7.5), 7.5);
         assert_eq!(opt_mm_to_um(None), None);
+    }
+
+    #[test]
+    fn um_text_reads_back_exactly() {
+        for um in [0.71, -0.385, 1.0, 0.0, 123.456, -0.001, 1e-9, 5.0e3] {
+            let mm = um_to_mm(um);
+            let text = um_text(mm);
+            assert_eq!(um_to_mm(text.parse().unwrap()), mm, "{um}: {text}");
+        }
+        // 0.00071 mm is written as 0.71 µm, not 0.7100000000000001.
+        assert_eq!(um_text(um_to_mm(0.71)), "0.71");
     }
 
     #[test]

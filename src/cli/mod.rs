@@ -10,6 +10,7 @@ mod common;
 mod convert;
 mod evaluate;
 mod progress;
+mod synth;
 
 use std::process::ExitCode;
 
@@ -40,6 +41,14 @@ pub enum Command {
     /// or CEC for bidirectional tables) and LinuxCNC COMP_FILE, from the
     /// per-target mean deviations of a measurement.
     Convert(convert::ConvertArgs),
+    /// Write measurement files from a known truth (tests, demos, training).
+    ///
+    /// The truth (TOML) holds the axis error, effects the model does not
+    /// declare (reversal, scale, drift, periodic, outlier run, Abbe), noise,
+    /// the ISO 230-2 cycle with its timing and the conditions. With --table the
+    /// re-test of the compensated axis is written too, the table applied as the
+    /// controller applies it.
+    Synth(synth::SynthArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -70,6 +79,7 @@ fn run(args: Args) -> Result<()> {
     match args.command {
         Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
         Command::Convert(convert_args) => convert::run(&convert_args),
+        Command::Synth(synth_args) => synth::run(&synth_args),
     }
 }
 

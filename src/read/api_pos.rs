@@ -531,6 +531,7 @@ fn metadata(
         serial_number: header.text("MachID"),
         operator: header.text("Operator"),
         date,
+        end_date: None,
         location: None,
         description: header.text("Comments").filter(|c| c != "None"),
         source_file: None,

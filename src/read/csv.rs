@@ -29,7 +29,7 @@ use crate::measurement::{
 };
 use crate::read::text::{self, Line, end_of_file_line, split_key};
 use crate::read::{missing_readings_warning, parse_date};
-use crate::units::{LengthUnit, mm_to_um, um_to_mm};
+use crate::units::{LengthUnit, um_text, um_to_mm};
 
 /// The header line, lowercase, without spaces.
 pub const HEADER: &str = "target_mm,run,direction,deviation_um";
@@ -135,9 +135,7 @@ pub fn write(measurement: &Measurement) -> String {
     out.push('\n');
     for run in measurement.runs() {
         for (target_mm, deviation_mm) in measurement.targets_mm().iter().zip(&run.deviations_mm) {
-            let deviation = deviation_mm
-                .map(|d| mm_to_um(d).to_string())
-                .unwrap_or_default();
+            let deviation = deviation_mm.map(um_text).unwrap_or_default();
             out.push_str(&format!(
                 "{target_mm},{},{},{deviation}\n",
                 run.number,

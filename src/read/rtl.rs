@@ -38,7 +38,7 @@ use crate::measurement::{
 };
 use crate::read::text::{self, Line, end_of_file_line, split_key};
 use crate::read::{missing_readings_warning, parse_date};
-use crate::units::{LengthUnit, mm_to_um, um_to_mm};
+use crate::units::{LengthUnit, um_text, um_to_mm};
 
 /// Material temperature Renishaw writes when no sensor is fitted (°C).
 const NO_SENSOR_C: f64 = -10.0;
@@ -115,7 +115,7 @@ pub fn write(measurement: &Measurement) -> String {
                     "{:<3} {:<6} {}",
                     run_index + 1,
                     target_index + 1,
-                    mm_to_um(deviation_mm)
+                    um_text(deviation_mm)
                 ));
             }
         }
@@ -123,6 +123,9 @@ pub fn write(measurement: &Measurement) -> String {
     line("");
     line("ENVIRONMENT::");
     write_environment(&measurement.environment, &mut line);
+    if let Some(times) = capture_times(metadata) {
+        line(&times);
+    }
     line("");
     line("EOF::");
     out
@@ -172,6 +175,19 @@ fn write_environment(environment: &Environment, line: &mut impl FnMut(&str)) {
     if let Some(coefficient) = environment.expansion_coefficient_ppm_per_k {
         line(&format!("Exp coeff  : {coefficient:.6} {coefficient:.6}"));
     }
+}
+
+/// The `Date Time` line in the format of real files (`"10:46 Dec 12 2016"`),
+/// when the start and end of the test are known.
+fn capture_times(metadata: &Metadata) -> Option<String> {
+    let start = metadata.date.as_ref()?.parsed?;
+    let end = metadata.end_date.as_ref()?.parsed?;
+    let format = |at: chrono::NaiveDateTime| at.format("%H:%M %b %d %Y").to_string();
+    Some(format!(
+        "Date Time  : \"{}\" \"{}\"",
+        format(start),
+        format(end)
+    ))
 }
 
 /// The sections of an `.rtl` file, in the order the spec gives.
@@ -248,6 +264,7 @@ struct RtlParser {
     last_user_key: Option<String>,
     environment: Environment,
     capture_start: Option<String>,
+    capture_end: Option<String>,
     saw_eof: Option<usize>,
     warnings: Vec<Warning>,
 }
@@ -550,6 +567,7 @@ impl RtlParser {
             "date time" => {
                 let quoted: Vec<&str> = value.split('"').skip(1).step_by(2).collect();
                 self.capture_start = quoted.first().map(|s| s.to_string());
+                self.capture_end = quoted.get(1).map(|s| s.to_string());
             }
             "final data" => self.keep(key, value),
             _ => self.unknown_key(line, key),
@@ -646,12 +664,16 @@ impl RtlParser {
                 "X".to_string()
             }
         };
+        let capture = |raw: String| TestDate {
+            parsed: parse_date(&raw),
+            raw,
+        };
+        // The USER-TEXT date names the test; the capture times say how long it took.
+        let start = self.capture_start.take().map(capture);
         if self.metadata.date.is_none() {
-            self.metadata.date = self.capture_start.take().map(|raw| TestDate {
-                parsed: parse_date(&raw),
-                raw,
-            });
+            self.metadata.date = start;
         }
+        self.metadata.end_date = self.capture_end.take().map(capture);
         self.metadata.source_format = Some(SourceFormat::Rtl);
         self.metadata.length_unit = LengthUnit::Millimetre;
         let targets_mm: Vec<f64> = sorted_targets(&self.targets)

@@ -1,0 +1,130 @@
+//! `axcomp synth`: measurement files from a known truth.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use axcomp::emit::{self, EmitOptions, MachineProfile};
+use axcomp::measurement::Measurement;
+use axcomp::output::write_new;
+use axcomp::read::{csv, rtl};
+use axcomp::synth::{self, Truth};
+
+use super::common::print_text;
+
+/// Flags of `axcomp synth`.
+#[derive(Debug, clap::Args)]
+pub struct SynthArgs {
+    /// The ground truth (TOML): axis error, effects, noise, test cycle, conditions.
+    #[arg(long, value_name = "T.toml")]
+    pub truth: PathBuf,
+
+    /// The first test: .rtl (Renishaw) or .csv (axcomp CSV), by extension.
+    #[arg(short = 'o', long = "output", value_name = "BEFORE")]
+    pub output: PathBuf,
+
+    /// The compensation table the controller applies in the re-test (any format convert writes).
+    #[arg(long, value_name = "TABLE", requires = "output2")]
+    pub table: Option<PathBuf>,
+
+    /// The re-test of the compensated axis (.rtl or .csv).
+    #[arg(long = "o2", value_name = "AFTER", requires = "table")]
+    pub output2: Option<PathBuf>,
+
+    /// Seed of the random numbers (targets, noise); the same seed gives the same files.
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+
+    /// Machine profile, to read the table's axis names (as in convert).
+    #[arg(long, value_name = "M.toml")]
+    pub machine: Option<PathBuf>,
+
+    /// LinuxCNC table type, when its numbers do not tell it.
+    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1))]
+    pub linuxcnc_type: Option<u8>,
+
+    /// Replace existing output files.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `axcomp synth`.
+pub fn run(args: &SynthArgs) -> Result<()> {
+    let text =
+        std::fs::read_to_string(&args.truth).with_context(|| args.truth.display().to_string())?;
+    let truth = Truth::from_toml_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.truth.display()))?;
+    // Render everything before writing anything, so a bad table leaves no half result.
+    let first = synth::before(&truth, args.seed)?;
+    let first_text = render(&first, &args.output)?;
+    let second = match (&args.table, &args.output2) {
+        (Some(table_path), Some(output2)) => {
+            let table = read_table(table_path, &truth.axis.name, args)?;
+            let retest = synth::after(&truth, &table, args.seed)?;
+            let text = render(&retest, output2)?;
+            Some((output2, text))
+        }
+        _ => None,
+    };
+    write_new(&args.output, first_text.as_bytes(), args.force)?;
+    let mut summary = format!(
+        "Wrote {} ({} targets, {} runs)\n",
+        args.output.display(),
+        first.targets_mm().len(),
+        first.runs().len()
+    );
+    if let Some((path, text)) = second {
+        write_new(path, text.as_bytes(), args.force)?;
+        summary.push_str(&format!(
+            "Wrote {} (re-test with the table applied)\n",
+            path.display()
+        ));
+    }
+    print_text(&summary)
+}
+
+fn read_table(
+    path: &Path,
+    axis: &str,
+    args: &SynthArgs,
+) -> Result<axcomp::compensate::CompensationTable> {
+    let profile = match &args.machine {
+        Some(p) => MachineProfile::from_toml_str(
+            &std::fs::read_to_string(p).with_context(|| p.display().to_string())?,
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?,
+        None => MachineProfile::default(),
+    };
+    let options = EmitOptions {
+        axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
+        table_name: String::new(),
+        machine_unit: profile.machine_unit(),
+        linuxcnc_type: args.linuxcnc_type.unwrap_or(0),
+        max_points: None,
+        max_value_mm: None,
+        cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
+        cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
+        tnc640_columns: Vec::new(),
+    };
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let (_, table) = emit::read_any(&text, &options, args.linuxcnc_type)
+        .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?;
+    Ok(table)
+}
+
+/// The file text for an output path, by its extension.
+fn render(measurement: &Measurement, path: &Path) -> Result<String> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match extension.as_str() {
+        "rtl" => Ok(rtl::write(measurement)),
+        "csv" => Ok(csv::write(measurement)),
+        _ => bail!(
+            "{}: write .rtl or .csv (the extension chooses the format)",
+            path.display()
+        ),
+    }
+}
