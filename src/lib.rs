@@ -39,6 +39,7 @@
 
 pub mod compensate;
 pub mod cycle;
+pub mod diagnose;
 pub mod emit;
 pub mod error;
 pub mod evaluate;
@@ -46,5 +47,6 @@ pub mod measurement;
 pub mod output;
 pub mod read;
 pub mod report;
+pub mod spline;
 pub mod synth;
 pub mod units;

@@ -29,6 +29,8 @@
 //!
 //! Pure: no I/O. Lengths in mm.
 
+pub mod retest;
+
 use crate::evaluate::Evaluation;
 use crate::measurement::{Direction, Measurement, MeasurementError, Run};
 

@@ -6,6 +6,7 @@
 mod bad_input;
 mod cli;
 mod convert;
+mod diagnose;
 mod evaluate_ecmc;
 mod linuxcnc;
 mod read_api_pos;

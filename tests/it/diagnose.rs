@@ -1,0 +1,447 @@
+//! `diagnose` against synthetic re-tests whose truth is known, and on the
+//! real ESS/PSI files.
+//!
+//! Issue 6's criteria: for each effect kind, present in the re-test but not
+//! declared in the model, the diagnosis names the kind and estimates its
+//! parameter within 10 % (or 0.2 in its unit, whichever is larger) over 20
+//! seeds, at realistic noise, also with two effects at once; on clean data it
+//! accepts an effect in at most 5 % of 100 seeds; a step or a sag (no kind in
+//! the list) is reported as unexplained structure, never as a wrong kind.
+//!
+//! "Realistic noise (repeatability 0.5–2 µm)" is read as the ISO 230-2
+//! repeatability R = 4σ: σ cycles through 0.125, 0.25 and 0.5 µm.
+
+use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
+use axcomp::cycle::CycleTiming;
+use axcomp::diagnose::{AngularProfile, DiagnoseInput, Diagnosis, Effect, diagnose};
+use axcomp::evaluate::evaluate;
+use axcomp::measurement::Direction;
+use axcomp::read::read_path;
+use axcomp::synth::{self, EffectSpec, Truth};
+
+use crate::util::shared_files;
+
+const SIGMAS_UM: [f64; 3] = [0.125, 0.25, 0.5];
+const SEEDS: u64 = 20;
+
+/// The first test, a mean table from it at its targets, the re-test with the
+/// table applied, and the diagnosis (with the Abbe effect's angular profile
+/// when asked for, as an angular measurement at 16 points would give it).
+fn run(truth_text: &str, seed: u64, angular: bool) -> Diagnosis {
+    let truth = Truth::from_toml_str(truth_text).unwrap_or_else(|e| panic!("{e}\n{truth_text}"));
+    let before = synth::before(&truth, seed).unwrap();
+    let options = TableOptions {
+        mode: TableMode::Mean,
+        grid: GridSpec::Targets,
+        reference_mm: None,
+        extrapolate: Extrapolate::Hold,
+    };
+    let table = build_table(&before, &evaluate(&before), &options).unwrap();
+    let after = synth::after(&truth, &table, seed).unwrap();
+    let profile = angular.then(|| {
+        let targets = before.targets_mm();
+        let stroke = (targets[0], targets[targets.len() - 1]);
+        let positions_mm: Vec<f64> = (0..=15)
+            .map(|k| stroke.0 + (stroke.1 - stroke.0) * f64::from(k) / 15.0)
+            .collect();
+        let angle = truth
+            .effects
+            .iter()
+            .find_map(|e| {
+                if let EffectSpec::Abbe { angle_urad, .. } = e {
+                    Some(*angle_urad)
+                } else {
+                    None
+                }
+            })
+            .unwrap_or(0.0);
+        let angle_urad = positions_mm
+            .iter()
+            .map(|&x| synth::abbe_angle_urad(angle, x, stroke))
+            .collect();
+        AngularProfile {
+            positions_mm,
+            angle_urad,
+        }
+    });
+    let input = DiagnoseInput {
+        after: &after,
+        before: Some(&before),
+        table: Some(&table),
+        angular: profile.as_ref(),
+        timing: CycleTiming::ASSUMED,
+    };
+    diagnose(&input).unwrap()
+}
+
+/// A 750 mm axis, 31 irregular targets, 5 runs each way; `cycle` adds to [cycle].
+fn truth(sigma_um: f64, cycle: &str, effects: &str) -> String {
+    format!(
+        "[cycle]\nstart_mm = 0.0\nend_mm = 750.0\ncount = 31\njitter_mm = 8.0\nruns = 5\nstart = \"2026-11-20 09:00:00\"\n{cycle}\n\
+         [error]\nscale_um_per_m = 9.5\nperiodic = [{{ period_mm = 300.0, amplitude_um = 2.0, phase_rad = 0.4 }}]\n\
+         [noise]\nsigma_um = {sigma_um}\n\n{effects}"
+    )
+}
+
+/// A screw with a 5 mm lead error: the first test at an even 25 mm spacing
+/// (which aliases it away), the re-test at 1.5 mm steps over 150 mm.
+fn periodic_truth(sigma_um: f64, effects: &str) -> String {
+    format!(
+        "[cycle]\nstart_mm = 0.0\nend_mm = 750.0\ncount = 31\njitter_mm = 0.0\nruns = 5\n\
+         [cycle.after]\nstart_mm = 0.0\nend_mm = 150.0\ncount = 101\njitter_mm = 0.4\nruns = 3\n\
+         [error]\nscale_um_per_m = 9.5\n[noise]\nsigma_um = {sigma_um}\n\n\
+         [[effect]]\nkind = \"periodic\"\nperiod_mm = 5.0\namplitude_um = 1.0\nphase_rad = 0.7\n{effects}"
+    )
+}
+
+fn within(actual: f64, expected: f64) -> bool {
+    (actual - expected).abs() <= (0.1 * expected.abs()).max(0.2)
+}
+
+/// Finds the effect of a kind among the accepted ones.
+fn find<'a>(d: &'a Diagnosis, kind: &str) -> Option<&'a Effect> {
+    d.accepted
+        .iter()
+        .map(|a| &a.effect)
+        .find(|e| e.kind().name() == kind)
+}
+
+/// An effect kind expected in a diagnosis, and the test of its parameters.
+type Expected<'a> = (&'a str, &'a dyn Fn(&Effect) -> bool);
+
+/// Extra effects accepted beside the expected ones, over many runs: a
+/// diagnosis may, as on clean data, accept a small extra effect by chance,
+/// at most in 5 % of the runs (the clean-data criterion), never instead of
+/// the expected ones.
+#[derive(Default)]
+struct Extras {
+    runs: usize,
+    extra: Vec<String>,
+}
+
+impl Extras {
+    fn check(&mut self, name: &str, d: &Diagnosis, expected: &[Expected], seed: u64, sigma: f64) {
+        let found: Vec<&str> = d.accepted.iter().map(|a| a.effect.kind().name()).collect();
+        for (kind, parameter_ok) in expected {
+            let effect = find(d, kind).unwrap_or_else(|| panic!("{name}, seed {seed}, σ {sigma}: {kind} not found; accepted {found:?}, rejected {:?}", d.rejected));
+            assert!(
+                parameter_ok(effect),
+                "{name}, seed {seed}, σ {sigma}: {effect:?}"
+            );
+        }
+        for accepted in &d.accepted {
+            assert!(!accepted.explanation.is_empty());
+        }
+        self.runs += 1;
+        if found.len() > expected.len() {
+            self.extra.push(format!(
+                "{name}, seed {seed}, σ {sigma}: {:?}",
+                d.accepted.iter().map(|a| &a.effect).collect::<Vec<_>>()
+            ));
+        }
+    }
+
+    fn finish(self) {
+        assert!(
+            self.extra.len() * 20 <= self.runs,
+            "extra effects in {} of {} runs: {:#?}",
+            self.extra.len(),
+            self.runs,
+            self.extra
+        );
+    }
+}
+
+fn for_each_seed(mut body: impl FnMut(u64, f64)) {
+    for seed in 1..=SEEDS {
+        body(seed, SIGMAS_UM[(seed % 3) as usize]);
+    }
+}
+
+#[test]
+fn reversal_is_found_and_measured() {
+    let mut extras = Extras::default();
+    for_each_seed(|seed, sigma| {
+        let d = run(
+            &truth(sigma, "", "[[effect]]\nkind = \"reversal\"\nB_um = -4.0\n"),
+            seed,
+            false,
+        );
+        extras.check(
+            "reversal",
+            &d,
+            &[(
+                "reversal",
+                &|e| matches!(e, Effect::Reversal { b_um } if within(*b_um, -4.0)),
+            )],
+            seed,
+            sigma,
+        );
+        assert!(d.residual_after.rms_um < d.residual_before.rms_um);
+    });
+    extras.finish();
+}
+
+#[test]
+fn thermal_scale_is_found_and_measured() {
+    let mut extras = Extras::default();
+    for_each_seed(|seed, sigma| {
+        let d = run(
+            &truth(
+                sigma,
+                "",
+                "[[effect]]\nkind = \"scale\"\nscale_um_per_m = 6.0\ntests = [\"after\"]\n",
+            ),
+            seed,
+            false,
+        );
+        extras.check(
+            "scale",
+            &d,
+            &[(
+                "scale",
+                &|e| matches!(e, Effect::Scale { scale_um_per_m } if within(*scale_um_per_m, 6.0)),
+            )],
+            seed,
+            sigma,
+        );
+    });
+    extras.finish();
+}
+
+#[test]
+fn warm_up_drift_is_found_and_measured() {
+    let mut extras = Extras::default();
+    for_each_seed(|seed, sigma| {
+        let d = run(
+            &truth(
+                sigma,
+                "dwell_s = 6.0\n",
+                "[[effect]]\nkind = \"drift\"\nrate_um_per_h = 15.0\ntests = [\"after\"]\n",
+            ),
+            seed,
+            false,
+        );
+        extras.check(
+            "drift",
+            &d,
+            &[(
+                "drift",
+                &|e| matches!(e, Effect::Drift { rate_um_per_h } if within(*rate_um_per_h, 15.0)),
+            )],
+            seed,
+            sigma,
+        );
+    });
+    extras.finish();
+}
+
+#[test]
+fn an_outlier_run_is_found_and_measured() {
+    let mut extras = Extras::default();
+    for_each_seed(|seed, sigma| {
+        let effect = "[[effect]]\nkind = \"outlier-run\"\nrun = 1\ndirection = \"down\"\noffset_um = 5.0\ntests = [\"after\"]\n";
+        let d = run(&truth(sigma, "", effect), seed, false);
+        let ok = |e: &Effect| matches!(e, Effect::OutlierRun { run: 1, direction: Direction::Down, offset_um } if within(*offset_um, 5.0));
+        extras.check("outlier-run", &d, &[("outlier-run", &ok)], seed, sigma);
+    });
+    extras.finish();
+}
+
+#[test]
+fn a_screw_lead_error_is_found_and_measured() {
+    let mut extras = Extras::default();
+    for_each_seed(|seed, sigma| {
+        let d = run(&periodic_truth(sigma, ""), seed, false);
+        let ok = |e: &Effect| matches!(e, Effect::Periodic { period_mm, amplitude_um, .. } if within(*period_mm, 5.0) && within(*amplitude_um, 1.0));
+        extras.check("periodic", &d, &[("periodic", &ok)], seed, sigma);
+    });
+    extras.finish();
+}
+
+#[test]
+fn an_abbe_offset_is_found_and_measured_with_angular_data() {
+    let mut extras = Extras::default();
+    for_each_seed(|seed, sigma| {
+        let effect = "[[effect]]\nkind = \"abbe\"\noffset_mm = 100.0\nangle_urad = 40.0\ntests = [\"after\"]\n";
+        let d = run(&truth(sigma, "", effect), seed, true);
+        extras.check(
+            "abbe",
+            &d,
+            &[(
+                "abbe",
+                &|e| matches!(e, Effect::Abbe { offset_mm, .. } if within(*offset_mm, 100.0)),
+            )],
+            seed,
+            sigma,
+        );
+        // Without angular data the same bow is unexplained structure, not a wrong kind.
+        let blind = run(&truth(sigma, "", effect), seed, false);
+        assert!(
+            blind.accepted.is_empty() && blind.unexplained.significant,
+            "seed {seed}: {:?}",
+            blind.accepted
+        );
+    });
+    extras.finish();
+}
+
+#[test]
+fn two_effects_at_once() {
+    let mut extras = Extras::default();
+    for_each_seed(|seed, sigma| {
+        let effects = "[[effect]]\nkind = \"reversal\"\nB_um = -3.0\n\n[[effect]]\nkind = \"drift\"\nrate_um_per_h = 15.0\ntests = [\"after\"]\n";
+        let d = run(&truth(sigma, "dwell_s = 6.0\n", effects), seed, false);
+        extras.check(
+            "reversal + drift",
+            &d,
+            &[
+                ("reversal", &|e| matches!(e, Effect::Reversal { b_um } if within(*b_um, -3.0))),
+                ("drift", &|e| matches!(e, Effect::Drift { rate_um_per_h } if within(*rate_um_per_h, 15.0))),
+            ],
+            seed,
+            sigma,
+        );
+        let effects = "[[effect]]\nkind = \"scale\"\nscale_um_per_m = 8.0\ntests = [\"after\"]\n\n[[effect]]\nkind = \"outlier-run\"\nrun = 2\ndirection = \"up\"\noffset_um = -4.0\ntests = [\"after\"]\n";
+        let d = run(&truth(sigma, "", effects), seed, false);
+        extras.check(
+            "scale + outlier-run",
+            &d,
+            &[
+                ("scale", &|e| matches!(e, Effect::Scale { scale_um_per_m } if within(*scale_um_per_m, 8.0))),
+                ("outlier-run", &|e| matches!(e, Effect::OutlierRun { run: 2, direction: Direction::Up, offset_um } if within(*offset_um, -4.0))),
+            ],
+            seed,
+            sigma,
+        );
+        let d = run(
+            &periodic_truth(sigma, "[[effect]]\nkind = \"reversal\"\nB_um = -2.0\n"),
+            seed,
+            false,
+        );
+        extras.check(
+            "periodic + reversal",
+            &d,
+            &[
+                ("periodic", &|e| matches!(e, Effect::Periodic { period_mm, amplitude_um, .. } if within(*period_mm, 5.0) && within(*amplitude_um, 1.0))),
+                ("reversal", &|e| matches!(e, Effect::Reversal { b_um } if within(*b_um, -2.0))),
+            ],
+            seed,
+            sigma,
+        );
+    });
+    extras.finish();
+}
+
+#[test]
+fn clean_retests_rarely_accept_an_effect() {
+    let mut false_alarms = Vec::new();
+    for seed in 1..=100u64 {
+        let sigma = SIGMAS_UM[(seed % 3) as usize];
+        let d = run(&truth(sigma, "", ""), seed, false);
+        // What is left is the noise put in: σ estimated from 310 readings within 25 %.
+        assert!(
+            (d.noise_um / sigma - 1.0).abs() < 0.25,
+            "seed {seed}: noise {} µm for σ {sigma}",
+            d.noise_um
+        );
+        if !d.accepted.is_empty() {
+            false_alarms.push((
+                seed,
+                d.accepted
+                    .iter()
+                    .map(|a| a.effect.kind().name())
+                    .collect::<Vec<_>>(),
+            ));
+        }
+    }
+    assert!(
+        false_alarms.len() <= 5,
+        "{} of 100 clean seeds accepted an effect: {false_alarms:?}",
+        false_alarms.len()
+    );
+}
+
+#[test]
+fn a_step_or_a_sag_is_unexplained_not_a_wrong_kind() {
+    for_each_seed(|seed, sigma| {
+        for effect in [
+            "[[effect]]\nkind = \"step\"\nposition_mm = 400.0\nstep_um = 3.0\ntests = [\"after\"]\n",
+            "[[effect]]\nkind = \"quadratic\"\nsag_um = 3.0\ntests = [\"after\"]\n",
+        ] {
+            let d = run(&truth(sigma, "", effect), seed, false);
+            let positional: Vec<&str> = d
+                .accepted
+                .iter()
+                .map(|a| a.effect.kind().name())
+                .filter(|k| ["scale", "periodic", "abbe"].contains(k))
+                .collect();
+            assert!(
+                positional.is_empty(),
+                "seed {seed}, σ {sigma}, {effect}: forced into {positional:?}"
+            );
+            assert!(
+                d.unexplained.significant,
+                "seed {seed}, σ {sigma}, {effect}: structure not reported"
+            );
+            assert!(!d.unexplained.where_mm.is_empty());
+        }
+    });
+}
+
+/// The real ESS/PSI tests, without a first test: structure between runs only.
+#[test]
+fn real_ess_files_get_a_stated_diagnosis() {
+    let mut files = shared_files("ecmc/ecmccfg", ".dat");
+    files.extend(shared_files("ecmc/ecmc_target_muts_logger", ".dat"));
+    files.extend(shared_files("ecmc/ecmccomgui", ".dat"));
+    for path in &files {
+        let m = read_path(path, None).unwrap().measurement;
+        let input = DiagnoseInput {
+            after: &m,
+            before: None,
+            table: None,
+            angular: None,
+            timing: CycleTiming::ASSUMED,
+        };
+        let d = diagnose(&input).unwrap();
+        for effect in &d.accepted {
+            assert!(
+                !effect.explanation.is_empty()
+                    && !matches!(
+                        effect.effect,
+                        Effect::Scale { .. } | Effect::Periodic { .. }
+                    )
+            );
+        }
+        // Position-dependent kinds are not looked for without a prediction, and say so.
+        assert!(
+            d.rejected
+                .iter()
+                .any(|r| r.kind.name() == "scale" && r.why.contains("--before"))
+        );
+        if path
+            .to_string_lossy()
+            .ends_with("examples__mcu1025_fat_sat__report.md_ISO230.dat")
+        {
+            // The start-up run (anchors-and-standards.md §3.1, DS2): run 1↑ here.
+            let outlier = d.accepted.iter().find_map(|a| {
+                if let Effect::OutlierRun {
+                    run,
+                    direction,
+                    offset_um,
+                } = a.effect
+                {
+                    Some((run, direction, offset_um))
+                } else {
+                    None
+                }
+            });
+            assert!(
+                matches!(outlier, Some((1, Direction::Up, _))),
+                "{:?}",
+                d.accepted
+            );
+        }
+    }
+}
