@@ -9,6 +9,7 @@
 mod common;
 mod evaluate;
 mod progress;
+mod tolerance;
 
 use std::process::ExitCode;
 
@@ -33,6 +34,15 @@ pub enum Command {
     /// Give two files to join the forward and reverse files of one axis (API
     /// XD .pos) into one bidirectional measurement.
     Evaluate(evaluate::EvaluateArgs),
+
+    /// Monte Carlo tolerance study: random machines from straightness tolerances.
+    ///
+    /// Draws random rail mounting surfaces within the tolerances, turns them
+    /// into the 21 geometric errors through the guideway model, and reports
+    /// the distribution of the largest volumetric error over the work volume
+    /// (seed 000). --sweep adds the sensitivity to each tolerance;
+    /// --single-axis runs the one-axis study instead.
+    Tolerance(Box<tolerance::ToleranceArgs>),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -62,6 +72,7 @@ pub fn main() -> ExitCode {
 fn run(args: Args) -> Result<()> {
     match args.command {
         Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
+        Command::Tolerance(tolerance_args) => tolerance::run(&tolerance_args),
     }
 }
 

@@ -62,8 +62,10 @@
 pub mod components;
 pub mod guideway;
 pub mod machine;
+pub mod monte_carlo;
 pub mod profile;
 mod spline;
+pub mod stats;
 pub mod volumetric;
 
 pub use components::{

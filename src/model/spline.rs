@@ -77,7 +77,6 @@ impl CubicSpline {
 ///
 /// Column j is the spline through the j-th unit vector, as the peer's `basis`
 /// builds it.
-#[allow(dead_code)] // Used by the Monte Carlo study (next commit).
 pub(crate) fn basis_matrix(knots: &[f64], points: &[f64]) -> Vec<f64> {
     let n_knots = knots.len();
     let mut basis = vec![0.0; points.len() * n_knots];

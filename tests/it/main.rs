@@ -6,5 +6,6 @@
 mod bad_input;
 mod cli;
 mod evaluate_ecmc;
+mod model;
 mod read_api_pos;
 mod util;
