@@ -410,9 +410,9 @@ pub fn single_axis_study(
     let shifted = |shift: f64| -> Vec<f64> { axis_points.iter().map(|x| x + shift).collect() };
     let plan = AxisStudyPlan {
         n_knots: knots.len(),
-        rail: basis_matrix(&knots, &rail_points),
-        behind: basis_matrix(&knots, &shifted(-half_pitch)),
-        ahead: basis_matrix(&knots, &shifted(half_pitch)),
+        rail: transposed(&basis_matrix(&knots, &rail_points), knots.len()),
+        behind: transposed(&basis_matrix(&knots, &shifted(-half_pitch)), knots.len()),
+        ahead: transposed(&basis_matrix(&knots, &shifted(half_pitch)), knots.len()),
         normal: map.normal_outputs()[0],
         lateral: map.lateral_outputs()[0],
         shape: options.shape,
@@ -423,12 +423,12 @@ pub fn single_axis_study(
         .par_chunks_mut(BATCH_SIZE)
         .enumerate()
         .for_each_init(
-            || vec![0.0; 4 * plan.n_knots],
-            |walks, (batch, out)| {
+            || plan.workspace(),
+            |workspace, (batch, out)| {
                 let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
                 rng.set_stream(batch as u64);
                 for improvement in out.iter_mut() {
-                    *improvement = plan.sample(&mut rng, walks);
+                    *improvement = plan.sample(&mut rng, workspace);
                 }
                 progress(out.len() as u64);
             },
@@ -456,7 +456,8 @@ fn steps(start: f64, end: f64, step: f64) -> Vec<f64> {
 
 struct AxisStudyPlan {
     n_knots: usize,
-    /// Basis rows over the rail, at the carriages behind and ahead of each axis position.
+    /// Spline weights over the rail, and at the carriages behind and ahead
+    /// of each axis position, knot-major (see [`basis_product`]).
     rail: Vec<f64>,
     behind: Vec<f64>,
     ahead: Vec<f64>,
@@ -466,48 +467,72 @@ struct AxisStudyPlan {
     tolerance_mm: f64,
 }
 
+/// Per-thread buffers of the single-axis study.
+struct AxisStudyWorkspace {
+    /// Rails 1 normal, 1 lateral, 2 normal, 2 lateral: knot values, mm.
+    walks: [Vec<f64>; 4],
+    /// One rail over its length.
+    rail: Vec<f64>,
+    /// Rail 1 and rail 2 behind and ahead of each axis position.
+    behind: [Vec<f64>; 2],
+    ahead: [Vec<f64>; 2],
+}
+
 impl AxisStudyPlan {
+    fn workspace(&self) -> AxisStudyWorkspace {
+        let rail_points = self.rail.len() / self.n_knots;
+        let axis_points = self.behind.len() / self.n_knots;
+        AxisStudyWorkspace {
+            walks: std::array::from_fn(|_| vec![0.0; self.n_knots]),
+            rail: vec![0.0; rail_points],
+            behind: std::array::from_fn(|_| vec![0.0; axis_points]),
+            ahead: std::array::from_fn(|_| vec![0.0; axis_points]),
+        }
+    }
+
     /// One axis: rails 1 normal, 1 lateral, 2 normal, 2 lateral (the machine study's order).
-    fn sample(&self, rng: &mut ChaCha8Rng, walks: &mut [f64]) -> [f64; 2] {
-        for walk in walks.chunks_mut(self.n_knots) {
+    fn sample(&self, rng: &mut ChaCha8Rng, workspace: &mut AxisStudyWorkspace) -> [f64; 2] {
+        for walk in workspace.walks.iter_mut() {
             self.shape.unit_walk(rng, walk);
             walk.iter_mut().for_each(|v| *v *= self.tolerance_mm);
         }
-        let walk = |rail: usize| &walks[rail * self.n_knots..(rail + 1) * self.n_knots];
         let mut improvement = [0.0; 2];
         for (direction, weights) in [(0, &self.normal), (1, &self.lateral)] {
-            let (rail_1, rail_2) = (walk(direction), walk(direction + 2));
-            let input = peak_to_peak(&self.rail, rail_1).max(peak_to_peak(&self.rail, rail_2));
-            let mut low = f64::INFINITY;
-            let mut high = f64::NEG_INFINITY;
-            for (behind, ahead) in self
-                .behind
-                .chunks_exact(self.n_knots)
-                .zip(self.ahead.chunks_exact(self.n_knots))
+            let mut input: f64 = 0.0;
+            for (rail, walk) in [&workspace.walks[direction], &workspace.walks[direction + 2]]
+                .into_iter()
+                .enumerate()
             {
-                // Carriages 1, 2 on rail 1 behind and ahead; 3, 4 on rail 2 ahead and behind.
-                let d = [
-                    dot(behind, rail_1),
-                    dot(ahead, rail_1),
-                    dot(ahead, rail_2),
-                    dot(behind, rail_2),
-                ];
-                let value = weights.constant + dot(&weights.weights, &d);
-                low = low.min(value);
-                high = high.max(value);
+                basis_product(&self.rail, walk, &mut workspace.rail);
+                input = input.max(peak_to_peak(&workspace.rail));
+                basis_product(&self.behind, walk, &mut workspace.behind[rail]);
+                basis_product(&self.ahead, walk, &mut workspace.ahead[rail]);
             }
+            let (behind, ahead) = (&workspace.behind, &workspace.ahead);
+            // Carriages 1, 2 on rail 1 behind and ahead; 3, 4 on rail 2 ahead and behind.
+            let [w1, w2, w3, w4] = weights.weights;
+            let (low, high) = (0..behind[0].len())
+                .map(|p| {
+                    weights.constant
+                        + w1 * behind[0][p]
+                        + w2 * ahead[0][p]
+                        + w3 * ahead[1][p]
+                        + w4 * behind[1][p]
+                })
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), v| {
+                    (low.min(v), high.max(v))
+                });
             improvement[direction] = 1.0 - (high - low) / input;
         }
         improvement
     }
 }
 
-fn peak_to_peak(basis: &[f64], knot_values: &[f64]) -> f64 {
-    let (low, high) = basis
-        .chunks_exact(knot_values.len())
-        .map(|row| dot(row, knot_values))
+fn peak_to_peak(values: &[f64]) -> f64 {
+    let (low, high) = values
+        .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), v| {
-            (low.min(v), high.max(v))
+            (low.min(*v), high.max(*v))
         });
     high - low
 }
