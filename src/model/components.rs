@@ -4,7 +4,7 @@
 //! Seed 000 §2.1 and §3.3.1 (`../shared/notes/seed000-volumetric-model.md`
 //! §1): a linear axis has six error motions, one per rigid-body degree of
 //! freedom, and a three-axis machine adds three squareness errors, 21 in all.
-//! The name E<direction><axis> gives the direction of a translation (X, Y, Z)
+//! The name `E<direction><axis>` gives the direction of a translation (X, Y, Z)
 //! or the axis of a rotation (A, B, C about X, Y, Z) and then the moving axis:
 //! EYX is the straightness of X in Y, EBX the rotation of X about Y.
 //! Translations are mm, rotations rad (small, right-handed, as in the error

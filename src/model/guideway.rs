@@ -354,6 +354,19 @@ impl GuidewayMap {
         }
     }
 
+    /// The response at every axis position: straightness in both
+    /// directions, roll, pitch and yaw along the stroke.
+    pub fn along_stroke(
+        &self,
+        rails: &RailProfiles,
+        positions_mm: &[f64],
+    ) -> Vec<GuidewayResponse> {
+        positions_mm
+            .iter()
+            .map(|position| self.response(&self.deviations_at(rails, *position)))
+            .collect()
+    }
+
     /// b, mm.
     pub fn carriage_pitch_mm(&self) -> f64 {
         self.carriage_pitch_mm
@@ -539,6 +552,38 @@ mod tests {
         let expected = [0.0, 0.2, 0.4, 0.0];
         for (actual, expected) in deviations.normal_mm.iter().zip(expected) {
             close(*actual, expected, 1e-15);
+        }
+    }
+
+    #[test]
+    fn sloped_rails_give_pitch_and_an_offset_rail_gives_roll() {
+        use super::super::components::{ErrorTable, Interpolation};
+        // By hand, equal stiffness: rails d = k·x (rail 1) and d = k·x + c
+        // (rail 2) give z5 = k·x + c/2, pitch = k, roll = c/a; lateral rails
+        // d = −k·x on both give y5 = −k·x and yaw = k (eq. 38: (y1 − y2)/b).
+        let (k, c, a) = (2e-5, 0.004, 300.0);
+        let line = |slope: f64, offset: f64| {
+            ErrorFunction::Table(
+                ErrorTable::new(
+                    vec![-1000.0, 2000.0],
+                    vec![offset - 1000.0 * slope, offset + 2000.0 * slope],
+                    Interpolation::Linear,
+                )
+                .unwrap(),
+            )
+        };
+        let rails = RailProfiles {
+            normal: [line(k, 0.0), line(k, c)],
+            lateral: [line(-k, 0.0), line(-k, 0.0)],
+        };
+        let map = Guideway::unloaded(a, 400.0).linear_map().unwrap();
+        let positions = [0.0, 250.0, 700.0];
+        for (x, response) in positions.iter().zip(map.along_stroke(&rails, &positions)) {
+            close(response.normal_mm, k * x + c / 2.0, 1e-15);
+            close(response.pitch_rad, k, 1e-15);
+            close(response.roll_rad, c / a, 1e-15);
+            close(response.lateral_mm, -k * x, 1e-15);
+            close(response.yaw_rad, k, 1e-15);
         }
     }
 

@@ -24,7 +24,7 @@
 //!
 //! # Speed and determinism
 //!
-//! What does not change between samples is computed once ([`Plan`]): the
+//! What does not change between samples is computed once (the plan): the
 //! spline basis rows at the carriage positions of every grid coordinate (as
 //! the NumPy peer does), the guideway weights, and the lever arms of the
 //! linearised chain. A sample then costs a few small matrix-vector products

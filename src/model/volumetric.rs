@@ -5,7 +5,7 @@
 //! Each branch of the machine (frame → tool, frame → workpiece) is a product
 //! of 4 × 4 matrices: fixed offsets between joints (eqs 54–56), the axis
 //! motions, the error matrices T_E of each axis (eqs 48–50, linearised
-//! rotations I + [ε]× as in the thesis) and the squareness matrices (eqs
+//! rotations I + \[ε\]× as in the thesis) and the squareness matrices (eqs
 //! 51–53). The deviation of a branch is where its functional point goes with
 //! the errors minus where it goes without (eqs 61–66); the volumetric error
 //! combines the two branches (eq. 67) and subtracts its value at the

@@ -123,6 +123,7 @@ fn draw_histogram<DB: DrawingBackend>(
         .configure_mesh()
         .disable_x_mesh()
         .x_desc("largest volumetric error per machine [µm]")
+        .x_label_formatter(&|value| format!("{value:.0}"))
         .y_desc("machines")
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
