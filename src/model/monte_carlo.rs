@@ -1028,9 +1028,48 @@ mod tests {
     #[test]
     fn fast_path_equals_the_general_model_on_the_same_errors() {
         // The grid pass of `Workspace::max_norm` against `Machine::error_map`
-        // with the sample's errors as linear tables over the grid coordinates.
-        let machine = Machine::bundled();
-        let (plan, workspace, fast) = formula_machine(&machine);
+        // with the sample's errors as linear tables over the grid coordinates,
+        // for the thesis's chain and three others. Between them their lever
+        // arms fill every cross table m_kj: ZFYX has XY, XZ, YZ; YFXZ XY, ZX,
+        // ZY; XFYZ (X moving on the tool side) YX, ZX; FXYZ ZY.
+        use crate::model::tests::{fxyz_machine, yfxz_machine};
+        let xfyz = Machine::from_toml_str(
+            &Machine::bundled_toml()
+                .replace("chain = \"ZFYX\"", "chain = \"XFYZ\"")
+                .replace("error_frame = \"fixed\"", "error_frame = \"moving\""),
+        )
+        .unwrap();
+        let mut filled = [[false; 2]; 3];
+        for machine in [Machine::bundled(), yfxz_machine(), xfyz, fxyz_machine()] {
+            let (plan, workspace, fast) = formula_machine(&machine);
+            let errors = sample_errors(&plan, &workspace);
+            for (k, tables) in workspace.cross.iter().enumerate() {
+                for (slot, table) in tables.iter().enumerate() {
+                    filled[k][slot] |= table.iter().flatten().any(|v| *v != 0.0);
+                }
+            }
+            let grid = Grid::over_strokes(&machine, 50.0).unwrap();
+            let chain = machine.chain().as_str();
+            let map = machine.error_map(&errors, &grid, Method::FirstOrder);
+            let (first_order, _) = map.max_translation();
+            assert!(
+                (first_order - fast).abs() < 1e-14,
+                "{chain}: {first_order} vs {fast}"
+            );
+            // The full transforms differ only by products of errors (~1e-7 of 0.1 mm here).
+            let (full, _) = machine
+                .error_map(&errors, &grid, Method::Full)
+                .max_translation();
+            assert!(
+                (full - fast).abs() < 1e-5 * fast,
+                "{chain}: {full} vs {fast}"
+            );
+        }
+        assert_eq!(filled, [[true; 2]; 3], "every cross table exercised");
+    }
+
+    /// The errors the fast path drew, as tables for the general model.
+    fn sample_errors(plan: &Plan, workspace: &Workspace) -> GeometricErrors {
         let mut errors = GeometricErrors::default();
         for name in ErrorName::ALL {
             let function = match name.component() {
@@ -1039,31 +1078,19 @@ mod tests {
                     ErrorFunction::Constant(FORMULA_SQUARENESS_RAD[index])
                 }
                 ErrorComponent::Translation { axis, direction } => table(
-                    &plan,
+                    plan,
                     axis,
                     &workspace.errors[axis.index()].translation[direction.index()],
                 ),
                 ErrorComponent::Rotation { axis, about } => table(
-                    &plan,
+                    plan,
                     axis,
                     &workspace.errors[axis.index()].rotation[about.index()],
                 ),
             };
             errors.set(name, function).unwrap();
         }
-        let grid = Grid::over_strokes(&machine, 50.0).unwrap();
-        let (first_order, _) = machine
-            .error_map(&errors, &grid, Method::FirstOrder)
-            .max_translation();
-        assert!(
-            (first_order - fast).abs() < 1e-14,
-            "{first_order} vs {fast}"
-        );
-        // The full transforms differ only by products of errors (~1e-7 of 0.1 mm here).
-        let (full, _) = machine
-            .error_map(&errors, &grid, Method::Full)
-            .max_translation();
-        assert!((full - fast).abs() < 1e-5 * fast, "{full} vs {fast}");
+        errors
     }
 
     fn table(plan: &Plan, axis: Axis, values: &[f64]) -> ErrorFunction {

@@ -270,7 +270,7 @@ fn a_longer_tool_lengthens_the_tool_side_abbe_arm() {
 
 /// A YFXZ machine for hand checks: Y carries the tool 100 mm below its error
 /// frame; X carries Z carries the workpiece; every frame moves with its body.
-fn yfxz_machine() -> Machine {
+pub(super) fn yfxz_machine() -> Machine {
     let text = Machine::bundled_toml()
         .replace("chain = \"ZFYX\"", "chain = \"YFXZ\"")
         .replace(
@@ -294,7 +294,7 @@ fn yfxz_machine() -> Machine {
     Machine::from_toml_str(&text).unwrap()
 }
 
-fn fxyz_machine() -> Machine {
+pub(super) fn fxyz_machine() -> Machine {
     let text = Machine::bundled_toml().replace("chain = \"ZFYX\"", "chain = \"FXYZ\"");
     Machine::from_toml_str(&text).unwrap()
 }
