@@ -107,7 +107,7 @@ mod tests {
         ])
         .unwrap();
         let Command::Evaluate(evaluate) = args.command else {
-            panic!("expected the evaluate subcommand");
+            panic!("parsed as evaluate")
         };
         assert_eq!(evaluate.files.len(), 2);
         assert!(evaluate.json);

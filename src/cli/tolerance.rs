@@ -29,10 +29,11 @@ use super::progress;
 /// Flags of `axcomp tolerance`.
 #[derive(Debug, clap::Args)]
 pub struct ToleranceArgs {
-    /// Machine description (TOML); default: the bundled MCV 754 Quick.
+    /// Machine profile (TOML) with a [kinematics] table; default: the bundled MCV 754 Quick.
     ///
-    /// The format is documented in src/model/machine.rs and, with every
-    /// assumed dimension, in fixtures/machines/mcv754-quick.toml.
+    /// The table is documented in src/model/machine.rs and, with every
+    /// assumed dimension, in fixtures/machines/mcv754-quick.toml (whose
+    /// [controller] table is what `axcomp convert --machine` reads).
     #[arg(long, value_name = "M.toml", help_heading = "Machine")]
     pub machine: Option<PathBuf>,
 

@@ -11,20 +11,28 @@
 //!
 //! # Format
 //!
+//! One TOML file per machine, shared with other commands: `axcomp convert`
+//! reads its `[controller]` table, the model reads `[kinematics]` (and the
+//! optional top-level `name`). Unknown keys under `[kinematics]` are errors,
+//! so a typo cannot silently fall back to a default; other top-level tables
+//! are left to their own readers.
+//!
 //! ```toml
 //! name = "MCV 754 Quick"
+//!
+//! [kinematics]
 //! chain = "ZFYX"                    # tool side … F … workpiece side
 //! branch_deviations = "sum"         # optional: "sum" (eq. 67, default) or "difference"
 //! reference_mm = [0.0, 0.0, 0.0]    # optional: where E = 0 (eq. 68), default the origin
 //!
-//! [tool]
+//! [kinematics.tool]
 //! offset_mm = [0.0, -280.0, -250.0] # last tool-side error frame → tool tip
 //!
-//! [workpiece]
+//! [kinematics.workpiece]
 //! offset_mm = [0.0, 0.0, 80.0]      # last workpiece-side error frame → workpiece reference
 //! point_mm = [0.0, 250.0, 550.0]    # point under the tool at X = Y = Z = 0, from that reference
 //!
-//! [axes.X]                          # and [axes.Y], [axes.Z]
+//! [kinematics.axes.X]               # and [kinematics.axes.Y], [kinematics.axes.Z]
 //! stroke_mm = [0.0, 750.0]
 //! offset_mm = [0.0, 0.0, 200.0]     # previous error frame (or frame origin) → this axis's
 //! motion = -1                       # optional, ±1 (default 1): which way the body moves
@@ -52,8 +60,7 @@
 //! direction, roll the rotation about the axis itself, pitch the rotation
 //! about the lateral direction and yaw the rotation about the normal. The
 //! thesis gives no signs for this mapping; `mapping_signs` defaults to +1
-//! throughout, as the NumPy peer does. Unknown keys are errors, so a typo
-//! cannot silently fall back to a default.
+//! throughout, as the NumPy peer does.
 
 use serde::Deserialize;
 
@@ -258,8 +265,16 @@ impl Machine {
     /// # Ok::<(), axcomp::model::ModelError>(())
     /// ```
     pub fn from_toml_str(text: &str) -> Result<Machine, ModelError> {
-        let raw: RawMachine = toml::from_str(text).map_err(|error| toml_error(text, &error))?;
-        Machine::build(raw.into_description()?)
+        let raw: RawFile = toml::from_str(text).map_err(|error| toml_error(text, &error))?;
+        let Some(kinematics) = raw.kinematics else {
+            return Err(ModelError::invalid(
+                "machine description",
+                "a [kinematics] table (chain, strokes, offsets; see fixtures/machines/mcv754-quick.toml)",
+                "none",
+            ));
+        };
+        let name = raw.name.unwrap_or_else(|| "unnamed machine".to_string());
+        Machine::build(kinematics.into_description(name)?)
     }
 
     fn build(description: Description) -> Result<Machine, ModelError> {
@@ -268,7 +283,7 @@ impl Machine {
             let map = description.axes[axis.index()]
                 .guideway
                 .linear_map()
-                .map_err(|error| error.within(&format!("axes.{axis}")))?;
+                .map_err(|error| error.within(&format!("kinematics.axes.{axis}")))?;
             guideways.push(map);
         }
         let guideways = [guideways[0], guideways[1], guideways[2]];
@@ -379,10 +394,18 @@ fn toml_error(text: &str, error: &toml::de::Error) -> ModelError {
     ModelError::Toml(ParseError::new(line, column, message))
 }
 
+/// The whole file: only what the model reads. Other top-level tables
+/// (`[controller]` for `axcomp convert`, …) belong to other readers.
+#[derive(Deserialize)]
+struct RawFile {
+    name: Option<String>,
+    kinematics: Option<RawMachine>,
+}
+
+/// The `[kinematics]` table.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawMachine {
-    name: String,
     chain: String,
     branch_deviations: Option<BranchDeviations>,
     reference_mm: Option<[f64; 3]>,
@@ -443,31 +466,31 @@ struct RawSigns {
 }
 
 impl RawMachine {
-    fn into_description(self) -> Result<Description, ModelError> {
-        let chain = ChainCode::parse(&self.chain)?;
-        check_finite("tool.offset_mm", &self.tool.offset_mm)?;
-        check_finite("workpiece.offset_mm", &self.workpiece.offset_mm)?;
-        check_finite("workpiece.point_mm", &self.workpiece.point_mm)?;
+    fn into_description(self, name: String) -> Result<Description, ModelError> {
+        let chain = ChainCode::parse(&self.chain).map_err(|e| e.within("kinematics"))?;
+        check_finite("kinematics.tool.offset_mm", &self.tool.offset_mm)?;
+        check_finite("kinematics.workpiece.offset_mm", &self.workpiece.offset_mm)?;
+        check_finite("kinematics.workpiece.point_mm", &self.workpiece.point_mm)?;
         let axes = [
             self.axes.x.into_axis(Axis::X)?,
             self.axes.y.into_axis(Axis::Y)?,
             self.axes.z.into_axis(Axis::Z)?,
         ];
         let reference_mm = self.reference_mm.unwrap_or([0.0; 3]);
-        check_finite("reference_mm", &reference_mm)?;
+        check_finite("kinematics.reference_mm", &reference_mm)?;
         for axis in Axis::ALL {
             let [low, high] = axes[axis.index()].stroke_mm;
             let reference = reference_mm[axis.index()];
             if !(low..=high).contains(&reference) {
                 return Err(ModelError::invalid(
-                    "reference_mm",
+                    "kinematics.reference_mm",
                     format!("a position inside the {axis} stroke {low} … {high} mm"),
                     format!("{reference} mm"),
                 ));
             }
         }
         Ok(Description {
-            name: self.name,
+            name,
             chain,
             axes,
             tool_offset_mm: self.tool.offset_mm,
@@ -481,7 +504,7 @@ impl RawMachine {
 
 impl RawAxis {
     fn into_axis(self, axis: Axis) -> Result<AxisDescription, ModelError> {
-        let key = |field: &str| format!("axes.{axis}.{field}");
+        let key = |field: &str| format!("kinematics.axes.{axis}.{field}");
         let [low, high] = self.stroke_mm;
         if !(low.is_finite() && high.is_finite() && low < high) {
             return Err(ModelError::invalid(
@@ -621,32 +644,32 @@ mod tests {
             (
                 "chain = \"ZFYX\"",
                 "chain = \"ZFY\"",
-                "chain: expected X, Y and Z",
+                "kinematics: chain: expected X, Y and Z",
             ),
             (
                 "stroke_mm = [0.0, 750.0]",
                 "stroke_mm = [750.0, 0.0]",
-                "axes.X.stroke_mm: expected [lowest, highest]",
+                "kinematics.axes.X.stroke_mm: expected [lowest, highest]",
             ),
             (
                 "normal = \"Z\"",
                 "normal = \"X\"",
-                "axes.X.normal: expected one of X, Y, Z other than X",
+                "kinematics.axes.X.normal: expected one of X, Y, Z other than X",
             ),
             (
                 "rail_spacing_mm = 350.0",
                 "rail_spacing_mm = -350.0",
-                "axes.X: rail spacing a: expected a positive length",
+                "kinematics.axes.X: rail spacing a: expected a positive length",
             ),
             (
                 "motion = -1",
                 "motion = 2",
-                "axes.X.motion: expected 1 or -1, found 2",
+                "kinematics.axes.X.motion: expected 1 or -1, found 2",
             ),
             (
                 "reference_mm = [0.0, 0.0, 0.0]",
                 "reference_mm = [0.0, 0.0, 10.0]",
-                "reference_mm: expected a position inside the Z stroke",
+                "kinematics.reference_mm: expected a position inside the Z stroke",
             ),
             (
                 "branch_deviations = \"sum\"",
@@ -666,13 +689,14 @@ mod tests {
             (
                 "rail_spacing_mm = 350.0",
                 "rail_spacing_mm = nan",
-                "axes.X: rail spacing a: expected a positive length in mm, found NaN",
+                "kinematics.axes.X: rail spacing a: expected a positive length in mm, found NaN",
             ),
             (
                 "offset_mm = [0.0, -280.0, -250.0]",
                 "offset_mm = [0.0, -280.0, inf]",
-                "tool.offset_mm: expected finite numbers, found inf",
+                "kinematics.tool.offset_mm: expected finite numbers, found inf",
             ),
+            ("[kinematics]\n", "[kinematic]\n", "missing field `chain`"),
         ];
         for (replace, by, message) in cases {
             let error = with(replace, by).unwrap_err();
@@ -681,6 +705,22 @@ mod tests {
                 "{replace} → {by}: {error}"
             );
         }
+    }
+
+    #[test]
+    fn other_tables_are_left_to_their_readers() {
+        // A profile with only `axcomp convert`'s table has no model…
+        let controller_only = "name = \"M\"\n[controller]\nunits = \"mm\"\n";
+        let error = Machine::from_toml_str(controller_only).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("machine description: expected a [kinematics] table"),
+            "{error}"
+        );
+        // … and the bundled file, which has both, is read without complaint.
+        assert!(Machine::bundled_toml().contains("\n[controller]\n"));
+        assert_eq!(Machine::bundled().name(), "MCV 754 Quick");
     }
 
     #[test]

@@ -245,12 +245,12 @@ fn machine_files_are_read_and_their_errors_located() {
         ),
         (
             text.replacen("stroke_mm = [0.0, 750.0]", "stroke_mm = [750.0, 0.0]", 1),
-            "bad.toml: axes.X.stroke_mm: expected [lowest, highest] with lowest < highest, found [750, 0]",
+            "bad.toml: kinematics.axes.X.stroke_mm: expected [lowest, highest] with lowest < highest, found [750, 0]",
             "",
         ),
         (
             text.replacen("chain = \"ZFYX\"", "chain = \"XYZ\"", 1),
-            "bad.toml: chain: expected X, Y and Z",
+            "bad.toml: kinematics: chain: expected X, Y and Z",
             "",
         ),
     ];
