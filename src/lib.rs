@@ -15,6 +15,9 @@
 //!   standard leaves a figure undefined, and flags suspected outlier runs.
 //! - [`report`] turns them into the terminal report and the `--json` wire
 //!   format (µm, unit-suffixed keys).
+//! - [`model`] is the geometric model of a three-axis machine (seed 000):
+//!   the 21 errors, the kinematic chain as data, the volumetric error, the
+//!   guideway model and the Monte Carlo tolerance study.
 //! - [`output`] is the one place that creates files: via a temporary file and
 //!   a rename, never overwriting without `force`.
 //!
@@ -44,6 +47,7 @@ pub mod emit;
 pub mod error;
 pub mod evaluate;
 pub mod measurement;
+pub mod model;
 pub mod output;
 pub mod read;
 pub mod report;

@@ -18,7 +18,8 @@
 //! Outside the knot range the end values are held (a profile is generated
 //! over more than its use, and a table from a measurement must not be
 //! extrapolated by a cubic). Knots must be finite and strictly increasing;
-//! the callers guarantee it.
+//! the callers ([`crate::model::components::ErrorTable`], the profile
+//! generator, `compensate::retest`) guarantee it.
 
 /// A not-a-knot cubic spline through `(knots, values)`.
 #[derive(Clone, Debug, PartialEq)]

@@ -116,6 +116,18 @@ pub fn opt_mm_to_um(value_mm: Option<Mm>) -> Option<Um> {
     value_mm.map(mm_to_um)
 }
 
+/// An angle in µm/m (µrad, how squareness and angular errors are quoted) to rad.
+pub fn um_per_m_to_rad(value_um_per_m: f64) -> f64 {
+    // Dividing by the exact 1e6 (rather than multiplying by the inexact 1e-6)
+    // makes the round trip through rad_to_um_per_m give back 30, not 29.999…
+    value_um_per_m / 1e6
+}
+
+/// An angle in rad to µm/m (µrad).
+pub fn rad_to_um_per_m(value_rad: f64) -> f64 {
+    value_rad * 1e6
+}
+
 /// Inches to millimetres.
 pub fn inch_to_mm(value_inch: f64) -> Mm {
     value_inch * MM_PER_INCH
@@ -169,5 +181,12 @@ mod tests {
         assert!((inhg_to_kpa(29.92) - 101.320_759).abs() < 1e-6);
         // 6.7 ppm/°F (API file, steel) is 12.06 ppm/°C.
         assert!((per_fahrenheit_to_per_celsius(6.7) - 12.06).abs() < 1e-12);
+    }
+
+    #[test]
+    fn angle_conversions_by_hand() {
+        // 30 µm/m (seed 000 Tab. 3.3) is 30 µrad.
+        assert_eq!(um_per_m_to_rad(30.0), 30e-6);
+        assert_eq!(rad_to_um_per_m(um_per_m_to_rad(30.0)), 30.0);
     }
 }

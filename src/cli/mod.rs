@@ -11,6 +11,7 @@ mod convert;
 mod evaluate;
 mod progress;
 mod synth;
+mod tolerance;
 
 use std::process::ExitCode;
 
@@ -49,6 +50,14 @@ pub enum Command {
     /// re-test of the compensated axis is written too, the table applied as the
     /// controller applies it.
     Synth(synth::SynthArgs),
+
+    /// Monte Carlo tolerance study: random machines from straightness tolerances.
+    /// Draws random rail mounting surfaces within the tolerances, turns them
+    /// into the 21 geometric errors through the guideway model, and reports
+    /// the distribution of the largest volumetric error over the work volume
+    /// (seed 000). --sweep adds the sensitivity to each tolerance;
+    /// --single-axis runs the one-axis study instead.
+    Tolerance(Box<tolerance::ToleranceArgs>),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -80,6 +89,7 @@ fn run(args: Args) -> Result<()> {
         Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
         Command::Convert(convert_args) => convert::run(&convert_args),
         Command::Synth(synth_args) => synth::run(&synth_args),
+        Command::Tolerance(tolerance_args) => tolerance::run(&tolerance_args),
     }
 }
 

@@ -4,8 +4,12 @@
 //! keys carry units (`A_um`, `target_mm`); internal types are never
 //! serialised directly. [`terminal`] renders the same data as a readable
 //! terminal report. Both convert mm to µm through `crate::units`; nothing
-//! else in the crate depends on this module.
+//! else in the crate depends on this module. [`tolerance`] is the wire
+//! format and terminal report of `axcomp tolerance`; [`plot`] renders its
+//! histogram as SVG or PNG bytes (files are written by `crate::output`).
 
 pub mod convert;
 pub mod json;
+pub mod plot;
 pub mod terminal;
+pub mod tolerance;

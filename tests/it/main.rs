@@ -9,5 +9,6 @@ mod convert;
 mod diagnose;
 mod evaluate_ecmc;
 mod linuxcnc;
+mod model;
 mod read_api_pos;
 mod util;

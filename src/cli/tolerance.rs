@@ -1,0 +1,385 @@
+//! `axcomp tolerance`: the Monte Carlo tolerance study of seed 000.
+//!
+//! Random machines from straightness, positioning and squareness tolerances,
+//! the distribution of their largest volumetric error, the sensitivity of its
+//! 90th percentile to each straightness tolerance (`--sweep`), and the
+//! single-axis study of the guideway model (`--single-axis`). The work is in
+//! `axcomp::model::monte_carlo`; this file turns flags into its options,
+//! shows progress and prints.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use axcomp::model::monte_carlo::{
+    AxisStudyOptions, RailDirection, StudyOptions, SweptTolerance, THESIS_SWEEP_MM, Tolerances,
+    sensitivity_sweep, single_axis_study, sweep_runs, tolerance_study,
+};
+use axcomp::model::{Axis, Grid, Guideway, Machine, ModelError, ProfileShape};
+use axcomp::output::write_new;
+use axcomp::report::plot::{self, PlotFormat};
+use axcomp::report::tolerance::{
+    AxisStudyJson, ToleranceJson, axis_study_report, tolerance_report,
+};
+use axcomp::units::um_per_m_to_rad;
+
+use super::common::{print_json, print_text};
+use super::progress;
+
+/// Flags of `axcomp tolerance`.
+#[derive(Debug, clap::Args)]
+pub struct ToleranceArgs {
+    /// Machine profile (TOML) with a [kinematics] table; default: the bundled MCV 754 Quick.
+    ///
+    /// The table is documented in src/model/machine.rs and, with every
+    /// assumed dimension, in fixtures/machines/mcv754-quick.toml (whose
+    /// [controller] table is what `axcomp convert --machine` reads).
+    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
+    pub machine: Option<PathBuf>,
+
+    /// Number of random machines (or axes with --single-axis).
+    ///
+    /// The thesis used 50,000: the smallest count at which P90 no longer
+    /// changed in its fourth decimal (mm) between runs.
+    #[arg(long, value_name = "N", default_value_t = 50_000, value_parser = parse_samples, help_heading = "Study")]
+    pub samples: usize,
+
+    /// Seed of the random streams.
+    ///
+    /// The same seed gives the same result, bit for bit, on any number of threads.
+    #[arg(long, value_name = "S", default_value_t = 1, help_heading = "Study")]
+    pub seed: u64,
+
+    /// Straightness tolerance of all six rail mounting surfaces, mm.
+    ///
+    /// The peak-to-peak band of the generated surface profiles (seed 000
+    /// §3.2.2); the thesis's baseline is 0.03 mm.
+    #[arg(long, value_name = "MM", default_value_t = 0.03, value_parser = parse_length, help_heading = "Tolerances")]
+    pub straightness: f64,
+
+    /// One surface's straightness instead: AXIS.normal=MM or AXIS.lateral=MM (repeatable).
+    ///
+    /// normal is the thesis's "vertical" straightness (normal to the rail
+    /// mounting face), lateral its "horizontal"; e.g. X.normal=0.02.
+    #[arg(long = "surface", value_name = "AXIS.DIR=MM", value_parser = parse_surface, help_heading = "Tolerances")]
+    pub surfaces: Vec<(Axis, RailDirection, f64)>,
+
+    /// Positioning tolerance of X, Y and Z, mm (0: no positioning errors).
+    ///
+    /// Positioning errors come from the same generator as the surfaces; the
+    /// thesis's full machine uses 0.01 mm, its sensitivity study none.
+    #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
+    pub positioning: f64,
+
+    /// Largest squareness error of each axis pair, µm/m (uniform in ±; 0: none).
+    ///
+    /// The thesis's full machine uses 30 µm/m, its sensitivity study none.
+    #[arg(long, value_name = "UM_PER_M", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
+    pub squareness: f64,
+
+    /// Grid step over the work volume, mm.
+    #[arg(long = "grid", value_name = "MM", default_value_t = 50.0, value_parser = parse_positive, help_heading = "Study")]
+    pub grid_mm: f64,
+
+    /// Error period of the generated profiles (knot spacing), mm.
+    #[arg(long, value_name = "MM", default_value_t = 100.0, value_parser = parse_positive, help_heading = "Profiles")]
+    pub period: f64,
+
+    /// Step factor m of the random walk (eq. 39: steps m · U(−tol, tol)).
+    #[arg(long, value_name = "M", default_value_t = 0.5, value_parser = parse_positive, help_heading = "Profiles")]
+    pub step_factor: f64,
+
+    /// Width of the band the walk stays in, as a multiple of the tolerance.
+    ///
+    /// 1 is the band ±tol/2 of the issue and the NumPy peer.
+    #[arg(long, value_name = "FACTOR", default_value_t = 1.0, value_parser = parse_positive, help_heading = "Profiles")]
+    pub band_width: f64,
+
+    /// Also vary each straightness tolerance in turn and fit the slopes of P90.
+    ///
+    /// One study per tolerance and value (the thesis's Tabs 4.6–4.12: X, Y, Z
+    /// normal and lateral, then all six together), the other tolerances as set.
+    #[arg(long, help_heading = "Study")]
+    pub sweep: bool,
+
+    /// Tolerance values of the sweep, mm.
+    #[arg(long, value_name = "MM,…", value_delimiter = ',', value_parser = parse_positive, default_values_t = THESIS_SWEEP_MM, help_heading = "Study")]
+    pub sweep_values: Vec<f64>,
+
+    /// Run the single-axis study instead: one axis, two rails, four carriages.
+    ///
+    /// Reports how much straighter the assembled axis is than its mounting
+    /// surfaces (seed 000 §3.5.1); uses --straightness, --stroke,
+    /// --rail-spacing, --carriage-pitch and the profile flags.
+    #[arg(long, help_heading = "Single axis")]
+    pub single_axis: bool,
+
+    /// Stroke of the single axis, mm.
+    #[arg(long, value_name = "MM", default_value_t = 1000.0, value_parser = parse_positive, help_heading = "Single axis")]
+    pub stroke: f64,
+
+    /// Rail spacing a of the single axis, mm.
+    #[arg(long, value_name = "MM", default_value_t = 400.0, value_parser = parse_positive, help_heading = "Single axis")]
+    pub rail_spacing: f64,
+
+    /// Carriage pitch b of the single axis, mm.
+    #[arg(long, value_name = "MM", default_value_t = 500.0, value_parser = parse_positive, help_heading = "Single axis")]
+    pub carriage_pitch: f64,
+
+    /// Write the histogram of the machine study to FILE (.svg or .png).
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
+    pub histogram: Option<PathBuf>,
+
+    /// Replace an existing histogram file.
+    #[arg(long, help_heading = "Output")]
+    pub force: bool,
+
+    /// Worker threads (default: one per core). The result does not depend on it.
+    #[arg(long, value_name = "N", value_parser = parse_samples, help_heading = "Study")]
+    pub threads: Option<usize>,
+
+    /// Print one JSON object (units in the keys) instead of the report.
+    #[arg(long, help_heading = "Output")]
+    pub json: bool,
+
+    /// No progress bar.
+    #[arg(long, short = 'q', help_heading = "Output")]
+    pub quiet: bool,
+}
+
+/// Runs `axcomp tolerance`.
+pub fn run(args: &ToleranceArgs) -> Result<()> {
+    if let Some(threads) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global()
+            .context("cannot start the worker threads")?;
+    }
+    let shape = ProfileShape {
+        period_mm: args.period,
+        step_factor: args.step_factor,
+        band_width_factor: args.band_width,
+    };
+    if args.single_axis {
+        return run_single_axis(args, shape);
+    }
+    let histogram_format = match &args.histogram {
+        Some(path) => Some(PlotFormat::from_path(path).with_context(|| {
+            format!(
+                "--histogram {}: expected a file name ending in .svg or .png",
+                path.display()
+            )
+        })?),
+        None => None,
+    };
+    let machine = load_machine(args.machine.as_deref())?;
+    let mut tolerances = Tolerances::uniform(
+        args.straightness,
+        args.positioning,
+        um_per_m_to_rad(args.squareness),
+    );
+    for (axis, direction, value) in &args.surfaces {
+        tolerances.set_straightness(*axis, *direction, *value);
+    }
+    let options = StudyOptions {
+        samples: args.samples,
+        seed: args.seed,
+        tolerances,
+        shape,
+        grid_step_mm: args.grid_mm,
+    };
+    let grid = Grid::over_strokes(&machine, args.grid_mm)?;
+    let swept = SweptTolerance::all();
+    let runs = if args.sweep {
+        1 + sweep_runs(&tolerances, &swept, &args.sweep_values)
+    } else {
+        1
+    };
+    let bar = progress::bar((args.samples * runs) as u64, "tolerance study", args.quiet);
+    let advance = |done: u64| bar.inc(done);
+    let result = tolerance_study(&machine, &options, &advance)?;
+    let sensitivity = if args.sweep {
+        Some(sensitivity_sweep(
+            &machine,
+            &options,
+            result.summary.p90,
+            &swept,
+            &args.sweep_values,
+            &advance,
+        )?)
+    } else {
+        None
+    };
+    bar.finish_and_clear();
+    let report = ToleranceJson::new(&machine, &grid, &options, &result, sensitivity.as_deref());
+    if let (Some(path), Some(format)) = (&args.histogram, histogram_format) {
+        let title = format!(
+            "{} ({}): {} random machines, seed {}",
+            report.machine, report.chain, report.samples, report.seed
+        );
+        let bytes = plot::histogram(
+            &report.histogram,
+            report.max_volumetric_um.p90,
+            &title,
+            format,
+        )?;
+        write_new(path, &bytes, args.force)?;
+    }
+    if args.json {
+        print_json(&report)
+    } else {
+        print_text(&tolerance_report(&report))
+    }
+}
+
+fn run_single_axis(args: &ToleranceArgs, shape: ProfileShape) -> Result<()> {
+    for (flag, given) in [
+        ("--sweep", args.sweep),
+        ("--histogram", args.histogram.is_some()),
+        ("--machine", args.machine.is_some()),
+        ("--surface", !args.surfaces.is_empty()),
+    ] {
+        if given {
+            bail!("{flag} applies to the machine study, not to --single-axis");
+        }
+    }
+    let options = AxisStudyOptions {
+        samples: args.samples,
+        seed: args.seed,
+        stroke_mm: args.stroke,
+        guideway: Guideway::unloaded(args.rail_spacing, args.carriage_pitch),
+        tolerance_mm: args.straightness,
+        shape,
+        step_mm: 5.0,
+    };
+    let bar = progress::bar(args.samples as u64, "single-axis study", args.quiet);
+    let result = single_axis_study(&options, &|done| bar.inc(done))?;
+    bar.finish_and_clear();
+    let report = AxisStudyJson::new(&options, &result);
+    if args.json {
+        print_json(&report)
+    } else {
+        print_text(&axis_study_report(&report))
+    }
+}
+
+/// The machine from `path`, or the bundled one. The path goes in front of
+/// the error, with the line and column for TOML errors.
+fn load_machine(path: Option<&Path>) -> Result<Machine> {
+    let Some(path) = path else {
+        return Ok(Machine::bundled());
+    };
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    Machine::from_toml_str(&text).map_err(|error| match error {
+        ModelError::Toml(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
+        other => anyhow::anyhow!("{}: {other}", path.display()),
+    })
+}
+
+/// A count of at least 1.
+fn parse_samples(text: &str) -> Result<usize, String> {
+    match text.trim().replace('_', "").parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("expected a whole number ≥ 1, found {text:?}")),
+    }
+}
+
+/// A finite number ≥ 0 (a tolerance may be zero: that error is left out).
+fn parse_length(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("expected a finite number ≥ 0, found {text:?}")),
+    }
+}
+
+/// A finite number > 0.
+fn parse_positive(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("expected a finite number > 0, found {text:?}")),
+    }
+}
+
+/// `X.normal=0.02`, `z.lateral=0.06`.
+fn parse_surface(text: &str) -> Result<(Axis, RailDirection, f64), String> {
+    let expected = || {
+        format!("expected AXIS.normal=MM or AXIS.lateral=MM (e.g. X.normal=0.02), found {text:?}")
+    };
+    let (surface, value) = text.split_once('=').ok_or_else(expected)?;
+    let (axis, direction) = surface.trim().split_once('.').ok_or_else(expected)?;
+    let axis = match axis.trim().to_ascii_uppercase().as_str() {
+        "X" => Axis::X,
+        "Y" => Axis::Y,
+        "Z" => Axis::Z,
+        _ => return Err(expected()),
+    };
+    let direction = match direction.trim().to_ascii_lowercase().as_str() {
+        "normal" | "vertical" => RailDirection::Normal,
+        "lateral" | "horizontal" => RailDirection::Lateral,
+        _ => return Err(expected()),
+    };
+    Ok((axis, direction, parse_length(value)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Args, Command};
+    use super::*;
+    use clap::Parser;
+
+    fn parse(extra: &[&str]) -> Result<ToleranceArgs, clap::Error> {
+        let mut argv = vec!["axcomp", "tolerance"];
+        argv.extend_from_slice(extra);
+        match Args::try_parse_from(argv)?.command {
+            Command::Tolerance(args) => Ok(*args),
+            _ => panic!("expected the tolerance subcommand"),
+        }
+    }
+
+    #[test]
+    fn defaults_are_the_thesis_baseline() {
+        let args = parse(&[]).unwrap();
+        assert_eq!(args.samples, 50_000);
+        assert_eq!(args.seed, 1);
+        assert_eq!(args.straightness, 0.03);
+        assert_eq!((args.positioning, args.squareness), (0.0, 0.0));
+        assert_eq!(
+            (args.grid_mm, args.period, args.step_factor, args.band_width),
+            (50.0, 100.0, 0.5, 1.0)
+        );
+        assert_eq!(args.sweep_values, THESIS_SWEEP_MM);
+        assert!(!args.sweep && !args.single_axis && !args.json);
+    }
+
+    #[test]
+    fn surfaces_and_numbers() {
+        let args = parse(&[
+            "--surface",
+            "X.normal=0.02",
+            "--surface",
+            "z.horizontal=0.06",
+        ])
+        .unwrap();
+        assert_eq!(
+            args.surfaces,
+            vec![
+                (Axis::X, RailDirection::Normal, 0.02),
+                (Axis::Z, RailDirection::Lateral, 0.06)
+            ]
+        );
+        for bad in [
+            &["--surface", "X=0.02"][..],
+            &["--surface", "W.normal=0.02"],
+            &["--surface", "X.up=0.02"],
+            &["--straightness", "nan"],
+            &["--straightness", "-0.01"],
+            &["--samples", "0"],
+            &["--grid", "0"],
+            &["--sweep-values", "0.01,inf"],
+        ] {
+            assert!(parse(bad).is_err(), "{bad:?} must be refused");
+        }
+        let args = parse(&["--samples", "2_000", "--sweep-values", "0.01,0.02"]).unwrap();
+        assert_eq!((args.samples, args.sweep_values), (2000, vec![0.01, 0.02]));
+    }
+}

@@ -1,0 +1,662 @@
+//! One linear axis on two rails and four carriages: from the straightness of
+//! the rail mounting surfaces to the error motions of the saddle.
+//!
+//! Seed 000 §3.1–3.2 (`../shared/notes/seed000-volumetric-model.md` §3): a
+//! rigid saddle rests on four carriages, linear springs of stiffness k_i
+//! (N/mm) in the direction normal to the rail mounting face ("vertical", z)
+//! and across it ("horizontal", y). The rails copy their mounting surfaces,
+//! so carriage i sits on a rail deviation d_zi, d_yi and deforms by
+//! Δ_i = F_i / k_i; the saddle corner moves by z_i = d_zi + Δ_zi.
+//!
+//! Carriage indexing (derived from eqs 40–47, the figure is missing): with
+//! rail spacing a and carriage pitch b, at axis position x carriage 1 is on
+//! rail 1 at x − b/2, carriage 2 on rail 1 at x + b/2, carriage 3 on rail 2
+//! at x + b/2 and carriage 4 on rail 2 at x − b/2 (1→2→3→4 goes round the
+//! rectangle).
+//!
+//! - Normal direction: force balance (9), moments (10), (11) and the
+//!   coplanarity of the four corners (12), solved as K_z F_z = Q_z (14). The
+//!   printed matrix (13) is garbled (5 × 4); the consistent 4 × 4 form of the
+//!   notes is used. Outputs z5 = mean z_i (17), roll = (z4 − z1)/a (18),
+//!   pitch = (z2 − z1)/b (19).
+//! - Lateral direction: force balance (29), moment (30) and equal lateral
+//!   displacement across the rails (31), (32) as K_y F_y = Q_y (33); eq. 25
+//!   prints Δ_y4 where eq. 28 (and sense) has Δ_y3. Outputs y5 = mean y_i
+//!   (37), yaw = (y1 − y2)/b (38).
+//!
+//! The loads act at the saddle centre: F_zz downwards (the thesis's sign,
+//! −F_zz in eq. 9) and F_zy sideways (+F_zy in eq. 29). Both problems are
+//! linear, so [`Guideway::linear_map`] solves them once for unit inputs and
+//! the Monte Carlo study applies the resulting weights to every sample. With
+//! equal stiffness and no load, z5 and y5 are the means of the four rail
+//! deviations (the notes' closed forms, §3.5), which the tests check.
+//!
+//! Tilting stiffness of the carriages is neglected, as in the thesis.
+
+use nalgebra::{Matrix4, Vector4};
+
+use super::components::ErrorFunction;
+use super::{ModelError, check_positive};
+
+/// The geometry, stiffness and load of one axis's guideway (seed 000 Tab. 3.1, 3.4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Guideway {
+    /// a: distance between the two rails, mm.
+    pub rail_spacing_mm: f64,
+    /// b: distance between the two carriages on one rail, mm.
+    pub carriage_pitch_mm: f64,
+    /// k_z1 … k_z4: carriage stiffness normal to the mounting face, N/mm.
+    pub stiffness_normal_n_per_mm: [f64; 4],
+    /// k_y1 … k_y4: carriage stiffness across the rail, N/mm.
+    pub stiffness_lateral_n_per_mm: [f64; 4],
+    /// F_zz: load normal to the mounting face at the saddle centre, N
+    /// (positive pushes the saddle towards the rails, eq. 9).
+    pub load_normal_n: f64,
+    /// F_zy: lateral load at the saddle centre, N (eq. 29).
+    pub load_lateral_n: f64,
+}
+
+/// The stiffness of every carriage in seed 000 (Tab. 3.3, 3.4), N/mm.
+pub const THESIS_STIFFNESS_N_PER_MM: f64 = 100_000.0;
+
+impl Guideway {
+    /// Four equal carriages of the thesis's stiffness, no load.
+    pub fn unloaded(rail_spacing_mm: f64, carriage_pitch_mm: f64) -> Guideway {
+        Guideway {
+            rail_spacing_mm,
+            carriage_pitch_mm,
+            stiffness_normal_n_per_mm: [THESIS_STIFFNESS_N_PER_MM; 4],
+            stiffness_lateral_n_per_mm: [THESIS_STIFFNESS_N_PER_MM; 4],
+            load_normal_n: 0.0,
+            load_lateral_n: 0.0,
+        }
+    }
+
+    /// Solves the equilibrium for the rail deviations under the four carriages.
+    ///
+    /// # Example
+    ///
+    /// The thesis's Obr. 3.8 example; the check values are the notes' §3.3:
+    ///
+    /// ```
+    /// use axcomp::model::{CarriageDeviations, Guideway};
+    ///
+    /// let guideway = Guideway::unloaded(150.0, 200.0);
+    /// let deviations = CarriageDeviations {
+    ///     normal_mm: [0.006, 0.001, 0.0, -0.004],
+    ///     lateral_mm: [0.0; 4],
+    /// };
+    /// let response = guideway.solve(&deviations)?;
+    /// assert!((response.normal_mm - 0.00075).abs() < 1e-15);
+    /// assert!((response.pitch_rad - -2.5e-6).abs() < 1e-15);
+    /// # Ok::<(), axcomp::model::ModelError>(())
+    /// ```
+    pub fn solve(&self, deviations: &CarriageDeviations) -> Result<GuidewayResponse, ModelError> {
+        Ok(self.linear_map()?.response(deviations))
+    }
+
+    /// Checks the parameters and solves both systems once, for reuse.
+    pub fn linear_map(&self) -> Result<GuidewayMap, ModelError> {
+        self.check()?;
+        let k_z = self.stiffness_normal_n_per_mm;
+        let k_y = self.stiffness_lateral_n_per_mm;
+        // K_z F_z = Q_z, the consistent form of eq. 13 (rows: eqs 9, 10, 11, 12).
+        #[rustfmt::skip]
+        let matrix_z = Matrix4::new(
+            1.0, 1.0, 1.0, 1.0,
+            1.0, 1.0, 0.0, 0.0,
+            0.0, 1.0, 1.0, 0.0,
+            1.0 / k_z[0], -1.0 / k_z[1], 1.0 / k_z[2], -1.0 / k_z[3],
+        );
+        // K_y F_y = Q_y, eq. 33 (rows: eqs 29, 30, 31, 32).
+        #[rustfmt::skip]
+        let matrix_y = Matrix4::new(
+            1.0, 1.0, 1.0, 1.0,
+            0.0, 1.0, 1.0, 0.0,
+            1.0 / k_y[0], 0.0, 0.0, -1.0 / k_y[3],
+            0.0, 1.0 / k_y[1], -1.0 / k_y[2], 0.0,
+        );
+        let singular = || {
+            ModelError::invalid(
+                "guideway",
+                "carriage stiffnesses that give a solvable equilibrium",
+                format!("{:?} and {:?} N/mm", k_z, k_y),
+            )
+        };
+        let inverse_z = matrix_z.try_inverse().ok_or_else(singular)?;
+        let inverse_y = matrix_y.try_inverse().ok_or_else(singular)?;
+        let f_zz = self.load_normal_n;
+        let f_zy = self.load_lateral_n;
+        // Corner displacement z = d + diag(1/k) K⁻¹ Q(d): affine in d. The
+        // d-part of Q_z is (0, 0, 0, −d1 + d2 − d3 + d4), of Q_y
+        // (0, 0, −d1 + d4, −d2 + d3).
+        let twist = Vector4::new(-1.0, 1.0, -1.0, 1.0);
+        let mut normal = Matrix4::identity();
+        let mut lateral = Matrix4::identity();
+        for input in 0..4 {
+            let force_z = inverse_z.column(3) * twist[input];
+            let q_y = match input {
+                0 => Vector4::new(0.0, 0.0, -1.0, 0.0),
+                1 => Vector4::new(0.0, 0.0, 0.0, -1.0),
+                2 => Vector4::new(0.0, 0.0, 0.0, 1.0),
+                _ => Vector4::new(0.0, 0.0, 1.0, 0.0),
+            };
+            let force_y = inverse_y * q_y;
+            for corner in 0..4 {
+                normal[(corner, input)] += force_z[corner] / k_z[corner];
+                lateral[(corner, input)] += force_y[corner] / k_y[corner];
+            }
+        }
+        let load_force_z = inverse_z * Vector4::new(-f_zz, -f_zz / 2.0, -f_zz / 2.0, 0.0);
+        let load_force_y = inverse_y * Vector4::new(f_zy, f_zy / 2.0, 0.0, 0.0);
+        let inverse_stiffness_z = Vector4::from_fn(|i, _| 1.0 / k_z[i]);
+        let inverse_stiffness_y = Vector4::from_fn(|i, _| 1.0 / k_y[i]);
+        Ok(GuidewayMap {
+            rail_spacing_mm: self.rail_spacing_mm,
+            carriage_pitch_mm: self.carriage_pitch_mm,
+            inverse_z,
+            inverse_y,
+            normal,
+            lateral,
+            load_normal_mm: load_force_z.component_mul(&inverse_stiffness_z),
+            load_lateral_mm: load_force_y.component_mul(&inverse_stiffness_y),
+            load_force_normal_n: load_force_z,
+            load_force_lateral_n: load_force_y,
+        })
+    }
+
+    fn check(&self) -> Result<(), ModelError> {
+        check_positive(
+            "rail spacing a",
+            self.rail_spacing_mm,
+            "a positive length in mm",
+        )?;
+        check_positive(
+            "carriage pitch b",
+            self.carriage_pitch_mm,
+            "a positive length in mm",
+        )?;
+        let stiffnesses = self
+            .stiffness_normal_n_per_mm
+            .iter()
+            .chain(&self.stiffness_lateral_n_per_mm);
+        if let Some(bad) = stiffnesses
+            .into_iter()
+            .find(|k| !(k.is_finite() && **k > 0.0))
+        {
+            return Err(ModelError::invalid(
+                "carriage stiffness",
+                "a positive number of N/mm",
+                bad.to_string(),
+            ));
+        }
+        for (what, value) in [
+            ("normal load", self.load_normal_n),
+            ("lateral load", self.load_lateral_n),
+        ] {
+            if !value.is_finite() {
+                return Err(ModelError::invalid(
+                    what,
+                    "a finite force in N",
+                    value.to_string(),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The rail deviations under the four carriages (d_z1 … d_z4, d_y1 … d_y4), mm.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CarriageDeviations {
+    /// Normal to the mounting face ("vertical"), carriages 1–4.
+    pub normal_mm: [f64; 4],
+    /// Across the rail ("horizontal"), carriages 1–4.
+    pub lateral_mm: [f64; 4],
+}
+
+/// What the saddle does on given rail deviations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuidewayResponse {
+    /// z_1 … z_4: normal displacement of the saddle corners, mm (eq. 16).
+    pub corner_normal_mm: [f64; 4],
+    /// y_1 … y_4: lateral displacement of the saddle corners, mm (eq. 36).
+    pub corner_lateral_mm: [f64; 4],
+    /// F_z1 … F_z4: normal carriage forces, N (eq. 15).
+    pub force_normal_n: [f64; 4],
+    /// F_y1 … F_y4: lateral carriage forces, N (eq. 35).
+    pub force_lateral_n: [f64; 4],
+    /// z5: normal straightness at the saddle centre, mm (eq. 17).
+    pub normal_mm: f64,
+    /// y5: lateral straightness at the saddle centre, mm (eq. 37).
+    pub lateral_mm: f64,
+    /// (z4 − z1)/a, rad (eq. 18).
+    pub roll_rad: f64,
+    /// (z2 − z1)/b, rad (eq. 19).
+    pub pitch_rad: f64,
+    /// (y1 − y2)/b, rad (eq. 38).
+    pub yaw_rad: f64,
+}
+
+/// A guideway with both systems solved: the response is affine in the rail deviations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuidewayMap {
+    rail_spacing_mm: f64,
+    carriage_pitch_mm: f64,
+    inverse_z: Matrix4<f64>,
+    inverse_y: Matrix4<f64>,
+    /// Corner normal displacement per unit normal rail deviation.
+    normal: Matrix4<f64>,
+    /// Corner lateral displacement per unit lateral rail deviation.
+    lateral: Matrix4<f64>,
+    /// Corner displacements and carriage forces due to the loads alone.
+    load_normal_mm: Vector4<f64>,
+    load_lateral_mm: Vector4<f64>,
+    load_force_normal_n: Vector4<f64>,
+    load_force_lateral_n: Vector4<f64>,
+}
+
+/// The five outputs as weights on the rail deviations plus a constant (the load's share):
+/// `output = Σ_i weights[i] · d_i + constant`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutputWeights {
+    /// Weights on d_1 … d_4 (normal deviations for z5, roll and pitch; lateral for y5 and yaw).
+    pub weights: [f64; 4],
+    /// The part that does not depend on the rail deviations.
+    pub constant: f64,
+}
+
+impl GuidewayMap {
+    /// The full response to given rail deviations.
+    pub fn response(&self, deviations: &CarriageDeviations) -> GuidewayResponse {
+        let d_z = Vector4::from(deviations.normal_mm);
+        let d_y = Vector4::from(deviations.lateral_mm);
+        let z = self.normal * d_z + self.load_normal_mm;
+        let y = self.lateral * d_y + self.load_lateral_mm;
+        // Forces from F = K⁻¹ Q (eqs 15, 35) rather than k_i (z_i − d_i),
+        // which would cancel digits.
+        let q_z = Vector4::new(0.0, 0.0, 0.0, -d_z[0] + d_z[1] - d_z[2] + d_z[3]);
+        let q_y = Vector4::new(0.0, 0.0, -d_y[0] + d_y[3], -d_y[1] + d_y[2]);
+        let force_z = self.inverse_z * q_z + self.load_force_normal_n;
+        let force_y = self.inverse_y * q_y + self.load_force_lateral_n;
+        GuidewayResponse {
+            corner_normal_mm: z.into(),
+            corner_lateral_mm: y.into(),
+            force_normal_n: force_z.into(),
+            force_lateral_n: force_y.into(),
+            normal_mm: z.mean(),
+            lateral_mm: y.mean(),
+            roll_rad: (z[3] - z[0]) / self.rail_spacing_mm,
+            pitch_rad: (z[1] - z[0]) / self.carriage_pitch_mm,
+            yaw_rad: (y[0] - y[1]) / self.carriage_pitch_mm,
+        }
+    }
+
+    /// z5, roll and pitch (normal) as weights on d_z1 … d_z4.
+    pub fn normal_outputs(&self) -> [OutputWeights; 3] {
+        let (a, b) = (self.rail_spacing_mm, self.carriage_pitch_mm);
+        let of = |combination| combine(&self.normal, &self.load_normal_mm, combination);
+        [
+            of([0.25; 4]),                     // z5 = mean z_i (17)
+            of([-1.0 / a, 0.0, 0.0, 1.0 / a]), // roll = (z4 − z1)/a (18)
+            of([-1.0 / b, 1.0 / b, 0.0, 0.0]), // pitch = (z2 − z1)/b (19)
+        ]
+    }
+
+    /// y5 and yaw (lateral) as weights on d_y1 … d_y4.
+    pub fn lateral_outputs(&self) -> [OutputWeights; 2] {
+        let b = self.carriage_pitch_mm;
+        let of = |combination| combine(&self.lateral, &self.load_lateral_mm, combination);
+        [
+            of([0.25; 4]),                     // y5 = mean y_i (37)
+            of([1.0 / b, -1.0 / b, 0.0, 0.0]), // yaw = (y1 − y2)/b (38)
+        ]
+    }
+}
+
+/// The weights of Σ_corner combination[corner] · (corner displacement), where
+/// the corner displacements are `corners · d + load`.
+fn combine(corners: &Matrix4<f64>, load: &Vector4<f64>, combination: [f64; 4]) -> OutputWeights {
+    let combination = Vector4::from(combination);
+    OutputWeights {
+        weights: (corners.transpose() * combination).into(),
+        constant: combination.dot(load),
+    }
+}
+
+/// The four rail profiles of one axis, as functions of the position along the
+/// rail (the axis coordinate), mm: the straightness of the mounting surfaces.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RailProfiles {
+    /// Rail 1 and rail 2, normal to the mounting face ("vertical").
+    pub normal: [ErrorFunction; 2],
+    /// Rail 1 and rail 2, across the rail ("horizontal").
+    pub lateral: [ErrorFunction; 2],
+}
+
+impl GuidewayMap {
+    /// The rail deviations under the four carriages at axis position `position_mm`
+    /// (eqs 40–47: carriages 1 and 4 at x − b/2, 2 and 3 at x + b/2; 1, 2 on rail 1).
+    pub fn deviations_at(&self, rails: &RailProfiles, position_mm: f64) -> CarriageDeviations {
+        let behind = position_mm - self.carriage_pitch_mm / 2.0;
+        let ahead = position_mm + self.carriage_pitch_mm / 2.0;
+        let under = |profiles: &[ErrorFunction; 2]| {
+            [
+                profiles[0].value_at(behind),
+                profiles[0].value_at(ahead),
+                profiles[1].value_at(ahead),
+                profiles[1].value_at(behind),
+            ]
+        };
+        CarriageDeviations {
+            normal_mm: under(&rails.normal),
+            lateral_mm: under(&rails.lateral),
+        }
+    }
+
+    /// The response at every axis position: straightness in both
+    /// directions, roll, pitch and yaw along the stroke.
+    pub fn along_stroke(
+        &self,
+        rails: &RailProfiles,
+        positions_mm: &[f64],
+    ) -> Vec<GuidewayResponse> {
+        positions_mm
+            .iter()
+            .map(|position| self.response(&self.deviations_at(rails, *position)))
+            .collect()
+    }
+
+    /// b, mm.
+    pub fn carriage_pitch_mm(&self) -> f64 {
+        self.carriage_pitch_mm
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn close(actual: f64, expected: f64, tolerance: f64) {
+        assert!(
+            (actual - expected).abs() <= tolerance,
+            "{actual} differs from {expected} by more than {tolerance}"
+        );
+    }
+
+    #[test]
+    fn thesis_example_obr_3_8() {
+        // Check values of the notes §3.3 (a = 150, b = 200, k = 100 000 N/mm, no load).
+        let guideway = Guideway::unloaded(150.0, 200.0);
+        let response = guideway
+            .solve(&CarriageDeviations {
+                normal_mm: [0.006, 0.001, 0.0, -0.004],
+                lateral_mm: [0.0; 4],
+            })
+            .unwrap();
+        let expected_z = [0.00375, 0.00325, -0.00225, -0.00175];
+        for (actual, expected) in response.corner_normal_mm.iter().zip(expected_z) {
+            close(*actual, expected, 1e-15);
+        }
+        close(response.normal_mm, 0.00075, 1e-15);
+        close(response.roll_rad, -0.0055 / 150.0, 1e-17);
+        close(response.pitch_rad, -2.5e-6, 1e-17);
+        for (actual, expected) in response
+            .force_normal_n
+            .iter()
+            .zip([-225.0, 225.0, -225.0, 225.0])
+        {
+            close(*actual, expected, 1e-9);
+        }
+        // The plane condition (5): z1 − z2 = z4 − z3 = 0.0005.
+        let z = response.corner_normal_mm;
+        close(z[0] - z[1], 0.0005, 1e-15);
+        close(z[3] - z[2], 0.0005, 1e-15);
+    }
+
+    #[test]
+    fn equal_stiffness_closed_forms_with_load() {
+        // Notes §3.5: z_i = d_zi ∓ τ/4 − F_zz/(4k), y1 = y4 = (d_y1 + d_y4)/2 + F_zy/(4k), …
+        let k = 50_000.0;
+        let guideway = Guideway {
+            rail_spacing_mm: 400.0,
+            carriage_pitch_mm: 500.0,
+            stiffness_normal_n_per_mm: [k; 4],
+            stiffness_lateral_n_per_mm: [k; 4],
+            load_normal_n: 2000.0,
+            load_lateral_n: -800.0,
+        };
+        let d_z = [0.004, -0.002, 0.001, 0.003];
+        let d_y = [-0.001, 0.002, 0.005, 0.0];
+        let response = guideway
+            .solve(&CarriageDeviations {
+                normal_mm: d_z,
+                lateral_mm: d_y,
+            })
+            .unwrap();
+        let twist = d_z[0] - d_z[1] + d_z[2] - d_z[3];
+        let sink = 2000.0 / (4.0 * k);
+        let expected_z = [
+            d_z[0] - twist / 4.0 - sink,
+            d_z[1] + twist / 4.0 - sink,
+            d_z[2] - twist / 4.0 - sink,
+            d_z[3] + twist / 4.0 - sink,
+        ];
+        for (actual, expected) in response.corner_normal_mm.iter().zip(expected_z) {
+            close(*actual, expected, 1e-15);
+        }
+        close(
+            response.normal_mm,
+            d_z.iter().sum::<f64>() / 4.0 - sink,
+            1e-15,
+        );
+        close(
+            response.roll_rad,
+            ((d_z[2] + d_z[3]) - (d_z[0] + d_z[1])) / (2.0 * 400.0),
+            1e-17,
+        );
+        close(
+            response.pitch_rad,
+            ((d_z[1] + d_z[2]) - (d_z[0] + d_z[3])) / (2.0 * 500.0),
+            1e-17,
+        );
+        let shift = -800.0 / (4.0 * k);
+        close(
+            response.corner_lateral_mm[0],
+            (d_y[0] + d_y[3]) / 2.0 + shift,
+            1e-15,
+        );
+        close(
+            response.corner_lateral_mm[3],
+            (d_y[0] + d_y[3]) / 2.0 + shift,
+            1e-15,
+        );
+        close(
+            response.corner_lateral_mm[1],
+            (d_y[1] + d_y[2]) / 2.0 + shift,
+            1e-15,
+        );
+        close(
+            response.lateral_mm,
+            d_y.iter().sum::<f64>() / 4.0 + shift,
+            1e-15,
+        );
+        close(
+            response.yaw_rad,
+            ((d_y[0] + d_y[3]) - (d_y[1] + d_y[2])) / (2.0 * 500.0),
+            1e-17,
+        );
+    }
+
+    #[test]
+    fn output_weights_agree_with_the_response() {
+        let guideway = Guideway {
+            stiffness_normal_n_per_mm: [80_000.0, 120_000.0, 95_000.0, 60_000.0],
+            stiffness_lateral_n_per_mm: [70_000.0, 110_000.0, 100_000.0, 90_000.0],
+            load_normal_n: 1500.0,
+            load_lateral_n: 300.0,
+            ..Guideway::unloaded(350.0, 640.0)
+        };
+        let map = guideway.linear_map().unwrap();
+        let deviations = CarriageDeviations {
+            normal_mm: [0.01, -0.004, 0.002, 0.007],
+            lateral_mm: [-0.003, 0.001, 0.006, -0.002],
+        };
+        let response = map.response(&deviations);
+        let apply = |output: &OutputWeights, d: &[f64; 4]| -> f64 {
+            output.constant + (0..4).map(|i| output.weights[i] * d[i]).sum::<f64>()
+        };
+        let [z5, roll, pitch] = map.normal_outputs();
+        let [y5, yaw] = map.lateral_outputs();
+        close(apply(&z5, &deviations.normal_mm), response.normal_mm, 1e-15);
+        close(
+            apply(&roll, &deviations.normal_mm),
+            response.roll_rad,
+            1e-17,
+        );
+        close(
+            apply(&pitch, &deviations.normal_mm),
+            response.pitch_rad,
+            1e-17,
+        );
+        close(
+            apply(&y5, &deviations.lateral_mm),
+            response.lateral_mm,
+            1e-15,
+        );
+        close(apply(&yaw, &deviations.lateral_mm), response.yaw_rad, 1e-17);
+    }
+
+    #[test]
+    fn carriages_sit_where_eqs_40_to_47_put_them() {
+        use super::super::components::{ErrorTable, Interpolation};
+        // Rail 1 normal is the line d = x/1000; rail 2 normal d = 2x/1000.
+        let line = |slope: f64| {
+            ErrorFunction::Table(
+                ErrorTable::new(
+                    vec![-1000.0, 1000.0],
+                    vec![-slope, slope],
+                    Interpolation::Linear,
+                )
+                .unwrap(),
+            )
+        };
+        let rails = RailProfiles {
+            normal: [line(1.0), line(2.0)],
+            lateral: Default::default(),
+        };
+        let map = Guideway::unloaded(300.0, 200.0).linear_map().unwrap();
+        let deviations = map.deviations_at(&rails, 100.0);
+        // x − b/2 = 0, x + b/2 = 200.
+        let expected = [0.0, 0.2, 0.4, 0.0];
+        for (actual, expected) in deviations.normal_mm.iter().zip(expected) {
+            close(*actual, expected, 1e-15);
+        }
+    }
+
+    #[test]
+    fn sloped_rails_give_pitch_and_an_offset_rail_gives_roll() {
+        use super::super::components::{ErrorTable, Interpolation};
+        // By hand, equal stiffness: rails d = k·x (rail 1) and d = k·x + c
+        // (rail 2) give z5 = k·x + c/2, pitch = k, roll = c/a; lateral rails
+        // d = −k·x on both give y5 = −k·x and yaw = k (eq. 38: (y1 − y2)/b).
+        let (k, c, a) = (2e-5, 0.004, 300.0);
+        let line = |slope: f64, offset: f64| {
+            ErrorFunction::Table(
+                ErrorTable::new(
+                    vec![-1000.0, 2000.0],
+                    vec![offset - 1000.0 * slope, offset + 2000.0 * slope],
+                    Interpolation::Linear,
+                )
+                .unwrap(),
+            )
+        };
+        let rails = RailProfiles {
+            normal: [line(k, 0.0), line(k, c)],
+            lateral: [line(-k, 0.0), line(-k, 0.0)],
+        };
+        let map = Guideway::unloaded(a, 400.0).linear_map().unwrap();
+        let positions = [0.0, 250.0, 700.0];
+        for (x, response) in positions.iter().zip(map.along_stroke(&rails, &positions)) {
+            close(response.normal_mm, k * x + c / 2.0, 1e-15);
+            close(response.pitch_rad, k, 1e-15);
+            close(response.roll_rad, c / a, 1e-15);
+            close(response.lateral_mm, -k * x, 1e-15);
+            close(response.yaw_rad, k, 1e-15);
+        }
+    }
+
+    #[test]
+    fn bad_parameters_are_errors() {
+        let mut guideway = Guideway::unloaded(0.0, 200.0);
+        let error = guideway.linear_map().unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("rail spacing a: expected a positive length"),
+            "{error}"
+        );
+        guideway = Guideway::unloaded(100.0, 200.0);
+        guideway.stiffness_lateral_n_per_mm[2] = -1.0;
+        assert!(
+            guideway
+                .linear_map()
+                .unwrap_err()
+                .to_string()
+                .contains("stiffness")
+        );
+        guideway = Guideway::unloaded(100.0, 200.0);
+        guideway.load_normal_n = f64::NAN;
+        assert!(
+            guideway
+                .linear_map()
+                .unwrap_err()
+                .to_string()
+                .contains("normal load")
+        );
+    }
+
+    proptest! {
+        // The solution satisfies the thesis's own equations, whatever the
+        // stiffnesses and loads: force and moment balance (9)–(11), (29), (30),
+        // the plane condition (5), equal lateral displacement (22), (23) and
+        // Hooke's law (7), (26).
+        #[test]
+        fn solution_satisfies_the_equilibrium_equations(
+            k_z in proptest::array::uniform4(1e3f64..1e6),
+            k_y in proptest::array::uniform4(1e3f64..1e6),
+            d_z in proptest::array::uniform4(-0.05f64..0.05),
+            d_y in proptest::array::uniform4(-0.05f64..0.05),
+            f_zz in -5e3f64..5e3,
+            f_zy in -5e3f64..5e3,
+        ) {
+            let guideway = Guideway {
+                rail_spacing_mm: 300.0,
+                carriage_pitch_mm: 450.0,
+                stiffness_normal_n_per_mm: k_z,
+                stiffness_lateral_n_per_mm: k_y,
+                load_normal_n: f_zz,
+                load_lateral_n: f_zy,
+            };
+            let r = guideway.solve(&CarriageDeviations { normal_mm: d_z, lateral_mm: d_y }).unwrap();
+            let f = r.force_normal_n;
+            let g = r.force_lateral_n;
+            let force_tolerance = 1e-6 * (1.0 + f_zz.abs() + f_zy.abs());
+            prop_assert!((f.iter().sum::<f64>() + f_zz).abs() < force_tolerance);
+            prop_assert!((f[0] + f[1] + f_zz / 2.0).abs() < force_tolerance);
+            prop_assert!((f[1] + f[2] + f_zz / 2.0).abs() < force_tolerance);
+            prop_assert!((g.iter().sum::<f64>() - f_zy).abs() < force_tolerance);
+            prop_assert!((g[1] + g[2] - f_zy / 2.0).abs() < force_tolerance);
+            let z = r.corner_normal_mm;
+            let y = r.corner_lateral_mm;
+            prop_assert!(((z[0] - z[1]) - (z[3] - z[2])).abs() < 1e-12);
+            prop_assert!((y[0] - y[3]).abs() < 1e-12);
+            prop_assert!((y[1] - y[2]).abs() < 1e-12);
+            for i in 0..4 {
+                prop_assert!((z[i] - d_z[i] - f[i] / k_z[i]).abs() < 1e-12);
+                prop_assert!((y[i] - d_y[i] - g[i] / k_y[i]).abs() < 1e-12);
+            }
+        }
+    }
+}

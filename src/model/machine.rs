@@ -1,0 +1,739 @@
+//! The machine description: kinematic chain, strokes, offsets, functional
+//! points and guideways, as data (TOML).
+//!
+//! A [`Machine`] is built from a TOML text by [`Machine::from_toml_str`] (the
+//! CLI reads the file and adds its path to errors) or is the bundled
+//! [`Machine::bundled`], the seed's Kovosvit MAS MCV 754 Quick
+//! (`fixtures/machines/mcv754-quick.toml`, which documents every assumed
+//! dimension). It is validated once, when built: every number finite,
+//! strokes increasing, the reference position inside them, stiffnesses
+//! positive, the chain code a permutation of X, Y, Z around one F.
+//!
+//! # Format
+//!
+//! One TOML file per machine, shared with other commands: `axcomp convert`
+//! reads its `[controller]` table, the model reads `[kinematics]` (and the
+//! optional top-level `name`). Unknown keys under `[kinematics]` are errors,
+//! so a typo cannot silently fall back to a default; other top-level tables
+//! are left to their own readers.
+//!
+//! ```toml
+//! name = "MCV 754 Quick"
+//!
+//! [kinematics]
+//! chain = "ZFYX"                    # tool side … F … workpiece side
+//! branch_deviations = "sum"         # optional: "sum" (eq. 67, default) or "difference"
+//! reference_mm = [0.0, 0.0, 0.0]    # optional: where E = 0 (eq. 68), default the origin
+//!
+//! [kinematics.tool]
+//! offset_mm = [0.0, -280.0, -250.0] # last tool-side error frame → tool tip
+//!
+//! [kinematics.workpiece]
+//! offset_mm = [0.0, 0.0, 80.0]      # last workpiece-side error frame → workpiece reference
+//! point_mm = [0.0, 250.0, 550.0]    # point under the tool at X = Y = Z = 0, from that reference
+//!
+//! [kinematics.axes.X]               # and [kinematics.axes.Y], [kinematics.axes.Z]
+//! stroke_mm = [0.0, 750.0]
+//! offset_mm = [0.0, 0.0, 200.0]     # previous error frame (or frame origin) → this axis's
+//! motion = -1                       # optional, ±1 (default 1): which way the body moves
+//! error_frame = "fixed"             # optional: "moving" (default) or "fixed"
+//! normal = "Z"                      # direction normal to the rail mounting face
+//! rail_spacing_mm = 350.0           # a
+//! carriage_pitch_mm = 640.0         # b
+//! # optional: stiffness_normal_n_per_mm = [1e5, 1e5, 1e5, 1e5], stiffness_lateral_n_per_mm,
+//! # load_normal_n = 0.0, load_lateral_n = 0.0,
+//! # mapping_signs = { normal = 1, lateral = 1, roll = 1, pitch = 1, yaw = 1 }
+//! ```
+//!
+//! The chain code is read as seed 000 writes ZFYX for its C-frame mill with
+//! a cross table: the letters left of `F` carry the tool, listed from the
+//! tool towards the frame; the letters right of `F` carry the workpiece,
+//! listed from the frame towards the workpiece. So ZFYX is tool ← Z ← frame
+//! → Y → X → workpiece, FXYZ puts all three axes under the workpiece, and
+//! YFXZ has Y on the tool side and X carrying Z on the workpiece side. (ISO
+//! 10791-style codes are often read the other way round; this follows the
+//! thesis.) How the chain is evaluated is in [`super::volumetric`].
+//!
+//! The guideway of each axis turns four rail profiles into its six errors
+//! (seed 000 Tab. 3.2): the normal straightness feeds the translation along
+//! `normal`, the lateral straightness the translation along the remaining
+//! direction, roll the rotation about the axis itself, pitch the rotation
+//! about the lateral direction and yaw the rotation about the normal. The
+//! thesis gives no signs for this mapping; `mapping_signs` defaults to +1
+//! throughout, as the NumPy peer does.
+
+use serde::Deserialize;
+
+use super::ModelError;
+use super::components::{Axis, SquarenessPair};
+use super::guideway::{Guideway, GuidewayMap, THESIS_STIFFNESS_N_PER_MM};
+use super::volumetric::Kinematics;
+use crate::error::ParseError;
+
+/// The bundled description of seed 000's machine.
+const BUNDLED_TOML: &str = include_str!("../../fixtures/machines/mcv754-quick.toml");
+
+/// How the deviations of the tool and workpiece branches combine (eq. 67).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BranchDeviations {
+    /// E = Δtool + Δworkpiece, as the thesis writes eq. 67 ("superposition").
+    Sum,
+    /// E = Δtool − Δworkpiece: the tool relative to the workpiece.
+    Difference,
+}
+
+/// Where an axis's error motion is referred to (see [`super::volumetric`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ErrorFrame {
+    /// A point on the moving body (the centre of its carriages): Y and Z in eqs 63/64.
+    Moving,
+    /// A point on the carrying body under the functional point: X in eq. 64.
+    Fixed,
+}
+
+/// Signs of the mapping from guideway outputs to ISO 230-1 errors (±1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MappingSigns {
+    /// z5 → translation along the normal direction.
+    pub normal: f64,
+    /// y5 → translation along the lateral direction.
+    pub lateral: f64,
+    /// roll → rotation about the axis itself.
+    pub roll: f64,
+    /// pitch → rotation about the lateral direction.
+    pub pitch: f64,
+    /// yaw → rotation about the normal direction.
+    pub yaw: f64,
+}
+
+impl MappingSigns {
+    /// All +1, as the peer applies Tab. 3.2.
+    pub const POSITIVE: MappingSigns = MappingSigns {
+        normal: 1.0,
+        lateral: 1.0,
+        roll: 1.0,
+        pitch: 1.0,
+        yaw: 1.0,
+    };
+}
+
+/// One linear axis of the machine.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisDescription {
+    /// Lowest and highest position, mm.
+    pub stroke_mm: [f64; 2],
+    /// From the previous joint's error frame (or the frame origin) to this axis's, mm.
+    pub offset_mm: [f64; 3],
+    /// +1 or −1: the direction the body moves when the coordinate grows.
+    pub motion: f64,
+    /// Where the error motion is referred to.
+    pub error_frame: ErrorFrame,
+    /// The direction normal to the rail mounting face ("vertical" straightness).
+    pub normal: Axis,
+    /// The guideway: rail spacing, carriage pitch, stiffness, load.
+    pub guideway: Guideway,
+    /// Signs of the mapping of its outputs to the ISO errors.
+    pub signs: MappingSigns,
+}
+
+impl AxisDescription {
+    /// The lateral ("horizontal") direction: neither the axis nor the normal.
+    pub fn lateral(&self, axis: Axis) -> Axis {
+        Axis::ALL
+            .into_iter()
+            .find(|other| *other != axis && *other != self.normal)
+            .unwrap_or(axis)
+    }
+}
+
+/// A validated chain code such as `ZFYX`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ChainCode {
+    code: String,
+    tool: Vec<Axis>,
+    workpiece: Vec<Axis>,
+}
+
+impl ChainCode {
+    /// Parses a code: X, Y and Z once each and one F, nothing else.
+    pub fn parse(code: &str) -> Result<ChainCode, ModelError> {
+        let expected = "X, Y and Z once each around one F, like ZFYX, FXYZ or YFXZ";
+        let invalid = || ModelError::invalid("chain", expected, format!("{code:?}"));
+        let letters: Vec<char> = code.trim().chars().collect();
+        let frame = letters.iter().position(|c| *c == 'F').ok_or_else(invalid)?;
+        let to_axes = |part: &[char]| -> Option<Vec<Axis>> {
+            part.iter().map(|c| Axis::from_letter(*c)).collect()
+        };
+        let mut tool = to_axes(&letters[..frame]).ok_or_else(invalid)?;
+        tool.reverse();
+        let workpiece = to_axes(&letters[frame + 1..]).ok_or_else(invalid)?;
+        let mut all: Vec<Axis> = tool.iter().chain(&workpiece).copied().collect();
+        all.sort();
+        if all != Axis::ALL {
+            return Err(invalid());
+        }
+        Ok(ChainCode {
+            code: letters.iter().collect(),
+            tool,
+            workpiece,
+        })
+    }
+
+    /// The code as written.
+    pub fn as_str(&self) -> &str {
+        &self.code
+    }
+
+    /// The tool-side axes, from the frame outwards.
+    pub fn tool_axes(&self) -> &[Axis] {
+        &self.tool
+    }
+
+    /// The workpiece-side axes, from the frame outwards.
+    pub fn workpiece_axes(&self) -> &[Axis] {
+        &self.workpiece
+    }
+
+    /// The axis whose joint carries a squareness error: the outer of the two
+    /// when both are on one side, otherwise the tool-side one (eqs 63/64).
+    pub fn squareness_axis(&self, pair: SquarenessPair) -> Axis {
+        let (first, second) = pair.axes();
+        let tool_position = |axis: Axis| self.tool.iter().position(|a| *a == axis);
+        let workpiece_position = |axis: Axis| self.workpiece.iter().position(|a| *a == axis);
+        match (tool_position(first), tool_position(second)) {
+            (Some(a), Some(b)) => return if a > b { first } else { second },
+            (Some(_), None) => return first,
+            (None, Some(_)) => return second,
+            (None, None) => {}
+        }
+        if workpiece_position(first) > workpiece_position(second) {
+            first
+        } else {
+            second
+        }
+    }
+}
+
+/// A validated machine description with its compiled chain.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Machine {
+    description: Description,
+    guideways: [GuidewayMap; 3],
+    kinematics: Kinematics,
+}
+
+/// What a description file says, validated.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Description {
+    pub name: String,
+    pub chain: ChainCode,
+    pub axes: [AxisDescription; 3],
+    pub tool_offset_mm: [f64; 3],
+    pub workpiece_offset_mm: [f64; 3],
+    pub workpiece_point_mm: [f64; 3],
+    pub reference_mm: [f64; 3],
+    pub branch_deviations: BranchDeviations,
+}
+
+impl Machine {
+    /// Seed 000's MCV 754 Quick with the documented assumed dimensions
+    /// (`fixtures/machines/mcv754-quick.toml`).
+    pub fn bundled() -> Machine {
+        // The bundled text is part of the program, not user input, and a test parses it.
+        Machine::from_toml_str(BUNDLED_TOML)
+            .unwrap_or_else(|error| panic!("the bundled machine description is invalid: {error}"))
+    }
+
+    /// The text of the bundled description (to show or copy it).
+    pub fn bundled_toml() -> &'static str {
+        BUNDLED_TOML
+    }
+
+    /// Parses and validates a machine description.
+    ///
+    /// # Example
+    ///
+    /// ```
+    /// use axcomp::model::{Axis, Machine};
+    ///
+    /// let text = Machine::bundled_toml().replace("[0.0, 750.0]", "[0.0, 1000.0]");
+    /// let machine = Machine::from_toml_str(&text)?;
+    /// assert_eq!(machine.axis(Axis::X).stroke_mm, [0.0, 1000.0]);
+    /// assert_eq!(machine.chain().as_str(), "ZFYX");
+    /// # Ok::<(), axcomp::model::ModelError>(())
+    /// ```
+    pub fn from_toml_str(text: &str) -> Result<Machine, ModelError> {
+        let raw: RawFile = toml::from_str(text).map_err(|error| toml_error(text, &error))?;
+        let Some(kinematics) = raw.kinematics else {
+            return Err(ModelError::invalid(
+                "machine description",
+                "a [kinematics] table (chain, strokes, offsets; see fixtures/machines/mcv754-quick.toml)",
+                "none",
+            ));
+        };
+        let name = raw.name.unwrap_or_else(|| "unnamed machine".to_string());
+        Machine::build(kinematics.into_description(name)?)
+    }
+
+    fn build(description: Description) -> Result<Machine, ModelError> {
+        let mut guideways = Vec::with_capacity(3);
+        for axis in Axis::ALL {
+            let map = description.axes[axis.index()]
+                .guideway
+                .linear_map()
+                .map_err(|error| error.within(&format!("kinematics.axes.{axis}")))?;
+            guideways.push(map);
+        }
+        let guideways = [guideways[0], guideways[1], guideways[2]];
+        let kinematics = Kinematics::compile(&description);
+        Ok(Machine {
+            description,
+            guideways,
+            kinematics,
+        })
+    }
+
+    /// The machine's name.
+    pub fn name(&self) -> &str {
+        &self.description.name
+    }
+
+    /// The kinematic chain.
+    pub fn chain(&self) -> &ChainCode {
+        &self.description.chain
+    }
+
+    /// One axis.
+    pub fn axis(&self, axis: Axis) -> &AxisDescription {
+        &self.description.axes[axis.index()]
+    }
+
+    /// The solved guideway of one axis.
+    pub fn guideway_map(&self, axis: Axis) -> &GuidewayMap {
+        &self.guideways[axis.index()]
+    }
+
+    /// Last tool-side error frame → tool tip, mm.
+    pub fn tool_offset_mm(&self) -> [f64; 3] {
+        self.description.tool_offset_mm
+    }
+
+    /// Last workpiece-side error frame → workpiece reference, mm.
+    pub fn workpiece_offset_mm(&self) -> [f64; 3] {
+        self.description.workpiece_offset_mm
+    }
+
+    /// The workpiece point under the tool at X = Y = Z = 0, from the workpiece reference, mm.
+    pub fn workpiece_point_mm(&self) -> [f64; 3] {
+        self.description.workpiece_point_mm
+    }
+
+    /// The position where the volumetric error is zero by definition (eq. 68), mm.
+    pub fn reference_mm(&self) -> [f64; 3] {
+        self.description.reference_mm
+    }
+
+    /// Sum (the thesis) or difference of the branch deviations.
+    pub fn branch_deviations(&self) -> BranchDeviations {
+        self.description.branch_deviations
+    }
+
+    /// The same machine with another tool: Abbe offsets change with it.
+    pub fn with_tool_offset(&self, offset_mm: [f64; 3]) -> Result<Machine, ModelError> {
+        check_finite("tool.offset_mm", &offset_mm)?;
+        let mut description = self.description.clone();
+        description.tool_offset_mm = offset_mm;
+        Machine::build(description)
+    }
+
+    /// The same machine with another workpiece point (e.g. a laser line away from the table centre).
+    pub fn with_workpiece_point(&self, point_mm: [f64; 3]) -> Result<Machine, ModelError> {
+        check_finite("workpiece.point_mm", &point_mm)?;
+        let mut description = self.description.clone();
+        description.workpiece_point_mm = point_mm;
+        Machine::build(description)
+    }
+
+    /// The same machine with the branch deviations combined another way.
+    pub fn with_branch_deviations(&self, combination: BranchDeviations) -> Machine {
+        let mut machine = self.clone();
+        machine.description.branch_deviations = combination;
+        machine.kinematics = Kinematics::compile(&machine.description);
+        machine
+    }
+
+    /// The compiled chain.
+    pub(crate) fn kinematics(&self) -> &Kinematics {
+        &self.kinematics
+    }
+}
+
+fn check_finite(what: &str, values: &[f64]) -> Result<(), ModelError> {
+    match values.iter().find(|v| !v.is_finite()) {
+        Some(bad) => Err(ModelError::invalid(what, "finite numbers", bad.to_string())),
+        None => Ok(()),
+    }
+}
+
+/// A TOML error at its line and column (both from 1).
+fn toml_error(text: &str, error: &toml::de::Error) -> ModelError {
+    let mut offset = error.span().map_or(0, |span| span.start).min(text.len());
+    while !text.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let column = before
+        .rsplit('\n')
+        .next()
+        .map_or(0, |rest| rest.chars().count())
+        + 1;
+    let message = error.message().trim().replace('\n', " ");
+    ModelError::Toml(ParseError::new(line, column, message))
+}
+
+/// The whole file: only what the model reads. Other top-level tables
+/// (`[controller]` for `axcomp convert`, …) belong to other readers.
+#[derive(Deserialize)]
+struct RawFile {
+    name: Option<String>,
+    kinematics: Option<RawMachine>,
+}
+
+/// The `[kinematics]` table.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMachine {
+    chain: String,
+    branch_deviations: Option<BranchDeviations>,
+    reference_mm: Option<[f64; 3]>,
+    tool: RawTool,
+    workpiece: RawWorkpiece,
+    axes: RawAxes,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTool {
+    offset_mm: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWorkpiece {
+    offset_mm: [f64; 3],
+    point_mm: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawAxes {
+    #[serde(rename = "X")]
+    x: RawAxis,
+    #[serde(rename = "Y")]
+    y: RawAxis,
+    #[serde(rename = "Z")]
+    z: RawAxis,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawAxis {
+    stroke_mm: [f64; 2],
+    offset_mm: [f64; 3],
+    motion: Option<i64>,
+    error_frame: Option<ErrorFrame>,
+    normal: String,
+    rail_spacing_mm: f64,
+    carriage_pitch_mm: f64,
+    stiffness_normal_n_per_mm: Option<[f64; 4]>,
+    stiffness_lateral_n_per_mm: Option<[f64; 4]>,
+    load_normal_n: Option<f64>,
+    load_lateral_n: Option<f64>,
+    mapping_signs: Option<RawSigns>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSigns {
+    normal: Option<i64>,
+    lateral: Option<i64>,
+    roll: Option<i64>,
+    pitch: Option<i64>,
+    yaw: Option<i64>,
+}
+
+impl RawMachine {
+    fn into_description(self, name: String) -> Result<Description, ModelError> {
+        let chain = ChainCode::parse(&self.chain).map_err(|e| e.within("kinematics"))?;
+        check_finite("kinematics.tool.offset_mm", &self.tool.offset_mm)?;
+        check_finite("kinematics.workpiece.offset_mm", &self.workpiece.offset_mm)?;
+        check_finite("kinematics.workpiece.point_mm", &self.workpiece.point_mm)?;
+        let axes = [
+            self.axes.x.into_axis(Axis::X)?,
+            self.axes.y.into_axis(Axis::Y)?,
+            self.axes.z.into_axis(Axis::Z)?,
+        ];
+        let reference_mm = self.reference_mm.unwrap_or([0.0; 3]);
+        check_finite("kinematics.reference_mm", &reference_mm)?;
+        for axis in Axis::ALL {
+            let [low, high] = axes[axis.index()].stroke_mm;
+            let reference = reference_mm[axis.index()];
+            if !(low..=high).contains(&reference) {
+                return Err(ModelError::invalid(
+                    "kinematics.reference_mm",
+                    format!("a position inside the {axis} stroke {low} … {high} mm"),
+                    format!("{reference} mm"),
+                ));
+            }
+        }
+        Ok(Description {
+            name,
+            chain,
+            axes,
+            tool_offset_mm: self.tool.offset_mm,
+            workpiece_offset_mm: self.workpiece.offset_mm,
+            workpiece_point_mm: self.workpiece.point_mm,
+            reference_mm,
+            branch_deviations: self.branch_deviations.unwrap_or(BranchDeviations::Sum),
+        })
+    }
+}
+
+impl RawAxis {
+    fn into_axis(self, axis: Axis) -> Result<AxisDescription, ModelError> {
+        let key = |field: &str| format!("kinematics.axes.{axis}.{field}");
+        let [low, high] = self.stroke_mm;
+        if !(low.is_finite() && high.is_finite() && low < high) {
+            return Err(ModelError::invalid(
+                key("stroke_mm"),
+                "[lowest, highest] with lowest < highest",
+                format!("[{low}, {high}]"),
+            ));
+        }
+        check_finite(&key("offset_mm"), &self.offset_mm)?;
+        let normal = self
+            .normal
+            .trim()
+            .chars()
+            .next()
+            .filter(|_| self.normal.trim().chars().count() == 1)
+            .and_then(Axis::from_letter)
+            .filter(|normal| *normal != axis)
+            .ok_or_else(|| {
+                ModelError::invalid(
+                    key("normal"),
+                    format!("one of X, Y, Z other than {axis}"),
+                    format!("{:?}", self.normal),
+                )
+            })?;
+        let sign = |field: &str, value: Option<i64>| -> Result<f64, ModelError> {
+            match value {
+                None | Some(1) => Ok(1.0),
+                Some(-1) => Ok(-1.0),
+                Some(other) => Err(ModelError::invalid(
+                    key(field),
+                    "1 or -1",
+                    other.to_string(),
+                )),
+            }
+        };
+        let signs = match self.mapping_signs {
+            None => MappingSigns::POSITIVE,
+            Some(raw) => MappingSigns {
+                normal: sign("mapping_signs.normal", raw.normal)?,
+                lateral: sign("mapping_signs.lateral", raw.lateral)?,
+                roll: sign("mapping_signs.roll", raw.roll)?,
+                pitch: sign("mapping_signs.pitch", raw.pitch)?,
+                yaw: sign("mapping_signs.yaw", raw.yaw)?,
+            },
+        };
+        let guideway = Guideway {
+            rail_spacing_mm: self.rail_spacing_mm,
+            carriage_pitch_mm: self.carriage_pitch_mm,
+            stiffness_normal_n_per_mm: self
+                .stiffness_normal_n_per_mm
+                .unwrap_or([THESIS_STIFFNESS_N_PER_MM; 4]),
+            stiffness_lateral_n_per_mm: self
+                .stiffness_lateral_n_per_mm
+                .unwrap_or([THESIS_STIFFNESS_N_PER_MM; 4]),
+            load_normal_n: self.load_normal_n.unwrap_or(0.0),
+            load_lateral_n: self.load_lateral_n.unwrap_or(0.0),
+        };
+        Ok(AxisDescription {
+            stroke_mm: self.stroke_mm,
+            offset_mm: self.offset_mm,
+            motion: sign("motion", self.motion)?,
+            error_frame: self.error_frame.unwrap_or(ErrorFrame::Moving),
+            normal,
+            guideway,
+            signs,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chain_codes() {
+        let zfyx = ChainCode::parse("ZFYX").unwrap();
+        assert_eq!(zfyx.tool_axes(), [Axis::Z]);
+        assert_eq!(zfyx.workpiece_axes(), [Axis::Y, Axis::X]);
+        // Eqs 63/64: EXOY sits at X, EXOZ and EYOZ at Z.
+        assert_eq!(zfyx.squareness_axis(SquarenessPair::XY), Axis::X);
+        assert_eq!(zfyx.squareness_axis(SquarenessPair::XZ), Axis::Z);
+        assert_eq!(zfyx.squareness_axis(SquarenessPair::YZ), Axis::Z);
+        let fxyz = ChainCode::parse("FXYZ").unwrap();
+        assert!(fxyz.tool_axes().is_empty());
+        assert_eq!(fxyz.squareness_axis(SquarenessPair::XY), Axis::Y);
+        assert_eq!(fxyz.squareness_axis(SquarenessPair::XZ), Axis::Z);
+        let yzfx = ChainCode::parse("YZFX").unwrap();
+        assert_eq!(yzfx.tool_axes(), [Axis::Z, Axis::Y]);
+        assert_eq!(yzfx.squareness_axis(SquarenessPair::YZ), Axis::Y);
+        for bad in ["ZYX", "ZFYXF", "ZFYY", "zfyx", "ZFY", "ZFYXA", ""] {
+            let error = ChainCode::parse(bad).unwrap_err();
+            assert!(
+                error.to_string().starts_with("chain: expected X, Y and Z"),
+                "{error}"
+            );
+        }
+    }
+
+    #[test]
+    fn bundled_machine_is_the_thesis_machine() {
+        // Strokes and a/b from seed 000 (notes §2.1, Tab. 3.1); the assumed
+        // dimensions z3 = 200, z4 = 80, y2 = 0, yt = 280, zt = 250 mm from the issue.
+        let machine = Machine::bundled();
+        assert_eq!(machine.chain().as_str(), "ZFYX");
+        let expected = [
+            (Axis::X, [0.0, 750.0], 350.0, 640.0),
+            (Axis::Y, [0.0, 500.0], 604.0, 480.0),
+            (Axis::Z, [-550.0, 0.0], 316.0, 356.0),
+        ];
+        for (axis, stroke, a, b) in expected {
+            let description = machine.axis(axis);
+            assert_eq!(description.stroke_mm, stroke);
+            assert_eq!(description.guideway.rail_spacing_mm, a);
+            assert_eq!(description.guideway.carriage_pitch_mm, b);
+        }
+        assert_eq!(machine.axis(Axis::X).offset_mm, [0.0, 0.0, 200.0]);
+        assert_eq!(machine.workpiece_offset_mm(), [0.0, 0.0, 80.0]);
+        assert_eq!(machine.tool_offset_mm(), [0.0, -280.0, -250.0]);
+        assert_eq!(machine.workpiece_point_mm(), [0.0, 250.0, 550.0]);
+        assert_eq!(machine.branch_deviations(), BranchDeviations::Sum);
+        assert_eq!(machine.axis(Axis::Z).normal, Axis::Y);
+        assert_eq!(machine.axis(Axis::Z).lateral(Axis::Z), Axis::X);
+    }
+
+    fn with(replace: &str, by: &str) -> Result<Machine, ModelError> {
+        let text = Machine::bundled_toml();
+        assert!(
+            text.contains(replace),
+            "the bundled file has no {replace:?}"
+        );
+        Machine::from_toml_str(&text.replacen(replace, by, 1))
+    }
+
+    #[test]
+    fn bad_descriptions_name_the_key_or_the_position() {
+        let cases = [
+            (
+                "chain = \"ZFYX\"",
+                "chain = \"ZFY\"",
+                "kinematics: chain: expected X, Y and Z",
+            ),
+            (
+                "stroke_mm = [0.0, 750.0]",
+                "stroke_mm = [750.0, 0.0]",
+                "kinematics.axes.X.stroke_mm: expected [lowest, highest]",
+            ),
+            (
+                "normal = \"Z\"",
+                "normal = \"X\"",
+                "kinematics.axes.X.normal: expected one of X, Y, Z other than X",
+            ),
+            (
+                "rail_spacing_mm = 350.0",
+                "rail_spacing_mm = -350.0",
+                "kinematics.axes.X: rail spacing a: expected a positive length",
+            ),
+            (
+                "motion = -1",
+                "motion = 2",
+                "kinematics.axes.X.motion: expected 1 or -1, found 2",
+            ),
+            (
+                "reference_mm = [0.0, 0.0, 0.0]",
+                "reference_mm = [0.0, 0.0, 10.0]",
+                "kinematics.reference_mm: expected a position inside the Z stroke",
+            ),
+            (
+                "branch_deviations = \"sum\"",
+                "branch_deviations = \"total\"",
+                "unknown variant `total`",
+            ),
+            (
+                "rail_spacing_mm = 350.0",
+                "rail_spacing_mm = 350.0\nrail_spcing_mm = 1.0",
+                "unknown field `rail_spcing_mm`",
+            ),
+            (
+                "rail_spacing_mm = 350.0",
+                "rail_spacing_mm = \"wide\"",
+                "invalid type",
+            ),
+            (
+                "rail_spacing_mm = 350.0",
+                "rail_spacing_mm = nan",
+                "kinematics.axes.X: rail spacing a: expected a positive length in mm, found NaN",
+            ),
+            (
+                "offset_mm = [0.0, -280.0, -250.0]",
+                "offset_mm = [0.0, -280.0, inf]",
+                "kinematics.tool.offset_mm: expected finite numbers, found inf",
+            ),
+            ("[kinematics]\n", "[kinematic]\n", "missing field `chain`"),
+        ];
+        for (replace, by, message) in cases {
+            let error = with(replace, by).unwrap_err();
+            assert!(
+                error.to_string().contains(message),
+                "{replace} → {by}: {error}"
+            );
+        }
+    }
+
+    #[test]
+    fn other_tables_are_left_to_their_readers() {
+        // A profile with only `axcomp convert`'s table has no model…
+        let controller_only = "name = \"M\"\n[controller]\nunits = \"mm\"\n";
+        let error = Machine::from_toml_str(controller_only).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("machine description: expected a [kinematics] table"),
+            "{error}"
+        );
+        // … and the bundled file, which has both, is read without complaint.
+        assert!(Machine::bundled_toml().contains("\n[controller]\n"));
+        assert_eq!(Machine::bundled().name(), "MCV 754 Quick");
+    }
+
+    #[test]
+    fn toml_errors_carry_line_and_column() {
+        let error = with("rail_spacing_mm = 350.0", "rail_spacing_mm = \"wide\"").unwrap_err();
+        let ModelError::Toml(parse) = &error else {
+            panic!("expected a TOML error, found {error}");
+        };
+        let line = Machine::bundled_toml()
+            .lines()
+            .position(|l| l.starts_with("rail_spacing_mm = 350.0"))
+            .unwrap()
+            + 1;
+        assert_eq!((parse.position.line, parse.position.column), (line, 19));
+    }
+}
