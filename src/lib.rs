@@ -43,4 +43,5 @@ pub mod measurement;
 pub mod output;
 pub mod read;
 pub mod report;
+pub mod servo;
 pub mod units;
