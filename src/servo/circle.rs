@@ -7,7 +7,7 @@
 //! the simulation runs the 0.3 s run-up and two revolutions (notes §10); each
 //! reversal of this axis (φ = kπ for X, π/2 + kπ for Y) whose window
 //! φ ± π/2 lies wholly after the run-up is evaluated for the peak |x_z − x|
-//! at the 1 ms position samples and the peak |I| at every macro step; the
+//! at the 1 ms position samples and the peak |I| (continuous in time); the
 //! figures are the means over those reversals.
 
 use std::f64::consts::PI;
@@ -100,7 +100,7 @@ pub fn run_circle(
             if (snapshot.time_s - reversal.time_s).abs() > half_window_s {
                 continue;
             }
-            reversal.peak_current_a = reversal.peak_current_a.max(snapshot.current_a.abs());
+            reversal.peak_current_a = reversal.peak_current_a.max(snapshot.peak_current_a);
             if snapshot.is_position_sample {
                 let error = snapshot.following_error_m().abs();
                 reversal.peak_error_m = reversal.peak_error_m.max(error);

@@ -289,7 +289,23 @@ impl Ramp {
 impl Power {
     /// F_T(v) = a·|v|^(1/n)·sgn v, N.
     pub fn force_n(&self, v: f64) -> f64 {
-        v.signum() * self.coefficient_n * v.abs().powf(1.0 / self.order)
+        let root = if self.order == 3.0 {
+            v.abs().cbrt()
+        } else {
+            v.abs().powf(1.0 / self.order)
+        };
+        v.signum() * self.coefficient_n * root
+    }
+
+    /// u^(n−1), without `powf` for the thesis's orders 3 and 4 (it is in the inner loop).
+    fn power_below_order(&self, u: f64) -> f64 {
+        if self.order == 3.0 {
+            u * u
+        } else if self.order == 4.0 {
+            u * u * u
+        } else {
+            u.powf(self.order - 1.0)
+        }
     }
 
     fn step(&self, v_free: f64, alpha: f64) -> FrictionStep {
@@ -306,9 +322,9 @@ impl Power {
         }
         let n = self.order;
         let slope = alpha * self.coefficient_n;
-        let mut u = (target / slope).min(target.powf(1.0 / n));
+        let mut u = (target / slope).min(self.force_n(target) / self.coefficient_n);
         for _ in 0..60 {
-            let un1 = u.powf(n - 1.0);
+            let un1 = self.power_below_order(u);
             let residual = un1 * u + slope * u - target;
             let next = u - residual / (n * un1 + slope);
             let converged = (u - next).abs() <= 1e-15 * u;
@@ -317,7 +333,7 @@ impl Power {
                 break;
             }
         }
-        let speed = u.powf(n);
+        let speed = self.power_below_order(u) * u;
         FrictionStep {
             velocity_m_per_s: v_free.signum() * speed,
             force_n: v_free.signum() * self.coefficient_n * u,
@@ -328,27 +344,35 @@ impl Power {
 impl LuGre {
     /// The steady bristle deflection g(v) = (F_C + (F_Ts − F_C)·e^{−(v/v_s)²})/k_s, m (eq. 4.6).
     pub fn g_m(&self, v: f64) -> f64 {
+        self.g_and_slope(v).0
+    }
+
+    /// g(v) and dg/dv. With F_Ts = F_C (the thesis's Tab. 6.1 and 6.3) g is
+    /// constant; far beyond v_s the Stribeck term is below 1e-300 and skipped
+    /// (also to keep `exp` off its slow underflow path).
+    fn g_and_slope(&self, v: f64) -> (f64, f64) {
+        let stribeck_n = self.static_n - self.coulomb_n;
         let ratio = v / self.stribeck_velocity_m_per_s;
-        (self.coulomb_n + (self.static_n - self.coulomb_n) * (-ratio * ratio).exp())
-            / self.stiffness_n_per_m
+        if stribeck_n == 0.0 || ratio * ratio > 690.0 {
+            return (self.coulomb_n / self.stiffness_n_per_m, 0.0);
+        }
+        let bump = stribeck_n * (-ratio * ratio).exp();
+        let g = (self.coulomb_n + bump) / self.stiffness_n_per_m;
+        let slope = -2.0 * ratio / self.stribeck_velocity_m_per_s * bump / self.stiffness_n_per_m;
+        (g, slope)
     }
 
     /// z after a step of h with v held (exact solution of eq. 4.2), and dz/dv.
     fn bristle_after(&self, z0: f64, v: f64, h: f64) -> (f64, f64) {
+        let (g, dg) = self.g_and_slope(v);
         if v == 0.0 {
-            return (z0, h * (1.0 - z0.abs() / self.g_m(0.0)).max(0.0));
+            // One-sided slope in the direction that moves z least (the kink of |v|).
+            return (z0, h * (1.0 - z0.abs() / g).max(0.0));
         }
-        let g = self.g_m(v);
         let sign = v.signum();
         let z_ss = sign * g;
         let decay = (-v.abs() * h / g).exp();
         let z = z_ss + (z0 - z_ss) * decay;
-        // d/dv with g(v): dg/dv = −2v/v_s²·(F_Ts − F_C)·e^{−(v/v_s)²}/k_s.
-        let ratio = v / self.stribeck_velocity_m_per_s;
-        let dg = -2.0 * ratio / self.stribeck_velocity_m_per_s
-            * (self.static_n - self.coulomb_n)
-            * (-ratio * ratio).exp()
-            / self.stiffness_n_per_m;
         let d_rate = sign / g - v.abs() * dg / (g * g);
         let dz = sign * dg * (1.0 - decay) - (z0 - z_ss) * decay * h * d_rate;
         (z, dz)
@@ -377,7 +401,7 @@ impl LuGre {
         };
         let mut v = guess;
         let mut result = force(v);
-        for _ in 0..80 {
+        for _ in 0..60 {
             let (f, df, _) = result;
             let phi = v - v_free + alpha * f;
             if phi > 0.0 {
@@ -386,16 +410,16 @@ impl LuGre {
                 lo = v;
             }
             let slope = 1.0 + alpha * df;
-            let mut next = v - phi / slope;
-            if !(next > lo && next < hi) || slope <= 0.0 {
-                next = 0.5 * (lo + hi);
-            }
-            let done = (next - v).abs() <= 1e-15 + 1e-13 * v.abs() || hi - lo <= 1e-18;
-            v = next;
-            result = force(v);
-            if done {
+            let newton_step = phi / slope;
+            if newton_step.abs() <= 1e-17 + 1e-14 * v.abs() || hi - lo <= 1e-18 {
                 break;
             }
+            let mut next = v - newton_step;
+            if !(next >= lo && next <= hi) || slope <= 0.0 {
+                next = 0.5 * (lo + hi);
+            }
+            v = next;
+            result = force(v);
         }
         let (f, _, z) = result;
         *bristle_m = z;

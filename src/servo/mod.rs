@@ -13,6 +13,11 @@
 //! - [`simulate`]: the cascade in time, exact for the linear part, with
 //!   1 µs sub-steps only where friction is active.
 //! - [`circle`]: the circular test and its reversal figures (Tab. 6.4).
+//! - [`iso_cycle`]: a simulated ISO 230-2 linear test (a `Measurement`,
+//!   evaluated), with a structural compliance between drive and laser.
+//! - [`reversal`]: B ≈ 2·F_res/k_c and its inverse, for `diagnose`.
+//! - [`force_step`]: the force-step (impact compliance) test; and a
+//!   constant-velocity run.
 //! - [`identify`]: the thesis's identification arithmetic.
 //!
 //! Lengths are metres inside this module (the model is SI throughout);
@@ -24,8 +29,14 @@
 
 pub mod axis;
 pub mod circle;
+pub mod force_step;
 pub mod friction;
 pub mod identify;
+pub mod iso_cycle;
 pub mod linear;
+pub mod reversal;
 pub mod simulate;
 pub mod trajectory;
+
+#[cfg(test)]
+mod tests;

@@ -109,13 +109,21 @@ pub struct ProfileBuilder {
 impl Trajectory {
     /// The setpoint at time t (s).
     pub fn at(&self, time_s: f64) -> Setpoint {
+        let mut hint = 0;
+        self.at_hinted(time_s, &mut hint)
+    }
+
+    /// The same, starting the search for the profile segment at `hint` and
+    /// leaving the segment found there: a simulation asks for nearly
+    /// increasing times, so this is O(1) instead of a binary search.
+    pub fn at_hinted(&self, time_s: f64, hint: &mut usize) -> Setpoint {
         match self {
             Trajectory::Hold { position_m } => Setpoint {
                 position_m: *position_m,
                 ..Setpoint::default()
             },
             Trajectory::Circle(circle) => circle.at(time_s),
-            Trajectory::Profile(profile) => profile.at(time_s),
+            Trajectory::Profile(profile) => profile.at(time_s, hint),
         }
     }
 }
@@ -197,7 +205,7 @@ impl Profile {
         &self.segments
     }
 
-    fn at(&self, time_s: f64) -> Setpoint {
+    fn at(&self, time_s: f64, hint: &mut usize) -> Setpoint {
         let hold = |position_m| Setpoint {
             position_m,
             ..Setpoint::default()
@@ -205,7 +213,18 @@ impl Profile {
         if time_s >= self.end_s {
             return hold(self.end_position_m);
         }
-        let index = self.segments.partition_point(|s| s.start_s <= time_s);
+        let covers = |i: usize| {
+            self.segments.get(i).is_some_and(|s| s.start_s <= time_s)
+                && self.segments.get(i + 1).is_none_or(|s| s.start_s > time_s)
+        };
+        let index = if covers(*hint) {
+            *hint + 1
+        } else if covers(*hint + 1) {
+            *hint + 2
+        } else {
+            self.segments.partition_point(|s| s.start_s <= time_s)
+        };
+        *hint = index.saturating_sub(1);
         let Some(segment) = index.checked_sub(1).and_then(|i| self.segments.get(i)) else {
             return hold(
                 self.segments
