@@ -106,7 +106,9 @@ mod tests {
             "--json",
         ])
         .unwrap();
-        let Command::Evaluate(evaluate) = args.command;
+        let Command::Evaluate(evaluate) = args.command else {
+            panic!("parsed as another subcommand");
+        };
         assert_eq!(evaluate.files.len(), 2);
         assert!(evaluate.json);
         assert_eq!(evaluate.exclude_runs.len(), 1);

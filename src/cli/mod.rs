@@ -9,6 +9,7 @@
 mod common;
 mod evaluate;
 mod progress;
+mod servo_sim;
 
 use std::process::ExitCode;
 
@@ -33,6 +34,13 @@ pub enum Command {
     /// Give two files to join the forward and reverse files of one axis (API
     /// XD .pos) into one bidirectional measurement.
     Evaluate(evaluate::EvaluateArgs),
+    /// Simulate a feed axis with a friction model (seed 004).
+    ///
+    /// The circle test prints the quadrant (reversal) error and current the
+    /// thesis tabulates; the ISO 230-2 cycle prints the simulated readings
+    /// after each dwell and their ISO 230-2 figures, including the reversal
+    /// B that friction leaves through the structure's compliance.
+    ServoSim(servo_sim::ServoSimArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -62,6 +70,7 @@ pub fn main() -> ExitCode {
 fn run(args: Args) -> Result<()> {
     match args.command {
         Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
+        Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
     }
 }
 

@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 
 use crate::servo::axis::Axis;
 use crate::servo::friction::Friction;
-use crate::servo::simulate::{Simulator, StepCounts, Stepping};
+use crate::servo::simulate::{Simulator, Snapshot, StepCounts, Stepping};
 use crate::servo::trajectory::{Circle, CircleAxis, Trajectory};
 
 /// What one circle simulation gives.
@@ -30,6 +30,8 @@ pub struct CircleResult {
     pub simulated_s: f64,
     /// How the time was stepped.
     pub counts: StepCounts,
+    /// The state at every position sample (1 ms), for plots and CSV.
+    pub trace: Vec<Snapshot>,
 }
 
 /// One reversal of the axis on the circle.
@@ -91,8 +93,12 @@ pub fn run_circle(
     let mut simulator = Simulator::new(axis, friction, &trajectory, stepping, None);
     let report_every = (0.02 * end_s / simulator.macro_step_s()).max(1.0) as u64;
     let mut steps = 0u64;
+    let mut trace = Vec::new();
     simulator.run_until(end_s, |snapshot| {
         steps += 1;
+        if snapshot.is_position_sample {
+            trace.push(*snapshot);
+        }
         if steps % report_every == 0 {
             progress(snapshot.time_s / end_s);
         }
@@ -115,5 +121,6 @@ pub fn run_circle(
         reversals,
         simulated_s: end_s,
         counts: simulator.counts(),
+        trace,
     }
 }

@@ -13,11 +13,11 @@
 
 use crate::servo::axis::Axis;
 use crate::servo::friction::Friction;
-use crate::servo::simulate::{ForceStep, Simulator, StepCounts, Stepping};
+use crate::servo::simulate::{ForceStep, Simulator, Snapshot, StepCounts, Stepping};
 use crate::servo::trajectory::{MoveLimits, ProfileBuilder, Trajectory};
 
 /// What the force step gives.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ForceStepResult {
     /// Peak |x_z − x|, m.
     pub peak_error_m: f64,
@@ -36,6 +36,8 @@ pub struct ForceStepResult {
     pub simulated_s: f64,
     /// How the time was stepped.
     pub counts: StepCounts,
+    /// The state at every position sample (1 ms).
+    pub trace: Vec<Snapshot>,
 }
 
 /// Runs the force step for `duration_s`.
@@ -52,7 +54,11 @@ pub fn run_force_step(
     let mut peak_current_a = 0.0f64;
     let mut previous_friction = 0.0;
     let mut ripple = 0.0f64;
+    let mut trace = Vec::new();
     simulator.run_until(duration_s, |snapshot| {
+        if snapshot.is_position_sample {
+            trace.push(*snapshot);
+        }
         if snapshot.time_s >= step.at_s {
             errors.push((
                 snapshot.time_s - step.at_s,
@@ -84,6 +90,7 @@ pub fn run_force_step(
         final_friction_ripple_n: ripple,
         simulated_s: duration_s,
         counts: simulator.counts(),
+        trace,
     }
 }
 
@@ -100,6 +107,8 @@ pub struct ConstantVelocityResult {
     pub mean_following_error_m: f64,
     /// Simulated time, s.
     pub simulated_s: f64,
+    /// How the time was stepped.
+    pub counts: StepCounts,
 }
 
 /// Moves `distance_m` at `limits.feed_m_per_s` and averages the middle of the cruise.
@@ -132,5 +141,6 @@ pub fn run_constant_velocity(
         steady_friction_n: friction.steady_force_n(limits.feed_m_per_s),
         mean_following_error_m: error / count,
         simulated_s: to_s,
+        counts: simulator.counts(),
     }
 }

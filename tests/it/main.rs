@@ -7,4 +7,5 @@ mod bad_input;
 mod cli;
 mod evaluate_ecmc;
 mod read_api_pos;
+mod servo;
 mod util;
