@@ -274,10 +274,7 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
             "adaptive"
         },
         simulated_s: 0.0,
-        macro_steps: MacroStepsJson {
-            kept: 0,
-            refined: 0,
-        },
+        macro_steps: MacroStepsJson::new(Default::default()),
         circle: None,
         force_step: None,
         constant_velocity: None,

@@ -10,7 +10,7 @@
 //! ```text
 //! { "axis": "X", "axis_source": "mcfv5050-x", "friction": "lugre", "friction_label": "C",
 //!   "test": "circle", "stepping": "adaptive" | "uniform-1us", "simulated_s": 2.1,
-//!   "macro_steps": {"kept": 16000, "refined": 400},
+//!   "macro_steps": {"kept": 16000, "refined": 400, "skipped": 0},
 //!   "circle": {"radius_mm": 90, "feed_m_min": 16, "reversal_error_um": 7.7, "reversal_current_a": 3.35,
 //!              "reversals": [{"angle_deg": 180, "time_s": …, "direction_after": "up",
 //!                             "peak_error_um": …, "peak_current_a": …}, …]},
@@ -77,13 +77,15 @@ pub struct ServoSimJson {
     pub iso230_2: Option<IsoJson>,
 }
 
-/// Macro steps kept whole and re-taken in 1 µs sub-steps.
+/// Macro steps kept whole, re-taken in 1 µs sub-steps, or skipped while settled.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct MacroStepsJson {
     /// Kept whole.
     pub kept: u64,
     /// Re-taken finely.
     pub refined: u64,
+    /// Skipped: the axis stood settled under a still command.
+    pub skipped: u64,
 }
 
 /// Circle test.
@@ -209,6 +211,7 @@ impl MacroStepsJson {
         MacroStepsJson {
             kept: counts.coarse,
             refined: counts.refined,
+            skipped: counts.skipped,
         }
     }
 }
@@ -318,7 +321,7 @@ pub fn text(report: &ServoSimJson) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "Axis         {} ({})\nFriction     {} (model {})\nTest         {}\nSimulated    {:.3} s ({} stepping; {} macro steps kept, {} refined)",
+        "Axis         {} ({})\nFriction     {} (model {})\nTest         {}\nSimulated    {:.3} s ({} stepping; macro steps: {} kept, {} refined, {} skipped)",
         report.axis,
         report.axis_source,
         report.friction,
@@ -327,7 +330,8 @@ pub fn text(report: &ServoSimJson) -> String {
         report.simulated_s,
         report.stepping,
         report.macro_steps.kept,
-        report.macro_steps.refined
+        report.macro_steps.refined,
+        report.macro_steps.skipped
     );
     if let Some(c) = &report.circle {
         let _ = writeln!(

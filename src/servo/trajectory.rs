@@ -113,6 +113,16 @@ impl Trajectory {
         self.at_hinted(time_s, &mut hint)
     }
 
+    /// If the command stands still at `time_s`, until when it does (s;
+    /// infinity for good). `None` while it moves.
+    pub fn rest_until(&self, time_s: f64) -> Option<f64> {
+        match self {
+            Trajectory::Hold { .. } => Some(f64::INFINITY),
+            Trajectory::Circle(_) => None,
+            Trajectory::Profile(profile) => profile.rest_until(time_s),
+        }
+    }
+
     /// The same, starting the search for the profile segment at `hint` and
     /// leaving the segment found there: a simulation asks for nearly
     /// increasing times, so this is O(1) instead of a binary search.
@@ -203,6 +213,25 @@ impl Profile {
     /// The segments, in time order.
     pub fn segments(&self) -> &[Segment] {
         &self.segments
+    }
+
+    fn rest_until(&self, time_s: f64) -> Option<f64> {
+        if time_s >= self.end_s {
+            return Some(f64::INFINITY);
+        }
+        let index = self.segments.partition_point(|s| s.start_s <= time_s);
+        let segment = self.segments.get(index.checked_sub(1)?)?;
+        let still = segment.start.velocity_m_per_s == 0.0
+            && segment.start.acceleration_m_per_s2 == 0.0
+            && segment.start.jerk_m_per_s3 == 0.0;
+        if !still {
+            return None;
+        }
+        Some(
+            self.segments
+                .get(index)
+                .map_or(self.end_s, |next| next.start_s),
+        )
     }
 
     fn at(&self, time_s: f64, hint: &mut usize) -> Setpoint {
