@@ -15,6 +15,10 @@
 //!   standard leaves a figure undefined, and flags suspected outlier runs.
 //! - [`report`] turns them into the terminal report and the `--json` wire
 //!   format (µm, unit-suffixed keys).
+//! - [`servo`] simulates a feed axis with friction (seed 004: four friction
+//!   models, the cascade control of a linear-motor axis, the circle test and
+//!   a simulated ISO 230-2 cycle) and gives the reversal B ≈ 2·F_res/k_c that
+//!   friction leaves through a structural compliance.
 //! - [`output`] is the one place that creates files: via a temporary file and
 //!   a rename, never overwriting without `force`.
 //!
