@@ -74,8 +74,8 @@ pub fn run_circle(
         if angle_rad + PI / 2.0 > last_angle {
             break;
         }
-        // X = R cos φ moves as −sin φ: after φ = kπ it goes the way of −cos(kπ)·… ;
-        // the sign of the velocity just after the reversal is −sin(φ + 0) derivative.
+        // The commanded velocity just after the reversal: −R ω sin φ for X,
+        // R ω cos φ for Y, evaluated a little past the reversal angle.
         let direction_after = match circle.axis {
             CircleAxis::X => -(angle_rad + 1e-3).sin().signum(),
             CircleAxis::Y => (angle_rad + 1e-3).cos().signum(),

@@ -28,7 +28,7 @@
 //! not chatter (the thesis's ±15 N chatter, §6.2, is an artefact of explicit
 //! stepping), and LuGre's bristle state is advanced by the exact solution of
 //! ż = v − |v| z/g with v held (notes §7), which stays bounded (|z| ≤ g,
-//! property 1 of [13]) at any step. With the thesis's F_Ts = F_C, g is
+//! property 1 of the thesis's ref. 13) at any step. With the thesis's F_Ts = F_C, g is
 //! constant and every equation solved here is monotone, so the solution is
 //! unique.
 
