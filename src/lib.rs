@@ -18,6 +18,10 @@
 //! - [`model`] is the geometric model of a three-axis machine (seed 000):
 //!   the 21 errors, the kinematic chain as data, the volumetric error, the
 //!   guideway model and the Monte Carlo tolerance study.
+//! - [`servo`] simulates a feed axis with friction (seed 004: four friction
+//!   models, the cascade control of a linear-motor axis, the circle test and
+//!   a simulated ISO 230-2 cycle) and gives the reversal B ≈ 2·F_res/k_c that
+//!   friction leaves through a structural compliance.
 //! - [`output`] is the one place that creates files: via a temporary file and
 //!   a rename, never overwriting without `force`.
 //!
@@ -51,6 +55,7 @@ pub mod model;
 pub mod output;
 pub mod read;
 pub mod report;
+pub mod servo;
 pub mod spline;
 pub mod synth;
 pub mod units;

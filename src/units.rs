@@ -17,6 +17,8 @@ pub type Um = f64;
 pub const UM_PER_MM: f64 = 1000.0;
 /// Millimetres in one inch (exact by definition since 1959).
 pub const MM_PER_INCH: f64 = 25.4;
+/// Millimetres in one metre (the servo model works in SI units).
+pub const MM_PER_M: f64 = 1000.0;
 /// Kilopascal in one inch of mercury at 0 °C (NIST SP 811, B.8: 3.386 389 kPa).
 pub const KPA_PER_INHG: f64 = 3.386_389;
 
@@ -111,6 +113,21 @@ pub fn um_text(value_mm: Mm) -> String {
         .unwrap_or_else(|| um.to_string())
 }
 
+/// Metres to millimetres.
+pub fn m_to_mm(value_m: f64) -> Mm {
+    value_m * MM_PER_M
+}
+
+/// Metres to micrometres.
+pub fn m_to_um(value_m: f64) -> Um {
+    mm_to_um(m_to_mm(value_m))
+}
+
+/// Millimetres to metres.
+pub fn mm_to_m(value_mm: Mm) -> f64 {
+    value_mm / MM_PER_M
+}
+
 /// An optional length in millimetres to micrometres; `None` stays `None`.
 pub fn opt_mm_to_um(value_mm: Option<Mm>) -> Option<Um> {
     value_mm.map(mm_to_um)
@@ -161,6 +178,9 @@ mod tests {
         assert!((LengthUnit::Inch.from_mm(25.4) - 1.0).abs() < 1e-15);
         assert_eq!(LengthUnit::Millimetre.to_mm(7.5), 7.5);
         assert_eq!(opt_mm_to_um(None), None);
+        assert_eq!(m_to_mm(0.09), 90.0);
+        assert!((m_to_um(1.8e-6) - 1.8).abs() < 1e-12);
+        assert_eq!(mm_to_m(500.0), 0.5);
     }
 
     #[test]

@@ -10,6 +10,7 @@ mod common;
 mod convert;
 mod evaluate;
 mod progress;
+mod servo_sim;
 mod synth;
 mod tolerance;
 
@@ -58,6 +59,13 @@ pub enum Command {
     /// (seed 000). --sweep adds the sensitivity to each tolerance;
     /// --single-axis runs the one-axis study instead.
     Tolerance(Box<tolerance::ToleranceArgs>),
+    /// Simulate a feed axis with a friction model (seed 004).
+    ///
+    /// The circle test prints the quadrant (reversal) error and current the
+    /// thesis tabulates; the ISO 230-2 cycle prints the simulated readings
+    /// after each dwell and their ISO 230-2 figures, including the reversal
+    /// B that friction leaves through the structure's compliance.
+    ServoSim(servo_sim::ServoSimArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -90,6 +98,7 @@ fn run(args: Args) -> Result<()> {
         Command::Convert(convert_args) => convert::run(&convert_args),
         Command::Synth(synth_args) => synth::run(&synth_args),
         Command::Tolerance(tolerance_args) => tolerance::run(&tolerance_args),
+        Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
     }
 }
 

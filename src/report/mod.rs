@@ -3,13 +3,14 @@
 //! [`json`] holds the `--json` wire formats: dedicated serde structs whose
 //! keys carry units (`A_um`, `target_mm`); internal types are never
 //! serialised directly. [`terminal`] renders the same data as a readable
-//! terminal report. Both convert mm to µm through `crate::units`; nothing
-//! else in the crate depends on this module. [`tolerance`] is the wire
-//! format and terminal report of `axcomp tolerance`; [`plot`] renders its
-//! histogram as SVG or PNG bytes (files are written by `crate::output`).
-
+//! terminal report. [`convert`] is the summary of `axcomp convert`;
+//! [`tolerance`] the wire format and terminal report of `axcomp tolerance`,
+//! and [`plot`] its histogram as SVG or PNG bytes; [`servo`] the output of
+//! `servo-sim`. All convert mm to µm through `crate::units`; nothing else in
+//! the crate depends on this module; files are written by `crate::output`.
 pub mod convert;
 pub mod json;
 pub mod plot;
+pub mod servo;
 pub mod terminal;
 pub mod tolerance;

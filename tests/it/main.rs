@@ -11,4 +11,5 @@ mod evaluate_ecmc;
 mod linuxcnc;
 mod model;
 mod read_api_pos;
+mod servo;
 mod util;

@@ -1,0 +1,42 @@
+//! Feed-drive friction and servo model (seed 004: Mendřický 2006), and what
+//! friction does to an ISO 230-2 positioning test.
+//!
+//! # Brief overview
+//!
+//! - [`friction`]: the four friction models A (classic), B1 (ramp), B2
+//!   (power law) and C (LuGre), each a small type, with an implicit update
+//!   over a step that stays stable at machine speeds.
+//! - [`axis`]: the axis parameters (mass, motor, cascade gains, sampling,
+//!   quantisation, dead time, friction), read from TOML; the thesis's MCFV
+//!   5050 LN X and Y axes are bundled.
+//! - [`trajectory`]: circle, point-to-point moves with dwells, standstill.
+//! - [`simulate`]: the cascade in time, exact for the linear part, with
+//!   1 µs sub-steps only where friction is active.
+//! - [`circle`]: the circular test and its reversal figures (Tab. 6.4).
+//! - [`iso_cycle`]: a simulated ISO 230-2 linear test (a `Measurement`,
+//!   evaluated), with a structural compliance between drive and laser.
+//! - [`reversal`]: B ≈ 2·F_res/k_c and its inverse, for `diagnose`.
+//! - [`force_step`]: the force-step (impact compliance) test; and a
+//!   constant-velocity run.
+//! - [`identify`]: the thesis's identification arithmetic.
+//!
+//! Lengths are metres inside this module (the model is SI throughout);
+//! results that leave it for a `Measurement` are converted to mm through
+//! `crate::units`.
+//!
+//! Pure: no I/O, no printing, no clock, no randomness. Long runs report
+//! progress through a plain callback.
+
+pub mod axis;
+pub mod circle;
+pub mod force_step;
+pub mod friction;
+pub mod identify;
+pub mod iso_cycle;
+pub mod linear;
+pub mod reversal;
+pub mod simulate;
+pub mod trajectory;
+
+#[cfg(test)]
+mod tests;
