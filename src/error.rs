@@ -47,6 +47,29 @@ impl ParseError {
         }
     }
 
+    /// A TOML syntax or type error, at the line and column of its span; the
+    /// first line of toml's message (the rest is a source excerpt).
+    pub fn from_toml(text: &str, error: &toml::de::Error) -> ParseError {
+        let mut offset = error.span().map_or(0, |span| span.start).min(text.len());
+        while !text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let before = &text[..offset];
+        let line = before.matches('\n').count() + 1;
+        let column = before
+            .rsplit('\n')
+            .next()
+            .map_or(0, |rest| rest.chars().count())
+            + 1;
+        let message = error
+            .message()
+            .lines()
+            .next()
+            .unwrap_or("invalid TOML")
+            .trim();
+        ParseError::new(line, column, message.to_string())
+    }
+
     /// The usual shape: `expected X, found Y`.
     pub fn expected(line: usize, column: usize, expected: &str, found: &str) -> ParseError {
         ParseError::new(line, column, format!("expected {expected}, found {found}"))

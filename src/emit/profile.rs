@@ -28,6 +28,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
+use crate::error::ParseError;
 use crate::units::LengthUnit;
 
 /// A machine profile as read from TOML (only the `[controller]` part).
@@ -100,7 +101,8 @@ impl MachineProfile {
     /// must not silently fall back to a default), other top-level tables are
     /// left to their own readers.
     pub fn from_toml_str(text: &str) -> Result<MachineProfile, String> {
-        let profile: MachineProfile = toml::from_str(text).map_err(|e| e.to_string())?;
+        let profile: MachineProfile =
+            toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e).to_string())?;
         if let Some(units) = &profile.controller.units {
             LengthUnit::from_name(units).ok_or_else(|| {
                 format!("controller.units must be \"mm\" or \"inch\", found {units:?}")

@@ -379,19 +379,7 @@ fn check_finite(what: &str, values: &[f64]) -> Result<(), ModelError> {
 
 /// A TOML error at its line and column (both from 1).
 fn toml_error(text: &str, error: &toml::de::Error) -> ModelError {
-    let mut offset = error.span().map_or(0, |span| span.start).min(text.len());
-    while !text.is_char_boundary(offset) {
-        offset -= 1;
-    }
-    let before = &text[..offset];
-    let line = before.matches('\n').count() + 1;
-    let column = before
-        .rsplit('\n')
-        .next()
-        .map_or(0, |rest| rest.chars().count())
-        + 1;
-    let message = error.message().trim().replace('\n', " ");
-    ModelError::Toml(ParseError::new(line, column, message))
+    ModelError::Toml(ParseError::from_toml(text, error))
 }
 
 /// The whole file: only what the model reads. Other top-level tables

@@ -178,13 +178,8 @@ impl Axis {
 
     /// Parses and validates an axis file.
     pub fn from_toml_str(text: &str) -> Result<Axis, AxisError> {
-        let axis: Axis = toml::from_str(text).map_err(|error| {
-            let offset = error.span().map_or(0, |span| span.start);
-            let (line, column) = line_column(text, offset);
-            // toml's message may span lines with a source excerpt; keep the first.
-            let message = error.message().lines().next().unwrap_or("invalid TOML");
-            AxisError::Parse(ParseError::new(line, column, message.to_string()))
-        })?;
+        let axis: Axis = toml::from_str(text)
+            .map_err(|error| AxisError::Parse(ParseError::from_toml(text, &error)))?;
         axis.validate()?;
         Ok(axis)
     }
@@ -352,16 +347,6 @@ fn value_error(key: &'static str, expected: &'static str, found: f64) -> AxisErr
         expected,
         found,
     }
-}
-
-/// Line and column (both from 1, columns in characters) of a byte offset.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let offset = offset.min(text.len());
-    let before = text.get(..offset).unwrap_or(text);
-    let line = before.matches('\n').count() + 1;
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let column = before.get(line_start..).map_or(0, |s| s.chars().count()) + 1;
-    (line, column)
 }
 
 #[cfg(test)]

@@ -45,6 +45,8 @@
 
 use serde::Deserialize;
 
+use crate::error::ParseError;
+
 /// The whole truth file.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -367,7 +369,8 @@ impl EffectSpec {
 impl Truth {
     /// Parses a truth file.
     pub fn from_toml_str(text: &str) -> Result<Truth, String> {
-        let truth: Truth = toml::from_str(text).map_err(|e| e.to_string())?;
+        let truth: Truth =
+            toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e).to_string())?;
         truth.check()?;
         Ok(truth)
     }
