@@ -53,6 +53,7 @@ pub mod evaluate;
 pub mod measurement;
 pub mod model;
 pub mod output;
+pub mod predict;
 pub mod read;
 pub mod report;
 pub mod servo;

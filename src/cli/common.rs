@@ -1,12 +1,16 @@
 //! Flag parsers and printing helpers shared by several subcommands.
 
 use std::io::Write;
+use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde::Serialize;
 
+use axcomp::compensate::CompensationTable;
+use axcomp::emit::{self, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
 use axcomp::measurement::{Direction, RunSelector, SourceFormat};
+use axcomp::model::{Machine, ModelError};
 
 /// `--format NAME`: one of the input formats.
 pub fn parse_format(name: &str) -> Result<SourceFormat, String> {
@@ -40,6 +44,84 @@ pub fn parse_run_selector(text: &str) -> Result<RunSelector, String> {
     Ok(RunSelector { number, direction })
 }
 
+/// `x=0,y=250,z=-275` (any of the three, any order): a machine position, mm.
+pub fn parse_position(text: &str) -> Result<[Option<f64>; 3], String> {
+    let mut position = [None; 3];
+    for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (name, value) = part
+            .split_once('=')
+            .ok_or_else(|| format!("expected axis=value like y=250, found {part:?}"))?;
+        let index = match name.trim().to_ascii_lowercase().as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            other => return Err(format!("expected the axis x, y or z, found {other:?}")),
+        };
+        let value: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| format!("expected a number of mm after {name}=, found {value:?}"))?;
+        if position[index].replace(value).is_some() {
+            return Err(format!("{name} is given twice in {text:?}"));
+        }
+    }
+    Ok(position)
+}
+
+/// The machine's kinematics from `path`, or the bundled MCV 754 Quick. The
+/// path goes in front of the error, with the line and column for TOML errors.
+pub fn load_machine(path: Option<&Path>) -> Result<Machine> {
+    let Some(path) = path else {
+        return Ok(Machine::bundled());
+    };
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    Machine::from_toml_str(&text).map_err(|error| match error {
+        ModelError::Toml(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
+        other => anyhow::anyhow!("{}: {other}", path.display()),
+    })
+}
+
+/// The machine profile's `[controller]` part from `path`, or the defaults.
+pub fn load_profile(path: Option<&Path>) -> Result<MachineProfile> {
+    let Some(path) = path else {
+        return Ok(MachineProfile::default());
+    };
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    MachineProfile::from_toml_str(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+}
+
+/// A compensation table for `axis` in any format `convert` writes; the
+/// machine profile names the axis's columns. A LinuxCNC table's type is told
+/// from its numbers; `linuxcnc_type` decides when they do not.
+pub fn read_table(
+    path: &Path,
+    axis: &str,
+    profile: &MachineProfile,
+    linuxcnc_type: Option<u8>,
+) -> Result<CompensationTable> {
+    let options = EmitOptions {
+        axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
+        table_name: String::new(),
+        machine_unit: profile.machine_unit(),
+        linuxcnc_type: linuxcnc_type.unwrap_or(0),
+        max_points: None,
+        max_value_mm: None,
+        cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
+        cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
+        tnc640_columns: Vec::new(),
+    };
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let (_, table) = emit::read_any(&text, &options, None)
+        .or_else(|error| match linuxcnc_type {
+            Some(kind) => emit::read_any(&text, &options, Some(kind)),
+            None => Err(error),
+        })
+        .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?;
+    Ok(table)
+}
+
 /// Prints warnings to stderr unless `quiet`.
 pub fn print_warnings(warnings: &[Warning], quiet: bool) {
     if quiet {
@@ -70,6 +152,18 @@ pub fn print_text(text: &str) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn positions() {
+        assert_eq!(
+            parse_position("y=250, Z=-275").unwrap(),
+            [None, Some(250.0), Some(-275.0)]
+        );
+        assert!(parse_position("y=250,y=3").unwrap_err().contains("twice"));
+        assert!(parse_position("w=1").unwrap_err().contains("x, y or z"));
+        assert!(parse_position("y=abc").unwrap_err().contains("number"));
+        assert!(parse_position("y250").unwrap_err().contains("axis=value"));
+    }
 
     #[test]
     fn run_selectors() {

@@ -9,6 +9,7 @@
 mod common;
 mod convert;
 mod evaluate;
+mod predict;
 mod progress;
 mod servo_sim;
 mod synth;
@@ -51,8 +52,16 @@ pub enum Command {
     /// re-test of the compensated axis is written too, the table applied as the
     /// controller applies it.
     Synth(synth::SynthArgs),
-
+    /// Predict the re-test of a compensated axis and the residual volumetric error.
+    ///
+    /// From the volumetric model (21 errors): measured files give the
+    /// positioning errors along their lines, an error description the others;
+    /// each table is applied as its controller applies it. Prints the predicted
+    /// ISO 230-2 figures of the re-test on the line and the largest volumetric
+    /// error over the work volume with and without the tables.
+    Predict(predict::PredictArgs),
     /// Monte Carlo tolerance study: random machines from straightness tolerances.
+    ///
     /// Draws random rail mounting surfaces within the tolerances, turns them
     /// into the 21 geometric errors through the guideway model, and reports
     /// the distribution of the largest volumetric error over the work volume
@@ -97,6 +106,7 @@ fn run(args: Args) -> Result<()> {
         Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
         Command::Convert(convert_args) => convert::run(&convert_args),
         Command::Synth(synth_args) => synth::run(&synth_args),
+        Command::Predict(predict_args) => predict::run(&predict_args),
         Command::Tolerance(tolerance_args) => tolerance::run(&tolerance_args),
         Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
     }
@@ -104,9 +114,14 @@ fn run(args: Args) -> Result<()> {
 
 fn is_broken_pipe(error: &anyhow::Error) -> bool {
     error.chain().any(|cause| {
-        cause
+        let io = cause
             .downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            .map(std::io::Error::kind);
+        // serde_json wraps the writer's error without exposing it as a source.
+        let json = cause
+            .downcast_ref::<serde_json::Error>()
+            .and_then(serde_json::Error::io_error_kind);
+        io.or(json) == Some(std::io::ErrorKind::BrokenPipe)
     })
 }
 

@@ -7,7 +7,7 @@
 //! `axcomp::model::monte_carlo`; this file turns flags into its options,
 //! shows progress and prints.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 
@@ -15,7 +15,7 @@ use axcomp::model::monte_carlo::{
     AxisStudyOptions, RailDirection, StudyOptions, SweptTolerance, THESIS_SWEEP_MM, Tolerances,
     sensitivity_sweep, single_axis_study, sweep_runs, tolerance_study,
 };
-use axcomp::model::{Axis, Grid, Guideway, Machine, ModelError, ProfileShape};
+use axcomp::model::{Axis, Grid, Guideway, ProfileShape};
 use axcomp::output::write_new;
 use axcomp::report::plot::{self, PlotFormat};
 use axcomp::report::tolerance::{
@@ -23,7 +23,7 @@ use axcomp::report::tolerance::{
 };
 use axcomp::units::um_per_m_to_rad;
 
-use super::common::{print_json, print_text};
+use super::common::{load_machine, print_json, print_text};
 use super::progress;
 
 /// Flags of `axcomp tolerance`.
@@ -261,19 +261,6 @@ fn run_single_axis(args: &ToleranceArgs, shape: ProfileShape) -> Result<()> {
     } else {
         print_text(&axis_study_report(&report))
     }
-}
-
-/// The machine from `path`, or the bundled one. The path goes in front of
-/// the error, with the line and column for TOML errors.
-fn load_machine(path: Option<&Path>) -> Result<Machine> {
-    let Some(path) = path else {
-        return Ok(Machine::bundled());
-    };
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    Machine::from_toml_str(&text).map_err(|error| match error {
-        ModelError::Toml(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
-        other => anyhow::anyhow!("{}: {other}", path.display()),
-    })
 }
 
 /// A count of at least 1.

@@ -321,6 +321,34 @@ impl Effect {
         }
     }
 
+    /// The effect's systematic part at `x_mm` moving in `direction`, µm:
+    /// what a table or a prediction can account for (`predict --effects`).
+    /// `None` for what is not systematic in position (a drift, an outlier
+    /// run) and for Abbe, which the volumetric model gives from the line and
+    /// the angular errors rather than from an effect.
+    pub fn systematic_um(
+        &self,
+        x_mm: f64,
+        direction: Direction,
+        first_target_mm: f64,
+    ) -> Option<f64> {
+        match *self {
+            Effect::Reversal { b_um } => Some(match direction {
+                Direction::Up => b_um / 2.0,
+                Direction::Down => -b_um / 2.0,
+            }),
+            Effect::Scale { scale_um_per_m } => {
+                Some(scale_um_per_m * (x_mm - first_target_mm) / 1000.0)
+            }
+            Effect::Periodic {
+                period_mm,
+                amplitude_um,
+                phase_rad,
+            } => Some(amplitude_um * (TAU * x_mm / period_mm + phase_rad).sin()),
+            Effect::Drift { .. } | Effect::OutlierRun { .. } | Effect::Abbe { .. } => None,
+        }
+    }
+
     /// What it is physically and what to do about it at the machine, in one sentence.
     pub fn explanation(&self, context: &Context) -> String {
         match *self {

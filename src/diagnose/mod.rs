@@ -32,6 +32,7 @@
 mod along_axis;
 mod between_runs;
 pub mod effects;
+mod effects_file;
 pub mod fit;
 mod stats;
 
@@ -45,6 +46,7 @@ use between_runs::{
     cell_levels, cross_validation_folds, reversals, select_between_runs, select_reversal,
 };
 pub use effects::{Context, Effect, Kind, Reading, Shape};
+pub use effects_file::{read_effects, write_effects};
 use fit::{Design, WeightedFit, fit_gls};
 use stats::chi2_p;
 

@@ -10,6 +10,7 @@
 //!   ([`ErrorName`]), each a function of its own axis ([`ErrorFunction`]:
 //!   a constant or an [`ErrorTable`], linear or spline), gathered in
 //!   [`GeometricErrors`].
+//! - [`error_description`]: the error description file (`predict --errors`).
 //! - [`machine`]: the machine description ([`Machine`], from TOML), with the
 //!   kinematic chain as data (ZFYX, FXYZ, YFXZ, …).
 //! - [`volumetric`]: the chain evaluated with full homogeneous transforms or
@@ -60,6 +61,7 @@
 //! for the tool-relative-to-workpiece convention instead of the thesis's sum.
 
 pub mod components;
+pub mod error_description;
 pub mod guideway;
 pub mod machine;
 pub mod monte_carlo;
@@ -71,6 +73,7 @@ pub use components::{
     Axis, AxisErrors, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, ErrorValues,
     GeometricErrors, Interpolation, Squareness, SquarenessPair,
 };
+pub use error_description::read_error_description;
 pub use guideway::{
     CarriageDeviations, Guideway, GuidewayMap, GuidewayResponse, OutputWeights, RailProfiles,
 };

@@ -3,7 +3,8 @@
 //! [`json`] holds the `--json` wire formats: dedicated serde structs whose
 //! keys carry units (`A_um`, `target_mm`); internal types are never
 //! serialised directly. [`terminal`] renders the same data as a readable
-//! terminal report. [`convert`] is the summary of `axcomp convert`;
+//! terminal report. [`convert`] is the summary of `axcomp convert`,
+//! [`predict`] the wire format and report of `axcomp predict`;
 //! [`tolerance`] the wire format and terminal report of `axcomp tolerance`,
 //! and [`plot`] its histogram as SVG or PNG bytes; [`servo`] the output of
 //! `servo-sim`. All convert mm to µm through `crate::units`; nothing else in
@@ -11,6 +12,7 @@
 pub mod convert;
 pub mod json;
 pub mod plot;
+pub mod predict;
 pub mod servo;
 pub mod terminal;
 pub mod tolerance;

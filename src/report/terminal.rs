@@ -16,7 +16,11 @@ pub const NOT_EVALUATED: &str = "—";
 
 /// Formats an optional µm value with two decimals, or `—`.
 pub fn um(value: Option<f64>) -> String {
-    value.map_or_else(|| NOT_EVALUATED.to_string(), |v| format!("{v:.2}"))
+    value.map_or_else(
+        || NOT_EVALUATED.to_string(),
+        // −0.004 µm is 0.00, not "-0.00".
+        |v| format!("{:.2}", if v.abs() < 0.005 { 0.0 } else { v }),
+    )
 }
 
 /// Renders the whole evaluation report.

@@ -10,6 +10,7 @@ mod diagnose;
 mod evaluate_ecmc;
 mod linuxcnc;
 mod model;
+mod predict;
 mod read_api_pos;
 mod servo;
 mod util;

@@ -1,0 +1,255 @@
+//! `axcomp predict`: what a re-test of the compensated axis will show, and the
+//! residual volumetric error, from the volumetric model.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use axcomp::compensate::CompensationTable;
+use axcomp::diagnose::{Effect, read_effects};
+use axcomp::measurement::Measurement;
+use axcomp::model::{GeometricErrors, ModelError, read_error_description};
+use axcomp::predict::{MeasuredAxis, PredictInput, predict};
+use axcomp::read;
+use axcomp::report::predict::{PredictJson, render};
+
+use super::common::{
+    load_machine, load_profile, parse_position, print_json, print_text, print_warnings, read_table,
+};
+
+/// Flags of `axcomp predict`.
+#[derive(Debug, clap::Args)]
+pub struct PredictArgs {
+    /// Machine description (TOML: [kinematics], and [controller] for reading
+    /// tables); default: the bundled MCV 754 Quick.
+    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
+    pub machine: Option<PathBuf>,
+
+    /// The errors the model knows besides the measured ones (TOML: EXX … EYOZ,
+    /// tables or constants, µm and µrad).
+    #[arg(long, value_name = "E.toml", help_heading = "Errors")]
+    pub errors: Option<PathBuf>,
+
+    /// A linear test of an axis: its positioning error along the line it was
+    /// measured on, FILE or FILE@y=250,z=-275 (default: the --line).
+    #[arg(long, value_name = "FILE[@LINE]", help_heading = "Errors")]
+    pub measured: Vec<String>,
+
+    /// A compensation table in any format convert writes, [AXIS=]FILE (the
+    /// axis defaults to the one measured axis).
+    #[arg(
+        long,
+        value_name = "[AXIS=]TABLE",
+        required = true,
+        help_heading = "Tables"
+    )]
+    pub table: Vec<String>,
+
+    /// The re-test line as machine positions, x=…,y=…,z=… mm (missing
+    /// coordinates: the machine's reference position).
+    #[arg(long, value_name = "x=…,y=…,z=…", value_parser = parse_position, help_heading = "Re-test")]
+    pub line: Option<[Option<f64>; 3]>,
+
+    /// The re-test's tool: last tool-side error frame → functional point,
+    /// x=…,y=…,z=… mm (default: the machine description's).
+    #[arg(long = "tool-offset", value_name = "x=…,y=…,z=…", value_parser = parse_position, help_heading = "Re-test")]
+    pub tool_offset: Option<[Option<f64>; 3]>,
+
+    /// Effects found by diagnose (--write-effects) that the model lacks: their
+    /// systematic part is added to the re-test.
+    #[arg(long, value_name = "E.toml", help_heading = "Errors")]
+    pub effects: Option<PathBuf>,
+
+    /// Step of the volumetric error map, mm.
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 50.0,
+        help_heading = "Re-test"
+    )]
+    pub grid: f64,
+
+    /// LinuxCNC table type, when its numbers do not tell it.
+    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Tables")]
+    pub linuxcnc_type: Option<u8>,
+
+    /// Print JSON instead of the report.
+    #[arg(long, help_heading = "Output")]
+    pub json: bool,
+
+    /// No warnings on stderr.
+    #[arg(long, short = 'q', help_heading = "Output")]
+    pub quiet: bool,
+}
+
+/// Runs `axcomp predict`.
+pub fn run(args: &PredictArgs) -> Result<()> {
+    if !(args.grid > 0.0 && args.grid.is_finite()) {
+        bail!("--grid must be a step > 0 mm, found {}", args.grid);
+    }
+    let machine = load_machine(args.machine.as_deref())?;
+    let profile = load_profile(args.machine.as_deref())?;
+    let errors = match &args.errors {
+        Some(path) => load_errors(path)?,
+        None => GeometricErrors::default(),
+    };
+    let effects = match &args.effects {
+        Some(path) => load_effects(path)?,
+        None => Vec::new(),
+    };
+    let reference = machine.reference_mm();
+    let line_mm = complete(args.line, reference);
+    let mut measurements: Vec<(Measurement, [f64; 3])> = Vec::new();
+    for spec in &args.measured {
+        let (path, line) = split_measured(spec)?;
+        let result = read::read_path(&path, None)?;
+        print_warnings(&result.warnings, args.quiet);
+        let line = line.map_or(line_mm, |l| complete(Some(l), reference));
+        measurements.push((result.measurement, line));
+    }
+    let measured: Vec<MeasuredAxis<'_>> = measurements
+        .iter()
+        .map(|(measurement, line_mm)| MeasuredAxis {
+            measurement,
+            line_mm: *line_mm,
+        })
+        .collect();
+    let tables = args
+        .table
+        .iter()
+        .map(|spec| load_table(spec, &measurements, &profile, args.linuxcnc_type))
+        .collect::<Result<Vec<CompensationTable>>>()?;
+    let tool = args
+        .tool_offset
+        .map(|offset| complete(Some(offset), machine.tool_offset_mm()));
+    let input = PredictInput {
+        machine: &machine,
+        errors: &errors,
+        measured: &measured,
+        tables: &tables,
+        line_mm,
+        retest_tool_offset_mm: tool,
+        grid_step_mm: args.grid,
+        effects: &effects,
+    };
+    let prediction = predict(&input)?;
+    let mut notes = notes(&measurements, &tables, &effects);
+    if args.machine.is_none() {
+        notes.push("machine: the bundled MCV 754 Quick (give --machine for another)".to_string());
+    }
+    let report = PredictJson::new(
+        machine.name(),
+        machine.chain().as_str(),
+        &prediction,
+        args.grid,
+        effects.iter().map(|e| e.kind().name()).collect(),
+        notes,
+    );
+    if args.json {
+        print_json(&report)
+    } else {
+        print_text(&render(&report))
+    }
+}
+
+/// Missing coordinates from `default`.
+fn complete(position: Option<[Option<f64>; 3]>, default: [f64; 3]) -> [f64; 3] {
+    let given = position.unwrap_or([None; 3]);
+    [0, 1, 2].map(|i| given[i].unwrap_or(default[i]))
+}
+
+/// `FILE` or `FILE@y=250,z=-275`; the `@` part only when it reads as a position.
+fn split_measured(spec: &str) -> Result<(PathBuf, Option<[Option<f64>; 3]>)> {
+    if let Some((path, line)) = spec.rsplit_once('@')
+        && let Ok(position) = parse_position(line)
+    {
+        return Ok((PathBuf::from(path), Some(position)));
+    }
+    Ok((PathBuf::from(spec), None))
+}
+
+fn load_errors(path: &Path) -> Result<GeometricErrors> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    read_error_description(&text).map_err(|error| match error {
+        ModelError::Toml(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
+        other => anyhow::anyhow!("{}: {other}", path.display()),
+    })
+}
+
+fn load_effects(path: &Path) -> Result<Vec<Effect>> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    read_effects(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+}
+
+/// `[AXIS=]FILE`: the axis defaults to the one measured axis.
+fn load_table(
+    spec: &str,
+    measurements: &[(Measurement, [f64; 3])],
+    profile: &axcomp::emit::MachineProfile,
+    linuxcnc_type: Option<u8>,
+) -> Result<CompensationTable> {
+    let (axis, path) = match spec.split_once('=') {
+        Some((axis, path)) if axis.len() == 1 => (axis.to_ascii_uppercase(), path),
+        _ => match measurements {
+            [(only, _)] => (only.axis().to_string(), spec),
+            _ => bail!(
+                "--table {spec}: say which axis the table is for, as X={spec} (it cannot be taken from {} measured files)",
+                measurements.len()
+            ),
+        },
+    };
+    read_table(Path::new(path), &axis, profile, linuxcnc_type)
+}
+
+/// What the reader should know about this prediction.
+fn notes(
+    measurements: &[(Measurement, [f64; 3])],
+    tables: &[CompensationTable],
+    effects: &[Effect],
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    let has_reversal = effects.iter().any(|e| matches!(e, Effect::Reversal { .. }));
+    for (measurement, _) in measurements {
+        let b_mean = axcomp::evaluate::evaluate(measurement).figures.b_mean_mm;
+        if let (Some(b), false) = (b_mean, has_reversal) {
+            notes.push(format!(
+                "the test of {} shows a mean reversal B̄ = {:.2} µm, which the geometric model does not have: the prediction has none; diagnose the re-test, or give the reversal with --effects",
+                measurement.axis(),
+                b * 1000.0
+            ));
+        }
+    }
+    for table in tables {
+        let bidirectional = matches!(
+            table.values,
+            axcomp::compensate::TableValues::Bidirectional { .. }
+        );
+        if bidirectional && !has_reversal {
+            notes.push(format!(
+                "the {} table is bidirectional: without a reversal in the model, the prediction shows the opposite of the reversal the table takes out",
+                table.axis
+            ));
+        }
+        if !measurements
+            .iter()
+            .any(|(m, _)| m.axis().eq_ignore_ascii_case(&table.axis))
+        {
+            notes.push(format!(
+                "axis {} was not measured: its re-test is systematic only (one run each way, no R)",
+                table.axis
+            ));
+        }
+    }
+    for effect in effects {
+        if effect
+            .systematic_um(0.0, axcomp::measurement::Direction::Up, 0.0)
+            .is_none()
+        {
+            notes.push(format!(
+                "the {} effect is not systematic in position and is not added (Abbe: give the line and the angular errors instead)",
+                effect.kind().name()
+            ));
+        }
+    }
+    notes
+}

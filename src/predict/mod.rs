@@ -1,0 +1,542 @@
+//! Prediction after compensation (`axcomp predict`): what a re-test of a
+//! compensated axis will show along its laser line, and what the table leaves
+//! in the work volume, from the volumetric model (issue 4).
+//!
+//! **The errors.** The 21 errors come from an error description
+//! ([`crate::model::read_error_description`]) and from measured files: a
+//! linear test of axis A on line L reads A's positioning error EAA *plus*
+//! what the other errors add along L (the Abbe terms of pitch and yaw, a
+//! squareness, …). So EAA is set to the measured per-target means minus the
+//! model's contribution of the other errors on L, as a not-a-knot spline
+//! through the targets: the model then reproduces the measurement on L
+//! exactly at the targets (first order in the errors; to 1e-9 mm with full
+//! transforms), and predicts what changes on another line or with another
+//! tool.
+//!
+//! **The laser's reading** on line L at axis position x is
+//!
+//! ```text
+//! D(x) = E_A(x on L) + EAA(reference)
+//! ```
+//!
+//! E_A the model's volumetric error along A (zero at the machine's reference
+//! position, eq. 68), EAA(reference) added back so that D is the positioning
+//! error as the laser reads it, not shifted to zero at the machine reference
+//! (a constant: no ISO figure depends on it). EAA enters E_A with +1 in every
+//! chain the model builds; [`positioning_sign`] checks it.
+//!
+//! **The table** holds v(x, d) in the same convention (actual − target). The
+//! controller drives to m = x − v(x, d), linear between the table's points and
+//! holding its end values, per direction for a bidirectional table; the axis
+//! reaches m + its error there, so the re-test reads
+//!
+//! ```text
+//! predicted(x, d) = D(x − v(x, d)) − v(x, d)
+//! ```
+//!
+//! as in [`crate::compensate::retest`], with D from the model instead of the
+//! first test's spline. On the measured line and without other errors the
+//! two agree exactly.
+//!
+//! **Scatter.** A prediction is of the systematic part. When the axis was
+//! measured, the predicted re-test keeps that test's readings' scatter about
+//! their per-target means (each reading moved by the predicted change), so
+//! its R is the first test's and A and E are comparable with a real re-test.
+//! Without a measurement there is one run per direction and no R.
+//!
+//! **The work volume.** The residual volumetric error map applies each table
+//! to its axis's positioning error, EAA_c(x) = EAA(x − v) − v, sampled at the
+//! grid's positions and the table's points; the other errors of the axis are
+//! taken at x rather than at x − v (they move by the table's few µm of
+//! position: a change of slope × v, below a nanometre). A bidirectional table
+//! gives a map per direction; the larger maximum is reported.
+//!
+//! Pure: values in, values out.
+
+use crate::compensate::CompensationTable;
+use crate::compensate::retest::KnownError;
+use crate::diagnose::Effect;
+use crate::evaluate::{AxisFigures, evaluate};
+use crate::measurement::{Direction, Measurement, Run};
+use crate::model::{
+    Axis, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid, Interpolation, Machine,
+    Method, ModelError,
+};
+
+/// A measured file and the line it was measured on.
+#[derive(Clone, Copy, Debug)]
+pub struct MeasuredAxis<'a> {
+    /// The test: its axis name must be X, Y or Z.
+    pub measurement: &'a Measurement,
+    /// Machine position of the line (the measured axis's own coordinate is ignored), mm.
+    pub line_mm: [f64; 3],
+}
+
+/// What `predict` is given.
+#[derive(Clone, Copy, Debug)]
+pub struct PredictInput<'a> {
+    /// The machine as it was measured.
+    pub machine: &'a Machine,
+    /// Errors from a description (all zero if none); a measured axis's
+    /// positioning error must not be given here too.
+    pub errors: &'a GeometricErrors,
+    /// Measured files.
+    pub measured: &'a [MeasuredAxis<'a>],
+    /// Tables, each for its axis (at most one per axis).
+    pub tables: &'a [CompensationTable],
+    /// The re-test line: machine position, mm (each table's own axis coordinate is ignored).
+    pub line_mm: [f64; 3],
+    /// The tool of the re-test, if not the machine description's: last
+    /// tool-side error frame → functional point, mm.
+    pub retest_tool_offset_mm: Option<[f64; 3]>,
+    /// Step of the volumetric error map, mm.
+    pub grid_step_mm: f64,
+    /// Effects found by `diagnose` that the geometric model lacks: their
+    /// systematic part (reversal, scale, periodic) is added to every
+    /// re-test's line, about its first target.
+    pub effects: &'a [Effect],
+}
+
+/// The predicted re-test of one compensated axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PredictedRetest {
+    /// The axis.
+    pub axis: Axis,
+    /// The line, mm.
+    pub line_mm: [f64; 3],
+    /// Per target: the deviation without and with the table.
+    pub per_target: Vec<PredictedTarget>,
+    /// The predicted re-test as readings (with the measured scatter when the
+    /// axis was measured).
+    pub retest: Measurement,
+    /// Its ISO 230-2 figures.
+    pub figures: AxisFigures,
+    /// The figures of the same line without the table.
+    pub figures_before: AxisFigures,
+    /// Whether the readings carry a measured test's scatter (else one run per
+    /// direction, no repeatability).
+    pub with_measured_scatter: bool,
+}
+
+/// One target of a predicted re-test, mm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PredictedTarget {
+    /// Target, mm.
+    pub target_mm: f64,
+    /// Deviation on the line without the table moving ↑, mm.
+    pub before_up_mm: f64,
+    /// The same moving ↓ (differs from ↑ only by effects), mm.
+    pub before_down_mm: f64,
+    /// Predicted deviation with the table moving ↑, mm.
+    pub up_mm: f64,
+    /// Predicted deviation with the table moving ↓, mm.
+    pub down_mm: f64,
+}
+
+impl PredictedTarget {
+    /// With the table, in a direction, mm.
+    pub fn after(&self, direction: Direction) -> f64 {
+        match direction {
+            Direction::Up => self.up_mm,
+            Direction::Down => self.down_mm,
+        }
+    }
+
+    /// Without the table, in a direction, mm.
+    pub fn before(&self, direction: Direction) -> f64 {
+        match direction {
+            Direction::Up => self.before_up_mm,
+            Direction::Down => self.before_down_mm,
+        }
+    }
+}
+
+/// The largest volumetric error over the grid and where, mm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumetricMaximum {
+    /// max ‖E‖, mm.
+    pub max_mm: f64,
+    /// Machine position, mm.
+    pub at_mm: [f64; 3],
+}
+
+/// The prediction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// The 21 errors the model used (with the measured positioning errors).
+    pub errors: GeometricErrors,
+    /// One predicted re-test per table.
+    pub retests: Vec<PredictedRetest>,
+    /// Volumetric error without the tables.
+    pub volumetric_before: VolumetricMaximum,
+    /// With the tables (the worse direction).
+    pub volumetric_after: VolumetricMaximum,
+    /// Grid points of the map.
+    pub grid_points: usize,
+}
+
+/// Why a prediction cannot be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PredictError {
+    /// An axis name the model does not have.
+    #[error("{what} is for axis {name:?}; the model has the linear axes X, Y and Z")]
+    UnknownAxis {
+        /// A measurement or a table.
+        what: &'static str,
+        /// Its axis name.
+        name: String,
+    },
+    /// Two sources for one error.
+    #[error("{0} is given twice (by the error description or another measured file): give it once")]
+    GivenTwice(ErrorName),
+    /// Two tables for one axis.
+    #[error("two tables for axis {0}: give one table per axis")]
+    TwoTables(Axis),
+    /// A measured file without a single mean deviation.
+    #[error("the measurement of axis {0} has no target with a mean deviation")]
+    NoMeans(Axis),
+    /// No table.
+    #[error("no compensation table to predict with")]
+    NoTable,
+    /// The model refused a value.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A bug.
+    #[error("internal error, please report: {0}")]
+    Internal(String),
+}
+
+/// Predicts the re-tests and the residual volumetric error.
+pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
+    if input.tables.is_empty() {
+        return Err(PredictError::NoTable);
+    }
+    let errors = calibrated_errors(input)?;
+    let retest_machine = match input.retest_tool_offset_mm {
+        Some(offset) => input.machine.with_tool_offset(offset)?,
+        None => input.machine.clone(),
+    };
+    let mut retests = Vec::new();
+    let mut seen: Vec<Axis> = Vec::new();
+    for table in input.tables {
+        let axis = axis_named("a table", &table.axis)?;
+        if seen.contains(&axis) {
+            return Err(PredictError::TwoTables(axis));
+        }
+        seen.push(axis);
+        let measured = input
+            .measured
+            .iter()
+            .find(|m| axis_named("a measurement", m.measurement.axis()).ok() == Some(axis));
+        retests.push(predicted_retest(
+            &retest_machine,
+            &errors,
+            Line {
+                axis,
+                line_mm: input.line_mm,
+            },
+            table,
+            measured.map(|m| m.measurement),
+            input.effects,
+        )?);
+    }
+    let grid = Grid::over_strokes(&retest_machine, input.grid_step_mm)?;
+    let before = retest_machine.error_map(&errors, &grid, Method::Full);
+    let mut after = VolumetricMaximum {
+        max_mm: 0.0,
+        at_mm: [0.0; 3],
+    };
+    for direction in Direction::BOTH {
+        let compensated = compensated_errors(&errors, input.tables, &grid, direction)?;
+        let (max_mm, at_mm) = retest_machine
+            .error_map(&compensated, &grid, Method::Full)
+            .max_translation();
+        if max_mm >= after.max_mm {
+            after = VolumetricMaximum { max_mm, at_mm };
+        }
+    }
+    let (max_mm, at_mm) = before.max_translation();
+    Ok(Prediction {
+        errors,
+        retests,
+        volumetric_before: VolumetricMaximum { max_mm, at_mm },
+        volumetric_after: after,
+        grid_points: grid.len(),
+    })
+}
+
+/// The machine axis a measurement or table is for.
+pub fn axis_named(what: &'static str, name: &str) -> Result<Axis, PredictError> {
+    let mut letters = name.trim().chars();
+    match (letters.next(), letters.next()) {
+        (Some(letter), None) => Axis::from_letter(letter.to_ascii_uppercase()),
+        _ => None,
+    }
+    .ok_or_else(|| PredictError::UnknownAxis {
+        what,
+        name: name.to_string(),
+    })
+}
+
+/// The positioning error of an axis: EXX, EYY or EZZ.
+pub fn positioning_error(axis: Axis) -> ErrorName {
+    match axis {
+        Axis::X => ErrorName::EXX,
+        Axis::Y => ErrorName::EYY,
+        Axis::Z => ErrorName::EZZ,
+    }
+}
+
+/// The sign with which an axis's positioning error enters the volumetric
+/// error along that axis: +1 in every chain the model builds (the error is
+/// defined as actual − nominal along the axis); anything else is a bug.
+pub fn positioning_sign(machine: &Machine, axis: Axis) -> Result<f64, PredictError> {
+    let [low, high] = machine.axis(axis).stroke_mm;
+    let mut errors = GeometricErrors::default();
+    let slope = ErrorTable::new(vec![low, high], vec![0.0, 1e-3], Interpolation::Linear)?;
+    errors.set(positioning_error(axis), ErrorFunction::Table(slope))?;
+    let at = |x: f64| {
+        let mut p = machine.reference_mm();
+        p[axis.index()] = x;
+        machine
+            .volumetric_error(&errors, p, Method::Full)
+            .translation_mm[axis.index()]
+    };
+    let gain = (at(high) - at(low)) / 1e-3;
+    if (gain.abs() - 1.0).abs() > 1e-6 {
+        return Err(PredictError::Internal(format!(
+            "{} enters E_{axis} with a gain of {gain}, not ±1",
+            positioning_error(axis)
+        )));
+    }
+    Ok(gain.signum())
+}
+
+/// D(x): the laser's reading on `line_mm` with `axis` at `x_mm`, mm.
+fn line_deviation(
+    machine: &Machine,
+    errors: &GeometricErrors,
+    axis: Axis,
+    sign: f64,
+    line_mm: [f64; 3],
+    x_mm: f64,
+) -> f64 {
+    let mut p = line_mm;
+    p[axis.index()] = x_mm;
+    let reference = machine.reference_mm()[axis.index()];
+    let own_at_reference = errors
+        .function(positioning_error(axis))
+        .map_or(0.0, |f| f.value_at(reference));
+    sign * machine
+        .volumetric_error(errors, p, Method::Full)
+        .translation_mm[axis.index()]
+        + own_at_reference
+}
+
+/// The errors with each measured axis's positioning error set so that the
+/// model reproduces the measured means on the measured line.
+fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, PredictError> {
+    let mut errors = input.errors.clone();
+    let mut given: Vec<ErrorName> = ErrorName::ALL
+        .into_iter()
+        .filter(|name| {
+            errors
+                .function(*name)
+                .is_some_and(|f| *f != ErrorFunction::Constant(0.0))
+        })
+        .collect();
+    for measured in input.measured {
+        let axis = axis_named("a measurement", measured.measurement.axis())?;
+        let name = positioning_error(axis);
+        if given.contains(&name) {
+            return Err(PredictError::GivenTwice(name));
+        }
+        given.push(name);
+        let known = KnownError::from_evaluation(&evaluate(measured.measurement))
+            .ok_or(PredictError::NoMeans(axis))?;
+        let sign = positioning_sign(input.machine, axis)?;
+        // The others' contribution on the measured line, with EAA still zero.
+        let values: Vec<f64> = known
+            .positions_mm()
+            .iter()
+            .zip(known.values_mm())
+            .map(|(&x, &mean)| {
+                mean - line_deviation(input.machine, &errors, axis, sign, measured.line_mm, x)
+            })
+            .collect();
+        let table = ErrorTable::new(known.positions_mm().to_vec(), values, Interpolation::Spline)?;
+        errors.set(name, ErrorFunction::Table(table))?;
+    }
+    Ok(errors)
+}
+
+/// An axis and the line its re-test runs on.
+#[derive(Clone, Copy, Debug)]
+struct Line {
+    axis: Axis,
+    line_mm: [f64; 3],
+}
+
+/// The re-test of one compensated axis on the line.
+fn predicted_retest(
+    machine: &Machine,
+    errors: &GeometricErrors,
+    line: Line,
+    table: &CompensationTable,
+    measured: Option<&Measurement>,
+    effects: &[Effect],
+) -> Result<PredictedRetest, PredictError> {
+    let Line { axis, line_mm } = line;
+    let sign = positioning_sign(machine, axis)?;
+    let targets: Vec<f64> = match measured {
+        Some(m) => m.targets_mm().to_vec(),
+        None => table.positions_mm.clone(),
+    };
+    let first_target = targets.first().copied().unwrap_or(0.0);
+    // D(x, d): the model's reading plus the effects it lacks, mm.
+    let deviation = |x: f64, direction: Direction| {
+        let effects_um: f64 = effects
+            .iter()
+            .filter_map(|e| e.systematic_um(x, direction, first_target))
+            .sum();
+        line_deviation(machine, errors, axis, sign, line_mm, x) + effects_um / 1000.0
+    };
+    let compensated = |x: f64, direction: Direction| {
+        let v = table.value_at(x, direction);
+        deviation(x - v, direction) - v
+    };
+    let per_target: Vec<PredictedTarget> = targets
+        .iter()
+        .map(|&x| PredictedTarget {
+            target_mm: x,
+            before_up_mm: deviation(x, Direction::Up),
+            before_down_mm: deviation(x, Direction::Down),
+            up_mm: compensated(x, Direction::Up),
+            down_mm: compensated(x, Direction::Down),
+        })
+        .collect();
+    let (retest, before) = match measured {
+        Some(m) => (
+            with_scatter(m, |i, d| per_target[i].after(d))?,
+            with_scatter(m, |i, d| per_target[i].before(d))?,
+        ),
+        None => (
+            one_run_each_way(axis, &per_target, PredictedTarget::after)?,
+            one_run_each_way(axis, &per_target, PredictedTarget::before)?,
+        ),
+    };
+    Ok(PredictedRetest {
+        axis,
+        line_mm,
+        figures: evaluate(&retest).figures,
+        figures_before: evaluate(&before).figures,
+        per_target,
+        retest,
+        with_measured_scatter: measured.is_some(),
+    })
+}
+
+/// The measured readings with their per-target, per-direction mean replaced
+/// by `systematic(target index, direction)`: the scatter is kept.
+fn with_scatter(
+    measured: &Measurement,
+    systematic: impl Fn(usize, Direction) -> f64,
+) -> Result<Measurement, PredictError> {
+    let evaluation = evaluate(measured);
+    let runs = measured
+        .runs()
+        .iter()
+        .map(|run| Run {
+            deviations_mm: run
+                .deviations_mm
+                .iter()
+                .enumerate()
+                .map(|(i, reading)| {
+                    let stats = &evaluation.per_target[i];
+                    let cell_mean = match run.direction {
+                        Direction::Up => stats.up.mean_mm,
+                        Direction::Down => stats.down.mean_mm,
+                    };
+                    reading
+                        .zip(cell_mean)
+                        .map(|(value, mean)| systematic(i, run.direction) + (value - mean))
+                })
+                .collect(),
+            ..run.clone()
+        })
+        .collect();
+    Measurement::new(
+        measured.axis(),
+        measured.targets_mm().to_vec(),
+        runs,
+        measured.environment.clone(),
+        measured.metadata.clone(),
+    )
+    .map_err(|e| PredictError::Internal(e.to_string()))
+}
+
+/// A re-test of one run each way holding the predicted values.
+fn one_run_each_way(
+    axis: Axis,
+    per_target: &[PredictedTarget],
+    value: fn(&PredictedTarget, Direction) -> f64,
+) -> Result<Measurement, PredictError> {
+    let runs = Direction::BOTH
+        .into_iter()
+        .map(|direction| Run {
+            direction,
+            number: 1,
+            start_time_s: None,
+            deviations_mm: per_target
+                .iter()
+                .map(|t| Some(value(t, direction)))
+                .collect(),
+        })
+        .collect();
+    Measurement::new(
+        axis.letter().to_string(),
+        per_target.iter().map(|t| t.target_mm).collect(),
+        runs,
+        Default::default(),
+        Default::default(),
+    )
+    .map_err(|e| PredictError::Internal(e.to_string()))
+}
+
+/// The errors with each table applied to its axis's positioning error, for
+/// one direction: EAA_c(x) = EAA(x − v) − v, linear through the grid's
+/// positions and the table's points (exact at both).
+fn compensated_errors(
+    errors: &GeometricErrors,
+    tables: &[CompensationTable],
+    grid: &Grid,
+    direction: Direction,
+) -> Result<GeometricErrors, PredictError> {
+    let mut compensated = errors.clone();
+    for table in tables {
+        let axis = axis_named("a table", &table.axis)?;
+        let name = positioning_error(axis);
+        let own = errors.function(name).cloned().unwrap_or_default();
+        let mut positions: Vec<f64> = grid
+            .axis_mm(axis)
+            .iter()
+            .chain(&table.positions_mm)
+            .copied()
+            .collect();
+        positions.sort_by(f64::total_cmp);
+        positions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        let values = positions
+            .iter()
+            .map(|&x| {
+                let v = table.value_at(x, direction);
+                own.value_at(x - v) - v
+            })
+            .collect();
+        let function = ErrorTable::new(positions, values, Interpolation::Linear)?;
+        compensated.set(name, ErrorFunction::Table(function))?;
+    }
+    Ok(compensated)
+}
+
+#[cfg(test)]
+mod tests;
