@@ -8,6 +8,7 @@
 
 mod common;
 mod convert;
+mod diagnose;
 mod evaluate;
 mod predict;
 mod progress;
@@ -60,6 +61,14 @@ pub enum Command {
     /// ISO 230-2 figures of the re-test on the line and the largest volumetric
     /// error over the work volume with and without the tables.
     Predict(predict::PredictArgs),
+    /// Trace the residual of a re-test to the physical effect the model lacks.
+    ///
+    /// Compares the re-test with the prediction from the first test and the
+    /// table, fits the known effects (reversal, scale, drift, periodic,
+    /// outlier run, Abbe), accepts one only if it predicts the runs it was not
+    /// fitted on and passes an information criterion, and reports what no
+    /// effect explains as unexplained structure.
+    Diagnose(diagnose::DiagnoseArgs),
     /// Monte Carlo tolerance study: random machines from straightness tolerances.
     ///
     /// Draws random rail mounting surfaces within the tolerances, turns them
@@ -107,6 +116,7 @@ fn run(args: Args) -> Result<()> {
         Command::Convert(convert_args) => convert::run(&convert_args),
         Command::Synth(synth_args) => synth::run(&synth_args),
         Command::Predict(predict_args) => predict::run(&predict_args),
+        Command::Diagnose(diagnose_args) => diagnose::run(&diagnose_args),
         Command::Tolerance(tolerance_args) => tolerance::run(&tolerance_args),
         Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
     }

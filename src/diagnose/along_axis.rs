@@ -2,6 +2,13 @@
 //! per-target levels by generalised least squares with their known
 //! covariance (the re-test's scatter plus the prediction's uncertainty,
 //! shared between targets that interpolate the same points of the first test).
+//!
+//! Against a prediction the levels are residuals: a constant background, and
+//! what an effect does not explain is unexplained structure. Without one the
+//! levels are the test's own systematic curve, which the table is for; only a
+//! periodic error short next to the stroke is looked for there, against a
+//! smooth background (a regression spline with knots every span / 6), with the
+//! background's misfit counted as noise.
 
 use nalgebra::DMatrix;
 
@@ -66,6 +73,52 @@ pub(super) fn target_levels(problem: &Problem, cells: &[Cell]) -> Vec<Level> {
     levels
 }
 
+/// What the effects along the axis are fitted against.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Background {
+    /// A constant: the levels are residuals against a prediction.
+    Constant,
+    /// A smooth curve: the levels are a test's own systematic curve.
+    Smooth,
+}
+
+/// Knot spacing of the smooth background, as a fraction of the span: coarse
+/// enough that it cannot follow [`super::MIN_PERIODS_IN_CURVE`] periods.
+const SMOOTH_KNOTS_PER_SPAN: f64 = 6.0;
+
+/// The background's columns over the levels; with `rows`, a smooth
+/// background spans those rows only (the same knot spacing).
+fn background_columns(
+    background: Background,
+    levels: &[Level],
+    rows: Option<&[bool]>,
+) -> Vec<Vec<f64>> {
+    let m = levels.len();
+    if background == Background::Constant {
+        return vec![vec![1.0; m]];
+    }
+    let positions: Vec<f64> = levels.iter().map(|l| l.target_mm).collect();
+    let span = positions[m - 1] - positions[0];
+    let used: Vec<f64> = positions
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| rows.is_none_or(|r| r[*i]))
+        .map(|(_, x)| *x)
+        .collect();
+    let (low, high) = (used[0], used[used.len() - 1]);
+    let intervals = ((high - low) / (span / SMOOTH_KNOTS_PER_SPAN))
+        .round()
+        .max(1.0) as usize;
+    let knots: Vec<f64> = (0..=intervals)
+        .map(|k| low + (high - low) * k as f64 / intervals as f64)
+        .collect();
+    // The spline is linear in its knot values: one column per knot.
+    let basis = crate::spline::basis_matrix(&knots, &positions);
+    (0..knots.len())
+        .map(|k| (0..m).map(|i| basis[i * knots.len() + k]).collect())
+        .collect()
+}
+
 /// The columns of a position-dependent shape over the levels.
 fn level_columns(problem: &Problem, levels: &[Level], shape: Shape) -> Vec<Vec<f64>> {
     let readings: Vec<Reading> = levels
@@ -94,24 +147,37 @@ pub(super) fn select_along_axis(
     folds: &[Fold],
     reversal_b: f64,
     kinds: &[Kind],
+    background: Background,
     rejected: &mut Vec<RejectedEffect>,
 ) -> (Vec<Chosen>, WeightedFit) {
     let m = levels.len();
     let values: Vec<f64> = levels.iter().map(|l| l.value_um).collect();
-    let covariance = level_covariance(problem, levels);
-    let mut model = Design {
-        columns: vec![vec![1.0; m]],
+    let base = Design {
+        columns: background_columns(background, levels, None),
     };
+    let mut covariance = level_covariance(problem, levels);
+    if background == Background::Smooth {
+        // The smooth curve only approximates the test's own systematic error:
+        // its misfit counts as noise (the variance scaled by χ²/dof when > 1).
+        let fit = fit_gls(&base, &values, &covariance, None);
+        let dof = m.saturating_sub(fit.rank).max(1) as f64;
+        covariance *= (fit.chi2 / dof).max(1.0);
+    }
+    let mut model = base.clone();
     let mut model_fit = fit_gls(&model, &values, &covariance, None);
     let mut chosen: Vec<Chosen> = Vec::new();
-    let range = period_range(&problem.targets_mm);
+    let min_periods = match background {
+        Background::Constant => super::MIN_PERIODS_IN_SPAN,
+        Background::Smooth => super::MIN_PERIODS_IN_CURVE,
+    };
+    let range = period_range(&problem.targets_mm, min_periods);
     loop {
         let mut candidates: Vec<(Shape, usize, f64, WeightedFit)> = Vec::new();
         for &kind in kinds.iter().filter(|k| k.is_positional()) {
             if chosen.iter().any(|c| c.shape.kind() == kind) {
                 continue;
             }
-            let shapes = shapes(kind, &problem.targets_mm, &[], &chosen);
+            let shapes = shapes(kind, &problem.targets_mm, range, &[], &chosen);
             let Some((shape, chi2, trial_fit)) = best_of(&shapes, range, |shape| {
                 let f = fit_gls(
                     &model.with(&level_columns(problem, levels, shape)),
@@ -140,7 +206,8 @@ pub(super) fn select_along_axis(
             if !strong_evidence(rejected, shape.kind(), delta) {
                 continue;
             }
-            if let Some(why) = inconsistent_along_axis(problem, levels, &values, &covariance, shape)
+            if let Some(why) =
+                inconsistent_along_axis(problem, levels, &values, &covariance, background, shape)
             {
                 set_rejection(rejected, shape.kind(), why);
                 continue;
@@ -179,9 +246,10 @@ pub(super) fn select_along_axis(
         model = with;
         model_fit = with_fit;
     }
-    // Never the nearest kind: what is accepted along the axis must leave no structure there.
+    // Never the nearest kind: what is accepted along the axis must leave no
+    // structure there (against a prediction; a test's own curve is the table's).
     let p = chi2_p(model_fit.chi2, m.saturating_sub(model_fit.rank));
-    if p < LACK_OF_FIT_P && !chosen.is_empty() {
+    if background == Background::Constant && p < LACK_OF_FIT_P && !chosen.is_empty() {
         for c in &chosen {
             set_rejection(
                 rejected,
@@ -192,10 +260,7 @@ pub(super) fn select_along_axis(
             );
         }
         chosen.clear();
-        model = Design {
-            columns: vec![vec![1.0; m]],
-        };
-        model_fit = fit_gls(&model, &values, &covariance, None);
+        model_fit = fit_gls(&base, &values, &covariance, None);
     }
     (chosen, model_fit)
 }
@@ -207,6 +272,7 @@ fn inconsistent_along_axis(
     levels: &[Level],
     values: &[f64],
     covariance: &DMatrix<f64>,
+    background: Background,
     shape: Shape,
 ) -> Option<String> {
     let columns = level_columns(problem, levels, shape);
@@ -218,20 +284,20 @@ fn inconsistent_along_axis(
             .iter()
             .map(|l| (l.target_mm <= middle) == first_half)
             .collect();
-        if rows.iter().filter(|r| **r).count() < k + 3 {
+        if rows.iter().filter(|r| **r).count() < k + 6 {
             return None;
         }
         let design = Design {
-            columns: vec![vec![1.0; levels.len()]],
-        }
-        .with(&columns);
-        let fitted = fit_gls(&design, values, covariance, Some(&rows));
-        if fitted.rank < k + 1 {
+            columns: background_columns(background, levels, Some(&rows)),
+        };
+        let first = design.parameters();
+        let fitted = fit_gls(&design.with(&columns), values, covariance, Some(&rows));
+        if fitted.rank < first + k {
             return None;
         }
         halves.push((
-            fitted.coefficients[1..].to_vec(),
-            fitted.standard_errors[1..].to_vec(),
+            fitted.coefficients[first..].to_vec(),
+            fitted.standard_errors[first..].to_vec(),
         ));
     }
     // The halves as independent (their shared prediction error is small next to their own):

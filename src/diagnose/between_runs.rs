@@ -41,7 +41,7 @@ pub(super) fn select_between_runs(
             if kind != Kind::OutlierRun && chosen.iter().any(|c| c.shape.kind() == kind) {
                 continue;
             }
-            let shapes = shapes(kind, &problem.targets_mm, &runs, &chosen);
+            let shapes = shapes(kind, &problem.targets_mm, None, &runs, &chosen);
             let Some((shape, rss, trial_fit)) = best_of(&shapes, None, |shape| {
                 let f = fit::fit(&model.with(&problem.columns(shape)), y, None);
                 (f.rss, f)

@@ -39,15 +39,16 @@ mod stats;
 use crate::compensate::retest::{KnownError, predicted_deviation_mm};
 use crate::compensate::{CompensationTable, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
+use crate::error::{ParseError, describe_found};
 use crate::evaluate::{AxisFigures, Evaluation, evaluate};
 use crate::measurement::{Direction, Measurement, Run};
-use along_axis::{level_covariance, select_along_axis, target_levels};
+use along_axis::{Background, select_along_axis, target_levels};
 use between_runs::{
     cell_levels, cross_validation_folds, reversals, select_between_runs, select_reversal,
 };
 pub use effects::{Context, Effect, Kind, Reading, Shape};
 pub use effects_file::{read_effects, write_effects};
-use fit::{Design, WeightedFit, fit_gls};
+use fit::{Design, WeightedFit};
 use stats::chi2_p;
 
 /// Minimum drop of the BIC for an effect to be accepted.
@@ -56,6 +57,10 @@ pub const MIN_DELTA_BIC: f64 = 6.0;
 pub const LACK_OF_FIT_P: f64 = 0.001;
 /// A periodic error must fit at least this many periods in the measured span.
 pub const MIN_PERIODS_IN_SPAN: f64 = 2.0;
+/// Without a prediction, a periodic error is told from the smooth curve of the
+/// test itself (a regression spline with knots every span / 6), so it must be
+/// short next to it: at least this many periods in the span.
+pub const MIN_PERIODS_IN_CURVE: f64 = 8.0;
 
 /// What `diagnose` is given.
 #[derive(Clone, Copy, Debug)]
@@ -79,6 +84,81 @@ pub struct AngularProfile {
     pub positions_mm: Vec<f64>,
     /// Angle there, µrad.
     pub angle_urad: Vec<f64>,
+}
+
+impl AngularProfile {
+    /// Reads `position_mm,angle_urad` lines (that header first; `#` starts a
+    /// comment), positions strictly increasing, at least two: the pitch or
+    /// yaw of the axis from an angular laser measurement.
+    ///
+    /// ```
+    /// use axcomp::diagnose::AngularProfile;
+    ///
+    /// let profile = AngularProfile::from_csv_str("position_mm,angle_urad\n0,0\n375,12.5\n750,0\n")?;
+    /// assert_eq!(profile.angle_urad, [0.0, 12.5, 0.0]);
+    /// # Ok::<(), axcomp::error::ParseError>(())
+    /// ```
+    pub fn from_csv_str(text: &str) -> Result<AngularProfile, ParseError> {
+        let mut rows = text
+            .lines()
+            .enumerate()
+            .map(|(i, line)| (i + 1, line.split('#').next().unwrap_or("").trim()))
+            .filter(|(_, line)| !line.is_empty());
+        let header: Vec<&str> = rows
+            .next()
+            .map_or(Vec::new(), |(_, l)| l.split(',').map(str::trim).collect());
+        if header != ["position_mm", "angle_urad"] {
+            return Err(ParseError::expected(
+                1,
+                1,
+                "the header position_mm,angle_urad",
+                &header.join(","),
+            ));
+        }
+        let mut profile = AngularProfile {
+            positions_mm: Vec::new(),
+            angle_urad: Vec::new(),
+        };
+        for (number, line) in rows {
+            let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+            let [position, angle] = fields[..] else {
+                return Err(ParseError::expected(
+                    number,
+                    1,
+                    "two fields: position_mm,angle_urad",
+                    line,
+                ));
+            };
+            let parse = |field: &str, column: usize| {
+                field
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| {
+                        ParseError::expected(number, column, "a number", &describe_found(field))
+                    })
+            };
+            let x = parse(position, 1)?;
+            if profile.positions_mm.last().is_some_and(|last| x <= *last) {
+                return Err(ParseError::expected(
+                    number,
+                    1,
+                    "positions strictly increasing",
+                    position,
+                ));
+            }
+            profile.positions_mm.push(x);
+            profile.angle_urad.push(parse(angle, position.len() + 2)?);
+        }
+        if profile.positions_mm.len() < 2 {
+            return Err(ParseError::new(
+                1,
+                1,
+                "expected at least two positions with an angle",
+            ));
+        }
+        Ok(profile)
+    }
 }
 
 /// RMS and largest |value| of a residual, µm.
@@ -297,18 +377,21 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
 
     // 3. Along the axis (scale, periodic, Abbe) on the pooled per-target levels, with a prediction only.
     let levels = target_levels(&problem, &cells);
-    let (along, along_fit) = if with_prediction {
-        select_along_axis(&problem, &levels, &folds, reversal_b, &kinds, &mut rejected)
+    // Without a prediction only a periodic error is looked for there, in the test's own curve.
+    let background = if with_prediction {
+        Background::Constant
     } else {
-        let design = Design {
-            columns: vec![vec![1.0; levels.len()]],
-        };
-        let values: Vec<f64> = levels.iter().map(|l| l.value_um).collect();
-        (
-            Vec::new(),
-            fit_gls(&design, &values, &level_covariance(&problem, &levels), None),
-        )
+        Background::Smooth
     };
+    let (along, along_fit) = select_along_axis(
+        &problem,
+        &levels,
+        &folds,
+        reversal_b,
+        &kinds,
+        background,
+        &mut rejected,
+    );
     let along_p = chi2_p(along_fit.chi2, levels.len().saturating_sub(along_fit.rank));
 
     let context = context(input, time_assumed);
@@ -604,12 +687,13 @@ fn applicable_kinds(input: &DiagnoseInput<'_>, rejected: &mut Vec<RejectedEffect
             Kind::Reversal if after.run_count(Direction::Up) == 0 || after.run_count(Direction::Down) == 0 => {
                 Some("needs runs in both directions".to_string())
             }
-            Kind::Scale | Kind::Periodic | Kind::Abbe if input.before.is_none() => Some(
+            Kind::Scale | Kind::Abbe if input.before.is_none() => Some(
                 "needs a prediction (--before and --table): in a test alone a position-dependent error is part of the systematic curve the table compensates".to_string(),
             ),
             Kind::Abbe if input.angular.is_none() => Some("needs the axis' angular error along the stroke (--angular)".to_string()),
-            Kind::Periodic if period_range(after.targets_mm()).is_none() => Some(format!(
-                "the targets are too coarse to resolve a period shorter than 1/{MIN_PERIODS_IN_SPAN} of the measured span"
+            Kind::Periodic if period_range(after.targets_mm(), min_periods(input)).is_none() => Some(format!(
+                "the targets are too coarse to resolve a period shorter than 1/{} of the measured span",
+                min_periods(input)
             )),
             Kind::OutlierRun if after.run_count(Direction::Up) < 3 && after.run_count(Direction::Down) < 3 => {
                 Some("needs at least 3 runs in a direction to tell one apart".to_string())
@@ -624,9 +708,20 @@ fn applicable_kinds(input: &DiagnoseInput<'_>, rejected: &mut Vec<RejectedEffect
     kinds
 }
 
+/// How many periods the span must hold: fewer against a prediction (a
+/// constant background) than in a test's own curve (a smooth background).
+fn min_periods(input: &DiagnoseInput<'_>) -> f64 {
+    if input.before.is_some() {
+        MIN_PERIODS_IN_SPAN
+    } else {
+        MIN_PERIODS_IN_CURVE
+    }
+}
+
 /// The periods a periodic error is looked for at: from twice the median target
-/// spacing to the span / [`MIN_PERIODS_IN_SPAN`].
-fn period_range(targets_mm: &[f64]) -> Option<(f64, f64)> {
+/// spacing to the span / `min_periods` ([`MIN_PERIODS_IN_SPAN`] against a
+/// prediction, [`MIN_PERIODS_IN_CURVE`] in a test's own curve).
+fn period_range(targets_mm: &[f64], min_periods: f64) -> Option<(f64, f64)> {
     if targets_mm.len() < 8 {
         return None;
     }
@@ -634,15 +729,21 @@ fn period_range(targets_mm: &[f64]) -> Option<(f64, f64)> {
     gaps.sort_by(f64::total_cmp);
     let median = gaps[gaps.len() / 2];
     let span = targets_mm[targets_mm.len() - 1] - targets_mm[0];
-    let (shortest, longest) = (2.0 * median, span / MIN_PERIODS_IN_SPAN);
+    let (shortest, longest) = (2.0 * median, span / min_periods);
     (shortest < longest).then_some((shortest, longest))
 }
 
 /// The shapes of a kind to try.
-fn shapes(kind: Kind, after_targets: &[f64], runs: &[Run], chosen: &[Chosen]) -> Vec<Shape> {
+fn shapes(
+    kind: Kind,
+    after_targets: &[f64],
+    periods: Option<(f64, f64)>,
+    runs: &[Run],
+    chosen: &[Chosen],
+) -> Vec<Shape> {
     match kind {
         Kind::Periodic => {
-            let Some((shortest, longest)) = period_range(after_targets) else {
+            let Some((shortest, longest)) = periods else {
                 return Vec::new();
             };
             let span = after_targets[after_targets.len() - 1] - after_targets[0];

@@ -4,12 +4,14 @@
 //! keys carry units (`A_um`, `target_mm`); internal types are never
 //! serialised directly. [`terminal`] renders the same data as a readable
 //! terminal report. [`convert`] is the summary of `axcomp convert`,
-//! [`predict`] the wire format and report of `axcomp predict`;
+//! [`predict`] and [`diagnose`] the wire formats and reports of `axcomp
+//! predict` and `axcomp diagnose`;
 //! [`tolerance`] the wire format and terminal report of `axcomp tolerance`,
 //! and [`plot`] its histogram as SVG or PNG bytes; [`servo`] the output of
 //! `servo-sim`. All convert mm to µm through `crate::units`; nothing else in
 //! the crate depends on this module; files are written by `crate::output`.
 pub mod convert;
+pub mod diagnose;
 pub mod json;
 pub mod plot;
 pub mod predict;

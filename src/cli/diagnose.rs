@@ -1,0 +1,117 @@
+//! `axcomp diagnose`: the residual of a re-test against the prediction,
+//! traced to the physical effects the model lacks.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use axcomp::cycle::CycleTiming;
+use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose, write_effects};
+use axcomp::output::write_new;
+use axcomp::read;
+use axcomp::report::diagnose::{DiagnoseJson, render};
+
+use super::common::{load_profile, print_json, print_text, print_warnings, read_table};
+
+/// Flags of `axcomp diagnose`.
+#[derive(Debug, clap::Args)]
+pub struct DiagnoseArgs {
+    /// The re-test (any format evaluate reads).
+    #[arg(long, value_name = "FILE")]
+    pub after: PathBuf,
+
+    /// The first test, from which the model predicts the re-test on the same
+    /// line; without it, only structure between runs is looked for (drift,
+    /// outlier runs, reversal) and periodic errors in the re-test's own curve.
+    #[arg(long, value_name = "FILE")]
+    pub before: Option<PathBuf>,
+
+    /// The compensation table active during the re-test (any format convert writes).
+    #[arg(long, value_name = "TABLE", requires = "before")]
+    pub table: Option<PathBuf>,
+
+    /// Machine profile, to read the table's axis names (as in convert).
+    #[arg(long, value_name = "M.toml")]
+    pub machine: Option<PathBuf>,
+
+    /// The axis's pitch or yaw along the stroke (CSV: position_mm,angle_urad),
+    /// to tell an Abbe error.
+    #[arg(long, value_name = "FILE")]
+    pub angular: Option<PathBuf>,
+
+    /// Save the accepted effects (TOML) for predict --effects and convert --effects.
+    #[arg(long = "write-effects", value_name = "E.toml")]
+    pub write_effects: Option<PathBuf>,
+
+    /// Replace an existing --write-effects file.
+    #[arg(long)]
+    pub force: bool,
+
+    /// LinuxCNC table type, when its numbers do not tell it.
+    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1))]
+    pub linuxcnc_type: Option<u8>,
+
+    /// Print JSON instead of the report.
+    #[arg(long)]
+    pub json: bool,
+
+    /// No warnings on stderr.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// Runs `axcomp diagnose`.
+pub fn run(args: &DiagnoseArgs) -> Result<()> {
+    let after = read::read_path(&args.after, None)?;
+    print_warnings(&after.warnings, args.quiet);
+    let before = match &args.before {
+        Some(path) => {
+            let result = read::read_path(path, None)?;
+            print_warnings(&result.warnings, args.quiet);
+            Some(result.measurement)
+        }
+        None => None,
+    };
+    let table = match &args.table {
+        Some(path) => {
+            let profile = load_profile(args.machine.as_deref())?;
+            Some(read_table(
+                path,
+                after.measurement.axis(),
+                &profile,
+                args.linuxcnc_type,
+            )?)
+        }
+        None => None,
+    };
+    let angular = args.angular.as_deref().map(load_angular).transpose()?;
+    let input = DiagnoseInput {
+        after: &after.measurement,
+        before: before.as_ref(),
+        table: table.as_ref(),
+        angular: angular.as_ref(),
+        timing: CycleTiming::ASSUMED,
+    };
+    let diagnosis = diagnose(&input)?;
+    let name = |p: &Path| p.display().to_string();
+    if let Some(path) = &args.write_effects {
+        let text = write_effects(&diagnosis.accepted, &name(&args.after));
+        write_new(path, text.as_bytes(), args.force)?;
+    }
+    let report = DiagnoseJson::new(
+        &diagnosis,
+        name(&args.after),
+        args.before.as_deref().map(name),
+        args.table.as_deref().map(name),
+    );
+    if args.json {
+        print_json(&report)
+    } else {
+        print_text(&render(&report))
+    }
+}
+
+fn load_angular(path: &Path) -> Result<AngularProfile> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    AngularProfile::from_csv_str(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+}

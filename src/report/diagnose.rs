@@ -1,0 +1,327 @@
+//! The `--json` wire format and the terminal report of `axcomp diagnose`.
+//!
+//! # Wire format
+//!
+//! One object; keys may be added, never renamed or removed. Residuals are
+//! measured − predicted, µm, over every reading of the re-test.
+//!
+//! ```text
+//! { "after": "after.rtl", "before": "before.rtl" | null, "table": "X.COM" | null,
+//!   "predicted_from_first_test": true,
+//!   "residual_before_um": {"rms": …, "max_abs": …},
+//!   "effects": [{"kind": "periodic", "params": {"period_mm": …, "amplitude_um": …, "phase_rad": …},
+//!                "uncertainty": {"period_mm": …, "amplitude_um": …},
+//!                "evidence": {"delta_bic": …, "trials": …, "p_value": …,
+//!                             "cv_rmse_without_um": …, "cv_rmse_with_um": …},
+//!                "explanation": "…", "warnings": ["…"]}],
+//!   "rejected": [{"kind": "scale", "why": "…"}],
+//!   "residual_after_um": {"rms": …, "max_abs": …},
+//!   "figures_um": {"measured": {"A": …, …}, "predicted": {…}, "predicted_with_effects": {…}},
+//!   "unexplained": {"significant": false, "where_mm": [], "rms_um": …, "p_value": …},
+//!   "noise_um": …, "time_assumed": false }
+//! ```
+//!
+//! `params` of an `outlier-run` are `run` (a number), `direction` (`up` or
+//! `down`) and `offset_um`. `residual_before_um` is the model's error before
+//! the effects are added, `residual_after_um` with them.
+
+use std::fmt::Write;
+
+use serde::Serialize;
+use serde_json::{Map, Value};
+
+use crate::diagnose::{AcceptedEffect, Diagnosis, Effect, ResidualStats};
+use crate::report::json::FiguresJson;
+use crate::report::terminal::um;
+
+/// RMS and largest |value|, µm.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ResidualJson {
+    /// Root mean square, µm.
+    pub rms: f64,
+    /// Largest |value|, µm.
+    pub max_abs: f64,
+}
+
+impl From<ResidualStats> for ResidualJson {
+    fn from(s: ResidualStats) -> ResidualJson {
+        ResidualJson {
+            rms: s.rms_um,
+            max_abs: s.max_abs_um,
+        }
+    }
+}
+
+/// Why an effect was accepted.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct EvidenceJson {
+    /// Change of the BIC when it was added (negative is better).
+    pub delta_bic: f64,
+    /// Shapes tried (periods, runs).
+    pub trials: usize,
+    /// p-value of adding it.
+    pub p_value: f64,
+    /// Leave-one-run-out prediction error without it, µm.
+    pub cv_rmse_without_um: f64,
+    /// The same with it, µm.
+    pub cv_rmse_with_um: f64,
+}
+
+/// An accepted effect.
+#[derive(Clone, Debug, Serialize)]
+pub struct EffectJson {
+    /// `reversal`, `scale`, `drift`, `periodic`, `outlier-run` or `abbe`.
+    pub kind: &'static str,
+    /// Its parameters, keys with units.
+    pub params: Map<String, Value>,
+    /// Standard uncertainty of the parameters, same keys.
+    pub uncertainty: Map<String, Value>,
+    /// Why it was accepted.
+    pub evidence: EvidenceJson,
+    /// What it is and what to do, one sentence.
+    pub explanation: String,
+    /// Caveats (aliasing, assumed times).
+    pub warnings: Vec<String>,
+}
+
+impl EffectJson {
+    /// From an accepted effect.
+    pub fn new(a: &AcceptedEffect) -> EffectJson {
+        let mut params = Map::new();
+        for (key, value) in a.effect.parameters() {
+            let value = if key == "run" {
+                Value::from(value as u64)
+            } else {
+                Value::from(value)
+            };
+            params.insert(key.to_string(), value);
+        }
+        if let Effect::OutlierRun { direction, .. } = a.effect {
+            params.insert("direction".into(), Value::from(direction.as_str()));
+        }
+        let uncertainty = a
+            .uncertainty
+            .iter()
+            .map(|(k, v)| (k.to_string(), Value::from(*v)))
+            .collect();
+        EffectJson {
+            kind: a.effect.kind().name(),
+            params,
+            uncertainty,
+            evidence: EvidenceJson {
+                delta_bic: a.evidence.delta_bic,
+                trials: a.evidence.trials,
+                p_value: a.evidence.p_value,
+                cv_rmse_without_um: a.evidence.cv_rmse_without_um,
+                cv_rmse_with_um: a.evidence.cv_rmse_with_um,
+            },
+            explanation: a.explanation.clone(),
+            warnings: a.warnings.clone(),
+        }
+    }
+}
+
+/// A kind looked for and not accepted.
+#[derive(Clone, Debug, Serialize)]
+pub struct RejectedJson {
+    /// The kind.
+    pub kind: &'static str,
+    /// Why, in words.
+    pub why: String,
+}
+
+/// The figures of the re-test three ways, µm.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct FigureSetJson {
+    /// As measured.
+    pub measured: FiguresJson,
+    /// As the model predicted it.
+    pub predicted: FiguresJson,
+    /// Predicted with the accepted effects.
+    pub predicted_with_effects: FiguresJson,
+}
+
+/// What no effect explains.
+#[derive(Clone, Debug, Serialize)]
+pub struct UnexplainedJson {
+    /// Significant (lack-of-fit p < 0.001).
+    pub significant: bool,
+    /// Where it is largest, mm.
+    pub where_mm: Vec<f64>,
+    /// RMS of the per-target mean residual, µm.
+    pub rms_um: f64,
+    /// p-value of the lack-of-fit test.
+    pub p_value: f64,
+}
+
+/// The whole `diagnose --json` object.
+#[derive(Clone, Debug, Serialize)]
+pub struct DiagnoseJson {
+    /// The re-test file.
+    pub after: String,
+    /// The first test file, if given.
+    pub before: Option<String>,
+    /// The table file, if given.
+    pub table: Option<String>,
+    /// Whether the prediction came from a first test.
+    pub predicted_from_first_test: bool,
+    /// The model's error before adding effects, µm.
+    pub residual_before_um: ResidualJson,
+    /// Effects found.
+    pub effects: Vec<EffectJson>,
+    /// Effects looked for and not found.
+    pub rejected: Vec<RejectedJson>,
+    /// The model's error with the effects, µm.
+    pub residual_after_um: ResidualJson,
+    /// Figures.
+    pub figures_um: FigureSetJson,
+    /// What none of the effects explains.
+    pub unexplained: UnexplainedJson,
+    /// Scatter of one reading left at the end, µm.
+    pub noise_um: f64,
+    /// Whether the reading times were assumed from a typical cycle.
+    pub time_assumed: bool,
+}
+
+impl DiagnoseJson {
+    /// Builds the wire object.
+    pub fn new(
+        diagnosis: &Diagnosis,
+        after: String,
+        before: Option<String>,
+        table: Option<String>,
+    ) -> DiagnoseJson {
+        DiagnoseJson {
+            after,
+            before,
+            table,
+            predicted_from_first_test: diagnosis.predicted_from_first_test,
+            residual_before_um: diagnosis.residual_before.into(),
+            effects: diagnosis.accepted.iter().map(EffectJson::new).collect(),
+            rejected: diagnosis
+                .rejected
+                .iter()
+                .map(|r| RejectedJson {
+                    kind: r.kind.name(),
+                    why: r.why.clone(),
+                })
+                .collect(),
+            residual_after_um: diagnosis.residual_after.into(),
+            figures_um: FigureSetJson {
+                measured: FiguresJson::from_figures(&diagnosis.figures.measured),
+                predicted: FiguresJson::from_figures(&diagnosis.figures.predicted),
+                predicted_with_effects: FiguresJson::from_figures(
+                    &diagnosis.figures.predicted_with_effects,
+                ),
+            },
+            unexplained: UnexplainedJson {
+                significant: diagnosis.unexplained.significant,
+                where_mm: diagnosis.unexplained.where_mm.clone(),
+                rms_um: diagnosis.unexplained.rms_um,
+                p_value: diagnosis.unexplained.p_value,
+            },
+            noise_um: diagnosis.noise_um,
+            time_assumed: diagnosis.time_assumed,
+        }
+    }
+}
+
+/// The terminal report.
+pub fn render(report: &DiagnoseJson) -> String {
+    let mut out = String::new();
+    let source = match (&report.before, &report.table) {
+        (Some(before), Some(table)) => format!("predicted from {before} with {table}"),
+        (Some(before), None) => format!("predicted from {before} (no table)"),
+        _ => "no first test: structure between runs only".to_string(),
+    };
+    let _ = writeln!(out, "Re-test      {} ({source})", report.after);
+    let (b, a) = (&report.residual_before_um, &report.residual_after_um);
+    let _ = writeln!(
+        out,
+        "Residual     rms {} µm, max {} µm; with the effects rms {} µm, max {} µm; noise {} µm",
+        um(Some(b.rms)),
+        um(Some(b.max_abs)),
+        um(Some(a.rms)),
+        um(Some(a.max_abs)),
+        um(Some(report.noise_um)),
+    );
+    let _ = writeln!(out, "\nFound");
+    if report.effects.is_empty() {
+        let _ = writeln!(out, "  nothing beyond noise");
+    }
+    for effect in &report.effects {
+        let params: Vec<String> = effect
+            .params
+            .iter()
+            .map(
+                |(key, value)| match (value.as_f64(), effect.uncertainty.get(key)) {
+                    (Some(v), Some(u)) if key != "run" => {
+                        format!("{key} = {v:.2} ± {:.2}", u.as_f64().unwrap_or(f64::NAN))
+                    }
+                    _ => format!("{key} = {value}"),
+                },
+            )
+            .collect();
+        let _ = writeln!(
+            out,
+            "  {:<12} {}   (ΔBIC {:.1}; runs left out predicted {:.2} → {:.2} µm)",
+            effect.kind,
+            params.join(", "),
+            effect.evidence.delta_bic,
+            effect.evidence.cv_rmse_without_um,
+            effect.evidence.cv_rmse_with_um,
+        );
+        let _ = writeln!(out, "  {:<12} {}", "", effect.explanation);
+        for warning in &effect.warnings {
+            let _ = writeln!(out, "  {:<12} warning: {warning}", "");
+        }
+    }
+    let _ = writeln!(out, "\nNot found");
+    for rejected in &report.rejected {
+        let _ = writeln!(out, "  {:<12} {}", rejected.kind, rejected.why);
+    }
+    let u = &report.unexplained;
+    let _ = writeln!(out);
+    if u.significant {
+        let places: Vec<String> = u.where_mm.iter().map(|x| format!("{x}")).collect();
+        let _ = writeln!(
+            out,
+            "Unexplained  significant structure (p = {:.1e}), rms {} µm, largest at {} mm: no known effect describes it",
+            u.p_value,
+            um(Some(u.rms_um)),
+            places.join(", ")
+        );
+    } else {
+        let _ = writeln!(
+            out,
+            "Unexplained  nothing significant (p = {:.2}), rms {} µm",
+            u.p_value,
+            um(Some(u.rms_um))
+        );
+    }
+    let _ = writeln!(
+        out,
+        "\nFigures [µm] |  measured | predicted | predicted with effects"
+    );
+    let _ = writeln!(
+        out,
+        "-------------+-----------+-----------+-----------------------"
+    );
+    let f = &report.figures_um;
+    for (name, m, p, e) in [
+        ("A", f.measured.A, f.predicted.A, f.predicted_with_effects.A),
+        ("E", f.measured.E, f.predicted.E, f.predicted_with_effects.E),
+        ("M", f.measured.M, f.predicted.M, f.predicted_with_effects.M),
+        ("R", f.measured.R, f.predicted.R, f.predicted_with_effects.R),
+        ("B", f.measured.B, f.predicted.B, f.predicted_with_effects.B),
+    ] {
+        let _ = writeln!(
+            out,
+            " {name:<11} | {:>9} | {:>9} | {:>22}",
+            um(m),
+            um(p),
+            um(e)
+        );
+    }
+    out
+}
