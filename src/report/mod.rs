@@ -8,6 +8,7 @@
 //! and [`plot`] its histogram as SVG or PNG bytes; [`servo`] the output of
 //! `servo-sim`. All convert mm to µm through `crate::units`; nothing else in
 //! the crate depends on this module; files are written by `crate::output`.
+pub mod chart;
 pub mod convert;
 pub mod json;
 pub mod plot;
