@@ -1,10 +1,13 @@
 //! Flag parsers and printing helpers shared by several subcommands.
 
 use std::io::Write;
+use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde::Serialize;
 
+use axcomp::compensate::CompensationTable;
+use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
 use axcomp::measurement::{Direction, RunSelector, SourceFormat};
 
@@ -65,6 +68,40 @@ pub fn print_text(text: &str) -> Result<()> {
     stdout.write_all(text.as_bytes())?;
     stdout.flush()?;
     Ok(())
+}
+
+/// The machine profile of `--machine`, or the defaults from the axis letters.
+pub fn load_profile(path: Option<&Path>) -> Result<MachineProfile> {
+    let Some(path) = path else {
+        return Ok(MachineProfile::default());
+    };
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    MachineProfile::from_toml_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// Reads a compensation table of `axis` in any format `convert` writes; the
+/// axis names come from the profile. `linuxcnc_type` decides a LinuxCNC
+/// table whose numbers do not tell its type.
+pub fn read_table(
+    path: &Path,
+    axis: &str,
+    profile: &MachineProfile,
+    linuxcnc_type: Option<u8>,
+) -> Result<(Controller, CompensationTable)> {
+    let options = EmitOptions {
+        axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
+        table_name: String::new(),
+        machine_unit: profile.machine_unit(),
+        linuxcnc_type: linuxcnc_type.unwrap_or(0),
+        max_points: None,
+        max_value_mm: None,
+        cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
+        cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
+        tnc640_columns: Vec::new(),
+    };
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    emit::read_any(&text, &options, linuxcnc_type)
+        .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
 }
 
 #[cfg(test)]

@@ -4,13 +4,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use axcomp::emit::{self, EmitOptions, MachineProfile};
 use axcomp::measurement::Measurement;
 use axcomp::output::write_new;
 use axcomp::read::{csv, rtl};
 use axcomp::synth::{self, Truth};
 
-use super::common::print_text;
+use super::common::{load_profile, print_text, read_table};
 
 /// Flags of `axcomp synth`.
 #[derive(Debug, clap::Args)]
@@ -59,7 +58,9 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     let first_text = render(&first, &args.output)?;
     let second = match (&args.table, &args.output2) {
         (Some(table_path), Some(output2)) => {
-            let table = read_table(table_path, &truth.axis.name, args)?;
+            let profile = load_profile(args.machine.as_deref())?;
+            let (_, table) =
+                read_table(table_path, &truth.axis.name, &profile, args.linuxcnc_type)?;
             let retest = synth::after(&truth, &table, args.seed)?;
             let text = render(&retest, output2)?;
             Some((output2, text))
@@ -81,35 +82,6 @@ pub fn run(args: &SynthArgs) -> Result<()> {
         ));
     }
     print_text(&summary)
-}
-
-fn read_table(
-    path: &Path,
-    axis: &str,
-    args: &SynthArgs,
-) -> Result<axcomp::compensate::CompensationTable> {
-    let profile = match &args.machine {
-        Some(p) => MachineProfile::from_toml_str(
-            &std::fs::read_to_string(p).with_context(|| p.display().to_string())?,
-        )
-        .map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?,
-        None => MachineProfile::default(),
-    };
-    let options = EmitOptions {
-        axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
-        table_name: String::new(),
-        machine_unit: profile.machine_unit(),
-        linuxcnc_type: args.linuxcnc_type.unwrap_or(0),
-        max_points: None,
-        max_value_mm: None,
-        cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
-        cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
-        tnc640_columns: Vec::new(),
-    };
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    let (_, table) = emit::read_any(&text, &options, args.linuxcnc_type)
-        .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?;
-    Ok(table)
 }
 
 /// The file text for an output path, by its extension.
