@@ -11,5 +11,6 @@ mod evaluate_ecmc;
 mod linuxcnc;
 mod model;
 mod read_api_pos;
+mod report;
 mod servo;
 mod util;
