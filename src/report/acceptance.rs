@@ -285,7 +285,8 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
                 .filter_map(|(x, value)| value.map(|v| (*x, mm_to_um(v))))
                 .collect();
             lines.push(series(None, light, Mark::Line(1), points.clone()));
-            let label = (index == 0).then(|| format!("{count} runs {direction}"));
+            let runs = if count == 1 { "run" } else { "runs" };
+            let label = (index == 0).then(|| format!("{count} {runs} {direction}"));
             markers.push(series(label, color, mark.clone(), points));
         }
     }
