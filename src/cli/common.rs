@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use axcomp::compensate::CompensationTable;
-use axcomp::emit::{self, EmitOptions, MachineProfile};
+use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
 use axcomp::measurement::{Direction, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
@@ -100,7 +100,7 @@ pub fn read_table(
     axis: &str,
     profile: &MachineProfile,
     linuxcnc_type: Option<u8>,
-) -> Result<CompensationTable> {
+) -> Result<(Controller, CompensationTable)> {
     let options = EmitOptions {
         axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
         table_name: String::new(),
@@ -113,13 +113,12 @@ pub fn read_table(
         tnc640_columns: Vec::new(),
     };
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    let (_, table) = emit::read_any(&text, &options, None)
+    emit::read_any(&text, &options, None)
         .or_else(|error| match linuxcnc_type {
             Some(kind) => emit::read_any(&text, &options, Some(kind)),
             None => Err(error),
         })
-        .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?;
-    Ok(table)
+        .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
 }
 
 /// Prints warnings to stderr unless `quiet`.

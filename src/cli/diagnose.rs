@@ -75,12 +75,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let table = match &args.table {
         Some(path) => {
             let profile = load_profile(args.machine.as_deref())?;
-            Some(read_table(
-                path,
-                after.measurement.axis(),
-                &profile,
-                args.linuxcnc_type,
-            )?)
+            Some(read_table(path, after.measurement.axis(), &profile, args.linuxcnc_type)?.1)
         }
         None => None,
     };

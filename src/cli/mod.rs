@@ -12,6 +12,7 @@ mod diagnose;
 mod evaluate;
 mod predict;
 mod progress;
+mod report;
 mod servo_sim;
 mod synth;
 mod tolerance;
@@ -84,6 +85,13 @@ pub enum Command {
     /// after each dwell and their ISO 230-2 figures, including the reversal
     /// B that friction leaves through the structure's compliance.
     ServoSim(servo_sim::ServoSimArgs),
+    /// Write the acceptance report: one self-contained HTML file.
+    ///
+    /// Header, test conditions with the refractive index check, the ISO
+    /// 230-2 figures and per-target table, the deviation plot; with --after
+    /// the before/after comparison, with --table the table and the predicted
+    /// re-test, with --diagnose the diagnosis. --png writes the plots as PNG.
+    Report(Box<report::ReportArgs>),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -119,6 +127,7 @@ fn run(args: Args) -> Result<()> {
         Command::Diagnose(diagnose_args) => diagnose::run(&diagnose_args),
         Command::Tolerance(tolerance_args) => tolerance::run(&tolerance_args),
         Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
+        Command::Report(report_args) => report::run(&report_args),
     }
 }
 

@@ -198,7 +198,7 @@ fn load_table(
             ),
         },
     };
-    read_table(Path::new(path), &axis, profile, linuxcnc_type)
+    Ok(read_table(Path::new(path), &axis, profile, linuxcnc_type)?.1)
 }
 
 /// What the reader should know about this prediction.

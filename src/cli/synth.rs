@@ -59,7 +59,8 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     let second = match (&args.table, &args.output2) {
         (Some(table_path), Some(output2)) => {
             let profile = load_profile(args.machine.as_deref())?;
-            let table = read_table(table_path, &truth.axis.name, &profile, args.linuxcnc_type)?;
+            let (_, table) =
+                read_table(table_path, &truth.axis.name, &profile, args.linuxcnc_type)?;
             let retest = synth::after(&truth, &table, args.seed)?;
             let text = render(&retest, output2)?;
             Some((output2, text))

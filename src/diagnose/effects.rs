@@ -65,7 +65,7 @@ impl Kind {
 }
 
 /// One reading, as the effects see it.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reading {
     /// Index of its target.
     pub target_index: usize,

@@ -254,6 +254,21 @@ pub struct Diagnosis {
     pub noise_um: f64,
     /// Whether reading times were assumed from a typical cycle.
     pub time_assumed: bool,
+    /// Every reading of the re-test in the order measured, with its residual
+    /// and the fitted model (for plots).
+    pub readings: Vec<ReadingResidual>,
+}
+
+/// One reading of the re-test and what the diagnosis made of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReadingResidual {
+    /// Where, in which direction and run, and when it was taken.
+    pub reading: Reading,
+    /// Measured − predicted, µm.
+    pub residual_um: f64,
+    /// The fitted model of the residual there: the level along the axis, the
+    /// reversal and the between-runs effects, µm.
+    pub fitted_um: f64,
 }
 
 /// Why a diagnosis cannot be made.
@@ -508,6 +523,16 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         unexplained,
         noise_um,
         time_assumed,
+        readings: problem
+            .readings
+            .iter()
+            .zip(y.iter().zip(&model_um))
+            .map(|(reading, (residual_um, fitted_um))| ReadingResidual {
+                reading: *reading,
+                residual_um: *residual_um,
+                fitted_um: *fitted_um,
+            })
+            .collect(),
     })
 }
 

@@ -14,9 +14,12 @@
 //! axis figure is evaluated only when what it needs is defined at every
 //! target; otherwise it is `None` and a warning names the target. Suspected
 //! outlier runs are flagged ([`outliers`]) but stay in the figures.
+//! [`environment`] checks the test conditions: the refractive index the laser
+//! used against Edlén's equation.
 //!
 //! Pure: no I/O, no printing. All lengths in mm.
 
+pub mod environment;
 pub mod outliers;
 
 use crate::error::Warning;

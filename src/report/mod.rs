@@ -8,10 +8,16 @@
 //! predict` and `axcomp diagnose`;
 //! [`tolerance`] the wire format and terminal report of `axcomp tolerance`,
 //! and [`plot`] its histogram as SVG or PNG bytes; [`servo`] the output of
-//! `servo-sim`. All convert mm to µm through `crate::units`; nothing else in
-//! the crate depends on this module; files are written by `crate::output`.
+//! `servo-sim`. The acceptance report of `axcomp report`: [`acceptance`]
+//! what it is made from and its charts, [`chart`] x–y charts as data drawn
+//! as SVG or PNG, [`html`] the self-contained page. All convert mm to µm
+//! through `crate::units`; nothing else in the crate depends on this module;
+//! files are written by `crate::output`.
+pub mod acceptance;
+pub mod chart;
 pub mod convert;
 pub mod diagnose;
+pub mod html;
 pub mod json;
 pub mod plot;
 pub mod predict;

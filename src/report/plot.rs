@@ -1,4 +1,5 @@
-//! Plots as bytes: the histogram of `axcomp tolerance` as SVG or PNG.
+//! Plots as bytes: the histogram of `axcomp tolerance` as SVG or PNG, and
+//! the drawing of every plot (`render`), which `chart` uses too.
 //!
 //! Drawn with `plotters`. Text is laid out with an embedded subset of DejaVu
 //! Sans (`assets/fonts/`, Bitstream Vera licence) through plotters'
@@ -16,8 +17,8 @@ use plotters::style::{FontStyle, register_font};
 
 use crate::report::tolerance::HistogramJson;
 
-/// The embedded font (see `assets/fonts/LICENSE`).
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
+/// The embedded font (see `assets/fonts/LICENSE`); the HTML report embeds it too.
+pub(crate) const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
 
 /// Plot size in pixels (SVG user units).
 const SIZE: (u32, u32) = (900, 540);
@@ -64,26 +65,45 @@ pub fn histogram(
     title: &str,
     format: PlotFormat,
 ) -> Result<Vec<u8>, PlotError> {
+    let plot = HistogramPlot {
+        histogram,
+        p90_um,
+        title,
+    };
+    render(&plot, SIZE, format)
+}
+
+/// A plot that can be drawn on any plotters backend (SVG or bitmap).
+pub(crate) trait Draw {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError>;
+}
+
+/// Draws a plot as SVG text or PNG bytes of `size` pixels.
+pub(crate) fn render(
+    plot: &impl Draw,
+    size: (u32, u32),
+    format: PlotFormat,
+) -> Result<Vec<u8>, PlotError> {
     register_embedded_font()?;
     match format {
         PlotFormat::Svg => {
             let mut svg = String::new();
             {
-                let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-                draw_histogram(&root, histogram, p90_um, title)?;
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                plot.draw(&root)?;
                 root.present().map_err(draw_error)?;
             }
             Ok(svg.into_bytes())
         }
         PlotFormat::Png => {
-            let (width, height) = SIZE;
+            let (width, height) = size;
             let mut rgb = vec![0u8; (width * height * 3) as usize];
             {
-                let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-                draw_histogram(&root, histogram, p90_um, title)?;
+                let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+                plot.draw(&root)?;
                 root.present().map_err(draw_error)?;
             }
-            encode_png(&rgb, SIZE)
+            encode_png(&rgb, size)
         }
     }
 }
@@ -95,8 +115,20 @@ fn register_embedded_font() -> Result<(), PlotError> {
     if ok { Ok(()) } else { Err(PlotError::Font) }
 }
 
-fn draw_error(error: impl std::fmt::Display) -> PlotError {
+pub(crate) fn draw_error(error: impl std::fmt::Display) -> PlotError {
     PlotError::Draw(error.to_string())
+}
+
+struct HistogramPlot<'a> {
+    histogram: &'a HistogramJson,
+    p90_um: f64,
+    title: &'a str,
+}
+
+impl Draw for HistogramPlot<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
+        draw_histogram(root, self.histogram, self.p90_um, self.title)
+    }
 }
 
 fn draw_histogram<DB: DrawingBackend>(

@@ -12,5 +12,6 @@ mod linuxcnc;
 mod model;
 mod predict;
 mod read_api_pos;
+mod report;
 mod servo;
 mod util;

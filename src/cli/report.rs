@@ -1,0 +1,239 @@
+//! `axcomp report`: the acceptance report as one self-contained HTML file,
+//! and its plots as PNG files with `--png`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use axcomp::cycle::CycleTiming;
+use axcomp::diagnose::{DiagnoseInput, diagnose};
+use axcomp::error::Warning;
+use axcomp::evaluate::{Evaluation, evaluate};
+use axcomp::measurement::{Measurement, SourceFormat};
+use axcomp::output::write_new;
+use axcomp::read;
+use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
+use axcomp::report::chart::chart;
+use axcomp::report::html;
+use axcomp::report::plot::PlotFormat;
+
+use super::common::{load_profile, parse_format, print_text, print_warnings, read_table};
+
+/// Flags of `axcomp report`.
+#[derive(Debug, clap::Args)]
+pub struct ReportArgs {
+    /// The measurement to report (.rtl, ecmc .dat, API .pos or axcomp CSV).
+    ///
+    /// With --after it is the first test, before compensation.
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+
+    /// The re-test of the same axis: adds the before/after comparison.
+    ///
+    /// Figures side by side, both deviation plots on one scale, both
+    /// per-target tables.
+    #[arg(long, value_name = "FILE2", help_heading = "Input")]
+    pub after: Option<PathBuf>,
+
+    /// The compensation table (any format convert writes): its plot and the predicted re-test.
+    ///
+    /// The prediction is the first test's mean deviation with the table
+    /// applied as the controller applies it (linear between points, the end
+    /// values held), along the laser line.
+    #[arg(long, value_name = "T", help_heading = "Input")]
+    pub table: Option<PathBuf>,
+
+    /// Diagnose the re-test against the prediction (needs --after; uses --table).
+    ///
+    /// Adds the residual of every reading, the effects found in it (reversal,
+    /// scale, drift, periodic, outlier run) with what to do about each, and
+    /// what none of them explains.
+    #[arg(long, requires = "after", help_heading = "Input")]
+    pub diagnose: bool,
+
+    /// Input format of FILE and FILE2, instead of detecting it: rtl, ecmc, api-pos, csv.
+    #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
+    pub format: Option<SourceFormat>,
+
+    /// Machine profile (TOML), to read the table's axis names (as in convert).
+    #[arg(long, value_name = "M.toml", help_heading = "Input")]
+    pub machine: Option<PathBuf>,
+
+    /// LinuxCNC table type, 0 or 1, when its numbers do not tell it.
+    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Input")]
+    pub linuxcnc_type: Option<u8>,
+
+    /// The HTML file to write (refused if it exists, unless --force).
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "OUT",
+        default_value = "report.html",
+        help_heading = "Output"
+    )]
+    pub output: PathBuf,
+
+    /// Also write every plot as a PNG file into DIR (created if missing).
+    ///
+    /// The same plots as in the HTML, 960 × 600 pixels, text in the embedded
+    /// font (no system fonts needed): deviation.png (or deviation-before.png
+    /// and deviation-after.png), table.png, predicted.png, residual.png,
+    /// residual-along-axis.png, effects.png, as the inputs allow.
+    #[arg(long, value_name = "DIR", help_heading = "Output")]
+    pub png: Option<PathBuf>,
+
+    /// Replace existing output files.
+    #[arg(long, help_heading = "Output")]
+    pub force: bool,
+
+    /// Do not print warnings.
+    #[arg(long, short = 'q', help_heading = "Output")]
+    pub quiet: bool,
+}
+
+/// A measurement read and evaluated, with every warning (as `evaluate` has them).
+struct Test {
+    measurement: Measurement,
+    evaluation: Evaluation,
+    warnings: Vec<Warning>,
+}
+
+impl Test {
+    fn read(path: &Path, format: Option<SourceFormat>) -> Result<Test> {
+        let read::ReadResult {
+            measurement,
+            mut warnings,
+        } = read::read_paths(&[path.to_path_buf()], format)?;
+        let evaluation = evaluate(&measurement);
+        warnings.extend(evaluation.warnings.iter().cloned());
+        Ok(Test {
+            measurement,
+            evaluation,
+            warnings,
+        })
+    }
+
+    fn record(&self) -> TestRecord<'_> {
+        TestRecord {
+            measurement: &self.measurement,
+            evaluation: &self.evaluation,
+            warnings: &self.warnings,
+        }
+    }
+}
+
+/// Runs `axcomp report`.
+pub fn run(args: &ReportArgs) -> Result<()> {
+    let before = Test::read(&args.file, args.format)?;
+    let after = match &args.after {
+        Some(path) => Some(Test::read(path, args.format)?),
+        None => None,
+    };
+    let table = match &args.table {
+        Some(path) => {
+            let profile = load_profile(args.machine.as_deref())?;
+            let (controller, table) = read_table(
+                path,
+                before.measurement.axis(),
+                &profile,
+                args.linuxcnc_type,
+            )?;
+            Some((path.display().to_string(), controller, table))
+        }
+        None => None,
+    };
+    let diagnosis = match (&after, args.diagnose) {
+        (Some(after), true) => {
+            let input = DiagnoseInput {
+                after: &after.measurement,
+                before: Some(&before.measurement),
+                table: table.as_ref().map(|(_, _, t)| t),
+                angular: None,
+                timing: CycleTiming::ASSUMED,
+            };
+            Some(diagnose(&input).context("cannot diagnose the re-test")?)
+        }
+        _ => None,
+    };
+    let generator = format!(
+        "axcomp {} on {}",
+        env!("CARGO_PKG_VERSION"),
+        chrono::Local::now().format("%Y-%m-%d %H:%M")
+    );
+    let input = ReportInput {
+        before: before.record(),
+        after: after.as_ref().map(Test::record),
+        table: table.as_ref().map(|(file, controller, table)| TableRecord {
+            table,
+            file,
+            controller: *controller,
+        }),
+        diagnosis: diagnosis.as_ref(),
+        generator: &generator,
+    };
+    // Render everything before writing anything: a failure leaves no half report.
+    let mut files: Vec<(PathBuf, Vec<u8>)> =
+        vec![(args.output.clone(), html::render(&input)?.into_bytes())];
+    if let Some(directory) = &args.png {
+        for named in charts(&input) {
+            let bytes = chart(&named.chart, PlotFormat::Png)?;
+            files.push((directory.join(format!("{}.png", named.name)), bytes));
+        }
+    }
+    if !args.force
+        && let Some((existing, _)) = files.iter().find(|(path, _)| path.exists())
+    {
+        bail!(
+            "{}: already exists; use --force to replace it (nothing was written)",
+            existing.display()
+        );
+    }
+    if let Some(directory) = &args.png {
+        std::fs::create_dir_all(directory)
+            .with_context(|| format!("{}: cannot create the directory", directory.display()))?;
+    }
+    for (path, bytes) in &files {
+        write_new(path, bytes, args.force)?;
+    }
+    for test in std::iter::once(&before).chain(&after) {
+        print_warnings(&test.warnings, args.quiet);
+    }
+    let mut summary = format!("Wrote {}\n", args.output.display());
+    for (path, _) in files.iter().skip(1) {
+        summary.push_str(&format!("Wrote {}\n", path.display()));
+    }
+    print_text(&summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Args, Command};
+    use clap::Parser;
+
+    #[test]
+    fn diagnose_needs_a_retest_and_output_has_a_default() {
+        assert!(Args::try_parse_from(["axcomp", "report", "a.rtl", "--diagnose"]).is_err());
+        let args = Args::try_parse_from([
+            "axcomp",
+            "report",
+            "a.rtl",
+            "--after",
+            "b.rtl",
+            "--table",
+            "X.COM",
+            "--diagnose",
+            "--png",
+            "plots",
+        ])
+        .unwrap();
+        let Command::Report(report) = args.command else {
+            panic!("parsed as report")
+        };
+        assert!(report.diagnose);
+        assert_eq!(report.output.to_str(), Some("report.html"));
+        assert_eq!(
+            report.png.as_deref().and_then(|p| p.to_str()),
+            Some("plots")
+        );
+    }
+}

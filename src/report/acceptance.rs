@@ -1,0 +1,695 @@
+//! The acceptance report's content: what it is made from ([`ReportInput`])
+//! and its charts ([`charts`]), which the HTML shows as SVG and
+//! `axcomp report --png` writes as PNG: the same [`Chart`] values either way.
+//!
+//! Every number comes from the values the other commands print: the
+//! `Evaluation` of each test (as `evaluate`), the table as read back from its
+//! file (as `convert --existing` reads it), the prediction of
+//! `compensate::retest` and the `Diagnosis` (as `diagnose`). Deviations are
+//! drawn in µm through `crate::units`.
+
+use crate::compensate::CompensationTable;
+use crate::compensate::retest::{KnownError, predicted_deviation_mm};
+use crate::diagnose::{Diagnosis, ReadingResidual};
+use crate::emit::Controller;
+use crate::error::Warning;
+use crate::evaluate::{DirectionStats, Evaluation, TargetStats};
+use crate::measurement::{Direction, Measurement};
+use crate::report::chart::{Chart, Mark, Rgb, Series};
+use crate::units::mm_to_um;
+
+/// One test (the first, or the re-test) as the report shows it.
+#[derive(Clone, Copy, Debug)]
+pub struct TestRecord<'a> {
+    /// The measurement as read.
+    pub measurement: &'a Measurement,
+    /// Its ISO 230-2 evaluation (`evaluate::evaluate` of it).
+    pub evaluation: &'a Evaluation,
+    /// Reader and evaluator warnings.
+    pub warnings: &'a [Warning],
+}
+
+/// The compensation table active in the re-test, as read from its file.
+#[derive(Clone, Copy, Debug)]
+pub struct TableRecord<'a> {
+    /// The table, in axcomp's convention (axis error, zero at the reference).
+    pub table: &'a CompensationTable,
+    /// The file it was read from, as the report names it.
+    pub file: &'a str,
+    /// The controller format the file is in.
+    pub controller: Controller,
+}
+
+/// Everything the report is made from.
+#[derive(Clone, Copy, Debug)]
+pub struct ReportInput<'a> {
+    /// The test being reported (the first test when there is a re-test).
+    pub before: TestRecord<'a>,
+    /// The re-test, for the before/after comparison.
+    pub after: Option<TestRecord<'a>>,
+    /// The table, for its plot and the predicted re-test.
+    pub table: Option<TableRecord<'a>>,
+    /// The diagnosis of the re-test (`before` = the first test, `after` = the re-test).
+    pub diagnosis: Option<&'a Diagnosis>,
+    /// What made the report, e.g. `axcomp 0.1.0 on 2026-11-22 15:04`
+    /// (the library reads no clock: the caller says when).
+    pub generator: &'a str,
+}
+
+/// A chart with the name its PNG file gets (`deviation` → `deviation.png`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedChart {
+    /// File stem and HTML id.
+    pub name: &'static str,
+    /// The chart.
+    pub chart: Chart,
+}
+
+/// What a re-test with the table should read, sampled along the axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// Positions, mm.
+    pub positions_mm: Vec<f64>,
+    /// Predicted deviation moving ↑, µm.
+    pub up_um: Vec<f64>,
+    /// Predicted deviation moving ↓, µm.
+    pub down_um: Vec<f64>,
+    /// The first test's mean deviation there (what the axis does without the table), µm.
+    pub uncompensated_um: Vec<f64>,
+}
+
+impl Prediction {
+    /// Largest minus smallest predicted deviation, both directions, µm.
+    pub fn range_um(&self) -> f64 {
+        let all = self.up_um.iter().chain(&self.down_um);
+        let high = all.clone().fold(f64::NEG_INFINITY, |m, v| m.max(*v));
+        let low = all.fold(f64::INFINITY, |m, v| m.min(*v));
+        high - low
+    }
+
+    /// The same for the uncompensated axis, µm.
+    pub fn uncompensated_range_um(&self) -> f64 {
+        let values = &self.uncompensated_um;
+        let high = values.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v));
+        let low = values.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+        high - low
+    }
+}
+
+/// Points at which the prediction is sampled: fine enough that linear
+/// interpolation between table points shows as it is.
+const PREDICTION_SAMPLES: usize = 600;
+
+/// The predicted re-test of the first test with the table applied
+/// (`compensate::retest`), over the measured span; `None` if the first test
+/// has no mean deviation anywhere.
+pub fn prediction(before: &Evaluation, table: &CompensationTable) -> Option<Prediction> {
+    let known = KnownError::from_evaluation(before)?;
+    let first = *known.positions_mm().first()?;
+    let last = *known.positions_mm().last()?;
+    let positions_mm: Vec<f64> = (0..PREDICTION_SAMPLES)
+        .map(|k| first + (last - first) * k as f64 / (PREDICTION_SAMPLES - 1) as f64)
+        .collect();
+    let predict = |direction| {
+        positions_mm
+            .iter()
+            .map(|&x| mm_to_um(predicted_deviation_mm(&known, Some(table), x, direction)))
+            .collect()
+    };
+    Some(Prediction {
+        up_um: predict(Direction::Up),
+        down_um: predict(Direction::Down),
+        uncompensated_um: positions_mm
+            .iter()
+            .map(|&x| mm_to_um(known.at(x)))
+            .collect(),
+        positions_mm,
+    })
+}
+
+/// Colours: ↑ blue, ↓ orange (distinguishable in greyscale print by the
+/// marker shape, ▲ and ▼, too).
+const UP: Rgb = Rgb(31, 95, 170);
+const UP_LIGHT: Rgb = Rgb(160, 188, 225);
+const DOWN: Rgb = Rgb(200, 82, 0);
+const DOWN_LIGHT: Rgb = Rgb(238, 190, 150);
+const BLACK: Rgb = Rgb(30, 30, 30);
+const GREY: Rgb = Rgb(130, 130, 130);
+const MODEL: Rgb = Rgb(120, 40, 140);
+const ALERT: Rgb = Rgb(200, 20, 20);
+/// Colours of the fitted effects, in the order they are listed.
+const EFFECT_COLOURS: [Rgb; 6] = [
+    Rgb(31, 95, 170),
+    Rgb(200, 82, 0),
+    Rgb(40, 140, 60),
+    Rgb(120, 40, 140),
+    Rgb(160, 120, 0),
+    Rgb(0, 140, 150),
+];
+
+const POSITION_LABEL: &str = "target position [mm]";
+const DEVIATION_LABEL: &str = "positional deviation [µm]";
+
+/// All charts of the report, in the order the HTML shows them.
+pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
+    let mut charts = Vec::new();
+    let mut before = deviation_chart(&input.before, "first test");
+    match &input.after {
+        None => {
+            before.title = format!("Positional deviation{}", axis_suffix(&input.before));
+            charts.push(NamedChart {
+                name: "deviation",
+                chart: before,
+            });
+        }
+        Some(after_record) => {
+            let mut after = deviation_chart(after_record, "re-test");
+            // One scale for both, so the eye compares them truly.
+            let range = [before.y_extent(), after.y_extent()]
+                .into_iter()
+                .flatten()
+                .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+                .map(|range| pad(range, 0.06));
+            before.y_range = range;
+            after.y_range = range;
+            charts.push(NamedChart {
+                name: "deviation-before",
+                chart: before,
+            });
+            charts.push(NamedChart {
+                name: "deviation-after",
+                chart: after,
+            });
+        }
+    }
+    if let Some(table) = &input.table {
+        charts.push(NamedChart {
+            name: "table",
+            chart: table_chart(table.table, input.before.evaluation),
+        });
+        if let Some(prediction) = prediction(input.before.evaluation, table.table) {
+            charts.push(NamedChart {
+                name: "predicted",
+                chart: prediction_chart(
+                    &prediction,
+                    table.table,
+                    input.after.map(|a| a.evaluation),
+                ),
+            });
+        }
+    }
+    if let (Some(diagnosis), Some(after)) = (input.diagnosis, &input.after) {
+        charts.push(NamedChart {
+            name: "residual",
+            chart: residual_chart(diagnosis),
+        });
+        charts.push(NamedChart {
+            name: "residual-along-axis",
+            chart: residual_along_axis_chart(diagnosis),
+        });
+        if !diagnosis.accepted.is_empty() {
+            charts.push(NamedChart {
+                name: "effects",
+                chart: effects_chart(diagnosis, after.measurement),
+            });
+        }
+    }
+    charts
+}
+
+/// ` of axis X` when the axis name is plain ASCII (plots draw only the
+/// characters of the embedded font; file text is shown in the HTML).
+fn axis_suffix(test: &TestRecord<'_>) -> String {
+    let axis = test.measurement.axis();
+    let plain = !axis.is_empty()
+        && axis.len() <= 12
+        && axis
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    if plain {
+        format!(", axis {axis}")
+    } else {
+        String::new()
+    }
+}
+
+fn pad((low, high): (f64, f64), fraction: f64) -> (f64, f64) {
+    let span = (high - low).max(1e-9);
+    (low - span * fraction, high + span * fraction)
+}
+
+fn series(label: Option<String>, color: Rgb, mark: Mark, points: Vec<(f64, f64)>) -> Series {
+    Series {
+        label,
+        color,
+        mark,
+        points,
+    }
+}
+
+/// Every run (▲ moving ↑, ▼ moving ↓, a thin line joining each run's
+/// readings), the means per direction, the bidirectional mean and the
+/// x̄ ± 2s band of each direction.
+fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
+    let measurement = test.measurement;
+    let targets = measurement.targets_mm();
+    let per_target = &test.evaluation.per_target;
+    let mut all = Vec::new();
+    for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
+        let (lower, upper): (Vec<(f64, f64)>, Vec<f64>) = per_target
+            .iter()
+            .filter_map(|t| band(t.target_mm, t.direction(direction)))
+            .map(|(x, low, high)| ((x, low), high))
+            .unzip();
+        if !lower.is_empty() {
+            all.push(series(
+                Some(format!("mean {direction} ± 2s")),
+                color,
+                Mark::Band { upper },
+                lower,
+            ));
+        }
+    }
+    let mut lines = Vec::new();
+    let mut markers = Vec::new();
+    for direction in Direction::BOTH {
+        let (color, light, mark) = match direction {
+            Direction::Up => (UP, UP_LIGHT, Mark::Up),
+            Direction::Down => (DOWN, DOWN_LIGHT, Mark::Down),
+        };
+        let count = measurement.run_count(direction);
+        for (index, run) in measurement.runs_in(direction).enumerate() {
+            let points: Vec<(f64, f64)> = targets
+                .iter()
+                .zip(&run.deviations_mm)
+                .filter_map(|(x, value)| value.map(|v| (*x, mm_to_um(v))))
+                .collect();
+            lines.push(series(None, light, Mark::Line(1), points.clone()));
+            let runs = if count == 1 { "run" } else { "runs" };
+            let label = (index == 0).then(|| format!("{count} {runs} {direction}"));
+            markers.push(series(label, color, mark.clone(), points));
+        }
+    }
+    all.extend(lines);
+    all.extend(markers);
+    for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
+        let means = means_um(per_target, direction);
+        if !means.is_empty() {
+            all.push(series(
+                Some(format!("mean {direction}")),
+                color,
+                Mark::Line(2),
+                means,
+            ));
+        }
+    }
+    let bidirectional: Vec<(f64, f64)> = per_target
+        .iter()
+        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, mm_to_um(m))))
+        .collect();
+    if !bidirectional.is_empty() {
+        all.push(series(
+            Some("bidirectional mean".into()),
+            BLACK,
+            Mark::Dashed(2),
+            bidirectional,
+        ));
+    }
+    Chart {
+        title: format!("Positional deviation, {which}{}", axis_suffix(test)),
+        x_label: POSITION_LABEL.into(),
+        y_label: DEVIATION_LABEL.into(),
+        series: all,
+        y_range: None,
+    }
+}
+
+/// (target, x̄) in µm for one direction, where the mean is defined.
+fn means_um(per_target: &[TargetStats], direction: Direction) -> Vec<(f64, f64)> {
+    per_target
+        .iter()
+        .filter_map(|t| {
+            let mean = t.direction(direction).mean_mm?;
+            Some((t.target_mm, mm_to_um(mean)))
+        })
+        .collect()
+}
+
+/// (target, x̄ − 2s, x̄ + 2s) in µm, where both are defined.
+fn band(target_mm: f64, stats: &DirectionStats) -> Option<(f64, f64, f64)> {
+    let (mean, s) = (stats.mean_mm?, stats.s_mm?);
+    Some((
+        target_mm,
+        mm_to_um(mean - 2.0 * s),
+        mm_to_um(mean + 2.0 * s),
+    ))
+}
+
+/// The table as the controller applies it (linear between points, the end
+/// values held to the measured span) with its points, and the first test's
+/// mean shifted to zero at the reference (what the table should follow).
+fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
+    let mut all = Vec::new();
+    let first_target = before.per_target.first().map(|t| t.target_mm);
+    let last_target = before.per_target.last().map(|t| t.target_mm);
+    if let Some(known) = KnownError::from_evaluation(before) {
+        let at_reference = known.at(table.reference_mm);
+        let points = known
+            .positions_mm()
+            .iter()
+            .zip(known.values_mm())
+            .map(|(x, v)| (*x, mm_to_um(v - at_reference)))
+            .collect();
+        all.push(series(
+            Some(format!(
+                "first test's mean, zero at {} mm",
+                crate::report::chart::tick_label(table.reference_mm)
+            )),
+            GREY,
+            Mark::Dashed(2),
+            points,
+        ));
+    }
+    let directions: &[(Direction, Rgb, &str)] = match table.values.mode() {
+        crate::compensate::TableMode::Mean => &[(Direction::Up, BLACK, "table")],
+        crate::compensate::TableMode::Bidirectional => &[
+            (Direction::Up, UP, "table ↑"),
+            (Direction::Down, DOWN, "table ↓"),
+        ],
+    };
+    for (direction, color, label) in directions {
+        let values = table.values.for_direction(*direction);
+        let mut line: Vec<(f64, f64)> = table
+            .positions_mm
+            .iter()
+            .zip(values)
+            .map(|(x, v)| (*x, mm_to_um(*v)))
+            .collect();
+        // Held outside the table, as controllers do, over the measured span.
+        if let (Some(first), Some(&(x0, y0))) = (first_target, line.first())
+            && first < x0
+        {
+            line.insert(0, (first, y0));
+        }
+        if let (Some(last), Some(&(x1, y1))) = (last_target, line.last())
+            && last > x1
+        {
+            line.push((last, y1));
+        }
+        all.push(series(Some(label.to_string()), *color, Mark::Line(2), line));
+        let points = table
+            .positions_mm
+            .iter()
+            .zip(values)
+            .map(|(x, v)| (*x, mm_to_um(*v)))
+            .collect();
+        all.push(series(None, *color, Mark::Dot, points));
+    }
+    Chart {
+        title: format!(
+            "Compensation table, axis {}: {} points",
+            plain_or_blank(&table.axis),
+            table.positions_mm.len()
+        ),
+        x_label: "position [mm]".into(),
+        y_label: "axis error the table compensates [µm]".into(),
+        series: all,
+        y_range: None,
+    }
+}
+
+fn plain_or_blank(axis: &str) -> &str {
+    if axis.chars().all(|c| c.is_ascii_alphanumeric()) {
+        axis
+    } else {
+        "?"
+    }
+}
+
+/// The predicted re-test, the uncompensated axis for comparison, and the
+/// re-test's measured means when there is one.
+fn prediction_chart(
+    prediction: &Prediction,
+    table: &CompensationTable,
+    after: Option<&Evaluation>,
+) -> Chart {
+    let along = |values: &[f64]| -> Vec<(f64, f64)> {
+        prediction
+            .positions_mm
+            .iter()
+            .copied()
+            .zip(values.iter().copied())
+            .collect()
+    };
+    let mut all = vec![series(
+        Some("without the table (first test's mean)".into()),
+        GREY,
+        Mark::Dashed(2),
+        along(&prediction.uncompensated_um),
+    )];
+    match table.values.mode() {
+        crate::compensate::TableMode::Mean => all.push(series(
+            Some("predicted re-test".into()),
+            MODEL,
+            Mark::Line(2),
+            along(&prediction.up_um),
+        )),
+        crate::compensate::TableMode::Bidirectional => {
+            all.push(series(
+                Some("predicted re-test ↑".into()),
+                UP,
+                Mark::Line(2),
+                along(&prediction.up_um),
+            ));
+            all.push(series(
+                Some("predicted re-test ↓".into()),
+                DOWN,
+                Mark::Line(2),
+                along(&prediction.down_um),
+            ));
+        }
+    }
+    if let Some(after) = after {
+        for (direction, mark) in [(Direction::Up, Mark::Up), (Direction::Down, Mark::Down)] {
+            let color = if direction == Direction::Up { UP } else { DOWN };
+            let means = means_um(&after.per_target, direction);
+            if !means.is_empty() {
+                all.push(series(
+                    Some(format!("re-test mean {direction}, measured")),
+                    color,
+                    mark,
+                    means,
+                ));
+            }
+        }
+    }
+    Chart {
+        title: "Predicted re-test with the table applied".into(),
+        x_label: POSITION_LABEL.into(),
+        y_label: DEVIATION_LABEL.into(),
+        series: all,
+        y_range: None,
+    }
+}
+
+/// The residual of every reading (measured − predicted) in the order
+/// measured, and the fitted model through them.
+fn residual_chart(diagnosis: &Diagnosis) -> Chart {
+    let ordered = in_measured_order(diagnosis);
+    let numbered = ordered
+        .iter()
+        .enumerate()
+        .map(|(i, r)| ((i + 1) as f64, *r));
+    let by_direction = |direction: Direction| -> Vec<(f64, f64)> {
+        numbered
+            .clone()
+            .filter(|(_, r)| r.reading.direction == direction)
+            .map(|(x, r)| (x, r.residual_um))
+            .collect()
+    };
+    let count = diagnosis.readings.len() as f64;
+    Chart {
+        title: "Residual of each reading of the re-test".into(),
+        x_label: "reading, in the order measured".into(),
+        y_label: "measured − predicted [µm]".into(),
+        series: vec![
+            series(None, GREY, Mark::Line(1), vec![(1.0, 0.0), (count, 0.0)]),
+            series(
+                Some("fitted model".into()),
+                MODEL,
+                Mark::Line(2),
+                numbered.clone().map(|(x, r)| (x, r.fitted_um)).collect(),
+            ),
+            series(
+                Some("residual ↑".into()),
+                UP,
+                Mark::Up,
+                by_direction(Direction::Up),
+            ),
+            series(
+                Some("residual ↓".into()),
+                DOWN,
+                Mark::Down,
+                by_direction(Direction::Down),
+            ),
+        ],
+        y_range: None,
+    }
+}
+
+/// The readings in the order measured: by run, then by time within the run
+/// (a run moving ↓ visits the targets from the last to the first).
+fn in_measured_order(diagnosis: &Diagnosis) -> Vec<&ReadingResidual> {
+    let mut ordered: Vec<&ReadingResidual> = diagnosis.readings.iter().collect();
+    ordered.sort_by(|a, b| {
+        (a.reading.run_index, a.reading.time_h)
+            .partial_cmp(&(b.reading.run_index, b.reading.time_h))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    ordered
+}
+
+/// The residual along the axis: every reading, the fitted model per
+/// direction, and the targets where structure is left unexplained.
+fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
+    let mut all = Vec::new();
+    for (direction, color, mark) in [
+        (Direction::Up, UP, Mark::Up),
+        (Direction::Down, DOWN, Mark::Down),
+    ] {
+        let points: Vec<(f64, f64)> = diagnosis
+            .readings
+            .iter()
+            .filter(|r| r.reading.direction == direction)
+            .map(|r| (r.reading.target_mm, r.residual_um))
+            .collect();
+        all.push(series(
+            Some(format!("residual {direction}")),
+            color,
+            mark,
+            points,
+        ));
+    }
+    for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
+        let fitted = mean_per_target(diagnosis, direction, |r| r.fitted_um);
+        if !fitted.is_empty() {
+            all.push(series(
+                Some(format!("fitted model {direction} (mean per target)")),
+                color,
+                Mark::Line(2),
+                fitted,
+            ));
+        }
+    }
+    if diagnosis.unexplained.significant && !diagnosis.unexplained.where_mm.is_empty() {
+        let (low, _) = extent(diagnosis.readings.iter().map(|r| r.residual_um));
+        let marks = diagnosis
+            .unexplained
+            .where_mm
+            .iter()
+            .map(|x| (*x, low))
+            .collect();
+        all.push(series(
+            Some("unexplained structure".into()),
+            ALERT,
+            Mark::Dot,
+            marks,
+        ));
+    }
+    Chart {
+        title: "Residual along the axis".into(),
+        x_label: POSITION_LABEL.into(),
+        y_label: "measured − predicted [µm]".into(),
+        series: all,
+        y_range: None,
+    }
+}
+
+/// Mean over the readings of each target in one direction, (target, value).
+fn mean_per_target(
+    diagnosis: &Diagnosis,
+    direction: Direction,
+    value: impl Fn(&ReadingResidual) -> f64,
+) -> Vec<(f64, f64)> {
+    let mut sums: Vec<(f64, f64, usize)> = Vec::new();
+    for r in diagnosis
+        .readings
+        .iter()
+        .filter(|r| r.reading.direction == direction)
+    {
+        match sums.iter_mut().find(|(x, _, _)| *x == r.reading.target_mm) {
+            Some(entry) => {
+                entry.1 += value(r);
+                entry.2 += 1;
+            }
+            None => sums.push((r.reading.target_mm, value(r), 1)),
+        }
+    }
+    sums.sort_by(|a, b| a.0.total_cmp(&b.0));
+    sums.into_iter()
+        .map(|(x, sum, n)| (x, sum / n as f64))
+        .collect()
+}
+
+fn extent(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    values.fold((0.0, 0.0), |(low, high), v| (low.min(v), high.max(v)))
+}
+
+/// Each accepted effect's contribution to every reading, in the order measured.
+fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
+    let first_target_mm = after.targets_mm().first().copied().unwrap_or(0.0);
+    let mut all = Vec::new();
+    for (index, accepted) in diagnosis.accepted.iter().enumerate() {
+        // The Abbe effect needs the angular profile, which the report is not
+        // given: its contribution is drawn as 0 (the report never has one).
+        let points = in_measured_order(diagnosis)
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| {
+                (
+                    (i + 1) as f64,
+                    accepted.effect.value_um(&r.reading, first_target_mm, None),
+                )
+            })
+            .collect();
+        all.push(series(
+            Some(effect_label(&accepted.effect)),
+            EFFECT_COLOURS[index % EFFECT_COLOURS.len()],
+            Mark::Line(2),
+            points,
+        ));
+    }
+    Chart {
+        title: "Effects found in the residual".into(),
+        x_label: "reading, in the order measured".into(),
+        y_label: "contribution [µm]".into(),
+        series: all,
+        y_range: None,
+    }
+}
+
+/// A short legend label with the fitted parameters, in the plot font's characters.
+pub fn effect_label(effect: &crate::diagnose::Effect) -> String {
+    use crate::diagnose::Effect;
+    let signed = |v: f64| crate::report::chart::tick_label((v * 100.0).round() / 100.0);
+    match *effect {
+        Effect::Reversal { b_um } => format!("reversal B = {} µm", signed(b_um)),
+        Effect::Scale { scale_um_per_m } => format!("scale {} µm/m", signed(scale_um_per_m)),
+        Effect::Drift { rate_um_per_h } => format!("drift {} µm/h", signed(rate_um_per_h)),
+        Effect::Periodic {
+            period_mm,
+            amplitude_um,
+            ..
+        } => format!(
+            "periodic {} µm, period {} mm",
+            signed(amplitude_um),
+            signed(period_mm)
+        ),
+        Effect::OutlierRun {
+            run,
+            direction,
+            offset_um,
+        } => format!("run {run}{direction} offset {} µm", signed(offset_um)),
+        Effect::Abbe { offset_mm, .. } => format!("Abbe, offset {} mm", signed(offset_mm)),
+    }
+}

@@ -1,0 +1,712 @@
+//! `axcomp report` end to end (issue 7): the report's numbers are those of
+//! `evaluate --json` and of the library's `Diagnosis`; the page opens in a
+//! real browser (Debian's chromium, headless) without console messages and
+//! is not blank; it prints on A4; its PNG plots decode and every character
+//! they draw is in the embedded font; bad input fails with exit code 2.
+//!
+//! Screenshots and PDFs are kept under `target/tmp/report/` (not in git).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus};
+use std::time::{Duration, Instant};
+
+use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
+use axcomp::cycle::CycleTiming;
+use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
+use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
+use axcomp::evaluate::evaluate;
+use axcomp::read::{read_path, rtl};
+use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
+use axcomp::synth::{self, Truth};
+
+use crate::util::{axcomp, evaluate_json, test_data};
+
+const SAMPLE: &str = "fixtures/sample-x.rtl";
+
+/// Where screenshots and PDFs are kept for a person to look at.
+fn artefacts() -> PathBuf {
+    let directory = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("report");
+    std::fs::create_dir_all(&directory).unwrap();
+    directory
+}
+
+/// Every `data-key` value of a report: (key, full value, text shown).
+fn keyed_values(html: &str) -> Vec<(String, Option<f64>, String)> {
+    let mut found = Vec::new();
+    for piece in html.split("data-key=\"").skip(1) {
+        let (key, rest) = piece.split_once('"').unwrap();
+        let Some(rest) = rest.strip_prefix(" data-um=\"") else {
+            continue;
+        };
+        let (value, rest) = rest.split_once('"').unwrap();
+        let text = rest[1..].split('<').next().unwrap().to_string();
+        let value = (value != "null").then(|| value.parse::<f64>().unwrap());
+        found.push((key.to_string(), value, text));
+    }
+    found
+}
+
+/// The terminal report's rounding, written out again here: two decimals, `—`.
+fn shown(value: Option<f64>) -> String {
+    value.map_or_else(|| "—".to_string(), |v| format!("{v:.2}"))
+}
+
+/// Checks every cell whose key starts with `prefix.` against `source` (a
+/// JSON object such as `evaluate --json`'s); returns how many were checked.
+fn check_against_json(html: &str, prefix: &str, source: &serde_json::Value) -> usize {
+    let mut checked = 0;
+    for (key, value, text) in keyed_values(html) {
+        let Some(path) = key.strip_prefix(&format!("{prefix}.")) else {
+            continue;
+        };
+        let pointer = format!("/{}", path.replace('.', "/"));
+        let expected = source
+            .pointer(&pointer)
+            .unwrap_or_else(|| panic!("{key}: no {pointer} in the source JSON"));
+        assert_eq!(value, expected.as_f64(), "{key}: the report's value");
+        assert_eq!(text, shown(value), "{key}: the report's text");
+        checked += 1;
+    }
+    checked
+}
+
+/// The embedded `axcomp-data` JSON of a page (or of chromium's DOM dump).
+fn embedded_data(html: &str) -> serde_json::Value {
+    let start = html
+        .find("id=\"axcomp-data\">")
+        .expect("the page embeds #axcomp-data");
+    let json = &html[start + "id=\"axcomp-data\">".len()..];
+    let json = &json[..json.find("</script>").unwrap()];
+    serde_json::from_str(json).expect("#axcomp-data is JSON")
+}
+
+#[test]
+fn the_sample_report_shows_the_figures_of_evaluate_json() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("report.html");
+    let run = axcomp(["report", SAMPLE, "-o", output.to_str().unwrap()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&output).unwrap();
+    let evaluation = evaluate_json(&[Path::new(SAMPLE)]);
+    // 12 axis figures and 9 values at each of the 16 targets, each equal to evaluate's.
+    assert_eq!(
+        check_against_json(&html, "before", &evaluation),
+        12 + 16 * 9
+    );
+    assert_eq!(embedded_data(&html)["before"], evaluation);
+    // The figures of the README (computed by evaluate, checked there by hand).
+    for (key, text) in [
+        ("A", "13.19"),
+        ("E", "11.21"),
+        ("R", "6.26"),
+        ("M", "8.06"),
+        ("B", "3.44"),
+    ] {
+        let cell = format!("data-key=\"before.figures_um.{key}\"");
+        let at = html.find(&cell).unwrap();
+        assert!(
+            html[at..]
+                .split('<')
+                .next()
+                .unwrap()
+                .ends_with(&format!(">{text}")),
+            "{key}"
+        );
+    }
+    // The refractive index check, recomputed in Python from seed 001 eq. 36:
+    // at the start 20.412 °C, 987.12 mbar, 41.3 %RH give n − 1 = 264.0751 ppm;
+    // the factor 0.31641302 µm with λ 0.632991 µm and the material correction
+    // 11.7 ppm/K · (20.2395 − 20) K gives 257.8691 ppm: −6.2061 ppm. The
+    // sample's factor was not made from its air, and the report says so.
+    let ppm: f64 = html
+        .split("data-ppm=\"")
+        .nth(1)
+        .and_then(|rest| rest.split('"').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((ppm + 6.206_06).abs() < 1e-4, "{ppm}");
+    assert!(html.contains("differs by more than 1 ppm"));
+    assert!(html.contains("X axis as found, before compensation"));
+    // Self-contained: nothing is fetched.
+    for external in ["src=\"http", "href=\"http", "@import", "url(http"] {
+        assert!(!html.contains(external), "{external}");
+    }
+}
+
+/// A first test, a mean table written for a TNC 640, and a re-test with the
+/// table applied, a reversal and a warm-up drift the model does not declare,
+/// all written as files and read back as the report reads them.
+struct RetestCase {
+    directory: tempfile::TempDir,
+    before: PathBuf,
+    after: PathBuf,
+    table: PathBuf,
+}
+
+const TRUTH: &str = r#"
+[axis]
+name = "X"
+machine = "MCV 754 Quick <test & \"escape\">"
+
+[cycle]
+start_mm = 0.0
+end_mm = 750.0
+count = 16
+jitter_mm = 9.0
+runs = 5
+start = "2026-11-20 09:14:00"
+
+[error]
+scale_um_per_m = 9.5
+periodic = [{ period_mm = 200.0, amplitude_um = 1.8, phase_rad = 0.4 }]
+
+[noise]
+sigma_um = 0.35
+
+[[effect]]
+kind = "reversal"
+B_um = -3.2
+
+[[effect]]
+kind = "drift"
+rate_um_per_h = 4.0
+tests = ["after"]
+"#;
+
+fn table_options() -> EmitOptions {
+    let profile = MachineProfile::default();
+    EmitOptions {
+        axes: vec![profile.axis("X").unwrap()],
+        table_name: "X.COM".into(),
+        machine_unit: profile.machine_unit(),
+        linuxcnc_type: 0,
+        max_points: None,
+        max_value_mm: None,
+        cec_first_table: 0,
+        cec_values_are_corrections: true,
+        tnc640_columns: Vec::new(),
+    }
+}
+
+impl RetestCase {
+    fn new() -> RetestCase {
+        let truth = Truth::from_toml_str(TRUTH).unwrap();
+        let first = synth::before(&truth, 3).unwrap();
+        let options = TableOptions {
+            mode: TableMode::Mean,
+            grid: GridSpec::Targets,
+            reference_mm: None,
+            extrapolate: Extrapolate::Hold,
+        };
+        let table = build_table(&first, &evaluate(&first), &options).unwrap();
+        let retest = synth::after(&truth, &table, 3).unwrap();
+        let directory = tempfile::tempdir().unwrap();
+        let case = RetestCase {
+            before: directory.path().join("before.rtl"),
+            after: directory.path().join("after.rtl"),
+            table: directory.path().join("X.COM"),
+            directory,
+        };
+        std::fs::write(&case.before, rtl::write(&first)).unwrap();
+        std::fs::write(&case.after, rtl::write(&retest)).unwrap();
+        let text = emit::write(Controller::Tnc640, &table, &table_options()).unwrap();
+        std::fs::write(&case.table, text).unwrap();
+        case
+    }
+
+    fn report(&self, extra: &[&str]) -> (PathBuf, crate::util::Run) {
+        let output = self.directory.path().join("report.html");
+        let mut args = vec![
+            "report".to_string(),
+            self.before.display().to_string(),
+            "--after".into(),
+            self.after.display().to_string(),
+            "--table".into(),
+            self.table.display().to_string(),
+            "--diagnose".into(),
+            "-o".into(),
+            output.display().to_string(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        (output, axcomp(args))
+    }
+
+    /// The diagnosis as the library gives it for the files as read back.
+    fn diagnosis(&self) -> Diagnosis {
+        let before = read_path(&self.before, None).unwrap().measurement;
+        let after = read_path(&self.after, None).unwrap().measurement;
+        let text = std::fs::read_to_string(&self.table).unwrap();
+        let (_, table) = emit::read_any(&text, &table_options(), None).unwrap();
+        diagnose(&DiagnoseInput {
+            after: &after,
+            before: Some(&before),
+            table: Some(&table),
+            angular: None,
+            timing: CycleTiming::ASSUMED,
+        })
+        .unwrap()
+    }
+}
+
+/// The diagnosis values the report keys, from the library.
+fn diagnosis_json(d: &Diagnosis) -> serde_json::Value {
+    let figures = |f: &axcomp::evaluate::AxisFigures| {
+        let json = axcomp::report::json::FiguresJson::from_figures(f);
+        serde_json::to_value(json).unwrap()
+    };
+    let accepted: Vec<serde_json::Value> = d
+        .accepted
+        .iter()
+        .map(|a| {
+            let map: serde_json::Map<String, serde_json::Value> = a
+                .effect
+                .parameters()
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+                .collect();
+            serde_json::Value::Object(map)
+        })
+        .collect();
+    serde_json::json!({
+        "residual_before": {"rms_um": d.residual_before.rms_um, "max_abs_um": d.residual_before.max_abs_um},
+        "residual_after": {"rms_um": d.residual_after.rms_um, "max_abs_um": d.residual_after.max_abs_um},
+        "noise_um": d.noise_um,
+        "figures": {
+            "measured": figures(&d.figures.measured),
+            "predicted": figures(&d.figures.predicted),
+            "predicted_with_effects": figures(&d.figures.predicted_with_effects),
+        },
+        "accepted": accepted,
+    })
+}
+
+#[test]
+fn the_retest_report_shows_evaluate_and_diagnose_numbers_and_writes_pngs() {
+    let case = RetestCase::new();
+    let png = case.directory.path().join("png");
+    let (output, run) = case.report(&["--png", png.to_str().unwrap()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&output).unwrap();
+    let before = evaluate_json(&[&case.before]);
+    let after = evaluate_json(&[&case.after]);
+    assert_eq!(check_against_json(&html, "before", &before), 12 + 16 * 9);
+    assert_eq!(check_against_json(&html, "after", &after), 12 + 16 * 9);
+    let data = embedded_data(&html);
+    assert_eq!((&data["before"], &data["after"]), (&before, &after));
+
+    let diagnosis = case.diagnosis();
+    let kinds: Vec<&str> = diagnosis
+        .accepted
+        .iter()
+        .map(|a| a.effect.kind().name())
+        .collect();
+    assert_eq!(kinds, ["reversal", "drift"], "the truth has both");
+    // 5 residual values, 3 × 6 figures, and the reversal's B (drift has no µm parameter).
+    assert_eq!(
+        check_against_json(&html, "diagnosis", &diagnosis_json(&diagnosis)),
+        5 + 18 + 1
+    );
+    // Every reading is kept, and the fitted model is what residual_after measures.
+    let after_measurement = read_path(&case.after, None).unwrap().measurement;
+    let readings: usize = after_measurement
+        .runs()
+        .iter()
+        .map(|r| r.deviations_mm.iter().flatten().count())
+        .sum();
+    assert_eq!(diagnosis.readings.len(), readings);
+    let rms = (diagnosis
+        .readings
+        .iter()
+        .map(|r| (r.residual_um - r.fitted_um).powi(2))
+        .sum::<f64>()
+        / readings as f64)
+        .sqrt();
+    assert!(
+        (rms - diagnosis.residual_after.rms_um).abs() < 1e-9,
+        "{rms}"
+    );
+    // Text from the file is escaped: the machine name has <, & and ".
+    assert!(html.contains("MCV 754 Quick &lt;test &amp; &quot;escape&quot;&gt;"));
+    assert!(!html.contains("<test &"));
+
+    let names = [
+        "deviation-before",
+        "deviation-after",
+        "table",
+        "predicted",
+        "residual",
+        "residual-along-axis",
+        "effects",
+    ];
+    for name in names {
+        let path = png.join(format!("{name}.png"));
+        let pixels = Pixels::read(&path);
+        let coloured = pixels.inked();
+        assert_eq!(pixels.size, (960, 600), "{name}");
+        assert!(
+            coloured > 0.01,
+            "{name}: {coloured} of the pixels are not white"
+        );
+        assert!(
+            html.contains(&format!("id=\"plot-{name}\"")),
+            "{name} in the HTML"
+        );
+    }
+}
+
+/// A decoded PNG: width, height, and its pixels as RGB(A) rows.
+struct Pixels {
+    size: (u32, u32),
+    channels: usize,
+    data: Vec<u8>,
+}
+
+impl Pixels {
+    fn read(path: &Path) -> Pixels {
+        let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
+            .unwrap();
+        let mut data = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut data).unwrap();
+        data.truncate(info.buffer_size());
+        Pixels {
+            size: (info.width, info.height),
+            channels: info.color_type.samples(),
+            data,
+        }
+    }
+
+    /// The fraction of pixels for which `test(r, g, b)` holds.
+    fn fraction(&self, test: impl Fn(u8, u8, u8) -> bool) -> f64 {
+        let total = self.data.len() / self.channels;
+        let hits = self
+            .data
+            .chunks(self.channels)
+            .filter(|p| match p {
+                [r, g, b, ..] => test(*r, *g, *b),
+                [grey, ..] => test(*grey, *grey, *grey),
+                [] => false,
+            })
+            .count();
+        hits as f64 / total as f64
+    }
+
+    /// The fraction that is not (nearly) white.
+    fn inked(&self) -> f64 {
+        self.fraction(|r, g, b| r.min(g).min(b) < 235)
+    }
+
+    /// The fraction in the plots' blues (↑ runs, bands): a plot is drawn, not only text.
+    fn blue(&self) -> f64 {
+        self.fraction(|r, _, b| i32::from(b) > i32::from(r) + 60)
+    }
+}
+
+#[test]
+fn every_character_the_plots_draw_is_in_the_embedded_font() {
+    use ab_glyph::{Font, FontRef};
+    let font = FontRef::try_from_slice(include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf"))
+        .unwrap();
+    let case = RetestCase::new();
+    let read = |path: &Path| read_path(path, None).unwrap().measurement;
+    let (before, after) = (read(&case.before), read(&case.after));
+    let (evaluation_before, evaluation_after) = (evaluate(&before), evaluate(&after));
+    let text = std::fs::read_to_string(&case.table).unwrap();
+    let (controller, table) = emit::read_any(&text, &table_options(), None).unwrap();
+    let diagnosis = case.diagnosis();
+    let input = ReportInput {
+        before: TestRecord {
+            measurement: &before,
+            evaluation: &evaluation_before,
+            warnings: &[],
+        },
+        after: Some(TestRecord {
+            measurement: &after,
+            evaluation: &evaluation_after,
+            warnings: &[],
+        }),
+        table: Some(TableRecord {
+            table: &table,
+            file: "X.COM",
+            controller,
+        }),
+        diagnosis: Some(&diagnosis),
+        generator: "test",
+    };
+    let charts = charts(&input);
+    assert_eq!(charts.len(), 7);
+    // The tick labels: digits, point and the minus sign.
+    let mut texts = vec!["0123456789.\u{2212}".to_string()];
+    for named in &charts {
+        texts.extend(named.chart.texts().into_iter().map(str::to_string));
+    }
+    for text in &texts {
+        for c in text.chars() {
+            assert_ne!(
+                font.glyph_id(c).0,
+                0,
+                "{c:?} (U+{:04X}) in {text:?} is not in the font",
+                c as u32
+            );
+        }
+    }
+    // And the check can fail: a character the subset lacks.
+    assert_eq!(font.glyph_id('č').0, 0);
+}
+
+#[test]
+fn bad_input_names_the_file_and_line_and_writes_nothing() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("r.html");
+    let bad = test_data("bad/rtl-two-fields.rtl");
+    let run = axcomp([
+        "report",
+        bad.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(run.stderr.contains("rtl-two-fields.rtl:"), "{}", run.stderr);
+    assert!(!run.stderr.contains("panicked"));
+    assert!(!output.exists());
+
+    let not_a_table = test_data("bad/unknown.txt");
+    let run = axcomp([
+        "report",
+        SAMPLE,
+        "--table",
+        not_a_table.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("unknown.txt:1:1: unknown compensation table format"),
+        "{}",
+        run.stderr
+    );
+    assert!(!output.exists());
+
+    let run = axcomp(["report", SAMPLE, "--diagnose"]);
+    assert_eq!(run.code, 2, "--diagnose needs --after: {}", run.stderr);
+}
+
+#[test]
+fn an_existing_report_is_kept_unless_forced() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("r.html");
+    std::fs::write(&output, "keep me").unwrap();
+    let run = axcomp(["report", SAMPLE, "-o", output.to_str().unwrap()]);
+    assert_eq!(run.code, 2);
+    assert!(
+        run.stderr.contains("already exists; use --force"),
+        "{}",
+        run.stderr
+    );
+    assert_eq!(std::fs::read_to_string(&output).unwrap(), "keep me");
+    let run = axcomp(["report", SAMPLE, "-o", output.to_str().unwrap(), "--force"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        std::fs::read_to_string(&output)
+            .unwrap()
+            .starts_with("<!DOCTYPE html>")
+    );
+}
+
+// --- In a real browser -------------------------------------------------------
+
+/// Debian's chromium; CI installs it (`.ci/run`). Missing is a failure, not a skip.
+fn chromium() -> PathBuf {
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    for directory in std::env::split_paths(&path) {
+        for name in ["chromium", "chromium-browser"] {
+            let candidate = directory.join(name);
+            if candidate.is_file() {
+                return candidate;
+            }
+        }
+    }
+    panic!(
+        "chromium not found on PATH: the report is tested in a real browser; install Debian's \
+         chromium (apt-get install chromium), as .ci/run does"
+    );
+}
+
+/// What the browser made of a page.
+struct BrowserRun {
+    /// The DOM after loading (`--dump-dom`).
+    dom: String,
+    /// Console messages (`:CONSOLE` log lines): the report has no script, so any is an error.
+    console: Vec<String>,
+}
+
+/// Opens a local page headless, with the network and background services
+/// off, and takes a screenshot of `window` pixels (or prints a PDF).
+fn open_in_browser(page: &Path, window: (u32, u32), output: BrowserOutput<'_>) -> BrowserRun {
+    let profile = tempfile::tempdir().unwrap();
+    let mut command = Command::new(chromium());
+    command.args([
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--enable-logging=stderr",
+        "--v=0",
+    ]);
+    command.arg(format!("--user-data-dir={}", profile.path().display()));
+    command.arg(format!("--window-size={},{}", window.0, window.1));
+    match output {
+        BrowserOutput::Screenshot(path) => {
+            command.arg(format!("--screenshot={}", path.display()));
+            command.arg("--dump-dom");
+        }
+        BrowserOutput::Pdf(path) => {
+            command.arg("--no-pdf-header-footer");
+            command.arg(format!("--print-to-pdf={}", path.display()));
+        }
+    }
+    command.arg(format!("file://{}", page.canonicalize().unwrap().display()));
+    // Into files, not pipes: a DOM larger than a pipe's buffer would block
+    // chromium until someone reads it.
+    let stdout_path = profile.path().join("stdout");
+    let stderr_path = profile.path().join("stderr");
+    let child = command
+        .stdout(std::fs::File::create(&stdout_path).unwrap())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
+        .spawn()
+        .expect("start chromium");
+    let status = wait_with_timeout(child, Duration::from_secs(120));
+    let stderr = std::fs::read_to_string(&stderr_path).unwrap_or_default();
+    assert!(status.success(), "chromium failed: {stderr}");
+    BrowserRun {
+        dom: std::fs::read_to_string(&stdout_path).unwrap(),
+        console: stderr
+            .lines()
+            .filter(|l| l.contains(":CONSOLE"))
+            .map(str::to_string)
+            .collect(),
+    }
+}
+
+#[derive(Clone, Copy)]
+enum BrowserOutput<'a> {
+    Screenshot(&'a Path),
+    Pdf(&'a Path),
+}
+
+/// Waits for a child, killing it after `limit` (a hung browser must not hang the tests).
+fn wait_with_timeout(mut child: std::process::Child, limit: Duration) -> ExitStatus {
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("chromium did not finish within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+#[test]
+fn the_sample_report_opens_in_chromium_without_errors_and_is_not_blank() {
+    let directory = tempfile::tempdir().unwrap();
+    let page = directory.path().join("report.html");
+    let run = axcomp(["report", SAMPLE, "-o", page.to_str().unwrap()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let screenshot = artefacts().join("sample-x.png");
+    let browser = open_in_browser(&page, (1280, 2600), BrowserOutput::Screenshot(&screenshot));
+    assert!(browser.console.is_empty(), "console: {:?}", browser.console);
+    let shot = Pixels::read(&screenshot);
+    let (inked, blue) = (shot.inked(), shot.blue());
+    assert!(
+        inked > 0.05,
+        "screenshot {} is {inked} inked",
+        screenshot.display()
+    );
+    assert!(blue > 0.005, "no plot in {}: {blue}", screenshot.display());
+    // The browser parsed what was meant: one plot, 16 target rows, the data block intact.
+    assert_eq!(browser.dom.matches("<svg").count(), 1);
+    assert_eq!(
+        browser.dom.matches("data-key=\"before.per_target.").count(),
+        16 * 9
+    );
+    let evaluation = evaluate_json(&[Path::new(SAMPLE)]);
+    assert_eq!(embedded_data(&browser.dom)["before"], evaluation);
+}
+
+#[test]
+fn the_retest_report_opens_in_chromium_and_prints_on_a4() {
+    let case = RetestCase::new();
+    let (page, run) = case.report(&[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let screenshot = artefacts().join("retest.png");
+    let browser = open_in_browser(&page, (1280, 3000), BrowserOutput::Screenshot(&screenshot));
+    assert!(browser.console.is_empty(), "console: {:?}", browser.console);
+    let shot = Pixels::read(&screenshot);
+    let (inked, blue) = (shot.inked(), shot.blue());
+    assert!(
+        inked > 0.05 && blue > 0.005,
+        "{}: {inked}, {blue}",
+        screenshot.display()
+    );
+    assert_eq!(browser.dom.matches("<svg").count(), 7);
+
+    // Printed: A4 pages (595 × 842 pt), several of them.
+    let pdf = artefacts().join("retest.pdf");
+    open_in_browser(&page, (1280, 1000), BrowserOutput::Pdf(&pdf));
+    let bytes = std::fs::read(&pdf).unwrap();
+    let text = String::from_utf8_lossy(&bytes);
+    let boxes: Vec<&str> = text
+        .split("/MediaBox [")
+        .skip(1)
+        .map(|s| s.split(']').next().unwrap())
+        .collect();
+    assert!(boxes.len() >= 4, "{} pages", boxes.len());
+    for media_box in boxes {
+        let numbers: Vec<f64> = media_box
+            .split_whitespace()
+            .map(|n| n.parse().unwrap())
+            .collect();
+        // A4 is 210 × 297 mm = 595.3 × 841.9 pt; Chromium rounds to its pixel grid.
+        assert!(
+            (numbers[2] - 595.3).abs() < 2.0 && (numbers[3] - 841.9).abs() < 2.0,
+            "{media_box}"
+        );
+    }
+}
+
+#[test]
+fn the_browser_checks_can_fail() {
+    // A page with a script error and nothing drawn: the console check and the
+    // ink check must both catch it, or they prove nothing about the report.
+    let directory = tempfile::tempdir().unwrap();
+    let page = directory.path().join("broken.html");
+    std::fs::write(
+        &page,
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"></head><body>\
+         <script>undefinedFunction();</script></body></html>",
+    )
+    .unwrap();
+    let screenshot = directory.path().join("broken.png");
+    let browser = open_in_browser(&page, (800, 600), BrowserOutput::Screenshot(&screenshot));
+    assert!(
+        browser
+            .console
+            .iter()
+            .any(|l| l.contains("Uncaught ReferenceError")),
+        "{:?}",
+        browser.console
+    );
+    let shot = Pixels::read(&screenshot);
+    let (inked, blue) = (shot.inked(), shot.blue());
+    assert!(inked < 0.001 && blue == 0.0, "{inked} {blue}");
+}
