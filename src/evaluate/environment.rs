@@ -71,6 +71,22 @@ pub fn edlen_seed001(air_temperature_c: f64, air_pressure_kpa: f64, humidity_pct
     1.0 + 7.86e-5 * pressure_mbar / (273.0 + t) - 1.5e-11 * humidity_pct * (t * t + 160.0)
 }
 
+/// The environmental factor a laser records for these conditions, µm: the
+/// half wavelength in air with the material correction,
+/// λ_vac / (2 · n_air · (1 + α·(T_material − 20 °C))), n_air by eq. (36) —
+/// the relation [`check_refractive_index`] inverts. `axcomp synth` writes it
+/// so that its files pass the check.
+pub fn environmental_factor_um(
+    air_temperature_c: f64,
+    air_pressure_kpa: f64,
+    humidity_pct: f64,
+    material_correction_ppm: f64,
+    vacuum_wavelength_um: f64,
+) -> f64 {
+    let n = edlen_seed001(air_temperature_c, air_pressure_kpa, humidity_pct);
+    vacuum_wavelength_um / (2.0 * n * (1.0 + material_correction_ppm * 1e-6))
+}
+
 /// The comparison at the start or the end of the test.
 #[derive(Clone, Debug, PartialEq)]
 pub enum IndexComparison {

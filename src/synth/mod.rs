@@ -33,6 +33,9 @@ use rand_distr::{Distribution, Normal, Uniform};
 
 use crate::compensate::{CompensationTable, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
+use crate::evaluate::environment::{
+    ASSUMED_VACUUM_WAVELENGTH_UM, REFERENCE_TEMPERATURE_C, environmental_factor_um,
+};
 use crate::measurement::{Direction, Environment, Measurement, Metadata, Run, StartEnd, TestDate};
 pub use truth::{EffectSpec, TargetSpec, TestKind, Truth};
 
@@ -340,11 +343,20 @@ fn environment(truth: &Truth, test: TestKind, duration_s: f64, stroke: (f64, f64
     }
     let round = |v: f64| (v * 1e6).round() / 1e6;
     let sensor = |start: f64, end: f64| StartEnd::new(Some(round(start)), Some(round(end)));
+    let air_end = spec.air_temperature_c + warming / 2.0;
+    // The factor the laser would record for these conditions, to its 8 decimals.
+    let factor = |air_c: f64, material_c: f64| {
+        let value = environmental_factor_um(
+            round(air_c),
+            spec.pressure_kpa,
+            spec.humidity_pct,
+            alpha * (round(material_c) - REFERENCE_TEMPERATURE_C),
+            ASSUMED_VACUUM_WAVELENGTH_UM,
+        );
+        Some((value * 1e8).round() / 1e8)
+    };
     Environment {
-        air_temperature_c: sensor(
-            spec.air_temperature_c,
-            spec.air_temperature_c + warming / 2.0,
-        ),
+        air_temperature_c: sensor(spec.air_temperature_c, air_end),
         air_pressure_kpa: sensor(spec.pressure_kpa, spec.pressure_kpa),
         air_humidity_pct: sensor(spec.humidity_pct, spec.humidity_pct),
         material_temperature_c: [
@@ -353,7 +365,10 @@ fn environment(truth: &Truth, test: TestKind, duration_s: f64, stroke: (f64, f64
             StartEnd::default(),
         ],
         expansion_coefficient_ppm_per_k: Some(alpha),
-        environmental_factor_um: StartEnd::default(),
+        environmental_factor_um: StartEnd::new(
+            factor(spec.air_temperature_c, material_start),
+            factor(air_end, material_start + warming),
+        ),
         vacuum_wavelength_um: None,
     }
 }

@@ -218,3 +218,27 @@ fn bad_truths_are_refused() {
             .contains("jitter_mm")
     );
 }
+
+#[test]
+fn the_environmental_factor_matches_the_air_and_the_material() {
+    // A warm material (a scale of 11.5 µm/m at 11.5 ppm/K is +1 K) and a
+    // drift that warms the air: the factor follows both, and the report's
+    // check finds it within the rounding of its 8 decimals.
+    use crate::evaluate::environment::{IndexComparison, check_refractive_index};
+    let truth = truth(
+        "[environment]\nexpansion_coefficient_ppm_per_k = 11.5\n\n\
+         [[effect]]\nkind = \"scale\"\nscale_um_per_m = 11.5\n\n\
+         [[effect]]\nkind = \"drift\"\nrate_um_per_h = 20.0\n",
+    );
+    let m = before(&truth, 1).unwrap();
+    let check = check_refractive_index(&m.environment);
+    for comparison in [&check.start, &check.end] {
+        let IndexComparison::Made(at) = comparison else {
+            panic!("{comparison:?}")
+        };
+        assert!(at.difference_ppm.abs() < 0.05, "{at:?}");
+        assert!(at.material_correction_ppm.unwrap() > 11.0, "{at:?}");
+    }
+    let factor = m.environment.environmental_factor_um;
+    assert_ne!(factor.start, factor.end, "the air warmed");
+}
