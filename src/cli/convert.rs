@@ -5,12 +5,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::{self, Extrapolate, GridSpec, TableMode, TableOptions};
+use axcomp::diagnose::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::{RunSelector, SourceFormat};
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::convert::ConvertJson;
+use axcomp::units::LengthUnit;
 
 use super::common::{parse_format, parse_run_selector, print_json, print_text, print_warnings};
 use super::evaluate::check_selectors;
@@ -49,8 +51,11 @@ pub struct ConvertArgs {
     /// Bidirectional tables go into the TNC 640 BACKLASH column, two Sinumerik
     /// CEC tables ($AN_CEC_DIRECTION 1 and -1) and the LinuxCNC forward and
     /// reverse columns; the iTNC 530 has no place for them.
-    #[arg(long, value_name = "MODE", default_value = "mean", value_parser = parse_mode, help_heading = "Table")]
-    pub mode: TableMode,
+    ///
+    /// Default: mean, or bidirectional when --effects has a reversal and the
+    /// controller takes bidirectional tables.
+    #[arg(long, value_name = "MODE", value_parser = parse_mode, help_heading = "Table")]
+    pub mode: Option<TableMode>,
 
     /// First compensation point, mm (default: the first target).
     #[arg(
@@ -95,6 +100,13 @@ pub struct ConvertArgs {
     /// plus that residual, on the new grid.
     #[arg(long, value_name = "TABLE", help_heading = "Table")]
     pub existing: Option<PathBuf>,
+
+    /// Effects found by diagnose (--write-effects): a reversal makes the table
+    /// bidirectional, a periodic error a finer step (≤ period / 10) with the
+    /// periodic error at the points, a scale is taken out (the table stays
+    /// referred to the first test's conditions).
+    #[arg(long, value_name = "E.toml", help_heading = "Table")]
+    pub effects: Option<PathBuf>,
 
     /// Write the same table for a coupled axis too (gantry slave); repeatable.
     #[arg(long = "also", value_name = "AXIS", help_heading = "Table")]
@@ -209,13 +221,19 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     }
     let evaluation = evaluate(&measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
+    let effects = match &args.effects {
+        Some(path) => load_effects(path)?,
+        None => Vec::new(),
+    };
+    let plan = EffectsPlan::new(args, &effects, profile.machine_unit());
     let table_options = TableOptions {
-        mode: args.mode,
-        grid: grid(args, measurement.targets_mm())?,
+        mode: plan.mode,
+        grid: grid(args, measurement.targets_mm(), plan.step_mm)?,
         reference_mm: args.reference,
         extrapolate: args.extrapolate.unwrap_or(Extrapolate::Refuse),
     };
-    let table = compensate::build_table(&measurement, &evaluation, &table_options)?;
+    let table =
+        compensate::effects::build_table_with_effects(&measurement, &table_options, &effects)?;
     let text = emit::write(args.controller, &table, &options)?;
     write_new(&args.output, text.as_bytes(), args.force)?;
     let file_name = args.output.file_name().map_or_else(
@@ -224,7 +242,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     );
     let activation = emit::activation(args.controller, &table, &file_name, &options);
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
-    let report = ConvertJson::new(
+    let mut report = ConvertJson::new(
         args.controller.name(),
         args.output.display().to_string(),
         &table,
@@ -232,6 +250,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         activation,
         warning_texts,
     );
+    report.effects = plan.notes;
     print_warnings(&warnings, args.quiet);
     if args.json {
         print_json(&report)
@@ -240,11 +259,81 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     }
 }
 
-/// The grid: `--step` (with `--start`, `--count`), else the measured targets
-/// when the controller takes them.
-fn grid(args: &ConvertArgs, targets_mm: &[f64]) -> Result<GridSpec> {
+/// What `--effects` decides: the table mode, a finer step, and what to say.
+struct EffectsPlan {
+    mode: TableMode,
+    step_mm: Option<f64>,
+    notes: Vec<String>,
+}
+
+impl EffectsPlan {
+    fn new(args: &ConvertArgs, effects: &[Effect], unit: LengthUnit) -> EffectsPlan {
+        let mut notes = Vec::new();
+        let reversal = effects.iter().find_map(|e| match e {
+            Effect::Reversal { b_um } => Some(*b_um),
+            _ => None,
+        });
+        let mode = match (args.mode, reversal) {
+            (Some(mode), _) => mode,
+            (None, Some(_)) if args.controller.supports_bidirectional() => {
+                notes
+                    .push("reversal: a bidirectional table (one column per direction)".to_string());
+                TableMode::Bidirectional
+            }
+            (None, Some(b)) => {
+                notes.push(format!(
+                    "reversal: {} takes no bidirectional table; set the backlash parameter (the suggested value below; the diagnosis found B = {b:.2} µm)",
+                    args.controller.name()
+                ));
+                TableMode::Mean
+            }
+            (None, None) => TableMode::Mean,
+        };
+        // A step the format writes exactly, at most period / 10.
+        let resolution = emit::resolution_mm(args.controller, unit);
+        let step_mm = compensate::effects::finest_step_mm(effects).map(|finest| {
+            let step = ((finest / resolution).floor() * resolution).max(resolution);
+            let chosen = args.step.map_or(step, |given| given.min(step));
+            notes.push(format!(
+                "periodic: points every {chosen} mm (at most a tenth of the period), the periodic error at each point"
+            ));
+            chosen
+        });
+        for effect in effects {
+            let note = match effect {
+                Effect::Scale { scale_um_per_m } => format!(
+                    "scale: {scale_um_per_m:.2} µm/m taken out; the table stays referred to the first test's conditions"
+                ),
+                Effect::Drift { rate_um_per_h } => format!(
+                    "drift of {rate_um_per_h:.2} µm/h: not a table's business; measure again with the machine warm"
+                ),
+                Effect::OutlierRun { run, direction, .. } => format!(
+                    "outlier run {run}{direction}: left in; give --exclude-run {run}:{} if it was the start-up run",
+                    direction.as_str()
+                ),
+                Effect::Abbe { .. } => "abbe: not a table's business; measure on the functional line or compensate pitch and yaw".to_string(),
+                Effect::Reversal { .. } | Effect::Periodic { .. } => continue,
+            };
+            notes.push(note);
+        }
+        EffectsPlan {
+            mode,
+            step_mm,
+            notes,
+        }
+    }
+}
+
+fn load_effects(path: &Path) -> Result<Vec<Effect>> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    read_effects(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+}
+
+/// The grid: `--step` (with `--start`, `--count`) or the effects' finer step,
+/// else the measured targets when the controller takes them.
+fn grid(args: &ConvertArgs, targets_mm: &[f64], effects_step: Option<f64>) -> Result<GridSpec> {
     let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
-    let Some(step_mm) = args.step else {
+    let Some(step_mm) = effects_step.or(args.step) else {
         if args.controller.accepts_free_positions()
             || compensate::regular_step(targets_mm).is_some()
         {
@@ -257,7 +346,8 @@ fn grid(args: &ConvertArgs, targets_mm: &[f64]) -> Result<GridSpec> {
         );
     };
     let start_mm = args.start.unwrap_or(first);
-    let count = match args.count {
+    // A --count belongs to the --step it was given with, not to a finer step of the effects.
+    let count = match args.count.filter(|_| Some(step_mm) == args.step) {
         Some(count) => count,
         None => ((last - start_mm) / step_mm + 1e-9).floor().max(0.0) as usize + 1,
     };

@@ -29,6 +29,7 @@
 //!
 //! Pure: no I/O. Lengths in mm.
 
+pub mod effects;
 pub mod retest;
 
 use crate::evaluate::Evaluation;
@@ -217,6 +218,9 @@ pub enum CompensateError {
     /// The grid is not usable.
     #[error("invalid grid: {0}")]
     Grid(String),
+    /// A measurement could not be rebuilt with the effects taken out (a bug).
+    #[error("internal error, please report: {0}")]
+    Measurement(String),
 }
 
 /// The spacing of evenly spaced positions (within 1 nm), or `None`.

@@ -7,7 +7,8 @@
 //!   "mode": "mean" | "bidirectional", "positions_mm": [...], "count": 16,
 //!   "start_mm": 0.0, "step_mm": 50.0 | null, "reference_mm": 0.0,
 //!   "values_um": {"mean": [...]} | {"up": [...], "down": [...]},
-//!   "suggested_backlash_um": 3.2 | null, "activation": "…", "warnings": [...] }
+//!   "suggested_backlash_um": 3.2 | null, "activation": "…",
+//!   "effects": ["…what --effects changed…"], "warnings": [...] }
 //! ```
 //! Values are the axis error actual − target in µm, zero at the reference,
 //! before each controller's own sign convention (see `formats/`).
@@ -67,6 +68,8 @@ pub struct ConvertJson {
     pub suggested_backlash_um: Option<f64>,
     /// How to activate the table on the controller.
     pub activation: String,
+    /// What `--effects` changed, as sentences (empty without it).
+    pub effects: Vec<String>,
     /// Warnings from reading and evaluating.
     pub warnings: Vec<String>,
 }
@@ -104,6 +107,7 @@ impl ConvertJson {
             },
             suggested_backlash_um: table.suggested_backlash_mm.map(mm_to_um),
             activation,
+            effects: Vec::new(),
             warnings,
         }
     }
@@ -131,6 +135,9 @@ impl ConvertJson {
             self.positions_mm[self.count - 1],
             self.reference_mm
         );
+        for effect in &self.effects {
+            let _ = writeln!(out, "Effect: {effect}");
+        }
         if let Some(backlash) = self.suggested_backlash_um {
             let _ = writeln!(
                 out,

@@ -5,6 +5,7 @@
 
 mod bad_input;
 mod cli;
+mod close_loop;
 mod convert;
 mod diagnose;
 mod evaluate_ecmc;

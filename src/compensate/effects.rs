@@ -1,0 +1,180 @@
+//! A table that accounts for the effects a diagnosis found (`convert
+//! --effects`, issue 6): what the geometric curve of a test misses.
+//!
+//! - **periodic**: the test's targets (and a table at them, linear in
+//!   between) cannot follow a short period. The periodic error is taken out of
+//!   the readings, the smooth rest is interpolated to the table's points, and
+//!   the periodic error is put back *at the points*: with a step of at most
+//!   period / 10 ([`finest_step_mm`]) the controller's linear interpolation
+//!   leaves less than 5 % of its amplitude (A·(1 − cos(π·h/p)) for a step h).
+//! - **scale**: a scale the re-test showed beyond the prediction is the
+//!   thermal or alignment state of that test, not the machine's: it is taken
+//!   out of the table, which stays referred to the conditions of the first test
+//!   (20 °C when the laser's material compensation held then).
+//! - **reversal**: the caller chooses a bidirectional table (`convert` does
+//!   when the controller takes one); nothing changes here.
+//! - drift, outlier run and Abbe are not a table's business: the caller says
+//!   what to do instead.
+//!
+//! The table is zero at its reference point afterwards, as every table.
+
+use super::{CompensateError, CompensationTable, TableOptions, build_table};
+use crate::diagnose::Effect;
+use crate::evaluate::evaluate;
+use crate::measurement::{Measurement, Run};
+
+/// The finest step the periodic effects ask for: the shortest period / 10, mm.
+pub fn finest_step_mm(effects: &[Effect]) -> Option<f64> {
+    effects
+        .iter()
+        .filter_map(|e| match e {
+            Effect::Periodic { period_mm, .. } => Some(period_mm / 10.0),
+            _ => None,
+        })
+        .min_by(f64::total_cmp)
+}
+
+/// The table from `measurement` with the periodic and scale effects accounted for.
+pub fn build_table_with_effects(
+    measurement: &Measurement,
+    options: &TableOptions,
+    effects: &[Effect],
+) -> Result<CompensationTable, CompensateError> {
+    let periodic_um = |x: f64| -> f64 {
+        effects
+            .iter()
+            .filter(|e| matches!(e, Effect::Periodic { .. }))
+            .filter_map(|e| e.systematic_um(x, crate::measurement::Direction::Up, 0.0))
+            .sum()
+    };
+    let scale_um_per_m: f64 = effects
+        .iter()
+        .map(|e| match e {
+            Effect::Scale { scale_um_per_m } => *scale_um_per_m,
+            _ => 0.0,
+        })
+        .sum();
+    let smooth = without_periodic(measurement, &periodic_um)
+        .map_err(|e| CompensateError::Measurement(e.to_string()))?;
+    let mut table = build_table(&smooth, &evaluate(&smooth), options)?;
+    let reference = table.reference_mm;
+    // What the effects add at a point, relative to the reference, mm.
+    let added = |p: f64| {
+        (periodic_um(p) - periodic_um(reference) - scale_um_per_m * (p - reference) / 1000.0)
+            / 1000.0
+    };
+    let positions = table.positions_mm.clone();
+    table.values = table.values.map(|column| {
+        column
+            .iter()
+            .zip(&positions)
+            .map(|(value, &p)| value + added(p))
+            .collect()
+    });
+    Ok(table)
+}
+
+/// The readings less the periodic error at their targets.
+fn without_periodic(
+    measurement: &Measurement,
+    periodic_um: &dyn Fn(f64) -> f64,
+) -> Result<Measurement, crate::measurement::MeasurementError> {
+    let targets = measurement.targets_mm().to_vec();
+    let runs: Vec<Run> = measurement
+        .runs()
+        .iter()
+        .map(|run| Run {
+            deviations_mm: run
+                .deviations_mm
+                .iter()
+                .zip(&targets)
+                .map(|(value, &x)| value.map(|v| v - periodic_um(x) / 1000.0))
+                .collect(),
+            ..run.clone()
+        })
+        .collect();
+    Measurement::new(
+        measurement.axis(),
+        targets,
+        runs,
+        measurement.environment.clone(),
+        measurement.metadata.clone(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensate::{Extrapolate, GridSpec, TableMode};
+    use crate::measurement::Direction;
+
+    /// Two runs each way of e(x) = 2 µm · sin(2πx/5) + 10 µm/m · x at 0, 1, … 20 mm.
+    fn screw() -> Measurement {
+        let targets: Vec<f64> = (0..=20).map(f64::from).collect();
+        let value = |x: f64| (2.0 * (std::f64::consts::TAU * x / 5.0).sin() + 0.01 * x) / 1000.0;
+        let runs = [
+            Direction::Up,
+            Direction::Down,
+            Direction::Up,
+            Direction::Down,
+        ]
+        .iter()
+        .enumerate()
+        .map(|(i, &direction)| Run {
+            direction,
+            number: 1 + i as u32 / 2,
+            start_time_s: None,
+            deviations_mm: targets.iter().map(|&x| Some(value(x))).collect(),
+        })
+        .collect();
+        Measurement::new("X", targets, runs, Default::default(), Default::default()).unwrap()
+    }
+
+    #[test]
+    fn the_periodic_error_is_put_back_at_the_finer_points_by_hand() {
+        let effects = [Effect::Periodic {
+            period_mm: 5.0,
+            amplitude_um: 2.0,
+            phase_rad: 0.0,
+        }];
+        assert_eq!(finest_step_mm(&effects), Some(0.5));
+        let options = TableOptions {
+            mode: TableMode::Mean,
+            grid: GridSpec::Regular {
+                start_mm: 0.0,
+                step_mm: 0.5,
+                count: 41,
+            },
+            reference_mm: None,
+            extrapolate: Extrapolate::Refuse,
+        };
+        let table = build_table_with_effects(&screw(), &options, &effects).unwrap();
+        // At the point 0.5 mm, between the targets 0 and 1 mm:
+        // 2 µm · sin(π/5) + 10 µm/m · 0.5 mm = 1.175571 + 0.005 µm.
+        let expected = (2.0 * (std::f64::consts::PI / 5.0).sin() + 0.005) / 1000.0;
+        let at = table.value_at(0.5, Direction::Up);
+        assert!((at - expected).abs() < 1e-12, "{at} vs {expected}");
+        // Without the effect the table interpolates the targets: 0.956 µm there.
+        let plain = build_table(&screw(), &evaluate(&screw()), &options).unwrap();
+        assert!((plain.value_at(0.5, Direction::Up) - expected).abs() > 1e-4);
+    }
+
+    #[test]
+    fn a_scale_is_taken_out() {
+        let options = TableOptions {
+            mode: TableMode::Mean,
+            grid: GridSpec::Targets,
+            reference_mm: None,
+            extrapolate: Extrapolate::Refuse,
+        };
+        let effects = [Effect::Scale {
+            scale_um_per_m: 10.0,
+        }];
+        let plain = build_table(&screw(), &evaluate(&screw()), &options).unwrap();
+        let table = build_table_with_effects(&screw(), &options, &effects).unwrap();
+        // 10 µm/m over 20 mm: 0.2 µm less at the end, nothing at the reference (0 mm).
+        let difference = plain.value_at(20.0, Direction::Up) - table.value_at(20.0, Direction::Up);
+        assert!((difference - 0.0002).abs() < 1e-12, "{difference}");
+        assert_eq!(table.value_at(0.0, Direction::Down), 0.0);
+    }
+}
