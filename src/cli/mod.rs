@@ -8,6 +8,7 @@
 
 mod common;
 mod convert;
+mod demo;
 mod diagnose;
 mod evaluate;
 mod predict;
@@ -34,6 +35,12 @@ pub struct Args {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Run the whole workflow on bundled sample data and say where everything is.
+    ///
+    /// Evaluates a first test, writes the table for every controller, predicts
+    /// the re-test, diagnoses the bundled re-test (an axis with effects the
+    /// model does not declare), writes the next table and the acceptance report.
+    Demo(demo::DemoArgs),
     /// Read a laser measurement and evaluate it per ISO 230-2.
     ///
     /// Prints the per-target table and the axis figures A, E, M, R, B in µm.
@@ -120,6 +127,7 @@ pub fn main() -> ExitCode {
 
 fn run(args: Args) -> Result<()> {
     match args.command {
+        Command::Demo(demo_args) => demo::run(&demo_args),
         Command::Evaluate(evaluate_args) => evaluate::run(&evaluate_args),
         Command::Convert(convert_args) => convert::run(&convert_args),
         Command::Synth(synth_args) => synth::run(&synth_args),

@@ -7,7 +7,6 @@ use std::io::IsTerminal;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// A bar over `length` steps, or a hidden one when it must stay quiet.
-#[allow(dead_code)]
 pub fn bar(length: u64, message: &str, quiet: bool) -> ProgressBar {
     if quiet || !std::io::stdout().is_terminal() {
         return ProgressBar::hidden();

@@ -359,7 +359,7 @@ impl Effect {
                     "the axis overshoots in the direction it moves (a leading encoder, or an elastic preload released at reversal)"
                 };
                 format!(
-                    "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (--mode bidirectional) or set the backlash parameter to {:.2} µm.",
+                    "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or set the backlash parameter to {:.2} µm.",
                     -b_um
                 )
             }

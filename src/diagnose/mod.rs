@@ -836,13 +836,15 @@ fn best_of<T>(
 fn strong_evidence(rejected: &mut Vec<RejectedEffect>, kind: Kind, delta: f64) -> bool {
     let strong = delta <= -MIN_DELTA_BIC;
     if !strong {
+        let change = if delta < 0.0 {
+            format!("the BIC drops by {:.1}", -delta)
+        } else {
+            format!("the BIC rises by {delta:.1}")
+        };
         set_rejection(
             rejected,
             kind,
-            format!(
-                "not enough evidence: the BIC drops by {:.1}, {MIN_DELTA_BIC} is needed",
-                -delta
-            ),
+            format!("not enough evidence: {change}, a drop of {MIN_DELTA_BIC} is needed"),
         );
     }
     strong

@@ -4,9 +4,11 @@
 //! into the repository); small inputs and expected outputs live in `tests/data`.
 
 mod bad_input;
+mod browser;
 mod cli;
 mod close_loop;
 mod convert;
+mod demo;
 mod diagnose;
 mod evaluate_ecmc;
 mod linuxcnc;

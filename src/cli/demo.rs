@@ -1,0 +1,395 @@
+//! `axcomp demo`: the whole workflow on the bundled demo data (a synthetic X
+//! axis whose truth, in `fixtures/demo/truth.toml`, has a reversal and a
+//! warm-up drift the model does not declare): evaluate the first test, write
+//! the table for every controller, predict the re-test, read the bundled
+//! re-test, diagnose it, write the next table and the acceptance report.
+//!
+//! The data is compiled into the binary, so the demo runs anywhere. Every
+//! step is a library call the other subcommands make too; nothing here
+//! computes a figure of its own.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use axcomp::compensate::effects::build_table_with_effects;
+use axcomp::compensate::{self, CompensationTable, Extrapolate, GridSpec, TableMode, TableOptions};
+use axcomp::cycle::CycleTiming;
+use axcomp::diagnose::{DiagnoseInput, Diagnosis, Effect, diagnose, write_effects};
+use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
+use axcomp::evaluate::{Evaluation, evaluate};
+use axcomp::measurement::{Measurement, SourceFormat};
+use axcomp::model::{GeometricErrors, Machine};
+use axcomp::output::write_new;
+use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
+use axcomp::read;
+use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
+use axcomp::report::chart::chart;
+use axcomp::report::diagnose::DiagnoseJson;
+use axcomp::report::html;
+use axcomp::report::json::EvaluationJson;
+use axcomp::report::plot::PlotFormat;
+use axcomp::report::predict::PredictJson;
+use axcomp::synth::{EffectSpec, Truth};
+
+use super::common::print_text;
+use super::progress;
+
+const TRUTH: &str = include_str!("../../fixtures/demo/truth.toml");
+const BEFORE: &str = include_str!("../../fixtures/demo/before.rtl");
+const AFTER: &str = include_str!("../../fixtures/demo/after.rtl");
+
+/// Flags of `axcomp demo`.
+#[derive(Debug, clap::Args)]
+pub struct DemoArgs {
+    /// Where to write everything (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "axcomp-demo")]
+    pub out: PathBuf,
+
+    /// Replace files of an earlier demo in DIR.
+    #[arg(long)]
+    pub force: bool,
+
+    /// No progress bar.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// One file to write: path relative to the output folder, contents.
+type Output = (String, Vec<u8>);
+
+/// Runs `axcomp demo`.
+pub fn run(args: &DemoArgs) -> Result<()> {
+    let steps = progress::bar(6, "demo", args.quiet);
+    let truth = Truth::from_toml_str(TRUTH).map_err(|e| anyhow::anyhow!("bundled truth: {e}"))?;
+    let before = bundled(BEFORE, "before.rtl")?;
+    let after = bundled(AFTER, "after.rtl")?;
+    let mut files: Vec<Output> = vec![
+        ("truth.toml".into(), TRUTH.into()),
+        ("before.rtl".into(), BEFORE.into()),
+        ("after.rtl".into(), AFTER.into()),
+    ];
+
+    // 1. The first test per ISO 230-2.
+    let evaluation = evaluate(&before);
+    let json = EvaluationJson::new(&before, &evaluation, &[], &evaluation.warnings);
+    files.push(("evaluate.json".into(), serde_json::to_vec_pretty(&json)?));
+    steps.inc(1);
+
+    // 2. A mean table at the targets for every controller, read back as the controller applies it.
+    let options = TableOptions {
+        mode: TableMode::Mean,
+        grid: GridSpec::Targets,
+        reference_mm: None,
+        extrapolate: Extrapolate::Refuse,
+    };
+    let table = compensate::build_table(&before, &evaluation, &options)?;
+    let mut active = None;
+    for controller in Controller::ALL {
+        let emit_options = emit_options(&table.axis)?;
+        let text = emit::write(controller, &table, &emit_options)?;
+        let (_, read_back) = emit::read_any(&text, &emit_options, Some(0))
+            .map_err(|e| anyhow::anyhow!("{}: {e}", controller.name()))?;
+        if controller == Controller::Tnc640 {
+            active = Some(read_back);
+        }
+        files.push((table_path(controller, &table.axis), text.into_bytes()));
+    }
+    let active = active.context("no TNC 640 table")?;
+    steps.inc(1);
+
+    // 3. The prediction of the re-test with the TNC 640 table (the one the bundled re-test ran with).
+    let machine = Machine::bundled();
+    let measured = [MeasuredAxis {
+        measurement: &before,
+        line_mm: machine.reference_mm(),
+    }];
+    let prediction = predict(&PredictInput {
+        machine: &machine,
+        errors: &GeometricErrors::default(),
+        measured: &measured,
+        tables: std::slice::from_ref(&active),
+        line_mm: machine.reference_mm(),
+        retest_tool_offset_mm: None,
+        grid_step_mm: 50.0,
+        effects: &[],
+    })?;
+    let predict_json = PredictJson::new(
+        machine.name(),
+        machine.chain().as_str(),
+        &prediction,
+        50.0,
+        Vec::new(),
+        Vec::new(),
+    );
+    files.push((
+        "predict.json".into(),
+        serde_json::to_vec_pretty(&predict_json)?,
+    ));
+    steps.inc(1);
+
+    // 4. The re-test, diagnosed against the prediction.
+    let diagnosis = diagnose(&DiagnoseInput {
+        after: &after,
+        before: Some(&before),
+        table: Some(&active),
+        angular: None,
+        timing: CycleTiming::ASSUMED,
+    })?;
+    let diagnose_json = DiagnoseJson::new(
+        &diagnosis,
+        "after.rtl".into(),
+        Some("before.rtl".into()),
+        Some(table_path(Controller::Tnc640, &table.axis)),
+    );
+    files.push((
+        "diagnose.json".into(),
+        serde_json::to_vec_pretty(&diagnose_json)?,
+    ));
+    files.push((
+        "effects.toml".into(),
+        write_effects(&diagnosis.accepted, "after.rtl").into_bytes(),
+    ));
+    steps.inc(1);
+
+    // 5. The next table: the re-test's residual on top of the active table, with the effects.
+    let effects: Vec<Effect> = diagnosis
+        .accepted
+        .iter()
+        .map(|a| a.effect.clone())
+        .collect();
+    let next = next_table(&after, &active, &effects)?;
+    let next_text = emit::write(Controller::Tnc640, &next, &emit_options(&next.axis)?)?;
+    files.push((
+        format!("tables/next/{}.COM", next.axis),
+        next_text.into_bytes(),
+    ));
+    steps.inc(1);
+
+    // 6. The acceptance report with its plots.
+    let after_evaluation = evaluate(&after);
+    let tnc640_file = table_path(Controller::Tnc640, &table.axis);
+    let generator = format!("axcomp {} demo", env!("CARGO_PKG_VERSION"));
+    let input = ReportInput {
+        before: TestRecord {
+            measurement: &before,
+            evaluation: &evaluation,
+            warnings: &evaluation.warnings,
+        },
+        after: Some(TestRecord {
+            measurement: &after,
+            evaluation: &after_evaluation,
+            warnings: &after_evaluation.warnings,
+        }),
+        table: Some(TableRecord {
+            table: &active,
+            file: &tnc640_file,
+            controller: Controller::Tnc640,
+        }),
+        diagnosis: Some(&diagnosis),
+        generator: &generator,
+    };
+    files.push(("report.html".into(), html::render(&input)?.into_bytes()));
+    for named in charts(&input) {
+        files.push((
+            format!("png/{}.png", named.name),
+            chart(&named.chart, PlotFormat::Png)?,
+        ));
+    }
+    steps.finish_and_clear();
+
+    write_all(&args.out, &files, args.force)?;
+    print_text(&summary(&Summary {
+        out: &args.out,
+        truth: &truth,
+        evaluation: &evaluation,
+        after: &after_evaluation,
+        prediction: &prediction,
+        diagnosis: &diagnosis,
+        next: &next,
+        files: files.len(),
+    }))
+}
+
+/// A bundled test, named as the demo writes it.
+fn bundled(text: &str, name: &str) -> Result<Measurement> {
+    let (mut measurement, _) = read::parse_str(text, SourceFormat::Rtl)
+        .map_err(|e| anyhow::anyhow!("bundled {name}:{e}"))?;
+    measurement.metadata.source_file = Some(PathBuf::from(name));
+    Ok(measurement)
+}
+
+fn emit_options(axis: &str) -> Result<EmitOptions> {
+    let profile = MachineProfile::default();
+    Ok(EmitOptions {
+        axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
+        table_name: format!("{axis}.COM"),
+        machine_unit: profile.machine_unit(),
+        linuxcnc_type: 0,
+        max_points: None,
+        max_value_mm: None,
+        cec_first_table: 0,
+        cec_values_are_corrections: true,
+        tnc640_columns: Vec::new(),
+    })
+}
+
+/// Where a controller's table goes: one folder per controller, its usual extension.
+fn table_path(controller: Controller, axis: &str) -> String {
+    let file = match controller {
+        Controller::Itnc530 | Controller::Tnc640 => format!("{axis}.COM"),
+        Controller::Sinumerik840d => format!("{axis}.MPF"),
+        Controller::LinuxCnc => format!("{}.comp", axis.to_ascii_lowercase()),
+    };
+    format!("tables/{}/{file}", controller.name())
+}
+
+/// The table after the re-test: the active table plus the residual the re-test
+/// shows, with the diagnosis's effects (as `convert --existing --effects`).
+fn next_table(
+    after: &Measurement,
+    active: &CompensationTable,
+    effects: &[Effect],
+) -> Result<CompensationTable> {
+    let without = compensate::add_existing_table(after, active)?;
+    let reversal = effects.iter().any(|e| matches!(e, Effect::Reversal { .. }));
+    let options = TableOptions {
+        mode: if reversal {
+            TableMode::Bidirectional
+        } else {
+            TableMode::Mean
+        },
+        grid: GridSpec::Targets,
+        reference_mm: None,
+        extrapolate: Extrapolate::Refuse,
+    };
+    Ok(build_table_with_effects(&without, &options, effects)?)
+}
+
+/// Writes every file under `out`, refusing to replace any without `force`
+/// (checked for all before the first is written).
+fn write_all(out: &Path, files: &[Output], force: bool) -> Result<()> {
+    if !force && let Some((name, _)) = files.iter().find(|(name, _)| out.join(name).exists()) {
+        bail!(
+            "{} exists (from an earlier demo?); give --force to replace it, or --out another folder",
+            out.join(name).display()
+        );
+    }
+    for (name, bytes) in files {
+        let path = out.join(name);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
+        }
+        write_new(&path, bytes, force)?;
+    }
+    Ok(())
+}
+
+struct Summary<'a> {
+    out: &'a Path,
+    truth: &'a Truth,
+    evaluation: &'a Evaluation,
+    after: &'a Evaluation,
+    prediction: &'a Prediction,
+    diagnosis: &'a Diagnosis,
+    next: &'a CompensationTable,
+    files: usize,
+}
+
+/// Where everything is and what happened, in ten lines.
+fn summary(s: &Summary<'_>) -> String {
+    let um = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{:.2}", v * 1000.0));
+    let f = &s.evaluation.figures;
+    let retest = &s.prediction.retests[0].figures;
+    let a = &s.after.figures;
+    let found: Vec<String> = s
+        .diagnosis
+        .accepted
+        .iter()
+        .map(|accepted| {
+            let (key, value) = accepted.effect.parameters()[0];
+            let truth = truth_value(s.truth, &accepted.effect)
+                .map_or(String::new(), |t| format!(" (truth {t})"));
+            format!(
+                "{} {key} = {value:.2}{truth}",
+                accepted.effect.kind().name()
+            )
+        })
+        .collect();
+    let unexplained = if s.diagnosis.unexplained.significant {
+        "structure left unexplained (see the report)"
+    } else {
+        "nothing left unexplained"
+    };
+    let mut out = String::new();
+    let _ = writeln!(out, "axcomp demo: {} files in {}", s.files, s.out.display());
+    let _ = writeln!(
+        out,
+        " 1 first test    before.rtl: A {} µm, E {} µm, R {} µm, B {} µm (evaluate.json)",
+        um(f.a_mm),
+        um(f.e_mm),
+        um(f.r_mm),
+        um(f.b_mm)
+    );
+    let _ = writeln!(
+        out,
+        " 2 tables        iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC: {} points (tables/)",
+        s.next.positions_mm.len()
+    );
+    let _ = writeln!(
+        out,
+        " 3 prediction    re-test A {} µm, E {} µm; volumetric max {:.2} → {:.2} µm (predict.json)",
+        um(retest.a_mm),
+        um(retest.e_mm),
+        s.prediction.volumetric_before.max_mm * 1000.0,
+        s.prediction.volumetric_after.max_mm * 1000.0
+    );
+    let _ = writeln!(
+        out,
+        " 4 re-test       after.rtl: A {} µm, E {} µm, R {} µm, B {} µm: not what was predicted",
+        um(a.a_mm),
+        um(a.e_mm),
+        um(a.r_mm),
+        um(a.b_mm)
+    );
+    let _ = writeln!(
+        out,
+        " 5 diagnosis     {} (diagnose.json, effects.toml)",
+        found.join("; ")
+    );
+    let _ = writeln!(
+        out,
+        " 6 residual      rms {:.2} µm → {:.2} µm with the effects; {unexplained}",
+        s.diagnosis.residual_before.rms_um, s.diagnosis.residual_after.rms_um
+    );
+    let _ = writeln!(
+        out,
+        " 7 next table    tables/next/{}.COM: {} (the residual and the effects)",
+        s.next.axis,
+        s.next.values.mode().as_str()
+    );
+    let _ = writeln!(
+        out,
+        " 8 report        {} (open in a browser; plots in png/)",
+        s.out.join("report.html").display()
+    );
+    let _ = writeln!(
+        out,
+        " 9 the truth     truth.toml: what the synthetic axis really has"
+    );
+    out
+}
+
+/// The truth's value of the parameter the summary shows, when the truth has that kind.
+fn truth_value(truth: &Truth, effect: &Effect) -> Option<f64> {
+    truth.effects.iter().find_map(|spec| match (spec, effect) {
+        (EffectSpec::Reversal { B_um, .. }, Effect::Reversal { .. }) => Some(*B_um),
+        (EffectSpec::Scale { scale_um_per_m, .. }, Effect::Scale { .. }) => Some(*scale_um_per_m),
+        (EffectSpec::Drift { rate_um_per_h, .. }, Effect::Drift { .. }) => Some(*rate_um_per_h),
+        (EffectSpec::Periodic { period_mm, .. }, Effect::Periodic { .. }) => Some(*period_mm),
+        (EffectSpec::OutlierRun { run, .. }, Effect::OutlierRun { .. }) => Some(f64::from(*run)),
+        (EffectSpec::Abbe { offset_mm, .. }, Effect::Abbe { .. }) => Some(*offset_mm),
+        _ => None,
+    })
+}
