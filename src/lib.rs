@@ -13,15 +13,20 @@
 //! - [`evaluate`] computes the ISO 230-2 figures (A, E, M, R, B per direction
 //!   and per target) as an [`evaluate::Evaluation`], with `None` wherever the
 //!   standard leaves a figure undefined, and flags suspected outlier runs.
-//! - [`report`] turns them into the terminal report and the `--json` wire
-//!   format (µm, unit-suffixed keys).
+//! - [`compensate`] builds the compensation table (actual − target, zero at
+//!   the reference) and [`emit`] writes and reads it for each controller.
 //! - [`model`] is the geometric model of a three-axis machine (seed 000):
 //!   the 21 errors, the kinematic chain as data, the volumetric error, the
-//!   guideway model and the Monte Carlo tolerance study.
-//! - [`servo`] simulates a feed axis with friction (seed 004: four friction
-//!   models, the cascade control of a linear-motor axis, the circle test and
-//!   a simulated ISO 230-2 cycle) and gives the reversal B ≈ 2·F_res/k_c that
-//!   friction leaves through a structural compliance.
+//!   guideway model and the Monte Carlo tolerance study; [`predict`] applies
+//!   tables to it and predicts the re-test and the residual volumetric error.
+//! - [`diagnose`] traces the residual of a re-test to the effects the model
+//!   lacks (reversal, scale, drift, periodic, outlier run, Abbe).
+//! - [`servo`] simulates a feed axis with friction (seed 004) and gives the
+//!   reversal B ≈ 2·F_res/k_c that friction leaves through a compliance.
+//! - [`synth`] writes measurements from a known truth, with the ISO 230-2
+//!   cycle's timing from [`cycle`].
+//! - [`report`] turns all of them into terminal reports, the `--json` wire
+//!   formats (µm, unit-suffixed keys) and the acceptance report (HTML, PNG).
 //! - [`output`] is the one place that creates files: via a temporary file and
 //!   a rename, never overwriting without `force`.
 //!

@@ -1,12 +1,12 @@
 //! Heidenhain iTNC 530 nonlinear axis error compensation table (`.COM`): writer and reader.
 //!
-//! Spec and sources: `formats/itnc530/README.md`. [seen] seed 001 Fig. 28
+//! Spec and sources: `formats/itnc530/README.md`. \[seen\] seed 001 Fig. 28
 //! (the control's table editor: `DATUM` = start of the compensated range,
 //! `DISTANCE` = spacing in mm, columns `NR`, an unlabelled position column,
 //! `1=F() 2=F() 3=F()`…, one value per point in the column of the axis
 //! number), the iTNC 530 HSCI technical manual (position errors in "columns
 //! 1-18 of the COM files"), the TNC 407 manual (at most 256 entries; the error
-//! curve starts with 0 at the datum). [reconstructed] the raw file syntax,
+//! curve starts with 0 at the datum). \[reconstructed\] the raw file syntax,
 //! which no public source shows: the first line and the column widths are
 //! those the seed author's tool writes (`BEGIN AXIS-X.COM  DATUM:+0.0000
 //! DISTANCE:+100.0000`, NR 5 wide, position 12, axis columns 11; the author

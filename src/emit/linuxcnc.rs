@@ -1,6 +1,6 @@
 //! LinuxCNC screw compensation `COMP_FILE` (`[JOINT_n] COMP_FILE_TYPE = 0|1`): writer and reader.
 //!
-//! Spec and sources: `formats/linuxcnc/README.md` ([seen]: LinuxCNC 2.9
+//! Spec and sources: `formats/linuxcnc/README.md` (\[seen\]: LinuxCNC 2.9
 //! `ini-config.adoc`, `usrmotintf.cc`, `control.c`, and a run on LinuxCNC 2.9
 //! in this project's tests). One triplet per line, `nominal forward reverse`,
 //! nothing else (the loader stops at the first line that is not three

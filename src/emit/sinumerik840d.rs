@@ -2,14 +2,14 @@
 //! (`%_N_AX_EEC_INI`, `$AA_ENC_COMP`) for one table, CEC (`%_N_NC_CEC_INI`,
 //! `$AN_CEC`) for direction-dependent tables.
 //!
-//! Spec and sources: `formats/sinumerik840d/README.md`. [seen] the Siemens
+//! Spec and sources: `formats/sinumerik840d/README.md`. \[seen\] the Siemens
 //! Function Manual Extended Functions K3 (03/2013) examples: the LEC program
 //! skeleton, index order `[encoder, point, axis]`, points N = 0…(MAX−MIN)/STEP,
 //! end values held outside MIN…MAX, "a positive compensation value causes the
 //! machine axis to move in the negative direction" (so an LEC value is the
 //! measured error with its own sign); the CEC table parameters with
 //! `$AN_CEC_DIRECTION` = 1 / −1 for position-dependent backlash with two
-//! tables. [reconstructed] the CEC sign: the K3 sag examples enter the value
+//! tables. \[reconstructed\] the CEC sign: the K3 sag examples enter the value
 //! that moves the compensation axis (a correction, −error); it is a profile
 //! setting (`cec_values`) because no public page states it outright.
 //!

@@ -1,12 +1,12 @@
 //! Heidenhain TNC 640 nonlinear axis error compensation table (`.COM`): writer and reader.
 //!
-//! Spec and sources: `formats/tnc640/README.md`. [seen] seed 001 Fig. 29 (the
+//! Spec and sources: `formats/tnc640/README.md`. \[seen\] seed 001 Fig. 29 (the
 //! table the seed's after-test on a real TNC 640 used), the MANUALplus 620
 //! technical manual p.716/718 (same NC family: AXISPOS with respect to the
 //! machine datum, BACKLASH with the values measured in the negative
 //! direction, one column per axis of CfgAxes/axisList), and the generic
 //! Heidenhain table envelope (`BEGIN <NAME>.<SUFFIX> MM`, fixed-width columns
-//! sliced at the header's offsets, `[END]`). [reconstructed] the column
+//! sliced at the header's offsets, `[END]`). \[reconstructed\] the column
 //! widths (NR 5, others 14, as the seed author's tool writes them), CRLF line
 //! ends, and BACKLASH as absolute ↓ values.
 //!

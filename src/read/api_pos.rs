@@ -19,7 +19,7 @@
 //! positions, as for `.rtl`. Two files (forward and reverse) of one axis are
 //! joined by `read::read_paths`.
 //!
-//! [reconstructed] In inch files the temperatures are °F and the pressure
+//! \[reconstructed\] In inch files the temperatures are °F and the pressure
 //! inHg (68.00 and 29.92 are the standard values in those units) and
 //! `ExpCoef` is ppm/°F; they are converted to °C, kPa and ppm/°C. A material
 //! temperature of −1 means "no sensor" (the files use it for sensors 2 and 3).
