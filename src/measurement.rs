@@ -408,6 +408,34 @@ impl Measurement {
         })
     }
 
+    /// The same measurement with every reading replaced by
+    /// `reading(run, target index, value mm)`; missing readings stay missing,
+    /// targets, runs and conditions are kept. (A table taken off, an effect
+    /// taken out, a predicted change put in.)
+    pub fn map_readings(
+        &self,
+        reading: impl Fn(&Run, usize, Mm) -> Mm,
+    ) -> Result<Measurement, MeasurementError> {
+        let runs: Vec<Run> = self
+            .runs
+            .iter()
+            .map(|run| Run {
+                deviations_mm: run
+                    .deviations_mm
+                    .iter()
+                    .enumerate()
+                    .map(|(i, value)| value.map(|v| reading(run, i, v)))
+                    .collect(),
+                ..run.clone()
+            })
+            .collect();
+        check_runs(&runs, self.targets_mm.len())?;
+        Ok(Measurement {
+            runs,
+            ..self.clone()
+        })
+    }
+
     /// Joins two measurements of the same axis and targets (e.g. the forward
     /// and reverse `.pos` files of one test). Runs of `other` follow those of
     /// `self` and are renumbered after them, per direction.

@@ -101,17 +101,8 @@ pub fn read_table(
     profile: &MachineProfile,
     linuxcnc_type: Option<u8>,
 ) -> Result<(Controller, CompensationTable)> {
-    let options = EmitOptions {
-        axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
-        table_name: String::new(),
-        machine_unit: profile.machine_unit(),
-        linuxcnc_type: linuxcnc_type.unwrap_or(0),
-        max_points: None,
-        max_value_mm: None,
-        cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
-        cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
-        tnc640_columns: Vec::new(),
-    };
+    let mut options = EmitOptions::for_axis(profile, axis, "").map_err(anyhow::Error::msg)?;
+    options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
     emit::read_any(&text, &options, None)
         .or_else(|error| match linuxcnc_type {

@@ -187,29 +187,16 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     }
     check_selectors(&measurement, &args.exclude_runs)?;
     let mut measurement = measurement.without_runs(&args.exclude_runs)?;
-    let mut axes = vec![
-        profile
-            .axis(measurement.axis())
-            .map_err(anyhow::Error::msg)?,
-    ];
+    let mut options =
+        EmitOptions::for_axis(&profile, measurement.axis(), &table_name(&args.output))
+            .map_err(anyhow::Error::msg)?;
     for also in &args.also {
-        axes.push(profile.axis(also).map_err(anyhow::Error::msg)?);
+        options
+            .axes
+            .push(profile.axis(also).map_err(anyhow::Error::msg)?);
     }
-    let options = EmitOptions {
-        axes,
-        table_name: table_name(&args.output),
-        machine_unit: profile.machine_unit(),
-        linuxcnc_type: args.linuxcnc_type,
-        max_points: args.max_points.or(profile.controller.max_points),
-        max_value_mm: profile.controller.max_value_mm,
-        cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
-        cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
-        tnc640_columns: profile
-            .controller
-            .tnc640_columns
-            .clone()
-            .unwrap_or_default(),
-    };
+    options.linuxcnc_type = args.linuxcnc_type;
+    options.max_points = args.max_points.or(options.max_points);
     if let Some(existing) = &args.existing {
         let text =
             std::fs::read_to_string(existing).with_context(|| format!("{}", existing.display()))?;

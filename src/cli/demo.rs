@@ -221,18 +221,8 @@ fn bundled(text: &str, name: &str) -> Result<Measurement> {
 }
 
 fn emit_options(axis: &str) -> Result<EmitOptions> {
-    let profile = MachineProfile::default();
-    Ok(EmitOptions {
-        axes: vec![profile.axis(axis).map_err(anyhow::Error::msg)?],
-        table_name: format!("{axis}.COM"),
-        machine_unit: profile.machine_unit(),
-        linuxcnc_type: 0,
-        max_points: None,
-        max_value_mm: None,
-        cec_first_table: 0,
-        cec_values_are_corrections: true,
-        tnc640_columns: Vec::new(),
-    })
+    EmitOptions::for_axis(&MachineProfile::default(), axis, &format!("{axis}.COM"))
+        .map_err(anyhow::Error::msg)
 }
 
 /// Where a controller's table goes: one folder per controller, its usual extension.

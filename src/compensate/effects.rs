@@ -21,7 +21,7 @@
 use super::{CompensateError, CompensationTable, TableOptions, build_table};
 use crate::diagnose::Effect;
 use crate::evaluate::evaluate;
-use crate::measurement::{Measurement, Run};
+use crate::measurement::Measurement;
 
 /// The finest step the periodic effects ask for: the shortest period / 10, mm.
 pub fn finest_step_mm(effects: &[Effect]) -> Option<f64> {
@@ -54,7 +54,10 @@ pub fn build_table_with_effects(
             _ => 0.0,
         })
         .sum();
-    let smooth = without_periodic(measurement, &periodic_um)
+    // The readings less the periodic error at their targets.
+    let targets = measurement.targets_mm();
+    let smooth = measurement
+        .map_readings(|_, i, v| v - periodic_um(targets[i]) / 1000.0)
         .map_err(|e| CompensateError::Measurement(e.to_string()))?;
     let mut table = build_table(&smooth, &evaluate(&smooth), options)?;
     let reference = table.reference_mm;
@@ -74,39 +77,11 @@ pub fn build_table_with_effects(
     Ok(table)
 }
 
-/// The readings less the periodic error at their targets.
-fn without_periodic(
-    measurement: &Measurement,
-    periodic_um: &dyn Fn(f64) -> f64,
-) -> Result<Measurement, crate::measurement::MeasurementError> {
-    let targets = measurement.targets_mm().to_vec();
-    let runs: Vec<Run> = measurement
-        .runs()
-        .iter()
-        .map(|run| Run {
-            deviations_mm: run
-                .deviations_mm
-                .iter()
-                .zip(&targets)
-                .map(|(value, &x)| value.map(|v| v - periodic_um(x) / 1000.0))
-                .collect(),
-            ..run.clone()
-        })
-        .collect();
-    Measurement::new(
-        measurement.axis(),
-        targets,
-        runs,
-        measurement.environment.clone(),
-        measurement.metadata.clone(),
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::compensate::{Extrapolate, GridSpec, TableMode};
-    use crate::measurement::Direction;
+    use crate::measurement::{Direction, Run};
 
     /// Two runs each way of e(x) = 2 µm · sin(2πx/5) + 10 µm/m · x at 0, 1, … 20 mm.
     fn screw() -> Measurement {

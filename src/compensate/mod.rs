@@ -33,7 +33,7 @@ pub mod effects;
 pub mod retest;
 
 use crate::evaluate::Evaluation;
-use crate::measurement::{Direction, Measurement, MeasurementError, Run};
+use crate::measurement::{Direction, Measurement, MeasurementError};
 
 /// Whether the table has one column or one per direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -453,27 +453,8 @@ pub fn add_existing_table(
     measurement: &Measurement,
     active: &CompensationTable,
 ) -> Result<Measurement, MeasurementError> {
-    let targets = measurement.targets_mm().to_vec();
-    let runs: Vec<Run> = measurement
-        .runs()
-        .iter()
-        .map(|run| Run {
-            deviations_mm: run
-                .deviations_mm
-                .iter()
-                .zip(&targets)
-                .map(|(value, &p)| value.map(|v| v + active.value_at(p, run.direction)))
-                .collect(),
-            ..run.clone()
-        })
-        .collect();
-    Measurement::new(
-        measurement.axis(),
-        targets,
-        runs,
-        measurement.environment.clone(),
-        measurement.metadata.clone(),
-    )
+    let targets = measurement.targets_mm();
+    measurement.map_readings(|run, i, v| v + active.value_at(targets[i], run.direction))
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@ use proptest::prelude::*;
 
 use super::*;
 use crate::evaluate::evaluate;
-use crate::measurement::{Environment, Metadata};
+use crate::measurement::{Environment, Metadata, Run};
 
 /// Targets 0, 40, 100 mm; one run each way. Deviations in µm.
 fn measurement(up_um: [f64; 3], down_um: Option<[f64; 3]>) -> Measurement {

@@ -112,6 +112,33 @@ pub struct EmitOptions {
     pub tnc640_columns: Vec<String>,
 }
 
+impl EmitOptions {
+    /// The options a machine profile gives for one axis's table: its names
+    /// and units, the profile's limits and CEC convention, LinuxCNC type 0,
+    /// no coupled axes. Callers change what their flags say (convert).
+    pub fn for_axis(
+        profile: &MachineProfile,
+        axis: &str,
+        table_name: &str,
+    ) -> Result<EmitOptions, String> {
+        Ok(EmitOptions {
+            axes: vec![profile.axis(axis)?],
+            table_name: table_name.to_string(),
+            machine_unit: profile.machine_unit(),
+            linuxcnc_type: 0,
+            max_points: profile.controller.max_points,
+            max_value_mm: profile.controller.max_value_mm,
+            cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
+            cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
+            tnc640_columns: profile
+                .controller
+                .tnc640_columns
+                .clone()
+                .unwrap_or_default(),
+        })
+    }
+}
+
 /// Why a table is refused for a controller.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EmitError {

@@ -443,36 +443,17 @@ fn with_scatter(
     systematic: impl Fn(usize, Direction) -> f64,
 ) -> Result<Measurement, PredictError> {
     let evaluation = evaluate(measured);
-    let runs = measured
-        .runs()
-        .iter()
-        .map(|run| Run {
-            deviations_mm: run
-                .deviations_mm
-                .iter()
-                .enumerate()
-                .map(|(i, reading)| {
-                    let stats = &evaluation.per_target[i];
-                    let cell_mean = match run.direction {
-                        Direction::Up => stats.up.mean_mm,
-                        Direction::Down => stats.down.mean_mm,
-                    };
-                    reading
-                        .zip(cell_mean)
-                        .map(|(value, mean)| systematic(i, run.direction) + (value - mean))
-                })
-                .collect(),
-            ..run.clone()
+    measured
+        .map_readings(|run, i, value| {
+            let stats = &evaluation.per_target[i];
+            let cell = match run.direction {
+                Direction::Up => &stats.up,
+                Direction::Down => &stats.down,
+            };
+            // A reading's cell has a mean: the reading itself is in it.
+            systematic(i, run.direction) + (value - cell.mean_mm.unwrap_or(value))
         })
-        .collect();
-    Measurement::new(
-        measured.axis(),
-        measured.targets_mm().to_vec(),
-        runs,
-        measured.environment.clone(),
-        measured.metadata.clone(),
-    )
-    .map_err(|e| PredictError::Internal(e.to_string()))
+        .map_err(|e| PredictError::Internal(e.to_string()))
 }
 
 /// A re-test of one run each way holding the predicted values.

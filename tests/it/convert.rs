@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::measurement::Direction;
-use axcomp::units::LengthUnit;
 
 use crate::util::{assert_golden, axcomp, root, shared_data};
 
@@ -616,17 +615,7 @@ fn existing_output_is_not_overwritten_without_force() {
 #[test]
 fn existing_table_formats_are_detected() {
     // Every golden file reads back through the format detection of --existing.
-    let options = EmitOptions {
-        axes: vec![MachineProfile::default().axis("X").unwrap()],
-        table_name: String::new(),
-        machine_unit: LengthUnit::Millimetre,
-        linuxcnc_type: 0,
-        max_points: None,
-        max_value_mm: None,
-        cec_first_table: 0,
-        cec_values_are_corrections: true,
-        tnc640_columns: Vec::new(),
-    };
+    let options = EmitOptions::for_axis(&MachineProfile::default(), "X", "").unwrap();
     for (file, controller) in [
         ("formats/itnc530/golden/b02x-mean.COM", Controller::Itnc530),
         ("formats/tnc640/golden/sample-mean.COM", Controller::Tnc640),

@@ -312,13 +312,19 @@ fn no_progress_bar_when_stdout_is_not_a_terminal() {
 #[test]
 fn a_progress_bar_on_a_terminal() {
     // `script` (util-linux) runs the command on a pseudo-terminal, as a user's shell would.
-    let command = format!("{} tolerance --samples 200000", env!("CARGO_BIN_EXE_axcomp"));
+    let command = format!(
+        "{} tolerance --samples 200000",
+        env!("CARGO_BIN_EXE_axcomp")
+    );
     let output = std::process::Command::new("script")
         .args(["-qec", &command, "/dev/null"])
         .output()
         .expect("script (util-linux) runs the binary on a pseudo-terminal");
     let screen = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{screen}");
-    assert!(screen.contains("tolerance study ["), "no bar on a terminal:\n{screen}");
+    assert!(
+        screen.contains("tolerance study ["),
+        "no bar on a terminal:\n{screen}"
+    );
     assert!(screen.contains("Largest volumetric error per machine"));
 }

@@ -53,18 +53,7 @@ fn the_predicted_retest_is_the_table_applied_to_the_measurement() {
     let evaluation = evaluate(&measurement);
     let known = KnownError::from_evaluation(&evaluation).unwrap();
     let text = std::fs::read_to_string(&table_path).unwrap();
-    let profile = emit::MachineProfile::default();
-    let options = emit::EmitOptions {
-        axes: vec![profile.axis("X").unwrap()],
-        table_name: String::new(),
-        machine_unit: profile.machine_unit(),
-        linuxcnc_type: 0,
-        max_points: None,
-        max_value_mm: None,
-        cec_first_table: 0,
-        cec_values_are_corrections: true,
-        tnc640_columns: Vec::new(),
-    };
+    let options = emit::EmitOptions::for_axis(&emit::MachineProfile::default(), "X", "").unwrap();
     let (controller, active) = emit::read_any(&text, &options, None).unwrap();
     assert_eq!(controller, Controller::Tnc640);
     let per_target = json["per_target"].as_array().unwrap();

@@ -168,18 +168,7 @@ tests = ["after"]
 "#;
 
 fn table_options() -> EmitOptions {
-    let profile = MachineProfile::default();
-    EmitOptions {
-        axes: vec![profile.axis("X").unwrap()],
-        table_name: "X.COM".into(),
-        machine_unit: profile.machine_unit(),
-        linuxcnc_type: 0,
-        max_points: None,
-        max_value_mm: None,
-        cec_first_table: 0,
-        cec_values_are_corrections: true,
-        tnc640_columns: Vec::new(),
-    }
+    EmitOptions::for_axis(&MachineProfile::default(), "X", "X.COM").unwrap()
 }
 
 impl RetestCase {
