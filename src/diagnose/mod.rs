@@ -282,6 +282,14 @@ pub enum DiagnoseError {
     /// The first test has no usable means.
     #[error("the first test has no target with a mean deviation")]
     NoKnownError,
+    /// The two tests are of different axes.
+    #[error("the first test is of axis {before}, the re-test of axis {after}")]
+    AxisMismatch {
+        /// The first test's axis.
+        before: String,
+        /// The re-test's axis.
+        after: String,
+    },
     /// A measurement could not be rebuilt (a bug).
     #[error("{0}")]
     Internal(String),
@@ -541,6 +549,12 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
     let after = input.after;
     let (times, time_assumed) = times_h(after, input.timing);
     let first = match input.before {
+        Some(before) if !before.axis().eq_ignore_ascii_case(after.axis()) => {
+            return Err(DiagnoseError::AxisMismatch {
+                before: before.axis().to_string(),
+                after: after.axis().to_string(),
+            });
+        }
         Some(before) => {
             let evaluation = evaluate(before);
             let known =

@@ -508,3 +508,23 @@ fn real_ess_files_get_a_stated_diagnosis() {
         }
     }
 }
+
+#[test]
+fn tests_of_different_axes_are_refused() {
+    let truth = Truth::from_toml_str(&truth(0.25, "", "")).unwrap();
+    let mut before = synth::before(&truth, 1).unwrap();
+    let after = before.clone();
+    before.set_axis("Y");
+    let input = DiagnoseInput {
+        after: &after,
+        before: Some(&before),
+        table: None,
+        angular: None,
+        timing: CycleTiming::ASSUMED,
+    };
+    let error = diagnose(&input).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "the first test is of axis Y, the re-test of axis X"
+    );
+}
