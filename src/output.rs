@@ -45,7 +45,13 @@ pub fn write_new(path: &Path, contents: &[u8], force: bool) -> Result<(), Output
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
-    let mut temporary = tempfile::NamedTempFile::new_in(directory).map_err(io_error)?;
+    let mut builder = tempfile::Builder::new();
+    // tempfile creates its files 0600, right for a secret but wrong for a
+    // table or a report that others must read: ask for 0666 and let the
+    // umask decide, as `File::create` (and any editor) does.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut temporary = builder.tempfile_in(directory).map_err(io_error)?;
     temporary.write_all(contents).map_err(io_error)?;
     temporary.as_file().sync_all().map_err(io_error)?;
     if force {
@@ -82,6 +88,20 @@ mod tests {
         assert_eq!(std::fs::read(&path).unwrap(), b"second");
         let leftovers = std::fs::read_dir(directory.path()).unwrap().count();
         assert_eq!(leftovers, 1, "no temporary file may remain");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn files_get_the_permissions_file_create_gives() {
+        use std::os::unix::fs::PermissionsExt;
+        let directory = tempfile::tempdir().unwrap();
+        let ordinary = directory.path().join("ordinary");
+        std::fs::File::create(&ordinary).unwrap();
+        let written = directory.path().join("X.COM");
+        write_new(&written, b"x", false).unwrap();
+        let mode = |path: &Path| std::fs::metadata(path).unwrap().permissions().mode() & 0o777;
+        // Under the usual umask 022 that is 0644; the old 0600 failed here.
+        assert_eq!(mode(&written), mode(&ordinary));
     }
 
     #[test]
