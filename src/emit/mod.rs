@@ -184,6 +184,18 @@ pub enum EmitError {
         /// The format's resolution.
         resolution_mm: f64,
     },
+    /// A compensation point beyond the positions the format can hold.
+    #[error(
+        "compensation point {position_mm} mm is beyond the {controller} position range of ±{limit_mm} mm"
+    )]
+    PositionOutOfRange {
+        /// The controller.
+        controller: &'static str,
+        /// The point.
+        position_mm: f64,
+        /// The limit.
+        limit_mm: f64,
+    },
     /// A value beyond the format's or the machine's range.
     #[error("value {value_mm} mm at {position_mm} mm is beyond the {what} range of ±{limit_mm} mm")]
     ValueOutOfRange {
@@ -221,6 +233,9 @@ pub enum EmitError {
     #[error("internal error, please report: {0}")]
     Internal(String),
 }
+
+/// The largest |position| a Heidenhain table holds, mm (see [`check_table`]).
+const HEIDENHAIN_POSITION_LIMIT_MM: f64 = 99_999.999_9;
 
 /// Checks what the controller would reject, before anything is written.
 pub fn check_table(
@@ -277,6 +292,21 @@ pub fn check_table(
         return Err(EmitError::NotZeroAtDatum {
             controller: name,
             value_mm: first_value,
+        });
+    }
+    // [reconstructed] ±99 999.9999 mm: the input range of the iTNC 530's
+    // traverse limits (MP910–MP921). Beyond it a point is no axis position,
+    // and it would overflow the fixed-width AXISPOS column of a TNC 640 table.
+    if matches!(controller, Controller::Itnc530 | Controller::Tnc640)
+        && let Some(position_mm) = table
+            .positions_mm
+            .iter()
+            .find(|position| position.abs() > HEIDENHAIN_POSITION_LIMIT_MM)
+    {
+        return Err(EmitError::PositionOutOfRange {
+            controller: name,
+            position_mm: *position_mm,
+            limit_mm: HEIDENHAIN_POSITION_LIMIT_MM,
         });
     }
     let format_limit = match controller {
@@ -560,6 +590,33 @@ mod tests {
             )
             .is_ok()
         );
+    }
+
+    #[test]
+    fn a_point_beyond_the_heidenhain_position_range_is_refused() {
+        // Found by fuzzing (fuzz/fuzz_targets/read_tables.rs): a TNC 640 table
+        // with a point at 1.0e28 mm read, but its AXISPOS overflowed the
+        // 14-character column when written.
+        let table = CompensationTable {
+            axis: "X".into(),
+            positions_mm: vec![0.0, 58.557, 1.0055e28],
+            values: TableValues::Bidirectional {
+                up: vec![0.0014, 0.0031, 0.0013],
+                down: vec![-0.0014, -0.0003, 0.0],
+            },
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        };
+        let options = options(Controller::Tnc640, LengthUnit::Millimetre);
+        let error = write(Controller::Tnc640, &table, &options).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "compensation point 10055000000000000000000000000 mm is beyond the tnc640 position range of ±99999.9999 mm"
+        );
+        let mut near = table.clone();
+        near.positions_mm[2] = 99_999.999_9;
+        let text = write(Controller::Tnc640, &near, &options).unwrap();
+        assert!(text.contains("+99999.9999"), "{text}");
     }
 
     proptest! {
