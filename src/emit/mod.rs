@@ -234,8 +234,30 @@ pub enum EmitError {
     Internal(String),
 }
 
-/// The largest |position| a Heidenhain table holds, mm (see [`check_table`]).
-const HEIDENHAIN_POSITION_LIMIT_MM: f64 = 99_999.999_9;
+/// The largest |compensation point| and |value| a format holds, mm; the value
+/// limit comes with the name of its range, for the message.
+fn format_limits_mm(
+    controller: Controller,
+    machine_unit: LengthUnit,
+) -> (f64, (&'static str, f64)) {
+    match controller {
+        // [reconstructed] Points: ±99 999.9999 mm, the input range of the
+        // iTNC 530's traverse limits (MP910–MP921); beyond it a point is no
+        // axis position and would overflow the 14-character AXISPOS column of
+        // a TNC 640 table. Values: ±9.9999 mm, the range of the backlash
+        // parameter MP750 and of a signed 4-decimal field; no COM-specific
+        // limit is public.
+        Controller::Itnc530 | Controller::Tnc640 => (99_999.999_9, ("Heidenhain", 9.9999)),
+        // No published limit, but both controllers parse numbers as doubles,
+        // which hold every multiple of the resolution up to 9·10¹⁵ of them:
+        // 10¹⁵ resolutions keeps every written digit, also where a LinuxCNC
+        // type-0 row writes point + value.
+        Controller::Sinumerik840d | Controller::LinuxCnc => {
+            let digits_mm = resolution_mm(controller, machine_unit) * 1e15;
+            (digits_mm, ("15-digit", digits_mm))
+        }
+    }
+}
 
 /// Checks what the controller would reject, before anything is written.
 pub fn check_table(
@@ -294,29 +316,20 @@ pub fn check_table(
             value_mm: first_value,
         });
     }
-    // [reconstructed] ±99 999.9999 mm: the input range of the iTNC 530's
-    // traverse limits (MP910–MP921). Beyond it a point is no axis position,
-    // and it would overflow the fixed-width AXISPOS column of a TNC 640 table.
-    if matches!(controller, Controller::Itnc530 | Controller::Tnc640)
-        && let Some(position_mm) = table
-            .positions_mm
-            .iter()
-            .find(|position| position.abs() > HEIDENHAIN_POSITION_LIMIT_MM)
+    let (position_limit_mm, value_limit) = format_limits_mm(controller, options.machine_unit);
+    if let Some(position_mm) = table
+        .positions_mm
+        .iter()
+        .find(|position| position.abs() > position_limit_mm)
     {
         return Err(EmitError::PositionOutOfRange {
             controller: name,
             position_mm: *position_mm,
-            limit_mm: HEIDENHAIN_POSITION_LIMIT_MM,
+            limit_mm: position_limit_mm,
         });
     }
-    let format_limit = match controller {
-        // [reconstructed] ±9.9999 mm: the range of the iTNC 530 backlash
-        // parameter MP750 and of a 4-decimal signed field; no COM-specific limit is public.
-        Controller::Itnc530 | Controller::Tnc640 => Some(("Heidenhain", 9.9999)),
-        Controller::Sinumerik840d | Controller::LinuxCnc => None,
-    };
     let machine_limit = options.max_value_mm.map(|limit| ("machine profile", limit));
-    for (what, limit_mm) in format_limit.into_iter().chain(machine_limit) {
+    for (what, limit_mm) in std::iter::once(value_limit).chain(machine_limit) {
         for direction in crate::measurement::Direction::BOTH {
             let column = table.values.for_direction(direction);
             if let Some((value, position)) = column
@@ -617,6 +630,32 @@ mod tests {
         near.positions_mm[2] = 99_999.999_9;
         let text = write(Controller::Tnc640, &near, &options).unwrap();
         assert!(text.contains("+99999.9999"), "{text}");
+    }
+
+    #[test]
+    fn numbers_a_double_cannot_hold_to_the_resolution_are_refused() {
+        // Found by fuzzing: a LinuxCNC row at 8·10¹⁷ mm read, but point +
+        // value lost its last digits in the double.
+        let mut table = CompensationTable {
+            axis: "X".into(),
+            positions_mm: vec![0.0, 8e17],
+            values: TableValues::Mean(vec![0.0, 0.001]),
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        };
+        let options = options(Controller::LinuxCnc, LengthUnit::Millimetre);
+        let error = write(Controller::LinuxCnc, &table, &options).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "compensation point 800000000000000000 mm is beyond the linuxcnc position range of ±1000000000 mm"
+        );
+        // At the limit, point and value both at 10¹⁵ resolutions, it still round-trips.
+        table.positions_mm[1] = 1e9;
+        table.values = TableValues::Mean(vec![0.0, -1e9]);
+        write(Controller::LinuxCnc, &table, &options).unwrap();
+        table.values = TableValues::Mean(vec![0.0, -1.000_000_001e9]);
+        let error = write(Controller::LinuxCnc, &table, &options).unwrap_err();
+        assert!(error.to_string().contains("15-digit range"), "{error}");
     }
 
     proptest! {
