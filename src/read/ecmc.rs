@@ -454,6 +454,12 @@ mod tests {
                 "duplicate target",
             ),
             ("UNIT=deg\n", (1, 6), "rotary"),
+            // Found by fuzzing: an index that sized a table of gigabytes.
+            (
+                "TGT_DATA[99239814]=5\n",
+                (1, 10),
+                "index 99239814 is too large",
+            ),
             ("TGT_DATA[1,2]=1\n", (1, 1), "takes 1 index"),
             ("TGT_DATA[x]=1\n", (1, 10), "whole number"),
             ("just words\n", (1, 1), "KEY=VALUE"),
