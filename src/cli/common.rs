@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use axcomp::compensate::CompensationTable;
+use axcomp::diagnose::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
 use axcomp::measurement::{Direction, RunSelector, SourceFormat};
@@ -90,6 +91,13 @@ pub fn load_profile(path: Option<&Path>) -> Result<MachineProfile> {
     };
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
     MachineProfile::from_toml_str(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+}
+
+/// The effects a diagnosis wrote (`diagnose --write-effects`), for
+/// `convert --effects` and `predict --effects`.
+pub fn load_effects(path: &Path) -> Result<Vec<Effect>> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    read_effects(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
 }
 
 /// A compensation table for `axis` in any format `convert` writes; the

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::{self, Extrapolate, GridSpec, TableMode, TableOptions};
-use axcomp::diagnose::{Effect, read_effects};
+use axcomp::diagnose::Effect;
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::{RunSelector, SourceFormat};
@@ -14,7 +14,10 @@ use axcomp::read;
 use axcomp::report::convert::ConvertJson;
 use axcomp::units::LengthUnit;
 
-use super::common::{parse_format, parse_run_selector, print_json, print_text, print_warnings};
+use super::common::{
+    load_effects, parse_format, parse_run_selector, print_json, print_text, print_warnings,
+    read_table,
+};
 use super::evaluate::check_selectors;
 
 /// Flags of `axcomp convert`.
@@ -198,12 +201,12 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     options.linuxcnc_type = args.linuxcnc_type;
     options.max_points = args.max_points.or(options.max_points);
     if let Some(existing) = &args.existing {
-        let text =
-            std::fs::read_to_string(existing).with_context(|| format!("{}", existing.display()))?;
-        // A LinuxCNC table's type is told from its numbers; --linuxcnc-type decides when they do not.
-        let (_, active) = emit::read_any(&text, &options, None)
-            .or_else(|_| emit::read_any(&text, &options, Some(args.linuxcnc_type)))
-            .map_err(|error| anyhow::anyhow!("{}:{error}", existing.display()))?;
+        let (_, active) = read_table(
+            existing,
+            measurement.axis(),
+            &profile,
+            Some(args.linuxcnc_type),
+        )?;
         measurement = compensate::add_existing_table(&measurement, &active)?;
     }
     let evaluation = evaluate(&measurement);
@@ -309,11 +312,6 @@ impl EffectsPlan {
             notes,
         }
     }
-}
-
-fn load_effects(path: &Path) -> Result<Vec<Effect>> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    read_effects(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
 }
 
 /// The grid: `--step` (with `--start`, `--count`) or the effects' finer step,

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::CompensationTable;
-use axcomp::diagnose::{Effect, read_effects};
+use axcomp::diagnose::Effect;
 use axcomp::measurement::Measurement;
 use axcomp::model::{GeometricErrors, ModelError, read_error_description};
 use axcomp::predict::{MeasuredAxis, PredictInput, predict};
@@ -14,7 +14,8 @@ use axcomp::read;
 use axcomp::report::predict::{PredictJson, render};
 
 use super::common::{
-    load_machine, load_profile, parse_position, print_json, print_text, print_warnings, read_table,
+    load_effects, load_machine, load_profile, parse_position, print_json, print_text,
+    print_warnings, read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -174,11 +175,6 @@ fn load_errors(path: &Path) -> Result<GeometricErrors> {
         ModelError::Toml(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
         other => anyhow::anyhow!("{}: {other}", path.display()),
     })
-}
-
-fn load_effects(path: &Path) -> Result<Vec<Effect>> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    read_effects(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
 }
 
 /// `[AXIS=]FILE`: the axis defaults to the one measured axis.
