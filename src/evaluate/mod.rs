@@ -56,8 +56,8 @@ impl DirectionStats {
         }
     }
 
-    /// The band x̄ ± 2s used by A, as (low, high).
-    fn band(&self) -> Option<(f64, f64)> {
+    /// The band x̄ ± 2s used by A, as (low, high), mm.
+    pub fn band(&self) -> Option<(f64, f64)> {
         let (mean, s) = (self.mean_mm?, self.s_mm?);
         Some((mean - 2.0 * s, mean + 2.0 * s))
     }

@@ -337,12 +337,8 @@ fn means_um(per_target: &[TargetStats], direction: Direction) -> Vec<(f64, f64)>
 
 /// (target, x̄ − 2s, x̄ + 2s) in µm, where both are defined.
 fn band(target_mm: f64, stats: &DirectionStats) -> Option<(f64, f64, f64)> {
-    let (mean, s) = (stats.mean_mm?, stats.s_mm?);
-    Some((
-        target_mm,
-        mm_to_um(mean - 2.0 * s),
-        mm_to_um(mean + 2.0 * s),
-    ))
+    let (low, high) = stats.band()?;
+    Some((target_mm, mm_to_um(low), mm_to_um(high)))
 }
 
 /// The table as the controller applies it (linear between points, the end
