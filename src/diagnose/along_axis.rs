@@ -355,11 +355,7 @@ pub(super) fn along_axis_cv(
         );
         for (target, direction, value) in &fold.held_out {
             if let Some(at) = fold.levels.iter().position(|l| l.target_index == *target) {
-                let half = if *direction == Direction::Up {
-                    reversal_b / 2.0
-                } else {
-                    -reversal_b / 2.0
-                };
+                let half = effects::reversal_share_um(reversal_b, *direction);
                 sum += (value - fitted.fitted[at] - half).powi(2);
                 count += 1;
             }

@@ -3,6 +3,7 @@
 //! on those cell levels. No position-dependent error can pose as one of them:
 //! every cell has its own level.
 
+use super::effects::reversal_share_um;
 use super::fit::{self, Design, Fit, bic, leave_one_run_out_rmse};
 use super::stats::{chi2_p, partial_f_p};
 use super::{
@@ -231,11 +232,7 @@ pub(super) fn select_reversal(
                 let Some(level) = fold.levels.iter().find(|l| l.target_index == *target) else {
                     continue;
                 };
-                let half = if *direction == Direction::Up {
-                    b_fold / 2.0
-                } else {
-                    -b_fold / 2.0
-                };
+                let half = reversal_share_um(b_fold, *direction);
                 sum += (value - level.value_um - half).powi(2);
                 count += 1;
             }

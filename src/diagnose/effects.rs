@@ -226,6 +226,16 @@ pub struct Context {
     pub time_assumed: bool,
 }
 
+/// A reversal's share of a reading in `direction`, µm: ↑ readings sit B/2
+/// above the bidirectional mean and ↓ readings B/2 below, since B is
+/// x̄↑ − x̄↓ (ISO 230-2).
+pub(crate) fn reversal_share_um(b_um: f64, direction: Direction) -> f64 {
+    match direction {
+        Direction::Up => b_um / 2.0,
+        Direction::Down => -b_um / 2.0,
+    }
+}
+
 impl Effect {
     /// The kind.
     pub fn kind(&self) -> Kind {
@@ -286,10 +296,7 @@ impl Effect {
         angle_urad: Option<&[f64]>,
     ) -> f64 {
         match *self {
-            Effect::Reversal { b_um } => match reading.direction {
-                Direction::Up => b_um / 2.0,
-                Direction::Down => -b_um / 2.0,
-            },
+            Effect::Reversal { b_um } => reversal_share_um(b_um, reading.direction),
             Effect::Scale { scale_um_per_m } => {
                 scale_um_per_m * (reading.target_mm - first_target_mm) / 1000.0
             }
@@ -333,10 +340,7 @@ impl Effect {
         first_target_mm: f64,
     ) -> Option<f64> {
         match *self {
-            Effect::Reversal { b_um } => Some(match direction {
-                Direction::Up => b_um / 2.0,
-                Direction::Down => -b_um / 2.0,
-            }),
+            Effect::Reversal { b_um } => Some(reversal_share_um(b_um, direction)),
             Effect::Scale { scale_um_per_m } => {
                 Some(scale_um_per_m * (x_mm - first_target_mm) / 1000.0)
             }

@@ -464,10 +464,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         };
     }
     let constant = along_fit.coefficients.first().copied().unwrap_or(0.0);
-    let half_reversal = |d: Direction| match d {
-        Direction::Up => reversal_b / 2.0,
-        Direction::Down => -reversal_b / 2.0,
-    };
+    let half_reversal = |d: Direction| effects::reversal_share_um(reversal_b, d);
     let between_um: Vec<f64> = (0..n)
         .map(|i| {
             between
