@@ -46,6 +46,16 @@ impl Direction {
             Direction::Down => Direction::Up,
         }
     }
+
+    /// A reversal's share of a reading in this direction, in the reversal's
+    /// unit: ↑ readings sit B/2 above the bidirectional mean and ↓ readings
+    /// B/2 below, since B = x̄↑ − x̄↓ (ISO 230-2, `iso230-2.md` §reversal).
+    pub fn reversal_share(self, reversal: f64) -> f64 {
+        match self {
+            Direction::Up => reversal / 2.0,
+            Direction::Down => -reversal / 2.0,
+        }
+    }
 }
 
 impl fmt::Display for Direction {

@@ -77,6 +77,11 @@ pub fn um_to_mm(value_um: Um) -> Mm {
     value_um / UM_PER_MM
 }
 
+/// A variance in mm² to µm².
+pub fn mm2_to_um2(value_mm2: f64) -> f64 {
+    value_mm2 * UM_PER_MM * UM_PER_MM
+}
+
 /// The shortest decimal text, in µm, that reads back (µm → mm with
 /// [`um_to_mm`]) to exactly `value_mm`. `mm_to_um` and `um_to_mm` are not
 /// exact inverses in binary floating point, so the nearest neighbours of

@@ -1,6 +1,7 @@
 //! `axcomp demo`: the whole workflow on the bundled demo data (a synthetic X
-//! axis whose truth, in `fixtures/demo/truth.toml`, has a reversal and a
-//! warm-up drift the model does not declare): evaluate the first test, write
+//! axis whose truth, in `fixtures/demo/truth.toml`, has a reversal that both
+//! tests measure and a warm-up drift that only the re-test has, which the
+//! model cannot declare): evaluate the first test, write
 //! the table for every controller, predict the re-test, read the bundled
 //! re-test, diagnose it, write the next table and the acceptance report.
 //!
@@ -32,6 +33,7 @@ use axcomp::report::json::EvaluationJson;
 use axcomp::report::plot::PlotFormat;
 use axcomp::report::predict::PredictJson;
 use axcomp::synth::{EffectSpec, Truth};
+use axcomp::units::mm_to_um;
 
 use super::common::print_text;
 use super::progress;
@@ -114,6 +116,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         retest_tool_offset_mm: None,
         grid_step_mm: 50.0,
         effects: &[],
+        backlash_set: false,
     })?;
     let predict_json = PredictJson::new(
         machine.name(),
@@ -134,6 +137,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         after: &after,
         before: Some(&before),
         table: Some(&active),
+        backlash_set: false,
         angular: None,
         timing: CycleTiming::ASSUMED,
     })?;
@@ -207,6 +211,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         after: &after_evaluation,
         prediction: &prediction,
         diagnosis: &diagnosis,
+        table: &table,
         next: &next,
         files: files.len(),
     }))
@@ -236,14 +241,17 @@ fn table_path(controller: Controller, axis: &str) -> String {
 }
 
 /// The table after the re-test: the active table plus the residual the re-test
-/// shows, with the diagnosis's effects (as `convert --existing --effects`).
+/// shows, with the diagnosis's effects (as `convert --existing --effects`);
+/// bidirectional (the TNC 640 takes one) when the re-test measured a reversal
+/// beyond its noise or the diagnosis found one that changed.
 fn next_table(
     after: &Measurement,
     active: &CompensationTable,
     effects: &[Effect],
 ) -> Result<CompensationTable> {
     let without = compensate::add_existing_table(after, active)?;
-    let reversal = effects.iter().any(|e| matches!(e, Effect::Reversal { .. }));
+    let reversal = compensate::measured_reversal_mm(&evaluate(&without)).is_some()
+        || effects.iter().any(|e| matches!(e, Effect::Reversal { .. }));
     let options = TableOptions {
         mode: if reversal {
             TableMode::Bidirectional
@@ -283,13 +291,14 @@ struct Summary<'a> {
     after: &'a Evaluation,
     prediction: &'a Prediction,
     diagnosis: &'a Diagnosis,
+    table: &'a CompensationTable,
     next: &'a CompensationTable,
     files: usize,
 }
 
 /// Where everything is and what happened, in ten lines.
 fn summary(s: &Summary<'_>) -> String {
-    let um = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{:.2}", v * 1000.0));
+    let um = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{:.2}", mm_to_um(v)));
     let f = &s.evaluation.figures;
     let retest = &s.prediction.retests[0].figures;
     let a = &s.after.figures;
@@ -324,16 +333,18 @@ fn summary(s: &Summary<'_>) -> String {
     );
     let _ = writeln!(
         out,
-        " 2 tables        iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC: {} points (tables/)",
-        s.next.positions_mm.len()
+        " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC: {} points (tables/)",
+        s.table.values.mode().as_str(),
+        s.table.positions_mm.len()
     );
     let _ = writeln!(
         out,
-        " 3 prediction    re-test A {} µm, E {} µm; volumetric max {:.2} → {:.2} µm (predict.json)",
+        " 3 prediction    re-test A {} µm, E {} µm, B {} µm (the measured reversal stays with a mean table); volumetric max {:.2} → {:.2} µm (predict.json)",
         um(retest.a_mm),
         um(retest.e_mm),
-        s.prediction.volumetric_before.max_mm * 1000.0,
-        s.prediction.volumetric_after.max_mm * 1000.0
+        um(retest.b_mm),
+        mm_to_um(s.prediction.volumetric_before.max_mm),
+        mm_to_um(s.prediction.volumetric_after.max_mm)
     );
     let _ = writeln!(
         out,
@@ -353,9 +364,16 @@ fn summary(s: &Summary<'_>) -> String {
         " 6 residual      rms {:.2} µm → {:.2} µm with the effects; {unexplained}",
         s.diagnosis.residual_before.rms_um, s.diagnosis.residual_after.rms_um
     );
+    let next_reason = match s.next.values.mode() {
+        TableMode::Bidirectional => format!(
+            "the reversal B̄ {} µm the re-test measured, the residual and the effects",
+            um(s.after.figures.b_mean_mm)
+        ),
+        TableMode::Mean => "the residual and the effects".to_string(),
+    };
     let _ = writeln!(
         out,
-        " 7 next table    tables/next/{}.COM: {} (the residual and the effects)",
+        " 7 next table    tables/next/{}.COM: {} ({next_reason})",
         s.next.axis,
         s.next.values.mode().as_str()
     );

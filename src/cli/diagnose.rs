@@ -30,6 +30,11 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "TABLE", requires = "before")]
     pub table: Option<PathBuf>,
 
+    /// The controller's backlash parameter was set during the re-test as
+    /// convert suggests (−B̄ of the first test). Not with a bidirectional table.
+    #[arg(long = "backlash-set", requires = "before")]
+    pub backlash_set: bool,
+
     /// Machine profile, to read the table's axis names (as in convert).
     #[arg(long, value_name = "M.toml")]
     pub machine: Option<PathBuf>,
@@ -84,6 +89,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         after: &after.measurement,
         before: before.as_ref(),
         table: table.as_ref(),
+        backlash_set: args.backlash_set,
         angular: angular.as_ref(),
         timing: CycleTiming::ASSUMED,
     };

@@ -5,13 +5,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use axcomp::compensate::CompensationTable;
+use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::diagnose::Effect;
 use axcomp::measurement::Measurement;
 use axcomp::model::{GeometricErrors, ModelError, read_error_description};
-use axcomp::predict::{MeasuredAxis, PredictInput, predict};
+use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
 use axcomp::report::predict::{PredictJson, render};
+use axcomp::units::mm_to_um;
 
 use super::common::{
     load_effects, load_machine, load_profile, parse_position, print_json, print_text,
@@ -60,6 +61,12 @@ pub struct PredictArgs {
     /// systematic part is added to the re-test.
     #[arg(long, value_name = "E.toml", help_heading = "Errors")]
     pub effects: Option<PathBuf>,
+
+    /// The controller's backlash parameter is set as convert suggests (−B̄ of
+    /// the measured first test): it takes out the mean reversal that a mean
+    /// table leaves. Not with a bidirectional table.
+    #[arg(long = "backlash-set", help_heading = "Tables")]
+    pub backlash_set: bool,
 
     /// Step of the volumetric error map, mm.
     #[arg(
@@ -132,9 +139,10 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         retest_tool_offset_mm: tool,
         grid_step_mm: args.grid,
         effects: &effects,
+        backlash_set: args.backlash_set,
     };
     let prediction = predict(&input)?;
-    let mut notes = notes(&measurements, &tables, &effects);
+    let mut notes = notes(&prediction, &effects);
     if args.machine.is_none() {
         notes.push("machine: the bundled MCV 754 Quick (give --machine for another)".to_string());
     }
@@ -198,43 +206,37 @@ fn load_table(
 }
 
 /// What the reader should know about this prediction.
-fn notes(
-    measurements: &[(Measurement, [f64; 3])],
-    tables: &[CompensationTable],
-    effects: &[Effect],
-) -> Vec<String> {
+fn notes(prediction: &Prediction, effects: &[Effect]) -> Vec<String> {
     let mut notes = Vec::new();
-    let has_reversal = effects.iter().any(|e| matches!(e, Effect::Reversal { .. }));
-    for (measurement, _) in measurements {
-        let b_mean = axcomp::evaluate::evaluate(measurement).figures.b_mean_mm;
-        if let (Some(b), false) = (b_mean, has_reversal) {
-            notes.push(format!(
-                "the test of {} shows a mean reversal B̄ = {:.2} µm, which the geometric model does not have: the prediction has none; diagnose the re-test, or give the reversal with --effects",
-                measurement.axis(),
-                b * 1000.0
-            ));
-        }
+    for retest in &prediction.retests {
+        let axis = retest.axis;
+        let note = match (retest.measured_mean_reversal_mm, retest.table_mode) {
+            (Some(b), _) if retest.backlash_reversal_mm != 0.0 => format!(
+                "the first test of {axis} measured a mean reversal B̄ = {:.2} µm; the backlash parameter (--backlash-set) takes it out, leaving its variation along the axis",
+                mm_to_um(b)
+            ),
+            (Some(b), TableMode::Mean) => format!(
+                "the first test of {axis} measured a mean reversal B̄ = {:.2} µm: the prediction carries it, and a mean table leaves it (take it out with a bidirectional table, or set the backlash parameter convert suggests and give --backlash-set)",
+                mm_to_um(b)
+            ),
+            (Some(b), TableMode::Bidirectional) => format!(
+                "the first test of {axis} measured a mean reversal B̄ = {:.2} µm: the bidirectional table takes it out",
+                mm_to_um(b)
+            ),
+            (None, _) if retest.with_measured_scatter => format!(
+                "the first test of {axis} is unidirectional: its reversal is not known, and the prediction has none"
+            ),
+            (None, _) => format!(
+                "axis {axis} was not measured: its re-test is systematic only (one run each way, no R, no reversal)"
+            ),
+        };
+        notes.push(note);
     }
-    for table in tables {
-        let bidirectional = matches!(
-            table.values,
-            axcomp::compensate::TableValues::Bidirectional { .. }
+    if effects.iter().any(|e| matches!(e, Effect::Reversal { .. })) {
+        notes.push(
+            "the reversal in --effects is added to the one the first test measured (diagnose reports the change)"
+                .to_string(),
         );
-        if bidirectional && !has_reversal {
-            notes.push(format!(
-                "the {} table is bidirectional: without a reversal in the model, the prediction shows the opposite of the reversal the table takes out",
-                table.axis
-            ));
-        }
-        if !measurements
-            .iter()
-            .any(|(m, _)| m.axis().eq_ignore_ascii_case(&table.axis))
-        {
-            notes.push(format!(
-                "axis {} was not measured: its re-test is systematic only (one run each way, no R)",
-                table.axis
-            ));
-        }
     }
     for effect in effects {
         if effect

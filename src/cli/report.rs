@@ -148,6 +148,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
                 after: &after.measurement,
                 before: Some(&before.measurement),
                 table: table.as_ref().map(|(_, _, t)| t),
+                backlash_set: false,
                 angular: None,
                 timing: CycleTiming::ASSUMED,
             };

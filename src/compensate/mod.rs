@@ -35,6 +35,32 @@ pub mod retest;
 use crate::evaluate::Evaluation;
 use crate::measurement::{Direction, Measurement, MeasurementError};
 
+/// How many standard errors B̄ must be from zero to count as a measured
+/// reversal: at 3σ a reversal-free axis passes for one in 0.3 % of tests.
+const REVERSAL_STANDARD_ERRORS: f64 = 3.0;
+
+/// The mean reversal value B̄ of a test (mm) when the test shows one beyond
+/// its noise, so that a bidirectional table (or the backlash parameter) is
+/// worth having: |B̄| > 3 standard errors. The standard error is that of the
+/// mean of the per-target x̄_i↑ − x̄_i↓, σ·√(Σ (1/n↑ + 1/n↓)) / m with σ pooled
+/// over every target and direction. `None` for a unidirectional test, one
+/// without repeated runs (no σ) or a reversal within the noise.
+pub fn measured_reversal_mm(evaluation: &Evaluation) -> Option<f64> {
+    let b_mean = evaluation.figures.b_mean_mm?;
+    let variance_mm2 = evaluation.pooled_variance_mm2()?;
+    let (mut sum_of_inverses, mut targets) = (0.0, 0usize);
+    for t in evaluation
+        .per_target
+        .iter()
+        .filter(|t| t.up.n > 0 && t.down.n > 0)
+    {
+        sum_of_inverses += 1.0 / t.up.n as f64 + 1.0 / t.down.n as f64;
+        targets += 1;
+    }
+    let standard_error = (variance_mm2 * sum_of_inverses).sqrt() / targets as f64;
+    (b_mean.abs() > REVERSAL_STANDARD_ERRORS * standard_error).then_some(b_mean)
+}
+
 /// Whether the table has one column or one per direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TableMode {

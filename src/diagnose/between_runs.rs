@@ -11,6 +11,8 @@ use super::{
     predicts_better, set_rejection, shapes, strong_evidence,
 };
 use crate::diagnose::along_axis::target_levels;
+use nalgebra::{DMatrix, DVector};
+
 use crate::measurement::{Direction, Run};
 
 /// The reversal found between the directions, from the cell levels.
@@ -136,6 +138,7 @@ pub(super) fn cell_levels(problem: &Problem, fitted: &Fit) -> Vec<Cell> {
             direction: *d,
             value_um: fitted.coefficients[c],
             variance_um2: fitted.standard_errors[c].powi(2),
+            reversal_prediction_variance_um2: problem.reversal_prediction_variance_um2(*t) / 2.0,
         })
         .collect()
 }
@@ -151,15 +154,50 @@ pub(super) fn reversals(cells: &[Cell]) -> Vec<(usize, f64, f64)> {
             list.push((
                 up.target_index,
                 up.value_um - down.value_um,
-                up.variance_um2 + down.variance_um2,
+                up.variance_um2
+                    + down.variance_um2
+                    + up.reversal_prediction_variance_um2
+                    + down.reversal_prediction_variance_um2,
             ));
         }
     }
     list
 }
 
-/// The weighted mean of per-target reversals, its standard error, and χ² about 0 and about the mean.
-fn constant_reversal(differences: &[(usize, f64, f64)]) -> (f64, f64, f64, f64) {
+/// The generalised-least-squares mean of the per-target reversals, its
+/// standard error, and χ² about 0 and about the mean. The covariance is each
+/// difference's own variance on the diagonal plus, off it, what two targets
+/// share through the predicted reversal: both interpolate the same targets of
+/// the first test (C = diag(v) + the off-diagonal part of W R Wᵀ). Without
+/// the shared part a dense re-test would count the few reversals of the
+/// first test as many independent ones.
+fn constant_reversal(problem: &Problem, differences: &[(usize, f64, f64)]) -> (f64, f64, f64, f64) {
+    let m = differences.len();
+    let covariance = DMatrix::from_fn(m, m, |a, b| {
+        if a == b {
+            differences[a].2.max(1e-300)
+        } else {
+            problem.shared_reversal_variance_um2(differences[a].0, differences[b].0)
+        }
+    });
+    let d = DVector::from_iterator(m, differences.iter().map(|(_, d, _)| *d));
+    let ones = DVector::from_element(m, 1.0);
+    let Some(cholesky) = covariance.cholesky() else {
+        // Not positive definite only if the variances are degenerate: treat them as independent.
+        return independent_constant_reversal(differences);
+    };
+    let inverse_d = cholesky.solve(&d);
+    let inverse_ones = cholesky.solve(&ones);
+    let weight = ones.dot(&inverse_ones);
+    let mean = ones.dot(&inverse_d) / weight;
+    let about_zero = d.dot(&inverse_d);
+    let residual = &d - &ones * mean;
+    let about_mean = residual.dot(&cholesky.solve(&residual));
+    (mean, (1.0 / weight).sqrt(), about_zero, about_mean)
+}
+
+/// [`constant_reversal`] with independent differences: the weighted mean.
+fn independent_constant_reversal(differences: &[(usize, f64, f64)]) -> (f64, f64, f64, f64) {
     let weight: f64 = differences
         .iter()
         .map(|(_, _, v)| 1.0 / v.max(1e-300))
@@ -185,6 +223,7 @@ fn constant_reversal(differences: &[(usize, f64, f64)]) -> (f64, f64, f64, f64) 
 /// it leaves no direction-dependent structure; returns it with the lack-of-fit
 /// p-value of the direction-dependent structure that is left.
 pub(super) fn select_reversal(
+    problem: &Problem,
     cells: &[Cell],
     folds: &[Fold],
     kinds: &[Kind],
@@ -194,7 +233,7 @@ pub(super) fn select_reversal(
     if differences.is_empty() {
         return (None, 1.0);
     }
-    let (b, standard_error, about_zero, about_mean) = constant_reversal(&differences);
+    let (b, standard_error, about_zero, about_mean) = constant_reversal(problem, &differences);
     let m = differences.len();
     let p_without = chi2_p(about_zero, m);
     if !kinds.contains(&Kind::Reversal) {
@@ -224,7 +263,7 @@ pub(super) fn select_reversal(
         let (mut sum, mut count) = (0.0, 0usize);
         for fold in folds {
             let b_fold = if with {
-                constant_reversal(&reversals(&fold.cells)).0
+                constant_reversal(problem, &reversals(&fold.cells)).0
             } else {
                 0.0
             };

@@ -224,16 +224,15 @@ pub struct Context {
     pub material_change_k: Option<f64>,
     /// Whether the times of the readings are assumed (no recorded duration).
     pub time_assumed: bool,
+    /// The first test's mean reversal B̄, µm, which the prediction carries (a
+    /// reversal found is then the change since that test).
+    pub first_test_reversal_um: Option<f64>,
 }
 
-/// A reversal's share of a reading in `direction`, µm: ↑ readings sit B/2
-/// above the bidirectional mean and ↓ readings B/2 below, since B is
-/// x̄↑ − x̄↓ (ISO 230-2).
+/// A reversal's share of a reading in `direction`, µm
+/// ([`Direction::reversal_share`]).
 pub(crate) fn reversal_share_um(b_um: f64, direction: Direction) -> f64 {
-    match direction {
-        Direction::Up => b_um / 2.0,
-        Direction::Down => -b_um / 2.0,
-    }
+    direction.reversal_share(b_um)
 }
 
 impl Effect {
@@ -362,10 +361,15 @@ impl Effect {
                 } else {
                     "the axis overshoots in the direction it moves (a leading encoder, or an elastic preload released at reversal)"
                 };
-                format!(
-                    "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or set the backlash parameter to {:.2} µm.",
-                    -b_um
-                )
+                match context.first_test_reversal_um {
+                    Some(before_um) => format!(
+                        "The reversal changed since the first test by B = {b_um:.2} µm (B̄ {before_um:.2} µm then, about {:.2} µm now; {how}); a bidirectional table from the re-test (convert --existing --effects) takes the new value out, or set the backlash parameter to the value convert --effects prints in the controller's unit.",
+                        before_um + b_um
+                    ),
+                    None => format!(
+                        "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or set the backlash parameter to the value convert prints in the controller's unit."
+                    ),
+                }
             }
             Effect::Scale { scale_um_per_m } => {
                 let thermal = context.expansion_coefficient_ppm_per_k.filter(|a| *a > 0.0).map(|alpha| {

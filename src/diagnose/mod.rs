@@ -36,7 +36,9 @@ mod effects_file;
 pub mod fit;
 mod stats;
 
-use crate::compensate::retest::{KnownError, predicted_deviation_mm};
+use crate::compensate::retest::{
+    Applied, BacklashError, KnownError, predicted_deviation_mm, with_scatter,
+};
 use crate::compensate::{CompensationTable, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
 use crate::error::{ParseError, describe_found};
@@ -71,6 +73,9 @@ pub struct DiagnoseInput<'a> {
     pub before: Option<&'a Measurement>,
     /// The table active during the re-test.
     pub table: Option<&'a CompensationTable>,
+    /// The controller's backlash parameter was set during the re-test as
+    /// `convert` suggests from the first test (−B̄).
+    pub backlash_set: bool,
     /// The axis' angular error (pitch or yaw) along the stroke, for Abbe.
     pub angular: Option<&'a AngularProfile>,
     /// Cycle timing to assume when the file records no duration.
@@ -227,9 +232,13 @@ pub struct Unexplained {
 pub struct FigureSet {
     /// As measured.
     pub measured: AxisFigures,
-    /// Predicted by the model (with the measured scatter).
+    /// Predicted by the model, as `predict` gives them: the first test's
+    /// readings with the predicted systematic error (so the first test's
+    /// scatter and R). Without a first test: the re-test's own systematic
+    /// curve with its scatter.
     pub predicted: AxisFigures,
-    /// Predicted with the accepted effects added.
+    /// What the prediction with the accepted effects explains of this
+    /// re-test: its systematic part with this re-test's scatter.
     pub predicted_with_effects: AxisFigures,
 }
 
@@ -282,6 +291,9 @@ pub enum DiagnoseError {
     /// The first test has no usable means.
     #[error("the first test has no target with a mean deviation")]
     NoKnownError,
+    /// The backlash parameter cannot be applied as said.
+    #[error("the backlash parameter {0}")]
+    Backlash(#[from] BacklashError),
     /// The two tests are of different axes.
     #[error("the first test is of axis {before}, the re-test of axis {after}")]
     AxisMismatch {
@@ -303,8 +315,14 @@ struct Problem {
     /// The prediction at each target of the re-test interpolates the first
     /// test's means: (index into `first_test_variance_um2`, weight) pairs.
     prediction_weights: Vec<Vec<(usize, f64)>>,
-    /// Variance of the first test's mean at each of its targets, µm².
+    /// The predicted re-test as `predict` gives it on the measured line: the
+    /// first test's readings with the predicted systematic error.
+    first_test_prediction: Option<Measurement>,
+    /// Variance of the first test's bidirectional mean at each of its targets, µm².
     first_test_variance_um2: Vec<f64>,
+    /// Variance of the first test's reversal x̄↑ − x̄↓ at each of its targets
+    /// (which the prediction carries), µm²; 0 for a unidirectional test.
+    first_test_reversal_variance_um2: Vec<f64>,
     run_count: usize,
     targets_mm: Vec<f64>,
     angle_urad: Option<Vec<f64>>,
@@ -317,6 +335,27 @@ struct Problem {
 impl Problem {
     fn first_target_mm(&self) -> f64 {
         self.targets_mm[0]
+    }
+
+    /// Covariance of the predicted reversals at the re-test's targets `a` and
+    /// `b`, µm²: what they share of the first test's reversals.
+    fn shared_reversal_variance_um2(&self, a: usize, b: usize) -> f64 {
+        self.prediction_weights[a]
+            .iter()
+            .flat_map(|(ka, wa)| {
+                self.prediction_weights[b]
+                    .iter()
+                    .filter(move |(kb, _)| kb == ka)
+                    .map(move |(_, wb)| wa * wb * self.first_test_reversal_variance_um2[*ka])
+            })
+            .sum()
+    }
+
+    /// Variance of the predicted reversal at the re-test's target `t`, µm²:
+    /// the first test's reversals through the spline weights (independent
+    /// between the first test's targets).
+    fn reversal_prediction_variance_um2(&self, t: usize) -> f64 {
+        self.shared_reversal_variance_um2(t, t)
     }
 
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
@@ -357,7 +396,12 @@ struct Cell {
     target_index: usize,
     direction: Direction,
     value_um: f64,
+    /// Variance of the level from the re-test's scatter, µm².
     variance_um2: f64,
+    /// This cell's half of the variance of the predicted reversal at its
+    /// target (the first test's x̄↑ − x̄↓, interpolated), µm²: a reversal
+    /// found is the change since the first test, uncertain by both tests.
+    reversal_prediction_variance_um2: f64,
 }
 
 /// One per-target level (both directions pooled): the position-dependent part.
@@ -395,8 +439,18 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     let folds = cross_validation_folds(&problem, &y, &between_model, &between);
 
     // 2. The reversal: the same difference between the directions at every target.
-    let (reversal, reversal_p) = select_reversal(&cells, &folds, &kinds, &mut rejected);
+    let (reversal, reversal_p) = select_reversal(&problem, &cells, &folds, &kinds, &mut rejected);
     let reversal_b = reversal.map_or(0.0, |r| r.b_um);
+    let context = context(input, time_assumed);
+    // With a first test the prediction carries its reversal: a reversal found is a change.
+    if let (None, Some(before_um)) = (&reversal, context.first_test_reversal_um)
+        && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
+    {
+        entry.why = format!(
+            "no change since the first test, whose B̄ = {before_um:.2} µm the prediction carries ({})",
+            entry.why
+        );
+    }
 
     // 3. Along the axis (scale, periodic, Abbe) on the pooled per-target levels, with a prediction only.
     let levels = target_levels(&problem, &cells);
@@ -417,7 +471,6 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     );
     let along_p = chi2_p(along_fit.chi2, levels.len().saturating_sub(along_fit.rank));
 
-    let context = context(input, time_assumed);
     let mut accepted: Vec<AcceptedEffect> = Vec::new();
     if let Some(r) = reversal {
         let effect = Effect::Reversal { b_um: r.b_um };
@@ -463,7 +516,6 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             level.value_um
         };
     }
-    let constant = along_fit.coefficients.first().copied().unwrap_or(0.0);
     let half_reversal = |d: Direction| effects::reversal_share_um(reversal_b, d);
     let between_um: Vec<f64> = (0..n)
         .map(|i| {
@@ -509,12 +561,11 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     );
     let figures = figures(input.after, &problem, |i, with_effects| {
         let r = &problem.readings[i];
-        let systematic = match (with_prediction, with_effects) {
-            (true, false) => constant,
-            (false, false) => level_at_target[r.target_index],
-            (_, true) => {
-                model_at_target[r.target_index] + half_reversal(r.direction) + between_um[i]
-            }
+        // Without effects this is only asked without a first test (see `figures`).
+        let systematic = if with_effects {
+            model_at_target[r.target_index] + half_reversal(r.direction) + between_um[i]
+        } else {
+            level_at_target[r.target_index]
         };
         problem.predicted_um[i] + systematic + scatter[i]
     })?;
@@ -558,7 +609,22 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
                 KnownError::from_evaluation(&evaluation).ok_or(DiagnoseError::NoKnownError)?;
             Some((known, mean_variances(&evaluation)))
         }
+        None if input.backlash_set => return Err(BacklashError::NoMeasuredReversal.into()),
         None => None,
+    };
+    let applied = Applied::with_backlash(
+        input.table,
+        first.as_ref().map(|(known, _)| known),
+        input.backlash_set,
+    )?;
+    let first_test_prediction = match (input.before, &first) {
+        (Some(before), Some((known, _))) => Some(
+            with_scatter(before, &evaluate(before), |i, direction| {
+                predicted_deviation_mm(known, applied, before.targets_mm()[i], direction)
+            })
+            .map_err(|e| DiagnoseError::Internal(e.to_string()))?,
+        ),
+        _ => None,
     };
     let mut readings = Vec::new();
     let mut measured_um = Vec::new();
@@ -578,7 +644,7 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
             });
             measured_um.push(value * 1000.0);
             let predicted = first.as_ref().map_or(0.0, |(known, _)| {
-                predicted_deviation_mm(known, input.table, target_mm, run.direction) * 1000.0
+                predicted_deviation_mm(known, applied, target_mm, run.direction) * 1000.0
             });
             predicted_um.push(predicted);
         }
@@ -586,17 +652,23 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
     if readings.len() < 4 || after.runs().len() < 2 {
         return Err(DiagnoseError::TooFewReadings(readings.len()));
     }
-    let (prediction_weights, first_test_variance_um2) = match &first {
-        Some((_, (positions, variances))) => (
-            after
-                .targets_mm()
-                .iter()
-                .map(|&x| interpolation_weights(positions, x))
-                .collect(),
-            variances.clone(),
-        ),
-        None => (vec![Vec::new(); after.targets_mm().len()], Vec::new()),
-    };
+    let (prediction_weights, first_test_variance_um2, first_test_reversal_variance_um2) =
+        match &first {
+            Some((_, variances)) => (
+                after
+                    .targets_mm()
+                    .iter()
+                    .map(|&x| interpolation_weights(&variances.positions_mm, x))
+                    .collect(),
+                variances.mean_um2.clone(),
+                variances.reversal_um2.clone(),
+            ),
+            None => (
+                vec![Vec::new(); after.targets_mm().len()],
+                Vec::new(),
+                Vec::new(),
+            ),
+        };
     let mut cells: Vec<(usize, Direction)> = Vec::new();
     for t in 0..after.targets_mm().len() {
         for direction in Direction::BOTH {
@@ -631,7 +703,9 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
         measured_um,
         predicted_um,
         prediction_weights,
+        first_test_prediction,
         first_test_variance_um2,
+        first_test_reversal_variance_um2,
         run_count: after.runs().len(),
         targets_mm: after.targets_mm().to_vec(),
         angle_urad,
@@ -641,46 +715,53 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
     Ok((problem, time_assumed))
 }
 
-/// Variance of the first test's mean at each of its targets, µm²: of the
-/// bidirectional mean σ²·(1/n↑ + 1/n↓)/4, or of one direction's mean σ²/n,
-/// with σ pooled over all targets and directions (each target's own s rests
-/// on a handful of readings and would make the weights as noisy as the data).
-fn mean_variances(evaluation: &Evaluation) -> (Vec<f64>, Vec<f64>) {
+/// The first test's uncertainty, per target where it has a mean.
+struct FirstTestVariances {
+    /// The targets, mm.
+    positions_mm: Vec<f64>,
+    /// Variance of the bidirectional mean, µm².
+    mean_um2: Vec<f64>,
+    /// Variance of the reversal x̄↑ − x̄↓, µm².
+    reversal_um2: Vec<f64>,
+}
+
+/// Variance of the first test's means at each of its targets, µm²: of the
+/// bidirectional mean σ²·(1/n↑ + 1/n↓)/4 and of the reversal σ²·(1/n↑ + 1/n↓),
+/// or, for a unidirectional test, of its one direction's mean σ²/n and no
+/// reversal; σ pooled over all targets and directions (each target's own s
+/// rests on a handful of readings and would make the weights as noisy as the
+/// data). The targets are those of `KnownError::from_evaluation`.
+fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
     let both = evaluation.runs_up > 0 && evaluation.runs_down > 0;
-    let (mut sum_sq, mut degrees) = (0.0, 0usize);
+    let pooled_um2 = evaluation
+        .pooled_variance_mm2()
+        .map_or(0.0, crate::units::mm2_to_um2);
+    let inverse = |n: usize| if n == 0 { 0.0 } else { 1.0 / n as f64 };
+    let mut variances = FirstTestVariances {
+        positions_mm: Vec::new(),
+        mean_um2: Vec::new(),
+        reversal_um2: Vec::new(),
+    };
     for t in &evaluation.per_target {
-        for stats in [&t.up, &t.down] {
-            if let Some(s) = stats.s_mm {
-                sum_sq += s * s * (stats.n - 1) as f64;
-                degrees += stats.n - 1;
-            }
+        let has_mean = if both {
+            t.mean_mm.is_some()
+        } else {
+            t.up.mean_mm.or(t.down.mean_mm).is_some()
+        };
+        if !has_mean {
+            continue;
+        }
+        let sum_of_inverses = inverse(t.up.n) + inverse(t.down.n);
+        variances.positions_mm.push(t.target_mm);
+        if both {
+            variances.mean_um2.push(pooled_um2 * sum_of_inverses / 4.0);
+            variances.reversal_um2.push(pooled_um2 * sum_of_inverses);
+        } else {
+            variances.mean_um2.push(pooled_um2 * sum_of_inverses);
+            variances.reversal_um2.push(0.0);
         }
     }
-    let pooled_um2 = if degrees == 0 {
-        0.0
-    } else {
-        sum_sq / degrees as f64 * 1e6
-    };
-    let inverse = |n: usize| if n == 0 { 0.0 } else { 1.0 / n as f64 };
-    evaluation
-        .per_target
-        .iter()
-        .filter(|t| {
-            if both {
-                t.mean_mm.is_some()
-            } else {
-                t.up.mean_mm.or(t.down.mean_mm).is_some()
-            }
-        })
-        .map(|t| {
-            let variance = if both {
-                pooled_um2 * (inverse(t.up.n) + inverse(t.down.n)) / 4.0
-            } else {
-                pooled_um2 * (inverse(t.up.n) + inverse(t.down.n))
-            };
-            (t.target_mm, variance)
-        })
-        .unzip()
+    variances
 }
 
 /// The weights with which the prediction at `x` combines the first test's
@@ -889,6 +970,15 @@ fn set_rejection(rejected: &mut Vec<RejectedEffect>, kind: Kind, why: String) {
     }
 }
 
+/// The mean reversal B̄ of the first test, µm, when it measured both directions.
+fn first_test_reversal_um(input: &DiagnoseInput<'_>) -> Option<f64> {
+    let before = input.before?;
+    let known = KnownError::from_evaluation(&evaluate(before))?;
+    known
+        .is_bidirectional()
+        .then(|| crate::units::mm_to_um(known.mean_reversal_mm()))
+}
+
 fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context {
     let material = |m: &Measurement| m.environment.material_temperature_c[0].start;
     let material_change_k = match (input.before, material(input.after)) {
@@ -901,6 +991,7 @@ fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context {
         expansion_coefficient_ppm_per_k: input.after.environment.expansion_coefficient_ppm_per_k,
         material_change_k,
         time_assumed,
+        first_test_reversal_um: first_test_reversal_um(input),
     }
 }
 
@@ -1070,9 +1161,13 @@ fn figures(
         )
         .map_err(|e| DiagnoseError::Internal(e.to_string()))
     };
+    let predicted = match &problem.first_test_prediction {
+        Some(prediction) => evaluate(prediction).figures,
+        None => evaluate(&build(false)?).figures,
+    };
     Ok(FigureSet {
         measured: evaluate(after).figures,
-        predicted: evaluate(&build(false)?).figures,
+        predicted,
         predicted_with_effects: evaluate(&build(true)?).figures,
     })
 }

@@ -145,6 +145,25 @@ pub struct Evaluation {
     pub warnings: Vec<Warning>,
 }
 
+impl Evaluation {
+    /// The variance of one reading about its target's mean, pooled over
+    /// every target and direction, s² = Σ (n − 1)·s_i² / Σ (n − 1), mm²;
+    /// `None` without repeated runs. (Each target's own s rests on a handful
+    /// of readings; where one σ serves the whole test, this is it.)
+    pub fn pooled_variance_mm2(&self) -> Option<f64> {
+        let (mut sum_sq, mut degrees) = (0.0, 0usize);
+        for t in &self.per_target {
+            for stats in [&t.up, &t.down] {
+                if let Some(s) = stats.s_mm {
+                    sum_sq += s * s * (stats.n - 1) as f64;
+                    degrees += stats.n - 1;
+                }
+            }
+        }
+        (degrees > 0).then(|| sum_sq / degrees as f64)
+    }
+}
+
 /// Evaluates a measurement per ISO 230-2.
 ///
 /// # Example

@@ -38,6 +38,14 @@
 //! first test's spline. On the measured line and without other errors the
 //! two agree exactly.
 //!
+//! **The measured reversal.** The geometric model has no direction; the
+//! first test of the axis has: D(x, d) adds the reversal's share the test
+//! measured at x, e(x, d) − x̄(x) (a spline through x̄_i↑ − x̄_i and
+//! x̄_i↓ − x̄_i). A mean table leaves it in the re-test, a bidirectional table
+//! takes it out, and so does the controller's backlash parameter when it is
+//! set as `convert` suggests ([`PredictInput::backlash_set`]; then only the
+//! reversal's variation along the axis, B_i − B̄, is left).
+//!
 //! **Scatter.** A prediction is of the systematic part. When the axis was
 //! measured, the predicted re-test keeps that test's readings' scatter about
 //! their per-target means (each reading moved by the predicted change), so
@@ -53,8 +61,8 @@
 //!
 //! Pure: values in, values out.
 
-use crate::compensate::CompensationTable;
-use crate::compensate::retest::KnownError;
+use crate::compensate::retest::{Applied, BacklashError, KnownError};
+use crate::compensate::{CompensationTable, TableMode};
 use crate::diagnose::Effect;
 use crate::evaluate::{AxisFigures, evaluate};
 use crate::measurement::{Direction, Measurement, Run};
@@ -93,8 +101,12 @@ pub struct PredictInput<'a> {
     pub grid_step_mm: f64,
     /// Effects found by `diagnose` that the geometric model lacks: their
     /// systematic part (reversal, scale, periodic) is added to every
-    /// re-test's line, about its first target.
+    /// re-test's line, about its first target. A reversal here is the change
+    /// since the first test, which the prediction already carries.
     pub effects: &'a [Effect],
+    /// The controller's backlash parameter is set as `convert` suggests: it
+    /// takes out the mean reversal B̄ of each measured axis with a mean table.
+    pub backlash_set: bool,
 }
 
 /// The predicted re-test of one compensated axis.
@@ -116,6 +128,13 @@ pub struct PredictedRetest {
     /// Whether the readings carry a measured test's scatter (else one run per
     /// direction, no repeatability).
     pub with_measured_scatter: bool,
+    /// The mean reversal B̄ the first test of the axis measured, which the
+    /// prediction carries, mm; `None` without a bidirectional first test.
+    pub measured_mean_reversal_mm: Option<f64>,
+    /// The mean reversal the controller's backlash parameter takes out, mm (0 if not set).
+    pub backlash_reversal_mm: f64,
+    /// Whether the table is mean or bidirectional.
+    pub table_mode: TableMode,
 }
 
 /// One target of a predicted re-test, mm.
@@ -198,6 +217,14 @@ pub enum PredictError {
     /// No table.
     #[error("no compensation table to predict with")]
     NoTable,
+    /// The backlash parameter is said to be set, but its value is not known or it cannot apply.
+    #[error("the backlash parameter of axis {axis} {why}")]
+    Backlash {
+        /// The axis.
+        axis: Axis,
+        /// Why it cannot be applied.
+        why: BacklashError,
+    },
     /// The model refused a value.
     #[error(transparent)]
     Model(#[from] ModelError),
@@ -238,6 +265,7 @@ pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
             table,
             measured.map(|m| m.measurement),
             input.effects,
+            input.backlash_set,
         )?);
     }
     let grid = Grid::over_strokes(&retest_machine, input.grid_step_mm)?;
@@ -359,8 +387,8 @@ fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, Predic
         let values: Vec<f64> = known
             .positions_mm()
             .iter()
-            .zip(known.values_mm())
-            .map(|(&x, &mean)| {
+            .zip(known.mean_values_mm())
+            .map(|(&x, mean)| {
                 mean - line_deviation(input.machine, &errors, axis, sign, measured.line_mm, x)
             })
             .collect();
@@ -385,6 +413,7 @@ fn predicted_retest(
     table: &CompensationTable,
     measured: Option<&Measurement>,
     effects: &[Effect],
+    backlash_set: bool,
 ) -> Result<PredictedRetest, PredictError> {
     let Line { axis, line_mm } = line;
     let sign = positioning_sign(machine, axis)?;
@@ -392,17 +421,28 @@ fn predicted_retest(
         Some(m) => m.targets_mm().to_vec(),
         None => table.positions_mm.clone(),
     };
+    // The first test's own error, per direction: the reversal it measured.
+    let known = measured.and_then(|m| KnownError::from_evaluation(&evaluate(m)));
+    let measured_mean_reversal_mm = known
+        .as_ref()
+        .filter(|k| k.is_bidirectional())
+        .map(KnownError::mean_reversal_mm);
+    let applied = Applied::with_backlash(Some(table), known.as_ref(), backlash_set)
+        .map_err(|why| PredictError::Backlash { axis, why })?;
     let first_target = targets.first().copied().unwrap_or(0.0);
-    // D(x, d): the model's reading plus the effects it lacks, mm.
+    // D(x, d): the model's reading, the measured reversal and the effects it lacks, mm.
     let deviation = |x: f64, direction: Direction| {
         let effects_um: f64 = effects
             .iter()
             .filter_map(|e| e.systematic_um(x, direction, first_target))
             .sum();
-        line_deviation(machine, errors, axis, sign, line_mm, x) + effects_um / 1000.0
+        let reversal = known
+            .as_ref()
+            .map_or(0.0, |k| k.reversal_share_at(x, direction));
+        line_deviation(machine, errors, axis, sign, line_mm, x) + reversal + effects_um / 1000.0
     };
     let compensated = |x: f64, direction: Direction| {
-        let v = table.value_at(x, direction);
+        let v = applied.value_at(x, direction);
         deviation(x - v, direction) - v
     };
     let per_target: Vec<PredictedTarget> = targets
@@ -433,6 +473,9 @@ fn predicted_retest(
         per_target,
         retest,
         with_measured_scatter: measured.is_some(),
+        measured_mean_reversal_mm,
+        backlash_reversal_mm: applied.backlash_reversal_mm,
+        table_mode: table.values.mode(),
     })
 }
 
@@ -442,17 +485,7 @@ fn with_scatter(
     measured: &Measurement,
     systematic: impl Fn(usize, Direction) -> f64,
 ) -> Result<Measurement, PredictError> {
-    let evaluation = evaluate(measured);
-    measured
-        .map_readings(|run, i, value| {
-            let stats = &evaluation.per_target[i];
-            let cell = match run.direction {
-                Direction::Up => &stats.up,
-                Direction::Down => &stats.down,
-            };
-            // A reading's cell has a mean: the reading itself is in it.
-            systematic(i, run.direction) + (value - cell.mean_mm.unwrap_or(value))
-        })
+    crate::compensate::retest::with_scatter(measured, &evaluate(measured), systematic)
         .map_err(|e| PredictError::Internal(e.to_string()))
 }
 

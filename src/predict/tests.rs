@@ -3,7 +3,7 @@
 //! scale error compensated by hand.
 
 use super::*;
-use crate::compensate::retest::predicted_deviation_mm;
+use crate::compensate::retest::{Applied, predicted_deviation_mm};
 use crate::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use crate::synth::{self, Truth};
 
@@ -43,6 +43,7 @@ fn input<'a>(
         retest_tool_offset_mm: None,
         grid_step_mm: 50.0,
         effects: &[],
+        backlash_set: false,
     }
 }
 
@@ -63,27 +64,32 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         let retest = &prediction.retests[0];
         for (t, target) in retest.per_target.iter().zip(before.targets_mm()) {
             for (direction, value) in [(Direction::Up, t.up_mm), (Direction::Down, t.down_mm)] {
-                let expected = predicted_deviation_mm(&known, Some(&tables[0]), *target, direction);
+                let expected =
+                    predicted_deviation_mm(&known, Applied::table(&tables[0]), *target, direction);
                 assert!(
                     (value - expected).abs() < 1e-9,
                     "{mode:?} {target} {direction:?}: {value} vs {expected}"
                 );
             }
-            // Without the table, the line reads the measured bidirectional mean.
-            assert!((t.before_up_mm - known.at(*target)).abs() < 1e-9);
+            // Without the table, the line reads the measured means, per direction.
+            assert!((t.before_up_mm - known.at(*target, Direction::Up)).abs() < 1e-9);
+            assert!((t.before_down_mm - known.at(*target, Direction::Down)).abs() < 1e-9);
         }
         // The predicted re-test keeps the first test's scatter: the same R per direction.
         let first = evaluate(&before).figures;
         assert!((retest.figures.r_up_mm.unwrap() - first.r_up_mm.unwrap()).abs() < 1e-12);
         assert!((retest.figures.r_down_mm.unwrap() - first.r_down_mm.unwrap()).abs() < 1e-12);
-        // Without the table the model's line has the measured bidirectional means: the same M.
+        // Without the table the model's line is the measurement: the same M and B̄.
         assert!((retest.figures_before.m_mm.unwrap() - first.m_mm.unwrap()).abs() < 1e-9);
-        // The geometric model has no reversal: with a mean table it predicts none (the re-test will show
-        // the measured −3 µm, which `diagnose` then finds); a bidirectional table takes the measured
-        // reversal out, so the model predicts its opposite, unless the effect is given.
+        assert!((retest.figures_before.b_mean_mm.unwrap() - first.b_mean_mm.unwrap()).abs() < 1e-9);
+        // The measured reversal (−3 µm in the truth) is carried: a mean table leaves it,
+        // a bidirectional table takes it out. An effect's reversal (a change found by
+        // diagnose) adds to it.
         let b = retest.figures.b_mean_mm.unwrap() * 1000.0;
+        let b_measured = first.b_mean_mm.unwrap() * 1000.0;
+        assert!((retest.measured_mean_reversal_mm.unwrap() * 1000.0 - b_measured).abs() < 1e-9);
         let b_with_effect = predict(&PredictInput {
-            effects: &[Effect::Reversal { b_um: -3.0 }],
+            effects: &[Effect::Reversal { b_um: -1.0 }],
             ..input(&machine, &errors, &measured, &tables, line)
         })
         .unwrap()
@@ -94,12 +100,18 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
             * 1000.0;
         match mode {
             TableMode::Mean => {
-                assert!(b.abs() < 1e-9, "{b}");
-                assert!((b_with_effect + 3.0).abs() < 1e-9, "{b_with_effect}");
+                // Equal up to second order: the table moves each direction's curve by the
+                // same v, and the two curves' slopes differ by the reversal's slope
+                // (nm per mm) × v (µm): below 1e-3 µm.
+                assert!((b - b_measured).abs() < 1e-3, "{b} vs {b_measured}");
+                assert!(
+                    (b_with_effect - (b_measured - 1.0)).abs() < 1e-3,
+                    "{b_with_effect}"
+                );
             }
             TableMode::Bidirectional => {
-                assert!((b - 3.0).abs() < 0.5, "{b}");
-                assert!(b_with_effect.abs() < 0.5, "{b_with_effect}");
+                assert!(b.abs() < 0.05, "{b}");
+                assert!((b_with_effect + 1.0).abs() < 0.05, "{b_with_effect}");
             }
         }
     }
@@ -142,10 +154,10 @@ fn pitch_changes_the_reading_on_another_line_by_hand() {
         let x = a.target_mm;
         // On the measured line the model gives back the measurement …
         assert!(
-            (a.before_up_mm - known.at(x)).abs() < 1e-9,
+            (a.before_up_mm - known.at(x, Direction::Up)).abs() < 1e-9,
             "{x}: {} vs {}",
             a.before_up_mm,
-            known.at(x)
+            known.at(x, Direction::Up)
         );
         // … and 500 mm lower the Abbe term of the pitch.
         let abbe = 20e-6 * x / 750.0 * -500.0;

@@ -9,11 +9,11 @@
 //! drawn in µm through `crate::units`.
 
 use crate::compensate::CompensationTable;
-use crate::compensate::retest::{KnownError, predicted_deviation_mm};
+use crate::compensate::retest::{Applied, KnownError, predicted_deviation_mm, with_scatter};
 use crate::diagnose::{Diagnosis, ReadingResidual};
 use crate::emit::Controller;
 use crate::error::Warning;
-use crate::evaluate::{DirectionStats, Evaluation, TargetStats};
+use crate::evaluate::{AxisFigures, DirectionStats, Evaluation, TargetStats, evaluate};
 use crate::measurement::{Direction, Measurement};
 use crate::report::chart::{Chart, Mark, Rgb, Series};
 use crate::units::mm_to_um;
@@ -76,6 +76,9 @@ pub struct Prediction {
     pub down_um: Vec<f64>,
     /// The first test's mean deviation there (what the axis does without the table), µm.
     pub uncompensated_um: Vec<f64>,
+    /// The predicted re-test's ISO 230-2 figures, as `predict` gives them on
+    /// the measured line (the first test's scatter about the predicted means).
+    pub figures: AxisFigures,
 }
 
 impl Prediction {
@@ -101,10 +104,15 @@ impl Prediction {
 const PREDICTION_SAMPLES: usize = 600;
 
 /// The predicted re-test of the first test with the table applied
-/// (`compensate::retest`), over the measured span; `None` if the first test
-/// has no mean deviation anywhere.
-pub fn prediction(before: &Evaluation, table: &CompensationTable) -> Option<Prediction> {
-    let known = KnownError::from_evaluation(before)?;
+/// (`compensate::retest`, with the reversal the first test measured), over
+/// the measured span; `None` if the first test has no mean deviation anywhere.
+pub fn prediction(before: &TestRecord<'_>, table: &CompensationTable) -> Option<Prediction> {
+    let known = KnownError::from_evaluation(before.evaluation)?;
+    let targets_mm = before.measurement.targets_mm();
+    let retest = with_scatter(before.measurement, before.evaluation, |i, direction| {
+        predicted_deviation_mm(&known, Applied::table(table), targets_mm[i], direction)
+    })
+    .ok()?;
     let first = *known.positions_mm().first()?;
     let last = *known.positions_mm().last()?;
     let positions_mm: Vec<f64> = (0..PREDICTION_SAMPLES)
@@ -113,7 +121,14 @@ pub fn prediction(before: &Evaluation, table: &CompensationTable) -> Option<Pred
     let predict = |direction| {
         positions_mm
             .iter()
-            .map(|&x| mm_to_um(predicted_deviation_mm(&known, Some(table), x, direction)))
+            .map(|&x| {
+                mm_to_um(predicted_deviation_mm(
+                    &known,
+                    Applied::table(table),
+                    x,
+                    direction,
+                ))
+            })
             .collect()
     };
     Some(Prediction {
@@ -121,9 +136,10 @@ pub fn prediction(before: &Evaluation, table: &CompensationTable) -> Option<Pred
         down_um: predict(Direction::Down),
         uncompensated_um: positions_mm
             .iter()
-            .map(|&x| mm_to_um(known.at(x)))
+            .map(|&x| mm_to_um(known.mean_at(x)))
             .collect(),
         positions_mm,
+        figures: evaluate(&retest).figures,
     })
 }
 
@@ -187,7 +203,7 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
             name: "table",
             chart: table_chart(table.table, input.before.evaluation),
         });
-        if let Some(prediction) = prediction(input.before.evaluation, table.table) {
+        if let Some(prediction) = prediction(&input.before, table.table) {
             charts.push(NamedChart {
                 name: "predicted",
                 chart: prediction_chart(
@@ -349,11 +365,11 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
     let first_target = before.per_target.first().map(|t| t.target_mm);
     let last_target = before.per_target.last().map(|t| t.target_mm);
     if let Some(known) = KnownError::from_evaluation(before) {
-        let at_reference = known.at(table.reference_mm);
+        let at_reference = known.mean_at(table.reference_mm);
         let points = known
             .positions_mm()
             .iter()
-            .zip(known.values_mm())
+            .zip(known.mean_values_mm())
             .map(|(x, v)| (*x, mm_to_um(v - at_reference)))
             .collect();
         all.push(series(

@@ -170,12 +170,22 @@ fn evaluation_json(test: &TestRecord<'_>) -> EvaluationJson {
 
 /// A µm cell with its source (see the module doc).
 fn um_cell(key: &str, value: Option<f64>) -> String {
-    let full = value.map_or_else(|| "null".to_string(), |v| v.to_string());
     format!(
-        "<td class=\"num\" data-key=\"{}\" data-um=\"{full}\">{}</td>",
-        esc(key),
+        "<td class=\"num\" {}>{}</td>",
+        source(key, value),
         um(value)
     )
+}
+
+/// A µm value in running text, with its source.
+fn um_strong(key: &str, value: Option<f64>) -> String {
+    format!("<strong {}>{}</strong>", source(key, value), um(value))
+}
+
+/// The `data-key` and `data-um` attributes of a µm value.
+fn source(key: &str, value: Option<f64>) -> String {
+    let full = value.map_or_else(|| "null".to_string(), |v| v.to_string());
+    format!("data-key=\"{}\" data-um=\"{full}\"", esc(key))
 }
 
 fn text_or_missing(value: Option<&str>) -> String {
@@ -742,16 +752,24 @@ fn table_section(
          controller applies it, linear between the points and the end values held; dashed: the \
          first test's bidirectional mean, shifted to zero at the reference.",
     );
-    if let Some(predicted) = prediction(input.before.evaluation, table) {
+    if let Some(predicted) = prediction(&input.before, table) {
+        let figures = &predicted.figures;
         let _ = writeln!(
             out,
             "<p>Predicted re-test along the laser line with the table active: the first test's \
-             mean deviation with the table applied as the controller applies it (linear between \
-             points, ends held). Its range (largest − smallest) is <strong data-key=\"prediction.range_um\">{} µm</strong>, \
-             against {} µm without the table. Reversal, drift and scatter are not in the \
-             prediction: a re-test adds them.</p>",
+             mean deviation in each direction with the table applied as the controller applies it \
+             (linear between points, ends held), so the reversal the first test measured is in it \
+             (a mean table leaves it, a bidirectional table takes it out). Its range (largest − \
+             smallest) is <strong data-key=\"prediction.range_um\">{} µm</strong>, against {} µm \
+             without the table. With the first test's scatter, the predicted re-test has \
+             A {} µm, E {} µm and B {} µm (as <code>axcomp predict</code> gives them). Drift \
+             and anything else that changes between the tests are not in the prediction: a \
+             re-test adds them.</p>",
             um(Some(predicted.range_um())),
-            um(Some(predicted.uncompensated_range_um()))
+            um(Some(predicted.uncompensated_range_um())),
+            um_strong("prediction.figures_um.A", figures.a_mm.map(mm_to_um)),
+            um_strong("prediction.figures_um.E", figures.e_mm.map(mm_to_um)),
+            um_strong("prediction.figures_um.B", figures.b_mm.map(mm_to_um)),
         );
         figure(
             out,

@@ -9,7 +9,9 @@
 //! ```text
 //! { "machine": "MCV 754 Quick", "chain": "ZFYX",
 //!   "axis": "X", "line_mm": {"x": 0.0, "y": 250.0, "z": -275.0},
-//!   "with_measured_scatter": true,
+//!   "with_measured_scatter": true, "table_mode": "mean",
+//!   "measured_B_mean_um": -3.18,              (the first test's B̄, which the prediction carries; null if unknown)
+//!   "backlash_set": false,                    (--backlash-set: the backlash parameter takes B̄ out)
 //!   "predicted_figures_um": {"A": …, … as in evaluate},
 //!   "figures_before_um": {…},                 (the same line without the table)
 //!   "per_target": [{"target_mm": …, "predicted_up_um": …, "predicted_down_um": …,
@@ -77,6 +79,14 @@ pub struct RetestJson {
     pub line_mm: PositionJson,
     /// Whether the readings carry the measured test's scatter.
     pub with_measured_scatter: bool,
+    /// `mean` or `bidirectional`.
+    pub table_mode: &'static str,
+    /// The mean reversal B̄ the first test measured, which the prediction
+    /// carries, µm; `null` without a bidirectional first test.
+    #[serde(rename = "measured_B_mean_um")]
+    pub measured_b_mean_um: Option<f64>,
+    /// Whether the controller's backlash parameter takes B̄ out (`--backlash-set`).
+    pub backlash_set: bool,
     /// ISO 230-2 figures of the predicted re-test, µm.
     pub predicted_figures_um: FiguresJson,
     /// The same line without the table, µm.
@@ -92,6 +102,9 @@ impl RetestJson {
             axis: retest.axis.letter().to_string(),
             line_mm: retest.line_mm.into(),
             with_measured_scatter: retest.with_measured_scatter,
+            table_mode: retest.table_mode.as_str(),
+            measured_b_mean_um: retest.measured_mean_reversal_mm.map(mm_to_um),
+            backlash_set: retest.backlash_reversal_mm != 0.0,
             predicted_figures_um: FiguresJson::from_figures(&retest.figures),
             figures_before_um: FiguresJson::from_figures(&retest.figures_before),
             per_target: retest

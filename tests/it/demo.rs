@@ -95,14 +95,33 @@ fn the_demo_writes_what_it_promises_with_the_numbers_of_evaluate_and_diagnose() 
     ] {
         assert_eq!(demo[key], diagnose[key], "{key}");
     }
-    // It finds what the truth put in and the model does not declare.
+    // It finds what the truth put in after the first test (the drift, 4 µm/h) and
+    // not the reversal both tests measured, which the prediction carries.
     let kinds: Vec<&str> = demo["effects"]
         .as_array()
         .unwrap()
         .iter()
         .map(|e| e["kind"].as_str().unwrap())
         .collect();
-    assert_eq!(kinds, ["reversal", "drift"]);
+    assert_eq!(kinds, ["drift"]);
+    let rate = demo["effects"][0]["params"]["rate_um_per_h"]
+        .as_f64()
+        .unwrap();
+    assert!((rate - 4.0).abs() < 0.4, "{rate}");
+    let reversal = demo["rejected"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["kind"] == "reversal")
+        .expect("reversal looked for");
+    assert!(
+        reversal["why"]
+            .as_str()
+            .unwrap()
+            .starts_with("no change since the first test, whose B̄ = -3.23 µm"),
+        "{reversal}"
+    );
+    let predicted_a = demo["figures_um"]["predicted"]["A"].clone();
     // The prediction: the same as `predict --json` with that table.
     let predict = json_run(&[
         "predict",
@@ -116,6 +135,23 @@ fn the_demo_writes_what_it_promises_with_the_numbers_of_evaluate_and_diagnose() 
     for key in ["predicted_figures_um", "per_target", "volumetric_max_um"] {
         assert_eq!(demo[key], predict[key], "{key}");
     }
+    // One predicted A for the one re-test: predict's, diagnose's and the report's.
+    assert_eq!(demo["predicted_figures_um"]["A"], predicted_a);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.contains(&format!(
+            "data-key=\"prediction.figures_um.A\" data-um=\"{predicted_a}\""
+        )),
+        "the report's predicted A is not {predicted_a}"
+    );
+    assert!(
+        run.stdout.contains(&format!(
+            "re-test A {:.2} µm",
+            predicted_a.as_f64().unwrap()
+        )),
+        "{}",
+        run.stdout
+    );
 
     // The PNGs are plots, not empty canvases.
     for name in PROMISED.iter().filter(|n| n.ends_with(".png")) {

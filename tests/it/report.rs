@@ -161,6 +161,12 @@ sigma_um = 0.35
 kind = "reversal"
 B_um = -3.2
 
+# The reversal grows by 1.5 µm after the first test: the change is what diagnose finds.
+[[effect]]
+kind = "reversal"
+B_um = -1.5
+tests = ["after"]
+
 [[effect]]
 kind = "drift"
 rate_um_per_h = 4.0
@@ -224,6 +230,7 @@ impl RetestCase {
             after: &after,
             before: Some(&before),
             table: Some(&table),
+            backlash_set: false,
             angular: None,
             timing: CycleTiming::ASSUMED,
         })
@@ -283,7 +290,11 @@ fn the_retest_report_shows_evaluate_and_diagnose_numbers_and_writes_pngs() {
         .iter()
         .map(|a| a.effect.kind().name())
         .collect();
-    assert_eq!(kinds, ["reversal", "drift"], "the truth has both");
+    assert_eq!(
+        kinds,
+        ["reversal", "drift"],
+        "the truth has both after the first test"
+    );
     // 5 residual values, 3 × 6 figures, and the reversal's B (drift has no µm parameter).
     assert_eq!(
         check_against_json(&html, "diagnosis", &diagnosis_json(&diagnosis)),
