@@ -25,9 +25,12 @@ use std::collections::HashMap;
 
 use crate::error::{ParseError, Warning};
 use crate::measurement::{
-    Direction, Environment, Measurement, Metadata, Run, SourceFormat, TestDate,
+    AXIS_PLACEHOLDER, AxisSource, Direction, Environment, Measurement, Metadata, Run, SourceFormat,
+    TestDate,
 };
-use crate::read::text::{self, Line, end_of_file_line, split_key};
+use crate::read::text::{
+    self, Line, check_deviation_mm, check_target_mm, end_of_file_line, split_key,
+};
 use crate::read::{missing_readings_warning, parse_date};
 use crate::units::{LengthUnit, um_text, um_to_mm};
 
@@ -101,14 +104,15 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
     }
     metadata.source_format = Some(SourceFormat::Csv);
     metadata.length_unit = LengthUnit::Millimetre;
-    let measurement = Measurement::new(
-        axis.unwrap_or_else(|| "X".to_string()),
-        targets_mm,
-        runs,
-        Environment::default(),
-        metadata,
-    )
-    .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
+    let axis = match axis {
+        Some(axis) => {
+            metadata.axis_source = AxisSource::file("# axis");
+            axis
+        }
+        None => AXIS_PLACEHOLDER.to_string(),
+    };
+    let measurement = Measurement::new(axis, targets_mm, runs, Environment::default(), metadata)
+        .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
     Ok((measurement, warnings))
 }
 
@@ -172,6 +176,7 @@ fn reading(line: &Line<'_>) -> Result<Reading, ParseError> {
         ));
     }
     let target_mm = text::number(line, fields[0], "target in mm")?;
+    check_target_mm(target_mm, line.number, line.column_of(fields[0]))?;
     let run = text::integer(line, fields[1], "run number")?;
     if run == 0 {
         return Err(line.error_at(fields[1], "expected a run number from 1, found 0"));
@@ -184,7 +189,12 @@ fn reading(line: &Line<'_>) -> Result<Reading, ParseError> {
     let deviation_mm = if fields[3].is_empty() {
         None
     } else {
-        Some(um_to_mm(text::number(line, fields[3], "deviation in µm")?))
+        let deviation_mm = um_to_mm(text::number(line, fields[3], "deviation in µm")?);
+        Some(check_deviation_mm(
+            deviation_mm,
+            line.number,
+            line.column_of(fields[3]),
+        )?)
     };
     Ok(Reading {
         target_mm,

@@ -48,7 +48,14 @@ pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult
         Some(format) => format,
         None => detect(&text).ok_or_else(|| located(unknown_format_error()))?,
     };
-    let (mut measurement, warnings) = parse_str(&text, format).map_err(located)?;
+    let (mut measurement, mut warnings) = parse_str(&text, format).map_err(located)?;
+    // The file name is the last place an ecmc file can state its axis
+    // (`ecmc` module doc); only this front end knows it.
+    if format == SourceFormat::Ecmc
+        && let Some(name) = path.file_name().and_then(|name| name.to_str())
+    {
+        warnings.extend(ecmc::axis_from_file_name(&mut measurement, name));
+    }
     measurement.metadata.source_file = Some(path.to_path_buf());
     Ok(ReadResult {
         measurement,
