@@ -617,6 +617,49 @@ mod tests {
     }
 
     #[test]
+    fn the_axis_is_the_letter_a_pv_states() {
+        let with = |lines: &str| parse_ok(&format!("{lines}\n{SMALL}"));
+        let z = with("TGT_SET_PV=TARGET_DU:Z-PosCmd\nREF_PV=IOC_TEST:m0s011-Enc01-PosAct");
+        assert_eq!(z.axis(), "Z");
+        assert_eq!(z.axis_source(), &AxisSource::file("TGT_SET_PV"));
+        let reference = with("TGT_SET_PV=IOC_TEST:Axis1-PosSet\nREF_PV=LAB:y-Enc-PosAct");
+        assert_eq!(reference.axis(), "Y");
+        assert_eq!(reference.axis_source(), &AxisSource::file("REF_PV"));
+        let none = with("TGT_SET_PV=IOC_TEST:Axis1-PosSet");
+        assert_eq!(none.axis(), AXIS_PLACEHOLDER);
+        assert_eq!(none.axis_source(), &AxisSource::NotRecorded);
+        let (_, warnings) = parse(&format!(
+            "TGT_SET_PV=T:Z-PosCmd\nREF_PV=R:X-PosAct\n{SMALL}"
+        ))
+        .unwrap();
+        assert!(
+            warnings.iter().any(|w| w
+                .to_string()
+                .contains("TGT_SET_PV names axis Z but REF_PV names X")),
+            "{warnings:?}"
+        );
+    }
+
+    #[test]
+    fn the_file_name_names_the_axis_only_when_the_pvs_do_not() {
+        let mut m = parse_ok(SMALL);
+        assert_eq!(axis_from_file_name(&mut m, "report_data.dat"), None);
+        assert!(!m.axis_recorded());
+        assert_eq!(
+            axis_from_file_name(&mut m, "target_w_report.md_ISO230.dat"),
+            None
+        );
+        assert_eq!(
+            (m.axis(), m.axis_source()),
+            ("W", &AxisSource::file("file name"))
+        );
+        let mut z = parse_ok(&format!("TGT_SET_PV=T:Z-PosCmd\n{SMALL}"));
+        let warning = axis_from_file_name(&mut z, "x.dat").unwrap();
+        assert!(warning.to_string().contains("names X"), "{warning}");
+        assert_eq!(z.axis(), "Z");
+    }
+
+    #[test]
     fn counts_are_inferred_when_absent() {
         let text = "TGT_DATA[1]=0\nTGT_DATA[2]=5\nREF_DATA_FWD[1,1]=0\nREF_DATA_FWD[2,1]=5.001\n";
         let m = parse_ok(text);
@@ -653,6 +696,22 @@ mod tests {
             ("TGT_DATA[1,2]=1\n", (1, 1), "takes 1 index"),
             ("TGT_DATA[x]=1\n", (1, 10), "whole number"),
             ("just words\n", (1, 1), "KEY=VALUE"),
+            // A truncated file: cycle 2 went forward but never came back.
+            (
+                "CYCLES=2\nTGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1\nREF_DATA_BWD[1,1]=1\nREF_DATA_FWD[1,2]=1\n",
+                (1, 8),
+                "CYCLES=2 but the file holds no REF_DATA_BWD cycle(s) 2: the file looks truncated",
+            ),
+            (
+                "TGT_DATA[1]=2e5\nREF_DATA_FWD[1,1]=1\n",
+                (1, 13),
+                "within ±100000 mm",
+            ),
+            (
+                "TGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1001.5\n",
+                (2, 19),
+                "found 1000500 µm",
+            ),
             ("TGT_DATA[1]=nan\n", (1, 13), "expected a number"),
             (
                 "CYCLES=1\nTGT_DATA[1]=1\nREF_DATA_BWD[1,2]=1\n",

@@ -161,13 +161,18 @@ pub fn check_deviation_mm(value_mm: f64, line: usize, column: usize) -> Result<f
     if value_mm.abs() <= MAX_DEVIATION_MM {
         return Ok(value_mm);
     }
+    // In µm, as deviations are read, unless that overflows (a value near f64::MAX in mm).
+    let found = if (value_mm * 1000.0).is_finite() {
+        format!("{} µm", shown(value_mm * 1000.0))
+    } else {
+        format!("{} mm", shown(value_mm))
+    };
     Err(ParseError::new(
         line,
         column,
         format!(
-            "expected a deviation within ±{} µm (±1 m), found {} µm: check the unit and the column of the file",
+            "expected a deviation within ±{} µm (±1 m), found {found}: check the unit and the column of the file",
             MAX_DEVIATION_MM * 1000.0,
-            shown(value_mm * 1000.0)
         ),
     ))
 }
@@ -287,6 +292,8 @@ mod tests {
         assert_eq!((error.position.line, error.position.column), (3, 4));
         assert!(error.message.contains("found 1e308 µm"), "{error}");
         assert!(error.message.contains("±1000000 µm"), "{error}");
+        let error = check_deviation_mm(-1e308, 3, 4).unwrap_err();
+        assert!(error.message.contains("found -1e308 mm"), "{error}");
         assert!(check_deviation_mm(f64::NAN, 1, 1).is_err());
         assert!(check_deviation_mm(1000.001, 1, 1).is_err());
         assert_eq!(check_target_mm(-100_000.0, 1, 1), Ok(-100_000.0));
