@@ -35,9 +35,9 @@ pub struct ReadResult {
 
 /// Reads one measurement file. `format` overrides detection.
 pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult, ReadError> {
-    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let located = |error: ParseError| ReadError::Parse {
         path: path.to_path_buf(),

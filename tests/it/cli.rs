@@ -1,6 +1,6 @@
 //! The `evaluate` command end to end: the report (golden file), flags, errors.
 
-use crate::util::{assert_golden, axcomp, test_data};
+use crate::util::{assert_golden, axcomp, root, test_data};
 
 const SAMPLE: &str = "fixtures/sample-x.rtl";
 
@@ -129,5 +129,47 @@ fn usage_errors_exit_2_and_help_exits_0() {
         missing.stderr.contains("no-such-file.rtl: No such file"),
         "{}",
         missing.stderr
+    );
+}
+
+/// A missing input and an output into a missing folder: one line each, the
+/// OS message once, no temporary file's name (issue 11, point 6).
+#[test]
+fn file_errors_are_one_clean_line() {
+    let missing = axcomp(["evaluate", "no-such-file.rtl"]);
+    assert_eq!(missing.code, 2);
+    assert_eq!(
+        missing.stderr,
+        "axcomp: error: cannot read no-such-file.rtl: No such file or directory (os error 2)\n"
+    );
+    let report = axcomp(["report", "no-such-file.rtl", "-o", "no-such-folder/r.html"]);
+    assert_eq!(
+        report.stderr,
+        "axcomp: error: cannot read no-such-file.rtl: No such file or directory (os error 2)\n"
+    );
+
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("out/dir/X.COM");
+    let sample = root().join("fixtures/sample-x.rtl");
+    let run = axcomp([
+        "convert".as_ref(),
+        sample.as_os_str(),
+        "--controller".as_ref(),
+        "tnc640".as_ref(),
+        "-o".as_ref(),
+        output.as_os_str(),
+    ]);
+    assert_eq!(run.code, 2);
+    assert_eq!(
+        run.stderr,
+        format!(
+            "axcomp: error: cannot write {}: the folder {} does not exist\n",
+            output.display(),
+            directory.path().join("out/dir").display()
+        )
+    );
+    assert!(
+        !directory.path().join("out").exists(),
+        "no folder is created"
     );
 }
