@@ -117,11 +117,8 @@ pub fn detect(text: &str) -> Option<SourceFormat> {
         .lines()
         .map(str::trim)
         .find(|line| !line.is_empty() && !line.starts_with('#'));
-    if let Some(line) = first_data {
-        let compact: String = line.chars().filter(|c| !c.is_whitespace()).collect();
-        if compact.to_ascii_lowercase().starts_with(csv::HEADER) {
-            return Some(SourceFormat::Csv);
-        }
+    if first_data.and_then(csv::header_separator).is_some() {
+        return Some(SourceFormat::Csv);
     }
     if text.contains("TGT_DATA[")
         || text.contains("REF_DATA_FWD[")
@@ -304,6 +301,14 @@ mod tests {
         );
         assert_eq!(
             detect("# axis: X\ntarget_mm, run, direction, deviation_um\n"),
+            Some(SourceFormat::Csv)
+        );
+        assert_eq!(
+            detect("Target_mm;Run;Direction;Deviation_um\r\n0;1;up;0,5\r\n"),
+            Some(SourceFormat::Csv)
+        );
+        assert_eq!(
+            detect("target_mm\trun\tdirection\tdeviation_um\n"),
             Some(SourceFormat::Csv)
         );
         assert_eq!(detect("hello\nworld\n"), None);

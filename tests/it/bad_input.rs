@@ -211,6 +211,12 @@ const CASES: &[(&str, usize, usize, &str)] = &[
         "expected a target within ±100000 mm (±100 m), found 2e9 mm",
     ),
     ("csv-bad-header.csv", 1, 1, "unknown format"),
+    (
+        "csv-mixed-decimal.csv",
+        4,
+        10,
+        "expected a decimal comma as on line 2, found a decimal point in \"1.5\": the file mixes decimal marks",
+    ),
     // Any format
     ("empty.rtl", 1, 1, "found an empty file"),
     ("blank.csv", 1, 1, "found an empty file"),

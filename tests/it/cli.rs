@@ -173,3 +173,53 @@ fn file_errors_are_one_clean_line() {
         "no folder is created"
     );
 }
+
+/// The CSV layout as Excel saves it in a European locale (`;` and a decimal
+/// comma) and as tab-separated text reads to the same figures as the comma
+/// layout (issue 11, point 6).
+#[test]
+fn excel_csv_layouts_give_the_same_figures() {
+    let directory = tempfile::tempdir().unwrap();
+    let rows = [
+        (0.0, 1, "up", "0.5"),
+        (100.0, 1, "up", "-1.25"),
+        (0.0, 1, "down", "1.5"),
+        (100.0, 1, "down", "-0.75"),
+        (0.0, 2, "up", "0.25"),
+        (100.0, 2, "up", "-1.5"),
+        (0.0, 2, "down", "1.75"),
+        (100.0, 2, "down", "-0.5"),
+    ];
+    let write = |name: &str, separator: &str, comma: bool| {
+        let mut text = format!(
+            "# axis: Y{separator}{separator}{separator}\r\ntarget_mm{separator}run{separator}direction{separator}deviation_um\r\n"
+        );
+        for (target, run, direction, value) in rows {
+            let value = if comma {
+                value.replace('.', ",")
+            } else {
+                value.to_string()
+            };
+            text.push_str(&format!(
+                "{target}{separator}{run}{separator}{direction}{separator}{value}\r\n"
+            ));
+        }
+        let path = directory.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let comma = write("comma.csv", ",", false);
+    let semicolon = write("excel.csv", ";", true);
+    let tab = write("text.txt", "\t", false);
+    let figures = |path: &std::path::Path| {
+        let report = crate::util::evaluate_json(&[path]);
+        assert_eq!(report["format"], "csv");
+        assert_eq!(report["axis"], "Y");
+        (report["figures_um"].clone(), report["per_target"].clone())
+    };
+    let expected = figures(&comma);
+    // x̄↑ at 0 mm: (0.5 + 0.25) / 2, by hand.
+    assert_eq!(expected.1[0]["mean_up_um"], 0.375);
+    assert_eq!(figures(&semicolon), expected);
+    assert_eq!(figures(&tab), expected);
+}
