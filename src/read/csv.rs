@@ -208,7 +208,10 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
 /// text that reads back to the same value.
 pub fn write(measurement: &Measurement) -> String {
     let mut out = String::new();
-    out.push_str(&format!("# axis: {}\n", measurement.axis()));
+    // A placeholder name stays unrecorded: the file must not claim an axis.
+    if measurement.axis_recorded() {
+        out.push_str(&format!("# axis: {}\n", measurement.axis()));
+    }
     let metadata = &measurement.metadata;
     let fields = [
         ("machine", metadata.machine.clone()),
@@ -412,6 +415,11 @@ mod tests {
         let (again, _) = parse(&write(&m)).unwrap();
         assert_eq!(again.targets_mm(), m.targets_mm());
         assert_eq!(again.runs(), m.runs());
+        assert_eq!(again.axis_source(), &AxisSource::file("# axis"));
+        // An axis the file did not record is not written as if it had been.
+        let (unnamed, _) = parse(&text.replace("# axis: Z\n", "")).unwrap();
+        let (again, _) = parse(&write(&unnamed)).unwrap();
+        assert_eq!(again.axis_source(), &AxisSource::NotRecorded);
     }
 
     #[test]

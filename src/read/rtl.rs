@@ -98,7 +98,13 @@ pub fn write(measurement: &Measurement) -> String {
         .unwrap_or_default();
     line(&format!("Date: {date}"));
     line(&format!("By: {}", field(&metadata.operator)));
-    line(&format!("Axis: {}", measurement.axis()));
+    // A placeholder name stays unrecorded: the file must not claim an axis.
+    let axis = if measurement.axis_recorded() {
+        measurement.axis()
+    } else {
+        ""
+    };
+    line(&format!("Axis: {axis}"));
     line(&format!("Location: {}", field(&metadata.location)));
     line(&format!("TITLE: {}", field(&metadata.description)));
     line("");
