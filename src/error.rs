@@ -92,13 +92,15 @@ pub fn describe_found(token: &str) -> String {
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
     /// The file could not be read at all.
-    #[error("{path}: {source}", path = path.display())]
+    ///
+    /// The operating system's message is part of the text, not a `source`:
+    /// an error chain printed with both said it twice.
+    #[error("cannot read {path}: {error}", path = path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// What the operating system said.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file was read but its content is wrong at a position.
     #[error("{path}:{error}", path = path.display())]

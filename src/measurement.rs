@@ -189,6 +189,60 @@ impl SourceFormat {
     }
 }
 
+/// Where a measurement's axis name came from.
+///
+/// A table written for the wrong axis compensates a correct axis with another
+/// axis' error, so the name is never guessed silently: a reader records which
+/// field of the file states it, and a file that states none is
+/// [`AxisSource::NotRecorded`], its name the placeholder
+/// [`AXIS_PLACEHOLDER`]. The CLI shows "not recorded" and refuses to write
+/// or read a table for such a measurement until the user names the axis.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum AxisSource {
+    /// The measurement file states the axis, in this field: `Axis` (`.rtl`
+    /// USER-TEXT), `TestAxis` or `File Name` (API `.pos`), `# axis` (CSV),
+    /// `TGT_SET_PV`, `REF_PV` or `file name` (ecmc, see [`crate::read::ecmc`]).
+    File {
+        /// The field, as the file spells it.
+        field: String,
+    },
+    /// Named outside the file: by the user (`--axis`), or by the program that
+    /// made the measurement (synth from its truth file, servo-sim, predict).
+    Given,
+    /// Nothing states the axis; the name is the placeholder [`AXIS_PLACEHOLDER`].
+    #[default]
+    NotRecorded,
+}
+
+/// The name a measurement whose file states no axis carries
+/// ([`AxisSource::NotRecorded`]): the first axis, so that figures can be
+/// computed, but never used for a table without the user's word.
+pub const AXIS_PLACEHOLDER: &str = "X";
+
+impl AxisSource {
+    /// The source of a name found in `field` of the file.
+    pub fn file(field: impl Into<String>) -> AxisSource {
+        AxisSource::File {
+            field: field.into(),
+        }
+    }
+
+    /// Whether the file or the user named the axis.
+    pub fn is_recorded(&self) -> bool {
+        !matches!(self, AxisSource::NotRecorded)
+    }
+}
+
+impl fmt::Display for AxisSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AxisSource::File { field } => write!(f, "from {field} in the file"),
+            AxisSource::Given => f.write_str("given, not from the file"),
+            AxisSource::NotRecorded => f.write_str("not recorded"),
+        }
+    }
+}
+
 /// Who measured what, where and when; all optional, as files leave fields empty.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Metadata {
@@ -214,6 +268,8 @@ pub struct Metadata {
     pub length_unit: LengthUnit,
     /// Format-specific fields kept verbatim for the report (software version, flags, PV names).
     pub extra: Vec<(String, String)>,
+    /// Where the axis name came from (default: not recorded).
+    pub axis_source: AxisSource,
 }
 
 impl Metadata {
@@ -368,9 +424,21 @@ impl Measurement {
         })
     }
 
-    /// The axis name (`X`, `Y`, `Z`, `U`, …).
+    /// The axis name (`X`, `Y`, `Z`, `U`, …); [`AXIS_PLACEHOLDER`] when the
+    /// file does not record it (see [`Measurement::axis_source`]).
     pub fn axis(&self) -> &str {
         &self.axis
+    }
+
+    /// Where the axis name came from.
+    pub fn axis_source(&self) -> &AxisSource {
+        &self.metadata.axis_source
+    }
+
+    /// Whether the axis name was stated by the file or given by the user,
+    /// rather than the placeholder.
+    pub fn axis_recorded(&self) -> bool {
+        self.metadata.axis_source.is_recorded()
     }
 
     /// The targets P_i, mm, strictly increasing.
@@ -395,9 +463,18 @@ impl Measurement {
         self.runs_in(direction).count()
     }
 
-    /// Renames the axis (for a file whose metadata names the wrong one).
+    /// Names the axis (for a file that names none, or the wrong one); the
+    /// name is then [`AxisSource::Given`].
     pub fn set_axis(&mut self, axis: impl Into<String>) {
         self.axis = axis.into();
+        self.metadata.axis_source = AxisSource::Given;
+    }
+
+    /// Names the axis as stated by the file, in `source` (for the reader,
+    /// which finds some names only after parsing, e.g. in a file name).
+    pub fn set_axis_from(&mut self, axis: impl Into<String>, source: AxisSource) {
+        self.axis = axis.into();
+        self.metadata.axis_source = source;
     }
 
     /// The same measurement without the selected runs. Remaining runs keep

@@ -19,22 +19,51 @@ pub enum OutputError {
         /// The target.
         path: PathBuf,
     },
+    /// The folder the file goes into does not exist (nothing is created:
+    /// a mistyped folder must not become a new one).
+    #[error("cannot write {path}: the folder {folder} does not exist", path = path.display(), folder = folder.display())]
+    NoFolder {
+        /// The target.
+        path: PathBuf,
+        /// Its folder.
+        folder: PathBuf,
+    },
     /// The file system refused.
-    #[error("{path}: {source}", path = path.display())]
+    ///
+    /// The operating system's message is part of the text, not a `source`
+    /// (printed with the chain it appeared twice), and never names the
+    /// temporary file the target is written through.
+    #[error("cannot write {path}: {error}", path = path.display())]
     Io {
         /// The target.
         path: PathBuf,
         /// What the operating system said.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
+}
+
+/// The operating system's error without the temporary file's path that
+/// `tempfile` wraps around it (`… at path "out/.tmpXXXX"`): the user never
+/// asked for that file.
+fn os_error(error: std::io::Error) -> std::io::Error {
+    // tempfile 3 hides the OS error in a private type whose text is
+    // `{os error} at path {path:?}` and whose `source` is the OS error's
+    // (none); its text is all there is to take the path off.
+    let Some(inner) = error.get_ref() else {
+        return error;
+    };
+    let text = inner.to_string();
+    match text.rfind(" at path ") {
+        Some(at) => std::io::Error::new(error.kind(), &text[..at]),
+        None => error,
+    }
 }
 
 /// Writes `contents` to `path` atomically; refuses an existing file unless `force`.
 pub fn write_new(path: &Path, contents: &[u8], force: bool) -> Result<(), OutputError> {
-    let io_error = |source| OutputError::Io {
+    let io_error = |error| OutputError::Io {
         path: path.to_path_buf(),
-        source,
+        error: os_error(error),
     };
     if !force && path.exists() {
         return Err(OutputError::Exists {
@@ -45,6 +74,12 @@ pub fn write_new(path: &Path, contents: &[u8], force: bool) -> Result<(), Output
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
+    if !directory.is_dir() {
+        return Err(OutputError::NoFolder {
+            path: path.to_path_buf(),
+            folder: directory.to_path_buf(),
+        });
+    }
     let mut builder = tempfile::Builder::new();
     // tempfile creates its files 0600, right for a secret but wrong for a
     // table or a report that others must read: ask for 0666 and let the
@@ -107,6 +142,21 @@ mod tests {
     #[test]
     fn missing_directory_is_an_error_not_a_panic() {
         let error = write_new(Path::new("/nonexistent-axcomp-dir/x.txt"), b"x", false).unwrap_err();
-        assert!(matches!(error, OutputError::Io { .. }));
+        assert_eq!(
+            error.to_string(),
+            "cannot write /nonexistent-axcomp-dir/x.txt: the folder /nonexistent-axcomp-dir does not exist"
+        );
+    }
+
+    #[test]
+    fn os_errors_lose_the_temporary_path() {
+        // What tempfile returns: an io::Error wrapping one that has the OS code.
+        let directory = tempfile::tempdir().unwrap();
+        let missing = directory.path().join("gone");
+        let wrapped = tempfile::Builder::new().tempfile_in(&missing).unwrap_err();
+        assert!(wrapped.to_string().contains("at path"), "{wrapped}");
+        let plain = os_error(wrapped);
+        assert_eq!(plain.kind(), std::io::ErrorKind::NotFound);
+        assert_eq!(plain.to_string(), "No such file or directory (os error 2)");
     }
 }

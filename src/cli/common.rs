@@ -10,7 +10,7 @@ use axcomp::compensate::CompensationTable;
 use axcomp::diagnose::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
-use axcomp::measurement::{Direction, RunSelector, SourceFormat};
+use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 
 /// `--format NAME`: one of the input formats.
@@ -118,6 +118,29 @@ pub fn read_table(
             None => Err(error),
         })
         .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+}
+
+/// Names the measured axis with `--axis`, when given (its source is then "given").
+pub fn name_axis(measurement: &mut Measurement, axis: Option<&String>) {
+    if let Some(axis) = axis {
+        measurement.set_axis(axis.clone());
+    }
+}
+
+/// The measured axis, to write or read a table for: refused when the file
+/// does not record it and `--axis` did not name it (a table for the wrong
+/// axis compensates one axis with another's error).
+pub fn recorded_axis<'a>(measurement: &'a Measurement, purpose: &str) -> Result<&'a str> {
+    if measurement.axis_recorded() {
+        return Ok(measurement.axis());
+    }
+    let file = measurement.metadata.source_file.as_ref().map_or_else(
+        || "the measurement".to_string(),
+        |p| p.display().to_string(),
+    );
+    anyhow::bail!(
+        "{file}: the file does not record which axis was measured; give --axis NAME (e.g. --axis X) {purpose}"
+    )
 }
 
 /// Prints warnings to stderr unless `quiet`.

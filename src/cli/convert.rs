@@ -15,8 +15,8 @@ use axcomp::report::convert::ConvertJson;
 use axcomp::units::LengthUnit;
 
 use super::common::{
-    load_effects, parse_format, parse_run_selector, print_json, print_text, print_warnings,
-    read_table,
+    load_effects, name_axis, parse_format, parse_run_selector, print_json, print_text,
+    print_warnings, read_table, recorded_axis,
 };
 use super::evaluate::check_selectors;
 
@@ -45,6 +45,10 @@ pub struct ConvertArgs {
     pub force: bool,
 
     /// The compensated axis, instead of the one the file names.
+    ///
+    /// Required when the file does not record its axis (an ecmc file whose
+    /// PV names and file name state no axis letter, an .rtl without Axis:,
+    /// a CSV without # axis:): no table is written for a guessed axis.
     #[arg(long, value_name = "NAME", help_heading = "Table")]
     pub axis: Option<String>,
 
@@ -185,14 +189,16 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         mut measurement,
         mut warnings,
     } = read::read_paths(&args.files, args.format)?;
-    if let Some(axis) = &args.axis {
-        measurement.set_axis(axis.clone());
-    }
+    name_axis(&mut measurement, args.axis.as_ref());
+    let axis = recorded_axis(
+        &measurement,
+        "to say which axis the table is for; nothing was written",
+    )?
+    .to_string();
     check_selectors(&measurement, &args.exclude_runs)?;
     let mut measurement = measurement.without_runs(&args.exclude_runs)?;
-    let mut options =
-        EmitOptions::for_axis(&profile, measurement.axis(), &table_name(&args.output))
-            .map_err(anyhow::Error::msg)?;
+    let mut options = EmitOptions::for_axis(&profile, &axis, &table_name(&args.output))
+        .map_err(anyhow::Error::msg)?;
     for also in &args.also {
         options
             .axes
@@ -201,12 +207,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     options.linuxcnc_type = args.linuxcnc_type;
     options.max_points = args.max_points.or(options.max_points);
     if let Some(existing) = &args.existing {
-        let (_, active) = read_table(
-            existing,
-            measurement.axis(),
-            &profile,
-            Some(args.linuxcnc_type),
-        )?;
+        let (_, active) = read_table(existing, &axis, &profile, Some(args.linuxcnc_type))?;
         measurement = compensate::add_existing_table(&measurement, &active)?;
     }
     let evaluation = evaluate(&measurement);

@@ -11,7 +11,9 @@ use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
 
-use super::common::{load_profile, print_json, print_text, print_warnings, read_table};
+use super::common::{
+    load_profile, name_axis, print_json, print_text, print_warnings, read_table, recorded_axis,
+};
 
 /// Flags of `axcomp diagnose`.
 #[derive(Debug, clap::Args)]
@@ -34,6 +36,11 @@ pub struct DiagnoseArgs {
     /// convert suggests (−B̄ of the first test). Not with a bidirectional table.
     #[arg(long = "backlash-set", requires = "before")]
     pub backlash_set: bool,
+
+    /// Name of the axis of both tests, instead of the one in the files
+    /// (needed with --table when the re-test does not record its axis).
+    #[arg(long, value_name = "NAME")]
+    pub axis: Option<String>,
 
     /// Machine profile, to read the table's axis names (as in convert).
     #[arg(long, value_name = "M.toml")]
@@ -67,12 +74,14 @@ pub struct DiagnoseArgs {
 
 /// Runs `axcomp diagnose`.
 pub fn run(args: &DiagnoseArgs) -> Result<()> {
-    let after = read::read_path(&args.after, None)?;
+    let mut after = read::read_path(&args.after, None)?;
     print_warnings(&after.warnings, args.quiet);
+    name_axis(&mut after.measurement, args.axis.as_ref());
     let before = match &args.before {
         Some(path) => {
-            let result = read::read_path(path, None)?;
+            let mut result = read::read_path(path, None)?;
             print_warnings(&result.warnings, args.quiet);
+            name_axis(&mut result.measurement, args.axis.as_ref());
             Some(result.measurement)
         }
         None => None,
@@ -80,7 +89,8 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let table = match &args.table {
         Some(path) => {
             let profile = load_profile(args.machine.as_deref())?;
-            Some(read_table(path, after.measurement.axis(), &profile, args.linuxcnc_type)?.1)
+            let axis = recorded_axis(&after.measurement, "to say which axis the table is for")?;
+            Some(read_table(path, axis, &profile, args.linuxcnc_type)?.1)
         }
         None => None,
     };

@@ -9,7 +9,9 @@ use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::read;
 use axcomp::report::{json::EvaluationJson, terminal};
 
-use super::common::{parse_format, parse_run_selector, print_json, print_text, print_warnings};
+use super::common::{
+    name_axis, parse_format, parse_run_selector, print_json, print_text, print_warnings,
+};
 
 /// Flags of `axcomp evaluate`.
 #[derive(Debug, clap::Args)]
@@ -27,8 +29,9 @@ pub struct EvaluateArgs {
 
     /// Name of the axis, instead of the one in the file.
     ///
-    /// Some files name no axis (ecmc) or the wrong one (API files copied
-    /// from another axis).
+    /// Some files name no axis (an ecmc file whose PV names and file name
+    /// state no axis letter; the report then says "not recorded") or the
+    /// wrong one (API files copied from another axis).
     #[arg(long, value_name = "NAME", help_heading = "Input")]
     pub axis: Option<String>,
 
@@ -56,9 +59,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         mut measurement,
         mut warnings,
     } = read::read_paths(&args.files, args.format)?;
-    if let Some(axis) = &args.axis {
-        measurement.set_axis(axis.clone());
-    }
+    name_axis(&mut measurement, args.axis.as_ref());
     check_selectors(&measurement, &args.exclude_runs)?;
     let measurement = measurement
         .without_runs(&args.exclude_runs)

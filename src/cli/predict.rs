@@ -15,7 +15,7 @@ use axcomp::report::predict::{PredictJson, render};
 use axcomp::units::mm_to_um;
 
 use super::common::{
-    load_effects, load_machine, load_profile, parse_position, print_json, print_text,
+    load_effects, load_machine, load_profile, name_axis, parse_position, print_json, print_text,
     print_warnings, read_table,
 };
 
@@ -34,7 +34,10 @@ pub struct PredictArgs {
 
     /// A linear test of an axis: its positioning error along the line it was
     /// measured on, FILE or FILE@y=250,z=-275 (default: the --line).
-    #[arg(long, value_name = "FILE[@LINE]", help_heading = "Errors")]
+    ///
+    /// X=FILE names the axis when the file does not record it (or records
+    /// another); a file that records no axis is refused without it.
+    #[arg(long, value_name = "[AXIS=]FILE[@LINE]", help_heading = "Errors")]
     pub measured: Vec<String>,
 
     /// A compensation table in any format convert writes, [AXIS=]FILE (the
@@ -109,9 +112,17 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     let line_mm = complete(args.line, reference);
     let mut measurements: Vec<(Measurement, [f64; 3])> = Vec::new();
     for spec in &args.measured {
+        let (axis, spec) = split_axis(spec);
         let (path, line) = split_measured(spec)?;
-        let result = read::read_path(&path, None)?;
+        let mut result = read::read_path(&path, None)?;
         print_warnings(&result.warnings, args.quiet);
+        name_axis(&mut result.measurement, axis.as_ref());
+        if !result.measurement.axis_recorded() {
+            bail!(
+                "{}: the file does not record which axis was measured; name it as --measured X={spec}",
+                path.display()
+            );
+        }
         let line = line.map_or(line_mm, |l| complete(Some(l), reference));
         measurements.push((result.measurement, line));
     }
@@ -165,6 +176,16 @@ pub fn run(args: &PredictArgs) -> Result<()> {
 fn complete(position: Option<[Option<f64>; 3]>, default: [f64; 3]) -> [f64; 3] {
     let given = position.unwrap_or([None; 3]);
     [0, 1, 2].map(|i| given[i].unwrap_or(default[i]))
+}
+
+/// `X=REST`: an axis letter in front of a `--measured` file, when there is one.
+fn split_axis(spec: &str) -> (Option<String>, &str) {
+    match spec.split_once('=') {
+        Some((axis, rest)) if axis.len() == 1 && axis.chars().all(|c| c.is_ascii_alphabetic()) => {
+            (Some(axis.to_ascii_uppercase()), rest)
+        }
+        _ => (None, spec),
+    }
 }
 
 /// `FILE` or `FILE@y=250,z=-275`; the `@` part only when it reads as a position.

@@ -17,7 +17,9 @@ use axcomp::report::chart::chart;
 use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
 
-use super::common::{load_profile, parse_format, print_text, print_warnings, read_table};
+use super::common::{
+    load_profile, name_axis, parse_format, print_text, print_warnings, read_table, recorded_axis,
+};
 
 /// Flags of `axcomp report`.
 #[derive(Debug, clap::Args)]
@@ -54,6 +56,11 @@ pub struct ReportArgs {
     /// Input format of FILE and FILE2, instead of detecting it: rtl, ecmc, api-pos, csv.
     #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
     pub format: Option<SourceFormat>,
+
+    /// Name of the axis of FILE and FILE2, instead of the one in the files
+    /// (needed with --table when FILE does not record its axis).
+    #[arg(long, value_name = "NAME", help_heading = "Input")]
+    pub axis: Option<String>,
 
     /// Machine profile (TOML), to read the table's axis names (as in convert).
     #[arg(long, value_name = "M.toml", help_heading = "Input")]
@@ -99,11 +106,12 @@ struct Test {
 }
 
 impl Test {
-    fn read(path: &Path, format: Option<SourceFormat>) -> Result<Test> {
+    fn read(path: &Path, format: Option<SourceFormat>, axis: Option<&String>) -> Result<Test> {
         let read::ReadResult {
-            measurement,
+            mut measurement,
             mut warnings,
         } = read::read_paths(&[path.to_path_buf()], format)?;
+        name_axis(&mut measurement, axis);
         let evaluation = evaluate(&measurement);
         warnings.extend(evaluation.warnings.iter().cloned());
         Ok(Test {
@@ -124,20 +132,16 @@ impl Test {
 
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
-    let before = Test::read(&args.file, args.format)?;
+    let before = Test::read(&args.file, args.format, args.axis.as_ref())?;
     let after = match &args.after {
-        Some(path) => Some(Test::read(path, args.format)?),
+        Some(path) => Some(Test::read(path, args.format, args.axis.as_ref())?),
         None => None,
     };
     let table = match &args.table {
         Some(path) => {
             let profile = load_profile(args.machine.as_deref())?;
-            let (controller, table) = read_table(
-                path,
-                before.measurement.axis(),
-                &profile,
-                args.linuxcnc_type,
-            )?;
+            let axis = recorded_axis(&before.measurement, "to say which axis the table is for")?;
+            let (controller, table) = read_table(path, axis, &profile, args.linuxcnc_type)?;
             Some((path.display().to_string(), controller, table))
         }
         None => None,

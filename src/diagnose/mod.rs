@@ -597,7 +597,12 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
     let after = input.after;
     let (times, time_assumed) = times_h(after, input.timing);
     let first = match input.before {
-        Some(before) if !before.axis().eq_ignore_ascii_case(after.axis()) => {
+        // A file that records no axis carries a placeholder name: nothing to compare.
+        Some(before)
+            if before.axis_recorded()
+                && after.axis_recorded()
+                && !before.axis().eq_ignore_ascii_case(after.axis()) =>
+        {
             return Err(DiagnoseError::AxisMismatch {
                 before: before.axis().to_string(),
                 after: after.axis().to_string(),

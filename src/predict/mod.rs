@@ -507,12 +507,16 @@ fn one_run_each_way(
                 .collect(),
         })
         .collect();
+    let metadata = crate::measurement::Metadata {
+        axis_source: crate::measurement::AxisSource::Given,
+        ..Default::default()
+    };
     Measurement::new(
         axis.letter().to_string(),
         per_target.iter().map(|t| t.target_mm).collect(),
         runs,
         Default::default(),
-        Default::default(),
+        metadata,
     )
     .map_err(|e| PredictError::Internal(e.to_string()))
 }

@@ -28,10 +28,11 @@ use chrono::NaiveDateTime;
 
 use crate::error::{ParseError, Warning};
 use crate::measurement::{
-    Direction, Environment, Measurement, Metadata, Run, SourceFormat, StartEnd, TestDate,
+    AXIS_PLACEHOLDER, AxisSource, Direction, Environment, Measurement, Metadata, Run, SourceFormat,
+    StartEnd, TestDate,
 };
 use crate::read::missing_readings_warning;
-use crate::read::text::{self, Line, end_of_file_line};
+use crate::read::text::{self, Line, check_deviation_mm, check_target_mm, end_of_file_line};
 use crate::units::{self, LengthUnit};
 
 /// Material temperature the files write when no sensor is fitted.
@@ -165,11 +166,19 @@ impl Columns {
             Ok(optional(self.material[slot], "material temperature")?.filter(|t| *t != NO_SENSOR))
         };
         let position = value(self.position, "position")?;
+        let column = |index: usize| line.column_of(cells[index]);
+        let position_mm =
+            check_target_mm(unit.to_mm(position), line.number, column(self.position))?;
+        let deviation_mm = check_deviation_mm(
+            error_unit.to_mm(value(self.linear_error, "linear error")?),
+            line.number,
+            column(self.linear_error),
+        )?;
         Ok(Row {
             line: line.number,
             position,
-            position_mm: unit.to_mm(position),
-            deviation_mm: error_unit.to_mm(value(self.linear_error, "linear error")?),
+            position_mm,
+            deviation_mm,
             air_temperature: optional(self.air_temperature, "air temperature")?,
             air_pressure: optional(self.air_pressure, "air pressure")?,
             material: [material(0)?, material(1)?, material(2)?],
@@ -479,7 +488,7 @@ fn metadata(
         .and_then(|name| name.split_whitespace().next())
         .filter(|word| word.len() == 1 && word.chars().all(|c| c.is_ascii_alphabetic()))
         .map(str::to_string);
-    let axis = match (&test_axis, &named_axis) {
+    let (axis, axis_source) = match (&test_axis, &named_axis) {
         (Some(test), Some(named)) if !test.eq_ignore_ascii_case(named) => {
             warnings.push(Warning::InconsistentMetadata {
                 message: format!(
@@ -487,11 +496,11 @@ fn metadata(
                     file_name.clone().unwrap_or_default()
                 ),
             });
-            test.clone()
+            (test.clone(), AxisSource::file("TestAxis"))
         }
-        (Some(test), _) => test.clone(),
-        (None, Some(named)) => named.clone(),
-        (None, None) => "X".to_string(),
+        (Some(test), _) => (test.clone(), AxisSource::file("TestAxis")),
+        (None, Some(named)) => (named.clone(), AxisSource::file("File Name")),
+        (None, None) => (AXIS_PLACEHOLDER.to_string(), AxisSource::NotRecorded),
     };
     let date = match (header.text("TestDate"), header.text("TestTime")) {
         (Some(date), time) => {
@@ -538,6 +547,7 @@ fn metadata(
         source_format: Some(SourceFormat::ApiPos),
         length_unit: unit,
         extra,
+        axis_source,
     };
     (axis, metadata)
 }

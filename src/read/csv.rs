@@ -19,26 +19,106 @@
 //! - Run numbers are per direction; if a direction's numbers are not 1, 2, 3, …
 //!   (e.g. a file numbering all passes 1–10) they are renumbered in ascending
 //!   order, with a warning.
-//! - `.` is the decimal point; a comma is the field separator only.
+//! - The separator is the header's: `,` (then `.` is the decimal point),
+//!   `;` or a tab. With `;` or a tab the decimal mark is `.` or `,`, whichever
+//!   the file uses: Excel in a European locale saves "CSV" with `;` and a
+//!   decimal comma, and "Text (tab delimited)" with a tab. A file that mixes
+//!   the two marks, or writes both in one number (`1.234,5`), is refused at
+//!   the number. Trailing separators after a `#` line (Excel pads every row
+//!   to the width of the sheet) and rows of empty fields are ignored.
 
 use std::collections::HashMap;
 
-use crate::error::{ParseError, Warning};
+use crate::error::{ParseError, Warning, describe_found};
 use crate::measurement::{
-    Direction, Environment, Measurement, Metadata, Run, SourceFormat, TestDate,
+    AXIS_PLACEHOLDER, AxisSource, Direction, Environment, Measurement, Metadata, Run, SourceFormat,
+    TestDate,
 };
-use crate::read::text::{self, Line, end_of_file_line, split_key};
+use crate::read::text::{
+    self, Line, check_deviation_mm, check_target_mm, end_of_file_line, split_key,
+};
 use crate::read::{missing_readings_warning, parse_date};
 use crate::units::{LengthUnit, um_text, um_to_mm};
 
-/// The header line, lowercase, without spaces.
+/// The header line, lowercase, without spaces, as axcomp writes it.
 pub const HEADER: &str = "target_mm,run,direction,deviation_um";
+
+/// The header's field names, in order.
+const HEADER_FIELDS: [&str; 4] = ["target_mm", "run", "direction", "deviation_um"];
+
+/// The field separator of a header line (`,`, `;` or tab), or `None` when
+/// the line is not the header.
+pub fn header_separator(line: &str) -> Option<char> {
+    [',', ';', '\t'].into_iter().find(|&separator| {
+        let mut fields = line.split(separator).map(str::trim);
+        HEADER_FIELDS
+            .iter()
+            .all(|name| fields.next().is_some_and(|f| f.eq_ignore_ascii_case(name)))
+            && fields.next().is_none()
+    })
+}
+
+/// How the file writes its rows: the header's separator, and the decimal
+/// mark the first number with a fraction used (with its line).
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    separator: char,
+    decimal: Option<(char, usize)>,
+}
+
+impl Layout {
+    /// Parses a number token; a decimal comma where the separator allows it.
+    fn number(&mut self, line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseError> {
+        let comma = token.contains(',');
+        let point = token.contains('.');
+        if comma && point {
+            return Err(line.error_at(
+                token,
+                format!(
+                    "expected a number ({what}) with one decimal mark, found both '.' and ',' in {} (no thousands separators)",
+                    describe_found(token)
+                ),
+            ));
+        }
+        if !(comma || point) {
+            return text::number(line, token, what);
+        }
+        let mark = if comma { ',' } else { '.' };
+        match self.decimal {
+            None => self.decimal = Some((mark, line.number)),
+            Some((first, first_line)) if first != mark => {
+                let name = |mark: char| if mark == ',' { "comma" } else { "point" };
+                return Err(line.error_at(
+                    token,
+                    format!(
+                        "expected a decimal {} as on line {first_line}, found a decimal {} in {}: the file mixes decimal marks",
+                        name(first),
+                        name(mark),
+                        describe_found(token)
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+        if !comma {
+            return text::number(line, token, what);
+        }
+        // Same length, so the columns of the text stay those of the line.
+        let with_point = token.replacen(',', ".", 1);
+        let shadow = Line {
+            number: line.number,
+            text: &with_point,
+        };
+        text::number(&shadow, &with_point, what)
+            .map_err(|_| line.expected_at(token, &format!("a number ({what})")))
+    }
+}
 
 /// Parses the text of an axcomp CSV file.
 pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
     let mut metadata = Metadata::default();
     let mut axis = None;
-    let mut header_seen = false;
+    let mut layout: Option<Layout> = None;
     let mut readings: Vec<Reading> = Vec::new();
     let mut seen: HashMap<(Direction, u64, u64), usize> = HashMap::new();
     for line in text::lines(input) {
@@ -47,20 +127,31 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
             continue;
         }
         if let Some(comment) = trimmed.strip_prefix('#') {
-            if !header_seen {
+            if layout.is_none() {
                 comment_metadata(comment, &mut metadata, &mut axis);
             }
             continue;
         }
-        if !header_seen {
-            let compact: String = trimmed.chars().filter(|c| !c.is_whitespace()).collect();
-            if !compact.eq_ignore_ascii_case(HEADER) {
-                return Err(line.expected_at(trimmed, &format!("the header {HEADER}")));
-            }
-            header_seen = true;
+        let Some(layout) = layout.as_mut() else {
+            let Some(separator) = header_separator(trimmed) else {
+                return Err(line.expected_at(
+                    trimmed,
+                    &format!("the header {HEADER} (or with ';' or tabs between the names)"),
+                ));
+            };
+            layout = Some(Layout {
+                separator,
+                decimal: None,
+            });
+            continue;
+        };
+        if trimmed
+            .split(layout.separator)
+            .all(|field| field.trim().is_empty())
+        {
             continue;
         }
-        let reading = reading(&line)?;
+        let reading = reading(&line, layout)?;
         let key = (
             reading.direction,
             reading.run,
@@ -77,7 +168,7 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
         }
         readings.push(reading);
     }
-    if !header_seen {
+    if layout.is_none() {
         return Err(ParseError::new(
             end_of_file_line(input),
             1,
@@ -101,14 +192,15 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
     }
     metadata.source_format = Some(SourceFormat::Csv);
     metadata.length_unit = LengthUnit::Millimetre;
-    let measurement = Measurement::new(
-        axis.unwrap_or_else(|| "X".to_string()),
-        targets_mm,
-        runs,
-        Environment::default(),
-        metadata,
-    )
-    .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
+    let axis = match axis {
+        Some(axis) => {
+            metadata.axis_source = AxisSource::file("# axis");
+            axis
+        }
+        None => AXIS_PLACEHOLDER.to_string(),
+    };
+    let measurement = Measurement::new(axis, targets_mm, runs, Environment::default(), metadata)
+        .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
     Ok((measurement, warnings))
 }
 
@@ -116,7 +208,10 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
 /// text that reads back to the same value.
 pub fn write(measurement: &Measurement) -> String {
     let mut out = String::new();
-    out.push_str(&format!("# axis: {}\n", measurement.axis()));
+    // A placeholder name stays unrecorded: the file must not claim an axis.
+    if measurement.axis_recorded() {
+        out.push_str(&format!("# axis: {}\n", measurement.axis()));
+    }
     let metadata = &measurement.metadata;
     let fields = [
         ("machine", metadata.machine.clone()),
@@ -155,11 +250,11 @@ struct Reading {
     deviation_mm: Option<f64>,
 }
 
-fn reading(line: &Line<'_>) -> Result<Reading, ParseError> {
-    let fields: Vec<&str> = line.text.split(',').map(str::trim).collect();
+fn reading(line: &Line<'_>, layout: &mut Layout) -> Result<Reading, ParseError> {
+    let fields: Vec<&str> = line.text.split(layout.separator).map(str::trim).collect();
     if fields.len() != 4 {
-        let hint = if fields.len() > 4 {
-            " (a decimal comma? use '.' as the decimal point)"
+        let hint = if fields.len() > 4 && layout.separator == ',' {
+            " (a decimal comma? use '.' as the decimal point, or save with ';' between the fields)"
         } else {
             ""
         };
@@ -171,7 +266,8 @@ fn reading(line: &Line<'_>) -> Result<Reading, ParseError> {
             ),
         ));
     }
-    let target_mm = text::number(line, fields[0], "target in mm")?;
+    let target_mm = layout.number(line, fields[0], "target in mm")?;
+    check_target_mm(target_mm, line.number, line.column_of(fields[0]))?;
     let run = text::integer(line, fields[1], "run number")?;
     if run == 0 {
         return Err(line.error_at(fields[1], "expected a run number from 1, found 0"));
@@ -184,7 +280,12 @@ fn reading(line: &Line<'_>) -> Result<Reading, ParseError> {
     let deviation_mm = if fields[3].is_empty() {
         None
     } else {
-        Some(um_to_mm(text::number(line, fields[3], "deviation in µm")?))
+        let deviation_mm = um_to_mm(layout.number(line, fields[3], "deviation in µm")?);
+        Some(check_deviation_mm(
+            deviation_mm,
+            line.number,
+            line.column_of(fields[3]),
+        )?)
     };
     Ok(Reading {
         target_mm,
@@ -198,6 +299,8 @@ fn comment_metadata(comment: &str, metadata: &mut Metadata, axis: &mut Option<St
     let Some((key, value)) = split_key(comment, ':') else {
         return;
     };
+    // Excel pads a one-cell row with separators to the width of the sheet.
+    let value = value.trim_end_matches([',', ';', '\t']).trim_end();
     if value.is_empty() {
         return;
     }
@@ -312,6 +415,34 @@ mod tests {
         let (again, _) = parse(&write(&m)).unwrap();
         assert_eq!(again.targets_mm(), m.targets_mm());
         assert_eq!(again.runs(), m.runs());
+        assert_eq!(again.axis_source(), &AxisSource::file("# axis"));
+        // An axis the file did not record is not written as if it had been.
+        let (unnamed, _) = parse(&text.replace("# axis: Z\n", "")).unwrap();
+        let (again, _) = parse(&write(&unnamed)).unwrap();
+        assert_eq!(again.axis_source(), &AxisSource::NotRecorded);
+    }
+
+    #[test]
+    fn excel_layouts_read_the_same_values() {
+        let comma = "# axis: Y\ntarget_mm,run,direction,deviation_um\n0,1,up,0.5\n12.5,1,up,-2.25\n0,1,down,1\n12.5,1,down,\n";
+        let semicolon = "# axis: Y;;;\r\nTarget_mm;Run;Direction;Deviation_um\r\n0;1;up;0,5\r\n12,5;1;up;-2,25\r\n;;;\r\n0;1;down;1\r\n12,5;1;down;\r\n";
+        let tab = "# axis: Y\ntarget_mm\trun\tdirection\tdeviation_um\n0\t1\tup\t0.5\n12.5\t1\tup\t-2.25\n0\t1\tdown\t1\n12.5\t1\tdown\t\n";
+        let (expected, _) = parse(comma).unwrap();
+        for text in [semicolon, tab] {
+            let (m, _) = parse(text).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(m.axis(), "Y");
+            assert_eq!(m.targets_mm(), &[0.0, 12.5]);
+            assert_eq!(m.runs(), expected.runs());
+        }
+        assert_eq!(
+            header_separator("target_mm;run;direction;deviation_um"),
+            Some(';')
+        );
+        assert_eq!(
+            header_separator("target_mm\trun\tdirection\tdeviation_um"),
+            Some('\t')
+        );
+        assert_eq!(header_separator("target_mm;run;direction"), None);
     }
 
     #[test]
@@ -347,6 +478,21 @@ mod tests {
                 "target_mm,run,direction,deviation_um\n0,1,up,inf\n",
                 (2, 8),
                 "expected a number",
+            ),
+            (
+                "target_mm;run;direction;deviation_um\n0;1;up;0,5\n10;1;up;1.5\n",
+                (3, 9),
+                "expected a decimal comma as on line 2, found a decimal point in \"1.5\"",
+            ),
+            (
+                "target_mm;run;direction;deviation_um\n1.000,5;1;up;0\n",
+                (2, 1),
+                "found both '.' and ','",
+            ),
+            (
+                "target_mm;run;direction;deviation_um\n0;1;up;1,2,3\n",
+                (2, 8),
+                "expected a number (deviation in µm), found \"1,2,3\"",
             ),
         ];
         for (text, (line, column), needle) in cases {

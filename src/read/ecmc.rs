@@ -14,13 +14,39 @@
 //! (`../shared/spec/iso230-2.md`, "Independent check values"). FWD runs are ↑,
 //! BWD runs ↓; the ecmc report script swaps the two labels (a known bug), we do
 //! not. `CYCLES` and `POSITIONS`, when given, must agree with the data; when
-//! absent they are taken from the data. The file names no axis; it is `X`
-//! unless the caller renames it.
+//! absent they are taken from the data. A file that declares `CYCLES=n` must
+//! hold every cycle 1..n in both directions: one that stops early (the logger
+//! was stopped, the file was cut) is refused, naming the missing cycles and
+//! the declaration's line, not evaluated as a shorter test.
+//!
+//! # The axis
+//!
+//! The format has no axis field. The axis is taken from what the file states,
+//! by one documented rule ([`axis_letter`]): a PV name or a file name states
+//! an axis when one of its segments (split at anything but a letter or a
+//! digit: `:`, `-`, `_`, `.`) is a single axis letter X, Y, Z, A, B, C, U, V
+//! or W (either case), and only one such letter appears in it. In this order:
+//! 1. `TGT_SET_PV`, the setpoint of the axis that moved
+//!    (`TARGET_DU:Z-PosCmd` is Z);
+//! 2. `REF_PV`, the reference system's position (`LAB:X-Enc-PosAct`);
+//! 3. the file name, which only the front end knows
+//!    ([`axis_from_file_name`], called by `read::read_path`):
+//!    `b02__z__report_z.md_ISO230.dat` and `target_x_report.md_ISO230.dat`.
+//!
+//! Names that merely number a motor (`IOC_TEST:Axis1-PosSet`,
+//! `sls-sioc-ecat01:M1-PosSet`) state no letter: the axis is then not
+//! recorded ([`AxisSource::NotRecorded`]), and a table is written only once
+//! the user names it. When two of the sources name different letters, the
+//! first in the order above is used, with a warning.
 
 use crate::error::{ParseError, Warning};
-use crate::measurement::{Direction, Environment, Measurement, Metadata, Run, SourceFormat};
+use crate::measurement::{
+    AXIS_PLACEHOLDER, AxisSource, Direction, Environment, Measurement, Metadata, Run, SourceFormat,
+};
 use crate::read::missing_readings_warning;
-use crate::read::text::{self, Line, end_of_file_line, split_key};
+use crate::read::text::{
+    self, Line, check_deviation_mm, check_target_mm, end_of_file_line, split_key,
+};
 use crate::units::LengthUnit;
 
 /// Largest number of positions or cycles, and so largest index, accepted.
@@ -54,7 +80,10 @@ struct Entry {
     cycle_index: usize,
     value: f64,
     line: usize,
+    /// Column of the first index (where errors about the key point).
     column: usize,
+    /// Column of the value.
+    value_column: usize,
 }
 
 #[derive(Default)]
@@ -123,6 +152,35 @@ impl EcmcFile {
             }),
         }
         Ok(())
+    }
+
+    /// The axis the PV names state (module doc, "The axis"); sets the
+    /// metadata's axis source and warns when the two PVs disagree.
+    fn axis(&mut self) -> String {
+        let pv = |name: &'static str| {
+            self.metadata
+                .extra
+                .iter()
+                .find(|(key, _)| key.eq_ignore_ascii_case(name))
+                .and_then(|(_, value)| axis_letter(value).map(|letter| (name, letter)))
+        };
+        let stated: Vec<(&str, char)> = ["TGT_SET_PV", "REF_PV"]
+            .into_iter()
+            .filter_map(pv)
+            .collect();
+        let Some(&(field, letter)) = stated.first() else {
+            self.metadata.axis_source = AxisSource::NotRecorded;
+            return AXIS_PLACEHOLDER.to_string();
+        };
+        if let Some(&(other_field, other)) = stated.iter().find(|(_, l)| *l != letter) {
+            self.warnings.push(Warning::InconsistentMetadata {
+                message: format!(
+                    "{field} names axis {letter} but {other_field} names {other}; the axis is called {letter} (use --axis to rename it)"
+                ),
+            });
+        }
+        self.metadata.axis_source = AxisSource::file(field);
+        letter.to_string()
     }
 
     fn keep(&mut self, key: &str, value: &str) {
@@ -212,8 +270,11 @@ impl EcmcFile {
         }
         let targets_mm: Vec<f64> = order
             .iter()
-            .map(|&i| unit.to_mm(targets[i].value))
-            .collect();
+            .map(|&i| {
+                let target = targets[i];
+                check_target_mm(unit.to_mm(target.value), target.line, target.value_column)
+            })
+            .collect::<Result<_, _>>()?;
         let grid = |entries: &[Entry], name: &str| -> Result<Vec<Vec<Option<f64>>>, ParseError> {
             let mut grid = vec![vec![None; position_count]; cycle_count];
             let mut lines = vec![vec![0usize; position_count]; cycle_count];
@@ -229,7 +290,11 @@ impl EcmcFile {
                         ),
                     ));
                 }
-                let deviation = unit.to_mm(entry.value - targets[position].value);
+                let deviation = check_deviation_mm(
+                    unit.to_mm(entry.value - targets[position].value),
+                    entry.line,
+                    entry.value_column,
+                )?;
                 grid[cycle][position] = Some(deviation);
                 lines[cycle][position] = entry.line;
             }
@@ -237,6 +302,12 @@ impl EcmcFile {
         };
         let forward = grid(&self.forward, "REF_DATA_FWD")?;
         let backward = grid(&self.backward, "REF_DATA_BWD")?;
+        if let Some(declared) = self.cycles {
+            check_cycles_complete(
+                declared,
+                &[("REF_DATA_FWD", &forward), ("REF_DATA_BWD", &backward)],
+            )?;
+        }
         // Runs in the order measured: each cycle goes forward, then backward.
         let mut runs = Vec::with_capacity(2 * cycle_count);
         let mut numbers = [0u32; 2];
@@ -268,11 +339,129 @@ impl EcmcFile {
         }
         self.metadata.source_format = Some(SourceFormat::Ecmc);
         self.metadata.length_unit = unit;
-        let measurement =
-            Measurement::new("X", targets_mm, runs, Environment::default(), self.metadata)
-                .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
+        let axis = self.axis();
+        let measurement = Measurement::new(
+            axis,
+            targets_mm,
+            runs,
+            Environment::default(),
+            self.metadata,
+        )
+        .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
         Ok((measurement, self.warnings))
     }
+}
+
+/// Letters that name an axis (ISO 841: X, Y, Z linear, A, B, C rotary about
+/// them, U, V, W secondary linear).
+const AXIS_LETTERS: &str = "XYZABCUVW";
+
+/// The axis letter a PV name or a file name states, by the rule of the module
+/// doc: a segment (between characters that are neither letters nor digits)
+/// that is one axis letter, the only such letter in the name. Uppercase.
+///
+/// ```
+/// use axcomp::read::ecmc::axis_letter;
+/// assert_eq!(axis_letter("TARGET_DU:Z-PosCmd"), Some('Z'));
+/// assert_eq!(axis_letter("b02__z__report_z.md_ISO230.dat"), Some('Z'));
+/// assert_eq!(axis_letter("IOC_TEST:Axis1-PosSet"), None);
+/// assert_eq!(axis_letter("sls-sioc-ecat01:M1-PosSet"), None);
+/// assert_eq!(axis_letter("GANTRY:X-Y-Pos"), None);
+/// ```
+pub fn axis_letter(name: &str) -> Option<char> {
+    let mut found = None;
+    for segment in name.split(|c: char| !c.is_alphanumeric()) {
+        let mut chars = segment.chars();
+        let (Some(only), None) = (chars.next(), chars.next()) else {
+            continue;
+        };
+        let letter = only.to_ascii_uppercase();
+        if !AXIS_LETTERS.contains(letter) {
+            continue;
+        }
+        match found {
+            None => found = Some(letter),
+            Some(previous) if previous == letter => {}
+            Some(_) => return None,
+        }
+    }
+    found
+}
+
+/// The last step of the axis rule (module doc), for the front end, which
+/// knows the file name: names the axis of an ecmc measurement whose PVs state
+/// none after the letter in `file_name`; warns when the PVs state another.
+pub fn axis_from_file_name(measurement: &mut Measurement, file_name: &str) -> Option<Warning> {
+    let letter = axis_letter(file_name)?;
+    match measurement.axis_source() {
+        AxisSource::NotRecorded => {
+            measurement.set_axis_from(letter.to_string(), AxisSource::file("file name"));
+            None
+        }
+        AxisSource::File { field }
+            if !measurement.axis().eq_ignore_ascii_case(&letter.to_string()) =>
+        {
+            Some(Warning::InconsistentMetadata {
+                message: format!(
+                    "{field} names axis {} but the file name {file_name:?} names {letter}; the axis is called {} (use --axis to rename it)",
+                    measurement.axis(),
+                    measurement.axis()
+                ),
+            })
+        }
+        _ => None,
+    }
+}
+
+/// Refuses a file that declares more cycles than it holds (a truncated
+/// file), naming the missing cycles per direction and the declaration.
+fn check_cycles_complete(
+    declared: Declared,
+    grids: &[(&str, &Vec<Vec<Option<f64>>>)],
+) -> Result<(), ParseError> {
+    let mut missing = Vec::new();
+    for (name, grid) in grids {
+        let absent: Vec<usize> = grid
+            .iter()
+            .enumerate()
+            .filter(|(_, cycle)| cycle.iter().all(Option::is_none))
+            .map(|(index, _)| index + 1)
+            .collect();
+        if !absent.is_empty() {
+            missing.push(format!("{name} cycle(s) {}", ranges(&absent)));
+        }
+    }
+    if missing.is_empty() {
+        return Ok(());
+    }
+    Err(ParseError::new(
+        declared.line,
+        declared.column,
+        format!(
+            "CYCLES={} but the file holds no {}: the file looks truncated; re-export it or measure again",
+            declared.value,
+            missing.join(" and no ")
+        ),
+    ))
+}
+
+/// `2–5`, `1, 3`, `2, 4–5`: sorted whole numbers as ranges.
+fn ranges(numbers: &[usize]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut start = 0;
+    while start < numbers.len() {
+        let mut end = start;
+        while end + 1 < numbers.len() && numbers[end + 1] == numbers[end] + 1 {
+            end += 1;
+        }
+        parts.push(if end == start {
+            numbers[start].to_string()
+        } else {
+            format!("{}–{}", numbers[start], numbers[end])
+        });
+        start = end + 1;
+    }
+    parts.join(", ")
 }
 
 /// The number of positions: as declared (checked against the data) or as found.
@@ -369,6 +558,7 @@ fn entry(line: &Line<'_>, key: &Key<'_>, value: &str, what: &str) -> Result<Entr
         value: number,
         line: line.number,
         column: line.column_of(key.indices[0].1),
+        value_column: line.column_of(value),
     })
 }
 
@@ -427,6 +617,49 @@ mod tests {
     }
 
     #[test]
+    fn the_axis_is_the_letter_a_pv_states() {
+        let with = |lines: &str| parse_ok(&format!("{lines}\n{SMALL}"));
+        let z = with("TGT_SET_PV=TARGET_DU:Z-PosCmd\nREF_PV=IOC_TEST:m0s011-Enc01-PosAct");
+        assert_eq!(z.axis(), "Z");
+        assert_eq!(z.axis_source(), &AxisSource::file("TGT_SET_PV"));
+        let reference = with("TGT_SET_PV=IOC_TEST:Axis1-PosSet\nREF_PV=LAB:y-Enc-PosAct");
+        assert_eq!(reference.axis(), "Y");
+        assert_eq!(reference.axis_source(), &AxisSource::file("REF_PV"));
+        let none = with("TGT_SET_PV=IOC_TEST:Axis1-PosSet");
+        assert_eq!(none.axis(), AXIS_PLACEHOLDER);
+        assert_eq!(none.axis_source(), &AxisSource::NotRecorded);
+        let (_, warnings) = parse(&format!(
+            "TGT_SET_PV=T:Z-PosCmd\nREF_PV=R:X-PosAct\n{SMALL}"
+        ))
+        .unwrap();
+        assert!(
+            warnings.iter().any(|w| w
+                .to_string()
+                .contains("TGT_SET_PV names axis Z but REF_PV names X")),
+            "{warnings:?}"
+        );
+    }
+
+    #[test]
+    fn the_file_name_names_the_axis_only_when_the_pvs_do_not() {
+        let mut m = parse_ok(SMALL);
+        assert_eq!(axis_from_file_name(&mut m, "report_data.dat"), None);
+        assert!(!m.axis_recorded());
+        assert_eq!(
+            axis_from_file_name(&mut m, "target_w_report.md_ISO230.dat"),
+            None
+        );
+        assert_eq!(
+            (m.axis(), m.axis_source()),
+            ("W", &AxisSource::file("file name"))
+        );
+        let mut z = parse_ok(&format!("TGT_SET_PV=T:Z-PosCmd\n{SMALL}"));
+        let warning = axis_from_file_name(&mut z, "x.dat").unwrap();
+        assert!(warning.to_string().contains("names X"), "{warning}");
+        assert_eq!(z.axis(), "Z");
+    }
+
+    #[test]
     fn counts_are_inferred_when_absent() {
         let text = "TGT_DATA[1]=0\nTGT_DATA[2]=5\nREF_DATA_FWD[1,1]=0\nREF_DATA_FWD[2,1]=5.001\n";
         let m = parse_ok(text);
@@ -463,6 +696,22 @@ mod tests {
             ("TGT_DATA[1,2]=1\n", (1, 1), "takes 1 index"),
             ("TGT_DATA[x]=1\n", (1, 10), "whole number"),
             ("just words\n", (1, 1), "KEY=VALUE"),
+            // A truncated file: cycle 2 went forward but never came back.
+            (
+                "CYCLES=2\nTGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1\nREF_DATA_BWD[1,1]=1\nREF_DATA_FWD[1,2]=1\n",
+                (1, 8),
+                "CYCLES=2 but the file holds no REF_DATA_BWD cycle(s) 2: the file looks truncated",
+            ),
+            (
+                "TGT_DATA[1]=2e5\nREF_DATA_FWD[1,1]=1\n",
+                (1, 13),
+                "within ±100000 mm",
+            ),
+            (
+                "TGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1001.5\n",
+                (2, 19),
+                "found 1000500 µm",
+            ),
             ("TGT_DATA[1]=nan\n", (1, 13), "expected a number"),
             (
                 "CYCLES=1\nTGT_DATA[1]=1\nREF_DATA_BWD[1,2]=1\n",

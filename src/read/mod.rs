@@ -35,9 +35,9 @@ pub struct ReadResult {
 
 /// Reads one measurement file. `format` overrides detection.
 pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult, ReadError> {
-    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let located = |error: ParseError| ReadError::Parse {
         path: path.to_path_buf(),
@@ -48,7 +48,14 @@ pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult
         Some(format) => format,
         None => detect(&text).ok_or_else(|| located(unknown_format_error()))?,
     };
-    let (mut measurement, warnings) = parse_str(&text, format).map_err(located)?;
+    let (mut measurement, mut warnings) = parse_str(&text, format).map_err(located)?;
+    // The file name is the last place an ecmc file can state its axis
+    // (`ecmc` module doc); only this front end knows it.
+    if format == SourceFormat::Ecmc
+        && let Some(name) = path.file_name().and_then(|name| name.to_str())
+    {
+        warnings.extend(ecmc::axis_from_file_name(&mut measurement, name));
+    }
     measurement.metadata.source_file = Some(path.to_path_buf());
     Ok(ReadResult {
         measurement,
@@ -110,11 +117,8 @@ pub fn detect(text: &str) -> Option<SourceFormat> {
         .lines()
         .map(str::trim)
         .find(|line| !line.is_empty() && !line.starts_with('#'));
-    if let Some(line) = first_data {
-        let compact: String = line.chars().filter(|c| !c.is_whitespace()).collect();
-        if compact.to_ascii_lowercase().starts_with(csv::HEADER) {
-            return Some(SourceFormat::Csv);
-        }
+    if first_data.and_then(csv::header_separator).is_some() {
+        return Some(SourceFormat::Csv);
     }
     if text.contains("TGT_DATA[")
         || text.contains("REF_DATA_FWD[")
@@ -297,6 +301,14 @@ mod tests {
         );
         assert_eq!(
             detect("# axis: X\ntarget_mm, run, direction, deviation_um\n"),
+            Some(SourceFormat::Csv)
+        );
+        assert_eq!(
+            detect("Target_mm;Run;Direction;Deviation_um\r\n0;1;up;0,5\r\n"),
+            Some(SourceFormat::Csv)
+        );
+        assert_eq!(
+            detect("target_mm\trun\tdirection\tdeviation_um\n"),
             Some(SourceFormat::Csv)
         );
         assert_eq!(detect("hello\nworld\n"), None);

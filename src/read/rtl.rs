@@ -34,9 +34,12 @@ use nom::{IResult, Parser};
 
 use crate::error::{ParseError, Warning, describe_found};
 use crate::measurement::{
-    Direction, Environment, Measurement, Metadata, Run, SourceFormat, StartEnd, TestDate,
+    AXIS_PLACEHOLDER, AxisSource, Direction, Environment, Measurement, Metadata, Run, SourceFormat,
+    StartEnd, TestDate,
 };
-use crate::read::text::{self, Line, end_of_file_line, split_key};
+use crate::read::text::{
+    self, Line, check_deviation_mm, check_target_mm, end_of_file_line, split_key,
+};
 use crate::read::{missing_readings_warning, parse_date};
 use crate::units::{LengthUnit, um_text, um_to_mm};
 
@@ -95,7 +98,13 @@ pub fn write(measurement: &Measurement) -> String {
         .unwrap_or_default();
     line(&format!("Date: {date}"));
     line(&format!("By: {}", field(&metadata.operator)));
-    line(&format!("Axis: {}", measurement.axis()));
+    // A placeholder name stays unrecorded: the file must not claim an axis.
+    let axis = if measurement.axis_recorded() {
+        measurement.axis()
+    } else {
+        ""
+    };
+    line(&format!("Axis: {axis}"));
     line(&format!("Location: {}", field(&metadata.location)));
     line(&format!("TITLE: {}", field(&metadata.description)));
     line("");
@@ -389,6 +398,7 @@ impl RtlParser {
     fn target_values(&mut self, line: &Line<'_>, values: &str) -> Result<(), ParseError> {
         for token in values.split_whitespace() {
             let value = text::number(line, token, "target position in mm")?;
+            check_target_mm(value, line.number, line.column_of(token))?;
             let column = line.column_of(token);
             let key = (value + 0.0).to_bits();
             if let Some(&index) = self.target_lookup.get(&key) {
@@ -520,6 +530,7 @@ impl RtlParser {
             ));
         }
         let deviation_um = text::number(line, value, "deviation in µm")?;
+        check_deviation_mm(um_to_mm(deviation_um), line.number, line.column_of(value))?;
         let file_run = file_run as u32;
         let target_number = target_number as usize;
         if let Some(first_line) = self
@@ -654,14 +665,18 @@ impl RtlParser {
         }
         let runs = self.assemble_runs(run_count)?;
         let axis = match self.axis.take() {
-            Some(axis) => axis,
+            Some(axis) => {
+                self.metadata.axis_source = AxisSource::file("Axis");
+                axis
+            }
             None => {
                 self.warnings.push(Warning::InconsistentMetadata {
                     message:
-                        "no Axis: in USER-TEXT::; the axis is called X (use --axis to name it)"
+                        "no Axis: in USER-TEXT::; the axis is not recorded (give --axis to name it)"
                             .to_string(),
                 });
-                "X".to_string()
+                self.metadata.axis_source = AxisSource::NotRecorded;
+                AXIS_PLACEHOLDER.to_string()
             }
         };
         let capture = |raw: String| TestDate {

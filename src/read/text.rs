@@ -141,6 +141,67 @@ pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseErro
     Ok(value)
 }
 
+/// Largest deviation accepted, mm, either sign: 1 m.
+///
+/// A positioning error is micrometres, at most millimetres; a reading beyond
+/// ±1 m is a wrong unit, a wrong column or a corrupt file, and values near
+/// ±1e308 overflow the statistics and the chart scales (`report` spun for
+/// minutes, `evaluate` printed `inf`). Every reader checks its deviations
+/// against this one bound ([`check_deviation_mm`]).
+pub const MAX_DEVIATION_MM: f64 = 1000.0;
+
+/// Largest target position accepted, mm, either sign: 100 m, longer than any
+/// machine axis a laser interferometer measures (the longest linear ranges
+/// are 80 m). Checked by every reader with [`check_target_mm`].
+pub const MAX_TARGET_MM: f64 = 100_000.0;
+
+/// Refuses a deviation (already in mm) that is not finite or beyond
+/// [`MAX_DEVIATION_MM`], at the given line and column.
+pub fn check_deviation_mm(value_mm: f64, line: usize, column: usize) -> Result<f64, ParseError> {
+    if value_mm.abs() <= MAX_DEVIATION_MM {
+        return Ok(value_mm);
+    }
+    // In µm, as deviations are read, unless that overflows (a value near f64::MAX in mm).
+    let found = if (value_mm * 1000.0).is_finite() {
+        format!("{} µm", shown(value_mm * 1000.0))
+    } else {
+        format!("{} mm", shown(value_mm))
+    };
+    Err(ParseError::new(
+        line,
+        column,
+        format!(
+            "expected a deviation within ±{} µm (±1 m), found {found}: check the unit and the column of the file",
+            MAX_DEVIATION_MM * 1000.0,
+        ),
+    ))
+}
+
+/// Refuses a target (already in mm) that is not finite or beyond
+/// [`MAX_TARGET_MM`], at the given line and column.
+pub fn check_target_mm(value_mm: f64, line: usize, column: usize) -> Result<f64, ParseError> {
+    if value_mm.abs() <= MAX_TARGET_MM {
+        return Ok(value_mm);
+    }
+    Err(ParseError::new(
+        line,
+        column,
+        format!(
+            "expected a target within ±{MAX_TARGET_MM} mm (±100 m), found {} mm: check the unit and the column of the file",
+            shown(value_mm)
+        ),
+    ))
+}
+
+/// A value for a message: short, whatever its size (`1.0e308`, not 309 digits).
+fn shown(value: f64) -> String {
+    if value.is_finite() && value.abs() < 1e9 {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}
+
 /// Parses a whole token as a non-negative integer.
 pub fn integer(line: &Line<'_>, token: &str, what: &str) -> Result<u64, ParseError> {
     let all_digits = !token.is_empty() && token.bytes().all(|b| b.is_ascii_digit());
@@ -222,6 +283,23 @@ mod tests {
         assert!(comma.message.contains("decimal comma"), "{comma}");
         let huge = number(&l, "1e400", "target").unwrap_err();
         assert!(huge.message.contains("overflows"), "{huge}");
+    }
+
+    #[test]
+    fn absurd_values_are_refused_with_their_position() {
+        assert_eq!(check_deviation_mm(-999.5, 3, 4), Ok(-999.5));
+        let error = check_deviation_mm(1e305, 3, 4).unwrap_err();
+        assert_eq!((error.position.line, error.position.column), (3, 4));
+        assert!(error.message.contains("found 1e308 µm"), "{error}");
+        assert!(error.message.contains("±1000000 µm"), "{error}");
+        let error = check_deviation_mm(-1e308, 3, 4).unwrap_err();
+        assert!(error.message.contains("found -1e308 mm"), "{error}");
+        assert!(check_deviation_mm(f64::NAN, 1, 1).is_err());
+        assert!(check_deviation_mm(1000.001, 1, 1).is_err());
+        assert_eq!(check_target_mm(-100_000.0, 1, 1), Ok(-100_000.0));
+        let error = check_target_mm(2e5, 9, 2).unwrap_err();
+        assert!(error.message.contains("found 200000 mm"), "{error}");
+        assert!(check_target_mm(f64::INFINITY, 1, 1).is_err());
     }
 
     #[test]

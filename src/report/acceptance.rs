@@ -237,7 +237,8 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
 /// characters of the embedded font; file text is shown in the HTML).
 fn axis_suffix(test: &TestRecord<'_>) -> String {
     let axis = test.measurement.axis();
-    let plain = !axis.is_empty()
+    let plain = test.measurement.axis_recorded()
+        && !axis.is_empty()
         && axis.len() <= 12
         && axis
             .chars()

@@ -127,7 +127,7 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
             .machine
             .as_deref()
             .unwrap_or("machine"),
-        input.before.measurement.axis()
+        axis_shown(input.before.measurement)
     );
     Ok(format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
@@ -188,6 +188,16 @@ fn source(key: &str, value: Option<f64>) -> String {
     format!("data-key=\"{}\" data-um=\"{full}\"", esc(key))
 }
 
+/// The axis name, or "not recorded" when the file does not state it (the
+/// name is then only a placeholder, `measurement::AXIS_PLACEHOLDER`).
+fn axis_shown(measurement: &Measurement) -> String {
+    if measurement.axis_recorded() {
+        measurement.axis().to_string()
+    } else {
+        "(not recorded)".to_string()
+    }
+}
+
 fn text_or_missing(value: Option<&str>) -> String {
     match value.map(str::trim).filter(|v| !v.is_empty()) {
         Some(text) => esc(text),
@@ -209,7 +219,7 @@ fn header(out: &mut String, input: &ReportInput<'_>) {
         out,
         "<header>\n<h1>Accuracy and repeatability of positioning</h1>\n\
          <p class=\"subtitle\">Acceptance report: linear axis {axis}, {kind} test to ISO 230-2:2014</p>\n</header>\n",
-        axis = esc(measurement.axis()),
+        axis = esc(&axis_shown(measurement)),
     );
     out.push_str("<table class=\"meta\">\n");
     let row = |out: &mut String, a: &str, b: String, c: &str, d: String| {
@@ -228,7 +238,7 @@ fn header(out: &mut String, input: &ReportInput<'_>) {
     row(
         out,
         "Axis",
-        esc(measurement.axis()),
+        esc(&axis_shown(measurement)),
         "Operator",
         text_or_missing(metadata.operator.as_deref()),
     );

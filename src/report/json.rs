@@ -6,7 +6,8 @@
 //! their unit in the key; not-evaluated figures are `null`, never 0.
 //!
 //! ```text
-//! { "format": "ecmc", "axis": "X", "source_file": "…", "length_unit": "mm",
+//! { "format": "ecmc", "axis": "Z", "axis_source": {"kind": "file", "field": "TGT_SET_PV"},
+//!   "source_file": "…", "length_unit": "mm",
 //!   "targets_mm": [15.0, …],
 //!   "runs": {"up": 5, "down": 5}, "excluded_runs": ["1:down"],
 //!   "figures_um": {"A": …, "A_up": …, "A_down": …, "E": …, "E_up": …, "E_down": …,
@@ -21,12 +22,16 @@
 //! ```
 //!
 //! `B` is max |B_i| (unsigned); `B_mean` (B̄) and `B_um` are signed, ↑ minus ↓.
+//!
+//! `axis_source` says where `axis` came from: `{"kind": "file", "field": …}`
+//! (the field of the file that states it), `{"kind": "given"}` (`--axis`) or
+//! `{"kind": "not_recorded"}`, when `axis` is only the placeholder `X`.
 
 use serde::Serialize;
 
 use crate::error::Warning;
 use crate::evaluate::{AxisFigures, Evaluation, SuspectedOutlier, TargetStats};
-use crate::measurement::{Environment, Measurement, RunSelector, StartEnd};
+use crate::measurement::{AxisSource, Environment, Measurement, RunSelector, StartEnd};
 use crate::units::{mm_to_um, opt_mm_to_um};
 
 /// The whole `evaluate --json` object.
@@ -34,8 +39,10 @@ use crate::units::{mm_to_um, opt_mm_to_um};
 pub struct EvaluationJson {
     /// Input format name (`rtl`, `ecmc`, `api-pos`, `csv`).
     pub format: Option<&'static str>,
-    /// Axis name.
+    /// Axis name (the placeholder `X` when `axis_source` is `not_recorded`).
     pub axis: String,
+    /// Where the axis name came from.
+    pub axis_source: AxisSourceJson,
     /// The file read (the first, when two were joined).
     pub source_file: Option<String>,
     /// Length unit of the source file (`mm` or `inch`); all values here are mm or µm.
@@ -58,6 +65,44 @@ pub struct EvaluationJson {
     pub metadata: MetadataJson,
     /// Reader and evaluator warnings, as sentences.
     pub warnings: Vec<String>,
+}
+
+/// Where the axis name came from ([`AxisSource`]), tagged by `kind`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum AxisSourceJson {
+    /// The file states it in `field`.
+    File {
+        /// The field, as the file spells it (`TGT_SET_PV`, `Axis`, …).
+        field: String,
+    },
+    /// Given by the user (`--axis`) or the program that made the measurement.
+    Given,
+    /// Nothing states it.
+    NotRecorded,
+}
+
+impl AxisSourceJson {
+    /// The wire form of an [`AxisSource`].
+    pub fn from_source(source: &AxisSource) -> AxisSourceJson {
+        match source {
+            AxisSource::File { field } => AxisSourceJson::File {
+                field: field.clone(),
+            },
+            AxisSource::Given => AxisSourceJson::Given,
+            AxisSource::NotRecorded => AxisSourceJson::NotRecorded,
+        }
+    }
+
+    /// The axis as a user reads it: `Z (from TGT_SET_PV)`, `X (--axis)`, or
+    /// `not recorded (give --axis)`.
+    pub fn describe(&self, axis: &str) -> String {
+        match self {
+            AxisSourceJson::File { field } => format!("{axis} (from {field})"),
+            AxisSourceJson::Given => format!("{axis} (--axis)"),
+            AxisSourceJson::NotRecorded => "not recorded (give --axis)".to_string(),
+        }
+    }
 }
 
 /// Run counts.
@@ -272,6 +317,7 @@ impl EvaluationJson {
         EvaluationJson {
             format: metadata.source_format.map(|f| f.name()),
             axis: measurement.axis().to_string(),
+            axis_source: AxisSourceJson::from_source(measurement.axis_source()),
             source_file: metadata
                 .source_file
                 .as_ref()

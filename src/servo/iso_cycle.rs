@@ -285,6 +285,8 @@ fn to_measurement(
     let metadata = Metadata {
         machine: Some("simulated feed axis (axcomp servo-sim)".to_string()),
         description: Some("ISO 230-2 linear cycle simulated with a friction model".to_string()),
+        // The axis file names the axis.
+        axis_source: crate::measurement::AxisSource::Given,
         ..Metadata::default()
     };
     Measurement::new(

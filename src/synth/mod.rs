@@ -404,6 +404,8 @@ fn metadata(truth: &Truth, test: TestKind, start_offset_s: f64, duration_s: f64)
         end_date: Some(date(end)),
         location: truth.axis.location.clone(),
         description: Some(description.to_string()),
+        // The truth file names the axis.
+        axis_source: crate::measurement::AxisSource::Given,
         ..Metadata::default()
     }
 }

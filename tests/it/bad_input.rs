@@ -44,6 +44,12 @@ const CASES: &[(&str, usize, usize, &str)] = &[
     ),
     ("rtl-overflow.rtl", 32, 15, "which overflows"),
     (
+        "rtl-absurd.rtl",
+        32,
+        15,
+        "expected a deviation within ±1000000 µm (±1 m), found 1e308 µm",
+    ),
+    (
         "rtl-duplicate-target.rtl",
         10,
         18,
@@ -122,6 +128,18 @@ const CASES: &[(&str, usize, usize, &str)] = &[
     ("ecmc-bad-unit.dat", 17, 6, "expected UNIT=mm or UNIT=inch"),
     ("ecmc-truncated.dat", 63, 1, "expected KEY=VALUE"),
     (
+        "ecmc-absurd.dat",
+        22,
+        19,
+        "expected a deviation within ±1000000 µm (±1 m), found -1e308 mm",
+    ),
+    (
+        "ecmc-missing-cycles.dat",
+        3,
+        8,
+        "CYCLES=3 but the file holds no REF_DATA_FWD cycle(s) 2–3 and no REF_DATA_BWD cycle(s) 2–3: the file looks truncated",
+    ),
+    (
         "ecmc-repeated.dat",
         77,
         14,
@@ -148,6 +166,12 @@ const CASES: &[(&str, usize, usize, &str)] = &[
         "NumofPoints is 26 but the data table has 27 rows",
     ),
     ("pos-unit.pos", 12, 7, "expected Unit: inch or mm"),
+    (
+        "pos-absurd.pos",
+        22,
+        36,
+        "expected a deviation within ±1000000 µm (±1 m), found 2.54e304 µm",
+    ),
     // axcomp CSV
     (
         "csv-decimal-comma.csv",
@@ -174,7 +198,25 @@ const CASES: &[(&str, usize, usize, &str)] = &[
         "expected a number (deviation in µm), found \"NaN\"",
     ),
     ("csv-no-rows.csv", 3, 1, "expected at least one data row"),
+    (
+        "csv-absurd.csv",
+        2,
+        8,
+        "expected a deviation within ±1000000 µm (±1 m), found 1e308 µm",
+    ),
+    (
+        "csv-absurd-target.csv",
+        4,
+        1,
+        "expected a target within ±100000 mm (±100 m), found 2e9 mm",
+    ),
     ("csv-bad-header.csv", 1, 1, "unknown format"),
+    (
+        "csv-mixed-decimal.csv",
+        4,
+        10,
+        "expected a decimal comma as on line 2, found a decimal point in \"1.5\": the file mixes decimal marks",
+    ),
     // Any format
     ("empty.rtl", 1, 1, "found an empty file"),
     ("blank.csv", 1, 1, "found an empty file"),
@@ -266,4 +308,31 @@ fn cli_exits_2_with_the_same_message() {
         );
         assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
     }
+}
+
+/// Readings of ±1e308 once made `report` spin for minutes over its chart
+/// scales: they are refused at reading, by every command.
+#[test]
+fn absurd_readings_stop_report_at_reading() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("r.html");
+    let file = test_data("bad/rtl-absurd.rtl");
+    let started = std::time::Instant::now();
+    let run = axcomp([
+        "report".as_ref(),
+        file.as_os_str(),
+        "-o".as_ref(),
+        output.as_os_str(),
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(&format!(
+            "{}:32:15: expected a deviation within ±1000000 µm",
+            file.display()
+        )),
+        "{}",
+        run.stderr
+    );
+    assert!(!output.exists());
+    assert!(started.elapsed().as_secs() < 10);
 }

@@ -1,6 +1,6 @@
 //! The `evaluate` command end to end: the report (golden file), flags, errors.
 
-use crate::util::{assert_golden, axcomp, test_data};
+use crate::util::{assert_golden, axcomp, root, test_data};
 
 const SAMPLE: &str = "fixtures/sample-x.rtl";
 
@@ -130,4 +130,96 @@ fn usage_errors_exit_2_and_help_exits_0() {
         "{}",
         missing.stderr
     );
+}
+
+/// A missing input and an output into a missing folder: one line each, the
+/// OS message once, no temporary file's name (issue 11, point 6).
+#[test]
+fn file_errors_are_one_clean_line() {
+    let missing = axcomp(["evaluate", "no-such-file.rtl"]);
+    assert_eq!(missing.code, 2);
+    assert_eq!(
+        missing.stderr,
+        "axcomp: error: cannot read no-such-file.rtl: No such file or directory (os error 2)\n"
+    );
+    let report = axcomp(["report", "no-such-file.rtl", "-o", "no-such-folder/r.html"]);
+    assert_eq!(
+        report.stderr,
+        "axcomp: error: cannot read no-such-file.rtl: No such file or directory (os error 2)\n"
+    );
+
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("out/dir/X.COM");
+    let sample = root().join("fixtures/sample-x.rtl");
+    let run = axcomp([
+        "convert".as_ref(),
+        sample.as_os_str(),
+        "--controller".as_ref(),
+        "tnc640".as_ref(),
+        "-o".as_ref(),
+        output.as_os_str(),
+    ]);
+    assert_eq!(run.code, 2);
+    assert_eq!(
+        run.stderr,
+        format!(
+            "axcomp: error: cannot write {}: the folder {} does not exist\n",
+            output.display(),
+            directory.path().join("out/dir").display()
+        )
+    );
+    assert!(
+        !directory.path().join("out").exists(),
+        "no folder is created"
+    );
+}
+
+/// The CSV layout as Excel saves it in a European locale (`;` and a decimal
+/// comma) and as tab-separated text reads to the same figures as the comma
+/// layout (issue 11, point 6).
+#[test]
+fn excel_csv_layouts_give_the_same_figures() {
+    let directory = tempfile::tempdir().unwrap();
+    let rows = [
+        (0.0, 1, "up", "0.5"),
+        (100.0, 1, "up", "-1.25"),
+        (0.0, 1, "down", "1.5"),
+        (100.0, 1, "down", "-0.75"),
+        (0.0, 2, "up", "0.25"),
+        (100.0, 2, "up", "-1.5"),
+        (0.0, 2, "down", "1.75"),
+        (100.0, 2, "down", "-0.5"),
+    ];
+    let write = |name: &str, separator: &str, comma: bool| {
+        let mut text = format!(
+            "# axis: Y{separator}{separator}{separator}\r\ntarget_mm{separator}run{separator}direction{separator}deviation_um\r\n"
+        );
+        for (target, run, direction, value) in rows {
+            let value = if comma {
+                value.replace('.', ",")
+            } else {
+                value.to_string()
+            };
+            text.push_str(&format!(
+                "{target}{separator}{run}{separator}{direction}{separator}{value}\r\n"
+            ));
+        }
+        let path = directory.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let comma = write("comma.csv", ",", false);
+    let semicolon = write("excel.csv", ";", true);
+    let tab = write("text.txt", "\t", false);
+    let figures = |path: &std::path::Path| {
+        let report = crate::util::evaluate_json(&[path]);
+        assert_eq!(report["format"], "csv");
+        assert_eq!(report["axis"], "Y");
+        (report["figures_um"].clone(), report["per_target"].clone())
+    };
+    let expected = figures(&comma);
+    // x̄↑ at 0 mm: (0.5 + 0.25) / 2, by hand.
+    assert_eq!(expected.1[0]["mean_up_um"], 0.375);
+    assert_eq!(figures(&semicolon), expected);
+    assert_eq!(figures(&tab), expected);
 }
