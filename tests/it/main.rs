@@ -13,6 +13,7 @@ mod diagnose;
 mod evaluate_ecmc;
 mod linuxcnc;
 mod model;
+mod outputs;
 mod predict;
 mod read_api_pos;
 mod report;
