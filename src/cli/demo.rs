@@ -33,7 +33,7 @@ use axcomp::report::plot::PlotFormat;
 use axcomp::report::predict::PredictJson;
 use axcomp::synth::{EffectSpec, Truth};
 
-use super::common::print_text;
+use super::common::{Verbosity, print_text};
 use super::progress;
 
 const TRUTH: &str = include_str!("../../fixtures/demo/truth.toml");
@@ -51,9 +51,9 @@ pub struct DemoArgs {
     #[arg(long)]
     pub force: bool,
 
-    /// No progress bar.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// One file to write: path relative to the output folder, contents.
@@ -61,7 +61,7 @@ type Output = (String, Vec<u8>);
 
 /// Runs `axcomp demo`.
 pub fn run(args: &DemoArgs) -> Result<()> {
-    let steps = progress::bar(6, "demo", args.quiet);
+    let steps = progress::bar(6, "demo", args.verbosity.quiet);
     let truth = Truth::from_toml_str(TRUTH).map_err(|e| anyhow::anyhow!("bundled truth: {e}"))?;
     let before = bundled(BEFORE, "before.rtl")?;
     let after = bundled(AFTER, "after.rtl")?;

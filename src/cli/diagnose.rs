@@ -11,7 +11,7 @@ use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
 
-use super::common::{load_profile, print_json, print_text, print_warnings, read_table};
+use super::common::{Verbosity, load_profile, print_json, print_text, print_warnings, read_table};
 
 /// Flags of `axcomp diagnose`.
 #[derive(Debug, clap::Args)]
@@ -55,19 +55,19 @@ pub struct DiagnoseArgs {
     #[arg(long)]
     pub json: bool,
 
-    /// No warnings on stderr.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp diagnose`.
 pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let after = read::read_path(&args.after, None)?;
-    print_warnings(&after.warnings, args.quiet);
+    print_warnings(&after.warnings, args.verbosity.quiet);
     let before = match &args.before {
         Some(path) => {
             let result = read::read_path(path, None)?;
-            print_warnings(&result.warnings, args.quiet);
+            print_warnings(&result.warnings, args.verbosity.quiet);
             Some(result.measurement)
         }
         None => None,

@@ -9,7 +9,9 @@ use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::read;
 use axcomp::report::{json::EvaluationJson, terminal};
 
-use super::common::{parse_format, parse_run_selector, print_json, print_text, print_warnings};
+use super::common::{
+    Verbosity, parse_format, parse_run_selector, print_json, print_text, print_warnings,
+};
 
 /// Flags of `axcomp evaluate`.
 #[derive(Debug, clap::Args)]
@@ -45,9 +47,9 @@ pub struct EvaluateArgs {
     #[arg(long, help_heading = "Output")]
     pub json: bool,
 
-    /// Do not print warnings.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp evaluate`.
@@ -66,7 +68,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let evaluation = evaluate(&measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
     let report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
-    print_warnings(&warnings, args.quiet);
+    print_warnings(&warnings, args.verbosity.quiet);
     if args.json {
         print_json(&report)
     } else {

@@ -14,7 +14,7 @@ use axcomp::read;
 use axcomp::report::predict::{PredictJson, render};
 
 use super::common::{
-    load_effects, load_machine, load_profile, parse_position, print_json, print_text,
+    Verbosity, load_effects, load_machine, load_profile, parse_position, print_json, print_text,
     print_warnings, read_table,
 };
 
@@ -78,9 +78,9 @@ pub struct PredictArgs {
     #[arg(long, help_heading = "Output")]
     pub json: bool,
 
-    /// No warnings on stderr.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp predict`.
@@ -104,7 +104,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     for spec in &args.measured {
         let (path, line) = split_measured(spec)?;
         let result = read::read_path(&path, None)?;
-        print_warnings(&result.warnings, args.quiet);
+        print_warnings(&result.warnings, args.verbosity.quiet);
         let line = line.map_or(line_mm, |l| complete(Some(l), reference));
         measurements.push((result.measurement, line));
     }

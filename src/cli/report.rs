@@ -17,7 +17,9 @@ use axcomp::report::chart::chart;
 use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
 
-use super::common::{load_profile, parse_format, print_text, print_warnings, read_table};
+use super::common::{
+    Verbosity, load_profile, parse_format, print_text, print_warnings, read_table,
+};
 
 /// Flags of `axcomp report`.
 #[derive(Debug, clap::Args)]
@@ -86,9 +88,9 @@ pub struct ReportArgs {
     #[arg(long, help_heading = "Output")]
     pub force: bool,
 
-    /// Do not print warnings.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// A measurement read and evaluated, with every warning (as `evaluate` has them).
@@ -197,7 +199,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         return Err(error.into());
     }
     for test in std::iter::once(&before).chain(&after) {
-        print_warnings(&test.warnings, args.quiet);
+        print_warnings(&test.warnings, args.verbosity.quiet);
     }
     let mut summary = format!("Wrote {}\n", args.output.display());
     for (path, _) in files.iter().skip(1) {

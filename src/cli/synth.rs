@@ -9,7 +9,7 @@ use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
 use axcomp::synth::{self, Truth};
 
-use super::common::{load_profile, print_text, read_table};
+use super::common::{Verbosity, load_profile, print_text, read_table};
 
 /// Flags of `axcomp synth`.
 #[derive(Debug, clap::Args)]
@@ -45,6 +45,10 @@ pub struct SynthArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
+
+    /// -q/--quiet (the same in every command; synth prints no warnings yet).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp synth`.

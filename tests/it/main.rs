@@ -11,6 +11,7 @@ mod convert;
 mod demo;
 mod diagnose;
 mod evaluate_ecmc;
+mod flags;
 mod linuxcnc;
 mod model;
 mod outputs;
