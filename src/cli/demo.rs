@@ -21,7 +21,7 @@ use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::{Evaluation, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::model::{GeometricErrors, Machine};
-use axcomp::output::write_new;
+use axcomp::output::write_all_new;
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
 use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
@@ -266,13 +266,17 @@ fn write_all(out: &Path, files: &[Output], force: bool) -> Result<()> {
             out.join(name).display()
         );
     }
-    for (name, bytes) in files {
-        let path = out.join(name);
+    let files: Vec<(PathBuf, &[u8])> = files
+        .iter()
+        .map(|(name, bytes)| (out.join(name), bytes.as_slice()))
+        .collect();
+    for (path, _) in &files {
         if let Some(parent) = path.parent() {
             std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
         }
-        write_new(&path, bytes, force)?;
     }
+    // All or none, also when the file system refuses one of them.
+    write_all_new(&files, force)?;
     Ok(())
 }
 
