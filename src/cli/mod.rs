@@ -18,11 +18,10 @@ mod servo_sim;
 mod synth;
 mod tolerance;
 
+use std::any::TypeId;
 use std::process::ExitCode;
 
 use anyhow::Result;
-use std::any::TypeId;
-
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// axcomp: laser measurements to ISO 230-2 figures and compensation tables.
