@@ -28,6 +28,12 @@ pub enum OutputError {
         /// Its folder.
         folder: PathBuf,
     },
+    /// The same file was named for two of the outputs of one command.
+    #[error("{path}: named for two outputs; give each output its own file", path = path.display())]
+    Twice {
+        /// The target named twice.
+        path: PathBuf,
+    },
     /// The file system refused.
     ///
     /// The operating system's message is part of the text, not a `source`
@@ -61,15 +67,107 @@ fn os_error(error: std::io::Error) -> std::io::Error {
 
 /// Writes `contents` to `path` atomically; refuses an existing file unless `force`.
 pub fn write_new(path: &Path, contents: &[u8], force: bool) -> Result<(), OutputError> {
+    write_all_new(&[(path, contents)], force)
+}
+
+/// Writes several files as one result: all of them or none.
+///
+/// Every target is checked first (none may exist without `force`, none may be
+/// named twice), then every file is written to a temporary file beside its
+/// target, and only when all are on disk are they renamed into place. A
+/// failure before the renames leaves nothing; a failure during them (the
+/// file system refusing a rename) removes the files this call created, so a
+/// command whose second output is refused never leaves its first behind.
+/// What `force` replaced cannot be restored.
+pub fn write_all_new<P: AsRef<Path>, B: AsRef<[u8]>>(
+    files: &[(P, B)],
+    force: bool,
+) -> Result<(), OutputError> {
+    for (index, (path, _)) in files.iter().enumerate() {
+        let path = path.as_ref();
+        if files[..index]
+            .iter()
+            .any(|(p, _)| same_file(p.as_ref(), path))
+        {
+            return Err(OutputError::Twice {
+                path: path.to_path_buf(),
+            });
+        }
+        if !force && path.exists() {
+            return Err(OutputError::Exists {
+                path: path.to_path_buf(),
+            });
+        }
+    }
+    let mut staged = Vec::with_capacity(files.len());
+    for (path, contents) in files {
+        let path = path.as_ref();
+        staged.push((path, stage(path, contents.as_ref())?, path.exists()));
+    }
+    let mut created: Vec<&Path> = Vec::new();
+    for (path, temporary, existed) in staged {
+        let persisted = if force {
+            temporary.persist(path).map(|_| ())
+        } else {
+            temporary.persist_noclobber(path).map(|_| ())
+        };
+        if let Err(e) = persisted {
+            for path in &created {
+                let _ = std::fs::remove_file(path);
+            }
+            return Err(if e.error.kind() == std::io::ErrorKind::AlreadyExists {
+                OutputError::Exists {
+                    path: path.to_path_buf(),
+                }
+            } else {
+                OutputError::Io {
+                    path: path.to_path_buf(),
+                    error: os_error(e.error),
+                }
+            });
+        }
+        if !existed {
+            created.push(path);
+        }
+    }
+    Ok(())
+}
+
+/// `a` and `b` name one file: the same path, or (when both exist) the same
+/// file by another path.
+fn same_file(a: &Path, b: &Path) -> bool {
+    if a == b {
+        return true;
+    }
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        // A file that does not exist yet: compare its directory and name.
+        _ => match (
+            a.parent().map(absolute_directory),
+            b.parent().map(absolute_directory),
+        ) {
+            (Some(Some(da)), Some(Some(db))) => da == db && a.file_name() == b.file_name(),
+            _ => false,
+        },
+    }
+}
+
+fn absolute_directory(directory: &Path) -> Option<PathBuf> {
+    if directory.as_os_str().is_empty() {
+        Path::new(".").canonicalize().ok()
+    } else {
+        directory.canonicalize().ok()
+    }
+}
+
+/// `contents` in a temporary file in `path`'s directory, synced to disk.
+/// A missing directory is refused, not created: a mistyped folder must not
+/// become a new one.
+fn stage(path: &Path, contents: &[u8]) -> Result<tempfile::NamedTempFile, OutputError> {
     let io_error = |error| OutputError::Io {
         path: path.to_path_buf(),
         error: os_error(error),
     };
-    if !force && path.exists() {
-        return Err(OutputError::Exists {
-            path: path.to_path_buf(),
-        });
-    }
     let directory = match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
@@ -89,21 +187,7 @@ pub fn write_new(path: &Path, contents: &[u8], force: bool) -> Result<(), Output
     let mut temporary = builder.tempfile_in(directory).map_err(io_error)?;
     temporary.write_all(contents).map_err(io_error)?;
     temporary.as_file().sync_all().map_err(io_error)?;
-    if force {
-        temporary.persist(path).map_err(|e| io_error(e.error))?;
-    } else {
-        // persist_noclobber is not atomic on every platform, hence the check above too.
-        temporary.persist_noclobber(path).map_err(|e| {
-            if e.error.kind() == std::io::ErrorKind::AlreadyExists {
-                OutputError::Exists {
-                    path: path.to_path_buf(),
-                }
-            } else {
-                io_error(e.error)
-            }
-        })?;
-    }
-    Ok(())
+    Ok(temporary)
 }
 
 #[cfg(test)]
@@ -158,5 +242,34 @@ mod tests {
         let plain = os_error(wrapped);
         assert_eq!(plain.kind(), std::io::ErrorKind::NotFound);
         assert_eq!(plain.to_string(), "No such file or directory (os error 2)");
+    }
+
+    #[test]
+    fn several_files_are_written_all_or_none() {
+        let directory = tempfile::tempdir().unwrap();
+        let first = directory.path().join("before.rtl");
+        let second = directory.path().join("after.rtl");
+        std::fs::write(&second, b"kept").unwrap();
+        // The second exists: the first must not be created.
+        let refused = write_all_new(&[(&first, b"1"), (&second, b"2")], false).unwrap_err();
+        assert!(matches!(refused, OutputError::Exists { ref path } if *path == second));
+        assert!(!first.exists());
+        assert_eq!(std::fs::read(&second).unwrap(), b"kept");
+        // One target in a folder that does not exist: nothing is written.
+        let missing = directory.path().join("no-such-folder").join("x.png");
+        let error = write_all_new(&[(&first, b"1"), (&missing, b"2")], true).unwrap_err();
+        assert!(matches!(error, OutputError::Io { .. }));
+        assert!(!first.exists());
+        // The same file twice (also by another spelling) is refused before anything.
+        let again = directory.path().join(".").join("before.rtl");
+        let twice = write_all_new(&[(&first, b"1"), (&again, b"2")], true).unwrap_err();
+        assert!(matches!(twice, OutputError::Twice { .. }), "{twice}");
+        assert!(!first.exists());
+        // With --force all are written.
+        write_all_new(&[(&first, b"1"), (&second, b"2")], true).unwrap();
+        assert_eq!(std::fs::read(&first).unwrap(), b"1");
+        assert_eq!(std::fs::read(&second).unwrap(), b"2");
+        let leftovers = std::fs::read_dir(directory.path()).unwrap().count();
+        assert_eq!(leftovers, 2, "no temporary file may remain");
     }
 }

@@ -143,6 +143,17 @@ pub fn recorded_axis<'a>(measurement: &'a Measurement, purpose: &str) -> Result<
     )
 }
 
+/// `-q/--quiet`, one meaning in every command: stderr carries no warnings
+/// and no progress bars. Results are never silenced: what goes to stdout
+/// (the report, the JSON) and the files written are the same with or
+/// without it, and errors are still printed.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct Verbosity {
+    /// No warnings and no progress bars on stderr (results and errors are unchanged).
+    #[arg(long, short = 'q', help_heading = "Output")]
+    pub quiet: bool,
+}
+
 /// Prints warnings to stderr unless `quiet`.
 pub fn print_warnings(warnings: &[Warning], quiet: bool) {
     if quiet {

@@ -15,7 +15,7 @@ use axcomp::report::convert::ConvertJson;
 use axcomp::units::LengthUnit;
 
 use super::common::{
-    load_effects, name_axis, parse_format, parse_run_selector, print_json, print_text,
+    Verbosity, load_effects, name_axis, parse_format, parse_run_selector, print_json, print_text,
     print_warnings, read_table, recorded_axis,
 };
 use super::evaluate::check_selectors;
@@ -143,9 +143,9 @@ pub struct ConvertArgs {
     #[arg(long, help_heading = "Output")]
     pub json: bool,
 
-    /// Do not print warnings.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 fn parse_controller(name: &str) -> Result<Controller, String> {
@@ -242,7 +242,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         warning_texts,
     );
     report.effects = plan.notes;
-    print_warnings(&warnings, args.quiet);
+    print_warnings(&warnings, args.verbosity.quiet);
     if args.json {
         print_json(&report)
     } else {

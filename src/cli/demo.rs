@@ -22,7 +22,7 @@ use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::{Evaluation, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::model::{GeometricErrors, Machine};
-use axcomp::output::write_new;
+use axcomp::output::write_all_new;
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
 use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
@@ -35,7 +35,7 @@ use axcomp::report::predict::PredictJson;
 use axcomp::synth::{EffectSpec, Truth};
 use axcomp::units::mm_to_um;
 
-use super::common::print_text;
+use super::common::{Verbosity, print_text};
 use super::progress;
 
 const TRUTH: &str = include_str!("../../fixtures/demo/truth.toml");
@@ -53,9 +53,9 @@ pub struct DemoArgs {
     #[arg(long)]
     pub force: bool,
 
-    /// No progress bar.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// One file to write: path relative to the output folder, contents.
@@ -63,7 +63,7 @@ type Output = (String, Vec<u8>);
 
 /// Runs `axcomp demo`.
 pub fn run(args: &DemoArgs) -> Result<()> {
-    let steps = progress::bar(6, "demo", args.quiet);
+    let steps = progress::bar(6, "demo", args.verbosity.quiet);
     let truth = Truth::from_toml_str(TRUTH).map_err(|e| anyhow::anyhow!("bundled truth: {e}"))?;
     let before = bundled(BEFORE, "before.rtl")?;
     let after = bundled(AFTER, "after.rtl")?;
@@ -274,13 +274,17 @@ fn write_all(out: &Path, files: &[Output], force: bool) -> Result<()> {
             out.join(name).display()
         );
     }
-    for (name, bytes) in files {
-        let path = out.join(name);
+    let files: Vec<(PathBuf, &[u8])> = files
+        .iter()
+        .map(|(name, bytes)| (out.join(name), bytes.as_slice()))
+        .collect();
+    for (path, _) in &files {
         if let Some(parent) = path.parent() {
             std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
         }
-        write_new(&path, bytes, force)?;
     }
+    // All or none, also when the file system refuses one of them.
+    write_all_new(&files, force)?;
     Ok(())
 }
 

@@ -12,7 +12,8 @@ use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
 
 use super::common::{
-    load_profile, name_axis, print_json, print_text, print_warnings, read_table, recorded_axis,
+    Verbosity, load_profile, name_axis, print_json, print_text, print_warnings, read_table,
+    recorded_axis,
 };
 
 /// Flags of `axcomp diagnose`.
@@ -67,20 +68,20 @@ pub struct DiagnoseArgs {
     #[arg(long)]
     pub json: bool,
 
-    /// No warnings on stderr.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp diagnose`.
 pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let mut after = read::read_path(&args.after, None)?;
-    print_warnings(&after.warnings, args.quiet);
+    print_warnings(&after.warnings, args.verbosity.quiet);
     name_axis(&mut after.measurement, args.axis.as_ref());
     let before = match &args.before {
         Some(path) => {
             let mut result = read::read_path(path, None)?;
-            print_warnings(&result.warnings, args.quiet);
+            print_warnings(&result.warnings, args.verbosity.quiet);
             name_axis(&mut result.measurement, args.axis.as_ref());
             Some(result.measurement)
         }

@@ -10,7 +10,7 @@ use axcomp::read;
 use axcomp::report::{json::EvaluationJson, terminal};
 
 use super::common::{
-    name_axis, parse_format, parse_run_selector, print_json, print_text, print_warnings,
+    Verbosity, name_axis, parse_format, parse_run_selector, print_json, print_text, print_warnings,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -48,9 +48,9 @@ pub struct EvaluateArgs {
     #[arg(long, help_heading = "Output")]
     pub json: bool,
 
-    /// Do not print warnings.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp evaluate`.
@@ -67,7 +67,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let evaluation = evaluate(&measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
     let report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
-    print_warnings(&warnings, args.quiet);
+    print_warnings(&warnings, args.verbosity.quiet);
     if args.json {
         print_json(&report)
     } else {

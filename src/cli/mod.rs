@@ -18,10 +18,11 @@ mod servo_sim;
 mod synth;
 mod tolerance;
 
+use std::any::TypeId;
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// axcomp: laser measurements to ISO 230-2 figures and compensation tables.
 #[derive(Debug, Parser)]
@@ -103,7 +104,10 @@ pub enum Command {
 
 /// Parses, runs, and maps the outcome to an exit code.
 pub fn main() -> ExitCode {
-    let args = match Args::try_parse() {
+    let parsed = command()
+        .try_get_matches()
+        .and_then(|mut matches| Args::from_arg_matches_mut(&mut matches));
+    let args = match parsed {
         Ok(args) => args,
         Err(error) => {
             // clap prints help and version to stdout with exit 0, usage errors to stderr.
@@ -123,6 +127,60 @@ pub fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// The command line as clap parses it: the derived flags, with every number
+/// allowed to be negative.
+///
+/// Without this clap reads `--step -50` or `--reference -10` as the flag
+/// `-5…`, and says "unexpected argument" instead of letting axcomp say what
+/// is wrong with the value (or use it: a reference below zero is fine). Set
+/// here for every flag whose value is a number, so a new flag cannot forget it.
+pub fn command() -> clap::Command {
+    numbers_may_be_negative(Args::command())
+}
+
+fn numbers_may_be_negative(mut command: clap::Command) -> clap::Command {
+    let numeric: Vec<(clap::Id, bool)> = command
+        .get_arguments()
+        .filter(|arg| takes_a_number(arg))
+        .map(|arg| (arg.get_id().clone(), arg.get_value_delimiter().is_some()))
+        .collect();
+    for (id, delimited) in numeric {
+        command = command.mut_arg(id, |arg| {
+            if delimited {
+                // `-0.1,0.2` is not one number, so clap would still take it for a flag.
+                arg.allow_hyphen_values(true)
+            } else {
+                arg.allow_negative_numbers(true)
+            }
+        });
+    }
+    let subcommands: Vec<String> = command
+        .get_subcommands()
+        .map(|sub| sub.get_name().to_string())
+        .collect();
+    for name in subcommands {
+        command = command.mut_subcommand(name, numbers_may_be_negative);
+    }
+    command
+}
+
+/// The value of `arg` is a number (whatever its sign may be).
+fn takes_a_number(arg: &clap::Arg) -> bool {
+    let value = arg.get_value_parser().type_id();
+    [
+        TypeId::of::<f64>(),
+        TypeId::of::<f32>(),
+        TypeId::of::<i64>(),
+        TypeId::of::<i32>(),
+        TypeId::of::<u64>(),
+        TypeId::of::<u32>(),
+        TypeId::of::<u8>(),
+        TypeId::of::<usize>(),
+    ]
+    .into_iter()
+    .any(|number| value == number)
 }
 
 fn run(args: Args) -> Result<()> {
@@ -155,10 +213,65 @@ fn is_broken_pipe(error: &anyhow::Error) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::CommandFactory;
 
     #[test]
     fn flag_definitions_are_consistent() {
-        Args::command().debug_assert();
+        command().debug_assert();
+    }
+
+    /// Every flag with a numeric value takes a negative one (issue 11:
+    /// `convert --step -50` was parsed as a flag).
+    #[test]
+    fn every_numeric_flag_takes_a_negative_value() {
+        let command = command();
+        let mut numeric = Vec::new();
+        for sub in command.get_subcommands() {
+            for arg in sub.get_arguments().filter(|a| takes_a_number(a)) {
+                numeric.push(format!("{} --{}", sub.get_name(), arg.get_id()));
+                assert!(
+                    arg.is_allow_negative_numbers_set() || arg.is_allow_hyphen_values_set(),
+                    "{} --{}",
+                    sub.get_name(),
+                    arg.get_id()
+                );
+            }
+        }
+        // The walk sees the flags the issue names (and so cannot pass by seeing none).
+        for flag in [
+            "convert --step",
+            "convert --start",
+            "convert --reference",
+            "servo-sim --first_mm",
+        ] {
+            assert!(numeric.contains(&flag.to_string()), "{flag} in {numeric:?}");
+        }
+        let parsed = Args::from_arg_matches(
+            &command
+                .clone()
+                .try_get_matches_from([
+                    "axcomp",
+                    "convert",
+                    "a.rtl",
+                    "--controller",
+                    "tnc640",
+                    "-o",
+                    "X.COM",
+                    "--start",
+                    "750",
+                    "--step",
+                    "-50",
+                    "--reference",
+                    "-10",
+                ])
+                .unwrap(),
+        )
+        .unwrap();
+        let Command::Convert(convert) = parsed.command else {
+            panic!("parsed as convert")
+        };
+        assert_eq!(
+            (convert.start, convert.step, convert.reference),
+            (Some(750.0), Some(-50.0), Some(-10.0))
+        );
     }
 }

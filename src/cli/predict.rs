@@ -15,8 +15,8 @@ use axcomp::report::predict::{PredictJson, render};
 use axcomp::units::mm_to_um;
 
 use super::common::{
-    load_effects, load_machine, load_profile, name_axis, parse_position, print_json, print_text,
-    print_warnings, read_table,
+    Verbosity, load_effects, load_machine, load_profile, name_axis, parse_position, print_json,
+    print_text, print_warnings, read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -88,9 +88,9 @@ pub struct PredictArgs {
     #[arg(long, help_heading = "Output")]
     pub json: bool,
 
-    /// No warnings on stderr.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp predict`.
@@ -115,7 +115,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         let (axis, spec) = split_axis(spec);
         let (path, line) = split_measured(spec)?;
         let mut result = read::read_path(&path, None)?;
-        print_warnings(&result.warnings, args.quiet);
+        print_warnings(&result.warnings, args.verbosity.quiet);
         name_axis(&mut result.measurement, axis.as_ref());
         if !result.measurement.axis_recorded() {
             bail!(

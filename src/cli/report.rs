@@ -3,14 +3,14 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::error::Warning;
 use axcomp::evaluate::{Evaluation, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
-use axcomp::output::write_new;
+use axcomp::output::write_all_new;
 use axcomp::read;
 use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
 use axcomp::report::chart::chart;
@@ -18,7 +18,8 @@ use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
 
 use super::common::{
-    load_profile, name_axis, parse_format, print_text, print_warnings, read_table, recorded_axis,
+    Verbosity, load_profile, name_axis, parse_format, print_text, print_warnings, read_table,
+    recorded_axis,
 };
 
 /// Flags of `axcomp report`.
@@ -93,9 +94,9 @@ pub struct ReportArgs {
     #[arg(long, help_heading = "Output")]
     pub force: bool,
 
-    /// Do not print warnings.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// A measurement read and evaluated, with every warning (as `evaluate` has them).
@@ -185,23 +186,24 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             files.push((directory.join(format!("{}.png", named.name)), bytes));
         }
     }
-    if !args.force
-        && let Some((existing, _)) = files.iter().find(|(path, _)| path.exists())
-    {
-        bail!(
-            "{}: already exists; use --force to replace it (nothing was written)",
-            existing.display()
-        );
-    }
-    if let Some(directory) = &args.png {
-        std::fs::create_dir_all(directory)
-            .with_context(|| format!("{}: cannot create the directory", directory.display()))?;
-    }
-    for (path, bytes) in &files {
-        write_new(path, bytes, args.force)?;
+    // All files or none (output::write_all_new checks every target first);
+    // a --png folder this run creates is removed again if nothing is written.
+    let created = match &args.png {
+        Some(directory) if !directory.is_dir() => {
+            std::fs::create_dir_all(directory)
+                .with_context(|| format!("{}: cannot create the directory", directory.display()))?;
+            Some(directory)
+        }
+        _ => None,
+    };
+    if let Err(error) = write_all_new(&files, args.force) {
+        if let Some(directory) = created {
+            let _ = std::fs::remove_dir(directory);
+        }
+        return Err(error.into());
     }
     for test in std::iter::once(&before).chain(&after) {
-        print_warnings(&test.warnings, args.quiet);
+        print_warnings(&test.warnings, args.verbosity.quiet);
     }
     let mut summary = format!("Wrote {}\n", args.output.display());
     for (path, _) in files.iter().skip(1) {

@@ -20,7 +20,7 @@ use axcomp::servo::simulate::{ForceStep, Stepping};
 use axcomp::servo::trajectory::{Circle, CircleAxis, MoveLimits};
 use axcomp::units::{mm_to_m, um_to_mm};
 
-use super::common::{print_json, print_text};
+use super::common::{Verbosity, print_json, print_text};
 use super::progress;
 
 /// Which test to simulate.
@@ -207,9 +207,9 @@ pub struct ServoSimArgs {
     #[arg(long, help_heading = "Output")]
     pub force: bool,
 
-    /// No progress bar.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 fn parse_friction(name: &str) -> Result<FrictionKind, String> {
@@ -260,7 +260,7 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
     } else {
         Stepping::DEFAULT
     };
-    let bar = progress::bar(1000, args.test.name(), args.quiet);
+    let bar = progress::bar(1000, args.test.name(), args.verbosity.quiet);
     let mut report_progress = |fraction: f64| bar.set_position((fraction * 1000.0) as u64);
     let mut report = ServoSimJson {
         axis: axis.name.clone(),

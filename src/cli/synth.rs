@@ -5,11 +5,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::measurement::Measurement;
-use axcomp::output::write_new;
+use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
 use axcomp::synth::{self, Truth};
 
-use super::common::{load_profile, print_text, read_table};
+use super::common::{Verbosity, load_profile, print_text, read_table};
 
 /// Flags of `axcomp synth`.
 #[derive(Debug, clap::Args)]
@@ -45,6 +45,10 @@ pub struct SynthArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
+
+    /// -q/--quiet (the same in every command; synth prints no warnings yet).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp synth`.
@@ -67,15 +71,19 @@ pub fn run(args: &SynthArgs) -> Result<()> {
         }
         _ => None,
     };
-    write_new(&args.output, first_text.as_bytes(), args.force)?;
+    // Both files or neither: an existing --o2 must not leave a new first file.
+    let mut files = vec![(args.output.as_path(), first_text.as_bytes())];
+    if let Some((path, text)) = &second {
+        files.push((path.as_path(), text.as_bytes()));
+    }
+    write_all_new(&files, args.force)?;
     let mut summary = format!(
         "Wrote {} ({} targets, {} runs)\n",
         args.output.display(),
         first.targets_mm().len(),
         first.runs().len()
     );
-    if let Some((path, text)) = second {
-        write_new(path, text.as_bytes(), args.force)?;
+    if let Some((path, _)) = &second {
         summary.push_str(&format!(
             "Wrote {} (re-test with the table applied)\n",
             path.display()

@@ -23,7 +23,7 @@ use axcomp::report::tolerance::{
 };
 use axcomp::units::um_per_m_to_rad;
 
-use super::common::{load_machine, print_json, print_text};
+use super::common::{Verbosity, load_machine, print_json, print_text};
 use super::progress;
 
 /// Flags of `axcomp tolerance`.
@@ -142,9 +142,9 @@ pub struct ToleranceArgs {
     #[arg(long, help_heading = "Output")]
     pub json: bool,
 
-    /// No progress bar.
-    #[arg(long, short = 'q', help_heading = "Output")]
-    pub quiet: bool,
+    /// -q/--quiet (the same in every command).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp tolerance`.
@@ -195,7 +195,11 @@ pub fn run(args: &ToleranceArgs) -> Result<()> {
     } else {
         1
     };
-    let bar = progress::bar((args.samples * runs) as u64, "tolerance study", args.quiet);
+    let bar = progress::bar(
+        (args.samples * runs) as u64,
+        "tolerance study",
+        args.verbosity.quiet,
+    );
     let advance = |done: u64| bar.inc(done);
     let result = tolerance_study(&machine, &options, &advance)?;
     let sensitivity = if args.sweep {
@@ -252,7 +256,11 @@ fn run_single_axis(args: &ToleranceArgs, shape: ProfileShape) -> Result<()> {
         shape,
         step_mm: 5.0,
     };
-    let bar = progress::bar(args.samples as u64, "single-axis study", args.quiet);
+    let bar = progress::bar(
+        args.samples as u64,
+        "single-axis study",
+        args.verbosity.quiet,
+    );
     let result = single_axis_study(&options, &|done| bar.inc(done))?;
     bar.finish_and_clear();
     let report = AxisStudyJson::new(&options, &result);

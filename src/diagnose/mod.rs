@@ -251,7 +251,7 @@ pub struct Diagnosis {
     pub residual_before: ResidualStats,
     /// Effects found.
     pub accepted: Vec<AcceptedEffect>,
-    /// Effects tried and not found.
+    /// Effects tried and not found: never a kind that is in `accepted`.
     pub rejected: Vec<RejectedEffect>,
     /// The model's error with the effects.
     pub residual_after: ResidualStats,
@@ -569,6 +569,9 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         };
         problem.predicted_um[i] + systematic + scatter[i]
     })?;
+    // A kind is either found or not: a second outlier run that fails a gate
+    // after the first was accepted records a rejection of the same kind.
+    rejected.retain(|r| !accepted.iter().any(|a| a.effect.kind() == r.kind));
     Ok(Diagnosis {
         predicted_from_first_test: with_prediction,
         residual_before: stats(&residual_before),

@@ -1015,7 +1015,7 @@ fn unexplained(out: &mut String, diagnosis: &Diagnosis) {
     } else {
         let _ = writeln!(
             out,
-            "<p>None: what the effects leave is the scatter of the readings (lack of fit p = {}; \
+            "<p>None: what the effects leave is the scatter of the readings (lack of fit p {}; \
              RMS of the per-target mean residual {} µm).</p>",
             p_value(u.p_value),
             um(Some(u.rms_um))

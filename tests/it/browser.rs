@@ -61,7 +61,7 @@ impl Pixels {
     }
 }
 
-/// Debian's chromium; CI installs it (`.ci/run`). Missing is a failure, not a skip.
+/// Debian's chromium; `scripts/test` installs it. Missing is a failure, not a skip.
 pub fn chromium() -> PathBuf {
     let path = std::env::var_os("PATH").unwrap_or_default();
     for directory in std::env::split_paths(&path) {
@@ -74,7 +74,7 @@ pub fn chromium() -> PathBuf {
     }
     panic!(
         "chromium not found on PATH: the report is tested in a real browser; install Debian's \
-         chromium (apt-get install chromium), as .ci/run does"
+         chromium (apt-get install chromium), or run the tests with scripts/test, which installs it"
     );
 }
 

@@ -72,7 +72,22 @@ fn run(truth_text: &str, seed: u64, angular: bool) -> Diagnosis {
         angular: profile.as_ref(),
         timing: CycleTiming::ASSUMED,
     };
-    diagnose(&input).unwrap()
+    let diagnosis = diagnose(&input).unwrap();
+    assert_found_or_not(&diagnosis);
+    diagnosis
+}
+
+/// A kind is under Found or under Not found, never both (issue 11).
+fn assert_found_or_not(d: &Diagnosis) {
+    for a in &d.accepted {
+        let kind = a.effect.kind();
+        assert!(
+            d.rejected.iter().all(|r| r.kind != kind),
+            "{} is accepted and rejected: {:?}",
+            kind.name(),
+            d.rejected
+        );
+    }
 }
 
 /// The re-test alone (no first test, no table): structure between runs and
@@ -96,7 +111,9 @@ fn run_alone(truth_text: &str, seed: u64) -> Diagnosis {
         angular: None,
         timing: CycleTiming::ASSUMED,
     };
-    diagnose(&input).unwrap()
+    let diagnosis = diagnose(&input).unwrap();
+    assert_found_or_not(&diagnosis);
+    diagnosis
 }
 
 /// A 750 mm axis, 31 irregular targets, 5 runs each way; `cycle` adds to [cycle].
@@ -531,6 +548,7 @@ fn real_ess_files_get_a_stated_diagnosis() {
             timing: CycleTiming::ASSUMED,
         };
         let d = diagnose(&input).unwrap();
+        assert_found_or_not(&d);
         for effect in &d.accepted {
             assert!(
                 !effect.explanation.is_empty()
@@ -591,4 +609,40 @@ fn tests_of_different_axes_are_refused() {
         error.to_string(),
         "the first test is of axis Y, the re-test of axis X"
     );
+}
+
+/// Issue 11: on the real file with a start-up run, `diagnose` listed
+/// outlier-run under Found (run 1↑) and under Not found (the next run failed
+/// the gate). Through the binary, in the terminal and in JSON.
+#[test]
+fn an_accepted_kind_is_not_also_listed_as_not_found() {
+    let file =
+        crate::util::shared_data("ecmc/ecmccfg/examples__mcu1025_fat_sat__report.md_ISO230.dat");
+    let run = crate::util::axcomp(["diagnose", "--after", file.to_str().unwrap(), "--json"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let kinds = |key: &str| -> Vec<String> {
+        json[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["kind"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let (found, not_found) = (kinds("effects"), kinds("rejected"));
+    assert_eq!(found, ["outlier-run"], "the start-up run 1↑");
+    assert!(
+        !not_found.contains(&"outlier-run".to_string()),
+        "{not_found:?}"
+    );
+    // The other kinds are still said to be looked for and not found.
+    assert!(not_found.contains(&"drift".to_string()), "{not_found:?}");
+
+    let run = crate::util::axcomp(["diagnose", "--after", file.to_str().unwrap()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let (found, rest) = run.stdout.split_once("\nNot found\n").unwrap();
+    let not_found = rest.split("\n\n").next().unwrap();
+    assert!(found.contains("\n  outlier-run "), "{found}");
+    assert!(!not_found.contains("outlier-run"), "{not_found}");
+    assert!(not_found.contains("  drift "), "{not_found}");
 }

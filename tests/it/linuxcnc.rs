@@ -17,7 +17,7 @@
 //! (to 400 mm and back below the table) comes first, and every measured
 //! point must show the applied correction settled on the computed one.
 //!
-//! The test installs nothing: `.ci/run` installs LinuxCNC and creates the
+//! The test installs nothing: `scripts/test` installs LinuxCNC and creates the
 //! user `axcomp-ci`. If LinuxCNC cannot start, the test fails.
 
 use std::os::unix::fs::PermissionsExt;
@@ -31,7 +31,7 @@ use axcomp::units::LengthUnit;
 
 use crate::util::{axcomp, test_data};
 
-/// The user LinuxCNC runs as when the tests run as root (created by `.ci/run`).
+/// The user LinuxCNC runs as when the tests run as root (created by `scripts/test`).
 const USER: &str = "axcomp-ci";
 const TOLERANCE_MM: f64 = 1e-6;
 /// Moves before the measured ones (see the module doc).
@@ -94,7 +94,7 @@ fn run_linuxcnc(dir: &Path, comp_file: &str, comp_type: u8) -> serde_json::Value
         .into_iter()
         .find(|p| Path::new(p).exists())
         .unwrap_or_else(|| {
-            panic!("LinuxCNC is not installed; .ci/run installs the Debian package linuxcnc-uspace")
+            panic!("LinuxCNC is not installed: install the Debian package linuxcnc-uspace (apt-get install linuxcnc-uspace), or run the tests with scripts/test, which installs it")
         });
     let mut command = if is_root() {
         let exists = Command::new("id")
@@ -103,7 +103,7 @@ fn run_linuxcnc(dir: &Path, comp_file: &str, comp_type: u8) -> serde_json::Value
             .is_ok_and(|o| o.status.success());
         assert!(
             exists,
-            "running as root and user {USER} does not exist; .ci/run creates it (LinuxCNC refuses to run as root)"
+            "running as root and user {USER} does not exist: LinuxCNC refuses to run as root; create it (useradd --create-home {USER}), or run the tests with scripts/test, which creates it"
         );
         let mut c = Command::new("runuser");
         c.args(["-u", USER, "--", "env"])

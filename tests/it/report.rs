@@ -556,3 +556,29 @@ fn the_browser_checks_can_fail() {
     let (inked, blue) = (shot.inked(), shot.blue());
     assert!(inked < 0.001 && blue == 0.0, "{inked} {blue}");
 }
+
+/// Issue 11: the unexplained-structure sentence read "lack of fit p = = 0.0290".
+/// The p-value is the library's, printed once, with one "=" (or "<").
+#[test]
+fn the_lack_of_fit_p_value_is_printed_once_with_one_sign() {
+    let case = RetestCase::new();
+    let (output, run) = case.report(&[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&output).unwrap();
+    let p = case.diagnosis().unexplained.p_value;
+    let expected = if p < 1e-4 {
+        "lack of fit p < 0.0001".to_string()
+    } else {
+        format!("lack of fit p = {p:.4}")
+    };
+    assert_eq!(html.matches("lack of fit p").count(), 1, "{html}");
+    assert_eq!(html.matches(&expected).count(), 1, "{expected} in the page");
+    for doubled in ["= =", "= < 0"] {
+        let at = html.find(doubled);
+        assert!(
+            at.is_none(),
+            "a doubled sign: {}",
+            &html[at.unwrap_or(0).saturating_sub(200)..][..300]
+        );
+    }
+}
