@@ -258,7 +258,7 @@ mod tests {
         // One target in a folder that does not exist: nothing is written.
         let missing = directory.path().join("no-such-folder").join("x.png");
         let error = write_all_new(&[(&first, b"1"), (&missing, b"2")], true).unwrap_err();
-        assert!(matches!(error, OutputError::Io { .. }));
+        assert!(matches!(error, OutputError::NoFolder { .. }));
         assert!(!first.exists());
         // The same file twice (also by another spelling) is refused before anything.
         let again = directory.path().join(".").join("before.rtl");
