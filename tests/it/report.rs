@@ -366,6 +366,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
             controller,
         }),
         diagnosis: Some(&diagnosis),
+        limits: &[],
         generator: "test",
     };
     let charts = charts(&input);
