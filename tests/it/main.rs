@@ -18,3 +18,4 @@ mod read_api_pos;
 mod report;
 mod servo;
 mod util;
+mod verdict;

@@ -45,7 +45,7 @@ fn shown(value: Option<f64>) -> String {
 
 /// Checks every cell whose key starts with `prefix.` against `source` (a
 /// JSON object such as `evaluate --json`'s); returns how many were checked.
-fn check_against_json(html: &str, prefix: &str, source: &serde_json::Value) -> usize {
+pub(crate) fn check_against_json(html: &str, prefix: &str, source: &serde_json::Value) -> usize {
     let mut checked = 0;
     for (key, value, text) in keyed_values(html) {
         let Some(path) = key.strip_prefix(&format!("{prefix}.")) else {
@@ -63,7 +63,7 @@ fn check_against_json(html: &str, prefix: &str, source: &serde_json::Value) -> u
 }
 
 /// The embedded `axcomp-data` JSON of a page (or of chromium's DOM dump).
-fn embedded_data(html: &str) -> serde_json::Value {
+pub(crate) fn embedded_data(html: &str) -> serde_json::Value {
     let start = html
         .find("id=\"axcomp-data\">")
         .expect("the page embeds #axcomp-data");
