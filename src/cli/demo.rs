@@ -192,6 +192,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
             controller: Controller::Tnc640,
         }),
         diagnosis: Some(&diagnosis),
+        limits: &[],
         generator: &generator,
     };
     files.push(("report.html".into(), html::render(&input)?.into_bytes()));

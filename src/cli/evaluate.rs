@@ -7,8 +7,9 @@ use anyhow::{Context, Result, bail};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::read;
-use axcomp::report::{json::EvaluationJson, terminal};
+use axcomp::report::{json::EvaluationJson, terminal, verdict};
 
+use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     Verbosity, name_axis, parse_format, parse_run_selector, print_json, print_text, print_warnings,
 };
@@ -44,6 +45,16 @@ pub struct EvaluateArgs {
     #[arg(long = "exclude-run", value_name = "RUN[:DIR]", value_parser = parse_run_selector, help_heading = "Evaluation")]
     pub exclude_runs: Vec<RunSelector>,
 
+    /// Machine profile (TOML): its [acceptance] table gives permissible values.
+    ///
+    /// See README.md for the table: a fixed µm value or one per 1000 mm of
+    /// measured travel with a minimum, per axis if wanted. --limit overrides it.
+    #[arg(long, value_name = "M.toml", help_heading = "Acceptance")]
+    pub machine: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub acceptance: LimitArgs,
+
     /// Print one JSON object (units in the keys) instead of the report.
     #[arg(long, help_heading = "Output")]
     pub json: bool,
@@ -64,9 +75,15 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let measurement = measurement
         .without_runs(&args.exclude_runs)
         .context("after excluding runs")?;
+    let limits = load_limits(
+        args.machine.as_deref(),
+        measurement.axis(),
+        &args.acceptance,
+    )?;
     let evaluation = evaluate(&measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
-    let report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
+    let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
+    report.verdict = verdict::judge(&evaluation, &limits);
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json {
         print_json(&report)

@@ -6,6 +6,7 @@
 //! their chain, and give exit code 2. A closed pipe (`axcomp … | head`) is
 //! success.
 
+mod acceptance;
 mod common;
 mod convert;
 mod demo;

@@ -17,6 +17,7 @@ use axcomp::report::chart::chart;
 use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
 
+use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     Verbosity, load_profile, name_axis, parse_format, print_text, print_warnings, read_table,
     recorded_axis,
@@ -63,9 +64,13 @@ pub struct ReportArgs {
     #[arg(long, value_name = "NAME", help_heading = "Input")]
     pub axis: Option<String>,
 
-    /// Machine profile (TOML), to read the table's axis names (as in convert).
+    /// Machine profile (TOML): the table's axis names (as in convert) and the
+    /// [acceptance] table's permissible values for the verdict box.
     #[arg(long, value_name = "M.toml", help_heading = "Input")]
     pub machine: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub acceptance: LimitArgs,
 
     /// LinuxCNC table type, 0 or 1, when its numbers do not tell it.
     #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Input")]
@@ -134,6 +139,11 @@ impl Test {
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
     let before = Test::read(&args.file, args.format, args.axis.as_ref())?;
+    let limits = load_limits(
+        args.machine.as_deref(),
+        before.measurement.axis(),
+        &args.acceptance,
+    )?;
     let after = match &args.after {
         Some(path) => Some(Test::read(path, args.format, args.axis.as_ref())?),
         None => None,
@@ -175,6 +185,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             controller: *controller,
         }),
         diagnosis: diagnosis.as_ref(),
+        limits: &limits,
         generator: &generator,
     };
     // Render everything before writing anything: a failure leaves no half report.

@@ -21,6 +21,7 @@
 
 pub mod environment;
 pub mod outliers;
+pub mod verdict;
 
 use crate::error::Warning;
 use crate::measurement::{Direction, Measurement};

@@ -51,6 +51,9 @@ pub struct ReportInput<'a> {
     pub table: Option<TableRecord<'a>>,
     /// The diagnosis of the re-test (`before` = the first test, `after` = the re-test).
     pub diagnosis: Option<&'a Diagnosis>,
+    /// The acceptance limits for the verdict box (`report::verdict`);
+    /// empty: no limits, no verdict.
+    pub limits: &'a [crate::evaluate::verdict::Limit],
     /// What made the report, e.g. `axcomp 0.1.0 on 2026-11-22 15:04`
     /// (the library reads no clock: the caller says when).
     pub generator: &'a str,

@@ -2,7 +2,9 @@
 //! SVG plots, the embedded plot font as a data URL, no script, no network.
 //!
 //! [`render`] turns a [`ReportInput`] into the page. Sections, in order:
-//! header (machine, axis, operator, date, files, standard); test conditions
+//! header (machine, axis, operator, date, files, standard); the acceptance
+//! verdict box (`report::verdict`: PASS or FAIL with its checks, or "no
+//! acceptance limits given: no verdict"); test conditions
 //! and environment with the refractive index check
 //! (`evaluate::environment`); the ISO 230-2 figures (side by side with the
 //! re-test's when there is one); the deviation plot(s); the per-target
@@ -22,7 +24,9 @@
 //! `data-key` is the path of the value in the `evaluate --json` object of
 //! the first test (`before.…`) or the re-test (`after.…`), or in the
 //! diagnosis (`diagnosis.residual_before.rms_um`,
-//! `diagnosis.figures.predicted.A`, `diagnosis.accepted.0.B_um`, …);
+//! `diagnosis.figures.predicted.A`, `diagnosis.accepted.0.B_um`, …), or
+//! the verdict's (`after.verdict.checks.0.value_um`, whose row also names
+//! the figure cell it checks in `data-figure-key`);
 //! `data-um` is the value at full precision (`null` when not evaluated). The
 //! page also embeds
 //!
@@ -44,6 +48,7 @@ use crate::evaluate::AxisFigures;
 use crate::evaluate::environment::{
     AGREEMENT_PPM, IndexAt, IndexComparison, RefractiveIndexCheck, check_refractive_index,
 };
+use crate::evaluate::verdict::Limit;
 use crate::measurement::{Direction, Measurement, StartEnd};
 use crate::report::acceptance::{
     NamedChart, ReportInput, TableRecord, TestRecord, charts, prediction,
@@ -74,7 +79,7 @@ struct ReportDataJson<'a> {
 /// let (measurement, warnings) = read::parse_str(csv, SourceFormat::Csv).unwrap();
 /// let evaluation = evaluate(&measurement);
 /// let before = TestRecord { measurement: &measurement, evaluation: &evaluation, warnings: &warnings };
-/// let input = ReportInput { before, after: None, table: None, diagnosis: None, generator: "axcomp" };
+/// let input = ReportInput { before, after: None, table: None, diagnosis: None, limits: &[], generator: "axcomp" };
 /// let html = axcomp::report::html::render(&input).unwrap();
 /// // E = max(x̄↑; x̄↓) − min(x̄↑; x̄↓) = 5 − (−1) = 6 µm, shown as the terminal shows it.
 /// assert!(html.contains(r#"data-key="before.figures_um.E" data-um="6">6.00</td>"#));
@@ -93,6 +98,7 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
     };
     let mut body = String::new();
     header(&mut body, input);
+    crate::report::verdict::html_section(&mut body, input);
     conditions(&mut body, input);
     figures_section(&mut body, input);
     deviation_section(&mut body, input, &svg_of);
@@ -114,8 +120,11 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
     );
     let data = ReportDataJson {
         generator: input.generator,
-        before: evaluation_json(&input.before),
-        after: input.after.as_ref().map(evaluation_json),
+        before: evaluation_json(&input.before, input.limits),
+        after: input
+            .after
+            .as_ref()
+            .map(|a| evaluation_json(a, input.limits)),
     };
     let json = serde_json::to_string(&data).unwrap_or_else(|_| "null".into());
     let title = format!(
@@ -164,12 +173,15 @@ fn json_in_script(json: &str) -> String {
     json.replace('<', "\\u003c")
 }
 
-fn evaluation_json(test: &TestRecord<'_>) -> EvaluationJson {
-    EvaluationJson::new(test.measurement, test.evaluation, &[], test.warnings)
+/// As `evaluate --json` prints it, with the same limits.
+fn evaluation_json(test: &TestRecord<'_>, limits: &[Limit]) -> EvaluationJson {
+    let mut json = EvaluationJson::new(test.measurement, test.evaluation, &[], test.warnings);
+    json.verdict = crate::report::verdict::judge(test.evaluation, limits);
+    json
 }
 
 /// A µm cell with its source (see the module doc).
-fn um_cell(key: &str, value: Option<f64>) -> String {
+pub(crate) fn um_cell(key: &str, value: Option<f64>) -> String {
     format!(
         "<td class=\"num\" {}>{}</td>",
         source(key, value),
@@ -1086,8 +1098,9 @@ fn font_base64() -> String {
 
 fn css() -> String {
     format!(
-        "@font-face {{ font-family: \"axcomp-plot\"; src: url(data:font/ttf;base64,{font}) format(\"truetype\"); }}\n{CSS}",
-        font = font_base64()
+        "@font-face {{ font-family: \"axcomp-plot\"; src: url(data:font/ttf;base64,{font}) format(\"truetype\"); }}\n{CSS}{verdict}",
+        font = font_base64(),
+        verdict = crate::report::verdict::CSS
     )
 }
 

@@ -18,8 +18,13 @@
 //!                   "R_up_um": …, "R_down_um": …, "R_um": …}, …],
 //!   "outliers": [{"run": 1, "direction": "down", "score": 48.2,
 //!                 "worst_target_mm": 15.0, "offset_um": 101.4}],
-//!   "environment": {…}, "metadata": {…}, "warnings": ["…"] }
+//!   "environment": {…}, "metadata": {…}, "warnings": ["…"],
+//!   "verdict": {"pass": …, "checks": […], …} }
 //! ```
+//!
+//! `verdict` is there only when acceptance limits are given (`--limit`, a
+//! profile's `[acceptance]`): no limits, no verdict. Its format is in
+//! `report::verdict`.
 //!
 //! `B` is max |B_i| (unsigned); `B_mean` (B̄) and `B_um` are signed, ↑ minus ↓.
 //!
@@ -65,6 +70,9 @@ pub struct EvaluationJson {
     pub metadata: MetadataJson,
     /// Reader and evaluator warnings, as sentences.
     pub warnings: Vec<String>,
+    /// The acceptance verdict; absent without limits (see `report::verdict`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<crate::report::verdict::VerdictJson>,
 }
 
 /// Where the axis name came from ([`AxisSource`]), tagged by `kind`.
@@ -355,6 +363,7 @@ impl EvaluationJson {
                 description: metadata.description.clone(),
             },
             warnings: warnings.iter().map(ToString::to_string).collect(),
+            verdict: None,
         }
     }
 }

@@ -11,7 +11,8 @@
 //! `servo-sim`. The acceptance report of `axcomp report`: [`acceptance`]
 //! what it is made from and its charts, [`chart`] x–y charts as data drawn
 //! as SVG or PNG, [`html`] the self-contained page. All convert mm to µm
-//! through `crate::units`; nothing else in the crate depends on this module;
+//! through `crate::units`; [`verdict`] the acceptance verdict (JSON,
+//! terminal lines, the report's box); nothing else in the crate depends on this module;
 //! files are written by `crate::output`.
 pub mod acceptance;
 pub mod chart;
@@ -24,3 +25,4 @@ pub mod predict;
 pub mod servo;
 pub mod terminal;
 pub mod tolerance;
+pub mod verdict;

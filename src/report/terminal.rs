@@ -43,6 +43,9 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
             );
         }
     }
+    if let Some(verdict) = &report.verdict {
+        out.push_str(&crate::report::verdict::terminal(verdict));
+    }
     out
 }
 

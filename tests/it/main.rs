@@ -21,3 +21,4 @@ mod read_api_pos;
 mod report;
 mod servo;
 mod util;
+mod verdict;

@@ -45,7 +45,7 @@ fn shown(value: Option<f64>) -> String {
 
 /// Checks every cell whose key starts with `prefix.` against `source` (a
 /// JSON object such as `evaluate --json`'s); returns how many were checked.
-fn check_against_json(html: &str, prefix: &str, source: &serde_json::Value) -> usize {
+pub(crate) fn check_against_json(html: &str, prefix: &str, source: &serde_json::Value) -> usize {
     let mut checked = 0;
     for (key, value, text) in keyed_values(html) {
         let Some(path) = key.strip_prefix(&format!("{prefix}.")) else {
@@ -63,7 +63,7 @@ fn check_against_json(html: &str, prefix: &str, source: &serde_json::Value) -> u
 }
 
 /// The embedded `axcomp-data` JSON of a page (or of chromium's DOM dump).
-fn embedded_data(html: &str) -> serde_json::Value {
+pub(crate) fn embedded_data(html: &str) -> serde_json::Value {
     let start = html
         .find("id=\"axcomp-data\">")
         .expect("the page embeds #axcomp-data");
@@ -377,6 +377,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
             controller,
         }),
         diagnosis: Some(&diagnosis),
+        limits: &[],
         generator: "test",
     };
     let charts = charts(&input);
@@ -466,10 +467,15 @@ fn an_existing_report_is_kept_unless_forced() {
 fn the_sample_report_opens_in_chromium_without_errors_and_is_not_blank() {
     let directory = tempfile::tempdir().unwrap();
     let page = directory.path().join("report.html");
-    let run = axcomp(["report", SAMPLE, "-o", page.to_str().unwrap()]);
+    // With limits A fails (13.19 > 12 µm): the verdict box is drawn too.
+    let limits = ["--limit", "A=12", "--limit", "R=7"];
+    let mut args = vec!["report", SAMPLE, "-o", page.to_str().unwrap()];
+    args.extend(limits);
+    let run = axcomp(args);
     assert_eq!(run.code, 0, "{}", run.stderr);
     let screenshot = artefacts().join("sample-x.png");
-    let browser = open_in_browser(&page, (1280, 2600), BrowserOutput::Screenshot(&screenshot));
+    // 2400 px: the page down to the plot's caption, verdict box included.
+    let browser = open_in_browser(&page, (1280, 2400), BrowserOutput::Screenshot(&screenshot));
     assert!(browser.console.is_empty(), "console: {:?}", browser.console);
     let shot = Pixels::read(&screenshot);
     let (inked, blue) = (shot.inked(), shot.blue());
@@ -479,13 +485,26 @@ fn the_sample_report_opens_in_chromium_without_errors_and_is_not_blank() {
         screenshot.display()
     );
     assert!(blue > 0.005, "no plot in {}: {blue}", screenshot.display());
+    // The FAIL box's red (#c81414 border and heading; the plot's orange has
+    // more green), above the test conditions. Measured: 0.003 of the pixels
+    // with the box, 0.0 for the same page without limits.
+    let red = shot.fraction(|r, g, b| r > 150 && g < 60 && b < 60);
+    assert!(
+        red > 0.0005,
+        "no red FAIL box in {}: {red}",
+        screenshot.display()
+    );
+    let at = |needle: &str| browser.dom.find(needle).unwrap();
+    assert!(at("data-verdict=\"fail\"") < at("id=\"conditions\""));
     // The browser parsed what was meant: one plot, 16 target rows, the data block intact.
     assert_eq!(browser.dom.matches("<svg").count(), 1);
     assert_eq!(
         browser.dom.matches("data-key=\"before.per_target.").count(),
         16 * 9
     );
-    let evaluation = evaluate_json(&[Path::new(SAMPLE)]);
+    let mut evaluate_args = vec![SAMPLE];
+    evaluate_args.extend(limits);
+    let evaluation = crate::verdict::evaluate_json_with(&evaluate_args);
     assert_eq!(embedded_data(&browser.dom)["before"], evaluation);
 }
 

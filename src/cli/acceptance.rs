@@ -1,0 +1,83 @@
+//! `--limit FIGURE=UM` and the machine profile's `[acceptance]` table, shared
+//! by `evaluate` and `report`: flags to the library's limits
+//! (`axcomp::evaluate::verdict`), which decide the verdict.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+use axcomp::evaluate::verdict::{
+    AcceptanceProfile, Figure, Limit, command_line_limits, with_overrides,
+};
+
+/// The acceptance flags.
+#[derive(Debug, Clone, clap::Args)]
+pub struct LimitArgs {
+    /// Permissible value of an ISO 230-2 figure, µm: FIGURE=UM, e.g. A=12 (repeat for several).
+    ///
+    /// FIGURE is a key of figures_um in evaluate --json: A, A_up, A_down, E,
+    /// E_up, E_down, M, R, R_up, R_down, B, B_mean (B_mean compares |B̄|).
+    /// Replaces the machine profile's [acceptance] limit for that figure. With
+    /// limits the output gets a PASS/FAIL verdict (simple acceptance: value ≤
+    /// limit); a figure that is not evaluated fails. The exit status stays 0:
+    /// a FAIL is a result, not an error.
+    #[arg(long = "limit", value_name = "FIGURE=UM", value_parser = parse_limit, help_heading = "Acceptance")]
+    pub limits: Vec<(Figure, f64)>,
+}
+
+/// `A=12`: a figure and a number of µm above 0.
+pub fn parse_limit(text: &str) -> Result<(Figure, f64), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected FIGURE=UM like A=12, found {text:?}"))?;
+    let name = name.trim();
+    let figure = Figure::from_name(name).ok_or_else(|| {
+        format!(
+            "unknown figure {name:?}; the figures are {}",
+            Figure::names()
+        )
+    })?;
+    let value: f64 = value
+        .trim()
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("expected a number of µm above 0 after {name}=, found {value:?}"))?;
+    Ok((figure, value))
+}
+
+/// The limits for `axis`: the profile's `[acceptance]` (if a profile is
+/// given), with the command line's on top. Empty: no verdict.
+pub fn load_limits(profile: Option<&Path>, axis: &str, args: &LimitArgs) -> Result<Vec<Limit>> {
+    let from_profile = match profile {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+            AcceptanceProfile::from_toml_str(&text)
+                .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?
+                .limits_for(axis, &path.display().to_string())
+        }
+        None => Vec::new(),
+    };
+    let from_command_line = command_line_limits(&args.limits)?;
+    Ok(with_overrides(from_profile, from_command_line))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn limits_parse_and_bad_ones_say_what_is_valid() {
+        assert_eq!(parse_limit("A=12").unwrap(), (Figure::A, 12.0));
+        assert_eq!(parse_limit("B_mean = 2.5").unwrap(), (Figure::BMean, 2.5));
+        let unknown = parse_limit("Q=3").unwrap_err();
+        assert!(unknown.contains("unknown figure \"Q\""), "{unknown}");
+        assert!(
+            unknown.contains("A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B, B_mean")
+        );
+        for bad in ["A=0", "A=-3", "A=inf", "A=NaN", "A=12um", "A="] {
+            assert!(parse_limit(bad).unwrap_err().contains("above 0"), "{bad}");
+        }
+        assert!(parse_limit("A12").unwrap_err().contains("FIGURE=UM"));
+    }
+}

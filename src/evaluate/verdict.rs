@@ -1,0 +1,873 @@
+//! The acceptance verdict: ISO 230-2 axis figures against permissible values.
+//!
+//! ISO 230-2 defines the figures but sets no limits: the permissible values
+//! come from the contract or a machine standard. They are given on the
+//! command line (`--limit A=12`, µm) or in a machine profile's `[acceptance]`
+//! table ([`AcceptanceProfile`]); command-line limits replace the profile's
+//! for the same figure ([`with_overrides`]). A limit is fixed or grows with
+//! the measured length ("10 µm per 1000 mm, at least 5 µm", as machine
+//! standards state tolerances for a measuring length); the length is the
+//! measured travel, last target − first target.
+//!
+//! The decision is simple acceptance (ISO 14253-1, `../shared/spec/standards.md`
+//! §5): a figure passes when its value is at most the limit, compared at full
+//! precision; the measurement uncertainty is not taken into account. A figure
+//! that is not evaluated (`None`, e.g. R of a one-run test) cannot pass: its
+//! check fails with [`Outcome::NotEvaluated`], never an implied pass. Without
+//! limits there is no verdict at all ([`verdict`] returns `None`).
+//!
+//! # The `[acceptance]` table
+//!
+//! ```toml
+//! [acceptance]
+//! A = { per_1000_mm_um = 10, min_um = 5 }  # 10 µm per 1000 mm of travel, at least 5 µm
+//! R = 4                                    # µm (the same as R = { um = 4 })
+//! B_mean = 2                               # compares |B̄|
+//!
+//! [acceptance.axes.X]                      # this axis only: replaces A above
+//! A = 12
+//! ```
+//!
+//! Keys are the figure names of `figures_um` in `evaluate --json`: A, A_up,
+//! A_down, E, E_up, E_down, M, R, R_up, R_down, B, B_mean. A value is a
+//! number of µm, or a table with either `um` (fixed) or `per_1000_mm_um` and
+//! optionally `min_um` (per length). Every value must be finite and above 0.
+//! Unknown keys are errors, at their line and column; `[acceptance.axes.NAME]`
+//! tables for axes other than the measured one are ignored (one profile
+//! serves the whole machine). Other top-level tables belong to other readers.
+//!
+//! Pure: no I/O. Lengths in mm inside; µm only at the TOML boundary, through
+//! `crate::units`.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use serde::Deserialize;
+use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
+
+use crate::error::ParseError;
+use crate::evaluate::{AxisFigures, Evaluation};
+use crate::units::um_to_mm;
+
+/// An ISO 230-2 axis figure a limit can be set on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Figure {
+    /// Bidirectional accuracy of positioning A.
+    A,
+    /// Unidirectional accuracy A↑.
+    AUp,
+    /// Unidirectional accuracy A↓.
+    ADown,
+    /// Bidirectional systematic positional deviation E.
+    E,
+    /// E↑.
+    EUp,
+    /// E↓.
+    EDown,
+    /// Mean bidirectional positional deviation M.
+    M,
+    /// Bidirectional repeatability R.
+    R,
+    /// R↑.
+    RUp,
+    /// R↓.
+    RDown,
+    /// Reversal value B = max |B_i|.
+    B,
+    /// Mean reversal value B̄, compared as |B̄|.
+    BMean,
+}
+
+impl Figure {
+    /// Every figure, in the order of `figures_um`.
+    pub const ALL: [Figure; 12] = [
+        Figure::A,
+        Figure::AUp,
+        Figure::ADown,
+        Figure::E,
+        Figure::EUp,
+        Figure::EDown,
+        Figure::M,
+        Figure::R,
+        Figure::RUp,
+        Figure::RDown,
+        Figure::B,
+        Figure::BMean,
+    ];
+
+    /// The name, as the key in `figures_um` of `evaluate --json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Figure::A => "A",
+            Figure::AUp => "A_up",
+            Figure::ADown => "A_down",
+            Figure::E => "E",
+            Figure::EUp => "E_up",
+            Figure::EDown => "E_down",
+            Figure::M => "M",
+            Figure::R => "R",
+            Figure::RUp => "R_up",
+            Figure::RDown => "R_down",
+            Figure::B => "B",
+            Figure::BMean => "B_mean",
+        }
+    }
+
+    /// The figure of a name (exactly as [`Figure::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Figure> {
+        Figure::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// Every name, comma-separated, for error messages.
+    pub fn names() -> String {
+        Figure::ALL.map(Figure::name).join(", ")
+    }
+
+    /// The value a limit is compared with, mm: the figure, except |B̄| for
+    /// B_mean (the signed mean reversal is a direction, its size is the
+    /// error). `None` when the figure is not evaluated.
+    pub fn value_mm(self, figures: &AxisFigures) -> Option<f64> {
+        match self {
+            Figure::A => figures.a_mm,
+            Figure::AUp => figures.a_up_mm,
+            Figure::ADown => figures.a_down_mm,
+            Figure::E => figures.e_mm,
+            Figure::EUp => figures.e_up_mm,
+            Figure::EDown => figures.e_down_mm,
+            Figure::M => figures.m_mm,
+            Figure::R => figures.r_mm,
+            Figure::RUp => figures.r_up_mm,
+            Figure::RDown => figures.r_down_mm,
+            Figure::B => figures.b_mm,
+            Figure::BMean => figures.b_mean_mm.map(f64::abs),
+        }
+    }
+}
+
+impl fmt::Display for Figure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How large a figure may be.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Permissible {
+    /// A fixed value, mm.
+    Fixed {
+        /// The permissible value, mm.
+        limit_mm: f64,
+    },
+    /// Proportional to the measured travel, with an optional floor.
+    PerLength {
+        /// Permissible value per 1000 mm of travel, mm.
+        per_1000_mm_mm: f64,
+        /// The limit is never below this, mm.
+        min_mm: Option<f64>,
+    },
+}
+
+impl Permissible {
+    /// The limit for a measured travel, mm: `per_1000_mm · travel / 1000 mm`,
+    /// raised to the minimum.
+    pub fn limit_mm(&self, travel_mm: f64) -> f64 {
+        match *self {
+            Permissible::Fixed { limit_mm } => limit_mm,
+            Permissible::PerLength {
+                per_1000_mm_mm,
+                min_mm,
+            } => {
+                let proportional = per_1000_mm_mm * travel_mm / 1000.0;
+                proportional.max(min_mm.unwrap_or(0.0))
+            }
+        }
+    }
+
+    /// Whether the minimum, not the proportional part, sets the limit.
+    pub fn minimum_applies(&self, travel_mm: f64) -> bool {
+        match *self {
+            Permissible::Fixed { .. } => false,
+            Permissible::PerLength {
+                per_1000_mm_mm,
+                min_mm,
+            } => min_mm.is_some_and(|min| min > per_1000_mm_mm * travel_mm / 1000.0),
+        }
+    }
+}
+
+/// Where a limit was given.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LimitSource {
+    /// `--limit` on the command line.
+    CommandLine,
+    /// A machine profile's `[acceptance]` table, or its
+    /// `[acceptance.axes.NAME]` table when `axis` is set.
+    Profile {
+        /// The profile, as the user named it.
+        file: String,
+        /// The axis table the limit came from; `None` for `[acceptance]`.
+        axis: Option<String>,
+    },
+}
+
+impl fmt::Display for LimitSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LimitSource::CommandLine => f.write_str("--limit"),
+            LimitSource::Profile { file, axis: None } => write!(f, "{file} [acceptance]"),
+            LimitSource::Profile {
+                file,
+                axis: Some(axis),
+            } => write!(f, "{file} [acceptance.axes.{axis}]"),
+        }
+    }
+}
+
+/// A permissible value of one figure and where it came from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limit {
+    /// The figure it limits.
+    pub figure: Figure,
+    /// How large the figure may be.
+    pub permissible: Permissible,
+    /// Where it was given.
+    pub source: LimitSource,
+}
+
+/// Why a limit is refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LimitError {
+    /// The same figure twice on the command line.
+    #[error("--limit {0} is given twice")]
+    Twice(Figure),
+    /// Zero, negative or not finite.
+    #[error("the limit of {figure} must be a number of µm above 0, found {value_um}")]
+    NotPositive {
+        /// The figure.
+        figure: Figure,
+        /// The value given, µm.
+        value_um: f64,
+    },
+}
+
+/// The limits given on the command line as (figure, µm): fixed values.
+/// A figure given twice, or a value that is not above 0, is refused.
+pub fn command_line_limits(limits: &[(Figure, f64)]) -> Result<Vec<Limit>, LimitError> {
+    let mut out: Vec<Limit> = Vec::with_capacity(limits.len());
+    for &(figure, value_um) in limits {
+        if !(value_um.is_finite() && value_um > 0.0) {
+            return Err(LimitError::NotPositive { figure, value_um });
+        }
+        if out.iter().any(|l| l.figure == figure) {
+            return Err(LimitError::Twice(figure));
+        }
+        out.push(Limit {
+            figure,
+            permissible: Permissible::Fixed {
+                limit_mm: um_to_mm(value_um),
+            },
+            source: LimitSource::CommandLine,
+        });
+    }
+    Ok(out)
+}
+
+/// `base` with every figure of `overrides` replaced (or added): how
+/// command-line limits override a profile's, and an axis table the general one.
+/// The result is in [`Figure::ALL`] order.
+pub fn with_overrides(base: Vec<Limit>, overrides: Vec<Limit>) -> Vec<Limit> {
+    let mut by_figure: BTreeMap<Figure, Limit> = BTreeMap::new();
+    for limit in base.into_iter().chain(overrides) {
+        by_figure.insert(limit.figure, limit);
+    }
+    by_figure.into_values().collect()
+}
+
+/// How a check came out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// The value is at most the limit.
+    Pass,
+    /// The value is above the limit.
+    Exceeds,
+    /// The figure is not evaluated for this test: it cannot pass.
+    NotEvaluated,
+}
+
+/// One figure compared with its limit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Check {
+    /// The limit, as given.
+    pub limit: Limit,
+    /// The value compared (|B̄| for B_mean), mm; `None` when not evaluated.
+    pub value_mm: Option<f64>,
+    /// The limit for this test's travel, mm.
+    pub limit_mm: f64,
+    /// The outcome.
+    pub outcome: Outcome,
+}
+
+impl Check {
+    /// The figure checked.
+    pub fn figure(&self) -> Figure {
+        self.limit.figure
+    }
+
+    /// Whether the figure passed.
+    pub fn pass(&self) -> bool {
+        self.outcome == Outcome::Pass
+    }
+}
+
+/// The verdict on one test.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verdict {
+    /// One check per limit, in [`Figure::ALL`] order.
+    pub checks: Vec<Check>,
+    /// The measured travel per-length limits use: last − first target, mm.
+    pub travel_mm: f64,
+}
+
+impl Verdict {
+    /// Pass: every check passed (and there is at least one).
+    pub fn pass(&self) -> bool {
+        !self.checks.is_empty() && self.checks.iter().all(Check::pass)
+    }
+
+    /// The checks that did not pass.
+    pub fn failed(&self) -> impl Iterator<Item = &Check> {
+        self.checks.iter().filter(|c| !c.pass())
+    }
+}
+
+/// Compares the figures of an evaluation with the limits; `None` without
+/// limits (no limits, no verdict).
+///
+/// # Example
+/// ```
+/// use axcomp::evaluate::evaluate;
+/// use axcomp::evaluate::verdict::{Figure, command_line_limits, verdict};
+/// use axcomp::measurement::{Direction, Measurement, Run};
+/// let run = |direction, number, values: [f64; 2]| Run {
+///     direction, number, start_time_s: None,
+///     deviations_mm: values.iter().map(|v| Some(*v)).collect() };
+/// let m = Measurement::new("X", vec![0.0, 100.0], vec![
+///     run(Direction::Up, 1, [0.000, 0.004]), run(Direction::Down, 1, [-0.002, 0.002]),
+///     run(Direction::Up, 2, [0.002, 0.006]), run(Direction::Down, 2, [0.000, 0.004]),
+/// ], Default::default(), Default::default()).unwrap();
+/// // E = 5 − (−1) = 6 µm, B = 2 µm.
+/// let limits = command_line_limits(&[(Figure::E, 5.0), (Figure::B, 2.0)]).unwrap();
+/// let v = verdict(&evaluate(&m), &limits).unwrap();
+/// assert!(!v.pass());
+/// assert_eq!(v.failed().map(|c| c.figure()).collect::<Vec<_>>(), [Figure::E]);
+/// assert!(verdict(&evaluate(&m), &[]).is_none());
+/// ```
+pub fn verdict(evaluation: &Evaluation, limits: &[Limit]) -> Option<Verdict> {
+    if limits.is_empty() {
+        return None;
+    }
+    let travel_mm = match (evaluation.per_target.first(), evaluation.per_target.last()) {
+        (Some(first), Some(last)) => last.target_mm - first.target_mm,
+        _ => 0.0,
+    };
+    let mut ordered: Vec<&Limit> = limits.iter().collect();
+    ordered.sort_by_key(|l| l.figure);
+    let checks = ordered
+        .into_iter()
+        .map(|limit| {
+            let value_mm = limit.figure.value_mm(&evaluation.figures);
+            let limit_mm = limit.permissible.limit_mm(travel_mm);
+            let outcome = match value_mm {
+                None => Outcome::NotEvaluated,
+                Some(value) if value <= limit_mm => Outcome::Pass,
+                Some(_) => Outcome::Exceeds,
+            };
+            Check {
+                limit: limit.clone(),
+                value_mm,
+                limit_mm,
+                outcome,
+            }
+        })
+        .collect();
+    Some(Verdict { checks, travel_mm })
+}
+
+/// The `[acceptance]` table of a machine profile (see the module doc).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AcceptanceProfile {
+    /// `[acceptance]`: for every axis.
+    pub general: Vec<(Figure, Permissible)>,
+    /// `[acceptance.axes.NAME]`: for one axis, replacing the general ones.
+    pub axes: BTreeMap<String, Vec<(Figure, Permissible)>>,
+}
+
+impl AcceptanceProfile {
+    /// Reads the `[acceptance]` table of a machine profile; an empty profile
+    /// when the file has none. Errors carry the line and column.
+    ///
+    /// # Example
+    /// ```
+    /// use axcomp::evaluate::verdict::{AcceptanceProfile, Figure};
+    /// let text = "[acceptance]\nA = { per_1000_mm_um = 10, min_um = 5 }\nR = 4\n\
+    ///             [acceptance.axes.X]\nA = 12\n";
+    /// let profile = AcceptanceProfile::from_toml_str(text).unwrap();
+    /// let limits = profile.limits_for("X", "m.toml");
+    /// assert_eq!(limits.len(), 2);
+    /// // X's own A replaces the general one: 12 µm at any travel.
+    /// assert!((limits[0].permissible.limit_mm(750.0) - 0.012).abs() < 1e-15);
+    /// let error = AcceptanceProfile::from_toml_str("[acceptance]\nQ = 3\n").unwrap_err();
+    /// assert_eq!(error.position.line, 2);
+    /// ```
+    pub fn from_toml_str(text: &str) -> Result<AcceptanceProfile, ParseError> {
+        let raw: RawFile = toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e))?;
+        let Some(acceptance) = raw.acceptance else {
+            return Ok(AcceptanceProfile::default());
+        };
+        Ok(AcceptanceProfile {
+            general: acceptance.figures,
+            axes: acceptance.axes,
+        })
+    }
+
+    /// Whether the profile sets no limit at all.
+    pub fn is_empty(&self) -> bool {
+        self.general.is_empty() && self.axes.values().all(Vec::is_empty)
+    }
+
+    /// The limits for one axis: the general ones, replaced per figure by the
+    /// axis table's. `file` names the profile in the limits' source.
+    pub fn limits_for(&self, axis: &str, file: &str) -> Vec<Limit> {
+        let limits = |entries: &[(Figure, Permissible)], axis: Option<&str>| -> Vec<Limit> {
+            entries
+                .iter()
+                .map(|&(figure, permissible)| Limit {
+                    figure,
+                    permissible,
+                    source: LimitSource::Profile {
+                        file: file.to_string(),
+                        axis: axis.map(str::to_string),
+                    },
+                })
+                .collect()
+        };
+        let general = limits(&self.general, None);
+        let own = self
+            .axes
+            .get(axis)
+            .map(|entries| limits(entries, Some(axis)))
+            .unwrap_or_default();
+        with_overrides(general, own)
+    }
+}
+
+// --- TOML -------------------------------------------------------------------
+//
+// Hand-written visitors so that every error names the key or value it is
+// about: toml attaches the span of the key (unknown figure or key) or of the
+// value (bad number) to an error raised while deserialising it.
+
+/// The whole file: only `[acceptance]`; other tables belong to other readers.
+#[derive(Deserialize)]
+struct RawFile {
+    acceptance: Option<RawLimits<true>>,
+}
+
+/// A figure table; `AXES` allows the `axes` key (only in `[acceptance]`).
+struct RawLimits<const AXES: bool> {
+    figures: Vec<(Figure, Permissible)>,
+    axes: BTreeMap<String, Vec<(Figure, Permissible)>>,
+}
+
+impl<'de, const AXES: bool> Deserialize<'de> for RawLimits<AXES> {
+    fn deserialize<D: de::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_map(LimitsVisitor::<AXES>)
+    }
+}
+
+struct LimitsVisitor<const AXES: bool>;
+
+impl<'de, const AXES: bool> Visitor<'de> for LimitsVisitor<AXES> {
+    type Value = RawLimits<AXES>;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a table of figure limits")
+    }
+
+    fn visit_map<M: MapAccess<'de>>(self, mut map: M) -> Result<Self::Value, M::Error> {
+        let mut out = RawLimits {
+            figures: Vec::new(),
+            axes: BTreeMap::new(),
+        };
+        while let Some(key) = map.next_key_seed(KeySeed { axes: AXES })? {
+            match key {
+                Key::Figure(figure) => {
+                    let RawPermissible(permissible) = map.next_value()?;
+                    out.figures.push((figure, permissible));
+                }
+                Key::Axes => {
+                    let axes: BTreeMap<String, RawLimits<false>> = map.next_value()?;
+                    out.axes = axes.into_iter().map(|(k, v)| (k, v.figures)).collect();
+                }
+            }
+        }
+        out.figures.sort_by_key(|(figure, _)| *figure);
+        Ok(out)
+    }
+}
+
+enum Key {
+    Figure(Figure),
+    Axes,
+}
+
+/// Reads a key of a figure table: a figure name, or `axes` where allowed.
+struct KeySeed {
+    axes: bool,
+}
+
+impl<'de> DeserializeSeed<'de> for KeySeed {
+    type Value = Key;
+
+    fn deserialize<D: de::Deserializer<'de>>(self, deserializer: D) -> Result<Key, D::Error> {
+        deserializer.deserialize_str(self)
+    }
+}
+
+impl Visitor<'_> for KeySeed {
+    type Value = Key;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a figure name")
+    }
+
+    fn visit_str<E: de::Error>(self, name: &str) -> Result<Key, E> {
+        if let Some(figure) = Figure::from_name(name) {
+            return Ok(Key::Figure(figure));
+        }
+        if self.axes && name == "axes" {
+            return Ok(Key::Axes);
+        }
+        let axes = if self.axes {
+            " (or [acceptance.axes.NAME])"
+        } else {
+            ""
+        };
+        Err(E::custom(format!(
+            "unknown figure `{name}`; expected one of {}{axes}",
+            Figure::names()
+        )))
+    }
+}
+
+/// A limit: a number of µm, or `{ um = … }`, or `{ per_1000_mm_um = …, min_um = … }`.
+struct RawPermissible(Permissible);
+
+impl<'de> Deserialize<'de> for RawPermissible {
+    fn deserialize<D: de::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(PermissibleVisitor)
+    }
+}
+
+struct PermissibleVisitor;
+
+impl<'de> Visitor<'de> for PermissibleVisitor {
+    type Value = RawPermissible;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(
+            "a number of µm above 0, or a table { um = … } or { per_1000_mm_um = …, min_um = … }",
+        )
+    }
+
+    fn visit_i64<E: de::Error>(self, value: i64) -> Result<RawPermissible, E> {
+        self.visit_f64(value as f64)
+    }
+
+    fn visit_u64<E: de::Error>(self, value: u64) -> Result<RawPermissible, E> {
+        self.visit_f64(value as f64)
+    }
+
+    fn visit_f64<E: de::Error>(self, value: f64) -> Result<RawPermissible, E> {
+        Ok(RawPermissible(Permissible::Fixed {
+            limit_mm: um_to_mm(positive_um(value)?),
+        }))
+    }
+
+    fn visit_map<M: MapAccess<'de>>(self, map: M) -> Result<RawPermissible, M::Error> {
+        let table = RawPermissibleTable::deserialize(de::value::MapAccessDeserializer::new(map))?;
+        let permissible = match (table.um, table.per_1000_mm_um, table.min_um) {
+            (Some(Um(um)), None, None) => Permissible::Fixed {
+                limit_mm: um_to_mm(um),
+            },
+            (None, Some(Um(per)), min) => Permissible::PerLength {
+                per_1000_mm_mm: um_to_mm(per),
+                min_mm: min.map(|Um(m)| um_to_mm(m)),
+            },
+            (Some(_), _, _) => {
+                return Err(de::Error::custom(
+                    "give either um (fixed) or per_1000_mm_um (per length, with min_um), not both",
+                ));
+            }
+            (None, None, _) => {
+                return Err(de::Error::custom(
+                    "expected um (fixed) or per_1000_mm_um (per length, optionally with min_um)",
+                ));
+            }
+        };
+        Ok(RawPermissible(permissible))
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPermissibleTable {
+    um: Option<Um>,
+    per_1000_mm_um: Option<Um>,
+    min_um: Option<Um>,
+}
+
+/// A number of µm above 0, integer or not.
+struct Um(f64);
+
+impl<'de> Deserialize<'de> for Um {
+    fn deserialize<D: de::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct UmVisitor;
+        impl Visitor<'_> for UmVisitor {
+            type Value = Um;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a number of µm above 0")
+            }
+            fn visit_i64<E: de::Error>(self, value: i64) -> Result<Um, E> {
+                self.visit_f64(value as f64)
+            }
+            fn visit_u64<E: de::Error>(self, value: u64) -> Result<Um, E> {
+                self.visit_f64(value as f64)
+            }
+            fn visit_f64<E: de::Error>(self, value: f64) -> Result<Um, E> {
+                positive_um(value).map(Um)
+            }
+        }
+        deserializer.deserialize_any(UmVisitor)
+    }
+}
+
+fn positive_um<E: de::Error>(value: f64) -> Result<f64, E> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(E::custom(format!(
+            "expected a number of µm above 0, found {value}"
+        )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evaluate::TargetStats;
+    use crate::units::mm_to_um;
+
+    fn evaluation(first_mm: f64, last_mm: f64, figures: AxisFigures) -> Evaluation {
+        let target = |target_mm| TargetStats {
+            target_mm,
+            up: Default::default(),
+            down: Default::default(),
+            mean_mm: None,
+            reversal_mm: None,
+            repeatability_up_mm: None,
+            repeatability_down_mm: None,
+            repeatability_mm: None,
+        };
+        Evaluation {
+            per_target: vec![target(first_mm), target(last_mm)],
+            figures,
+            runs_up: 5,
+            runs_down: 5,
+            outliers: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    fn per_length(per_um: f64, min_um: Option<f64>) -> Permissible {
+        Permissible::PerLength {
+            per_1000_mm_mm: um_to_mm(per_um),
+            min_mm: min_um.map(um_to_mm),
+        }
+    }
+
+    #[test]
+    fn per_length_limits_by_hand() {
+        // 10 µm per 1000 mm over 750 mm: 10 · 750 / 1000 = 7.5 µm.
+        let rule = per_length(10.0, None);
+        assert!((mm_to_um(rule.limit_mm(750.0)) - 7.5).abs() < 1e-12);
+        // With a 5 µm minimum over 200 mm: 10 · 0.2 = 2 µm, raised to 5 µm.
+        let rule = per_length(10.0, Some(5.0));
+        assert!((mm_to_um(rule.limit_mm(200.0)) - 5.0).abs() < 1e-12);
+        assert!(rule.minimum_applies(200.0));
+        // … and over 750 mm the proportional 7.5 µm is above the minimum.
+        assert!((mm_to_um(rule.limit_mm(750.0)) - 7.5).abs() < 1e-12);
+        assert!(!rule.minimum_applies(750.0));
+        // A fixed limit ignores the travel.
+        let fixed = Permissible::Fixed { limit_mm: 0.012 };
+        assert_eq!(fixed.limit_mm(10_000.0), 0.012);
+    }
+
+    #[test]
+    fn the_verdict_uses_the_travel_and_fails_what_is_not_evaluated() {
+        // A = 7 µm over 750 mm against 10 µm/1000 mm (7.5 µm): pass.
+        // R not evaluated (one run): a failed check, never an implied pass.
+        // B̄ = −3 µm against 2 µm: |B̄| = 3 µm exceeds.
+        let figures = AxisFigures {
+            a_mm: Some(0.007),
+            b_mean_mm: Some(-0.003),
+            ..Default::default()
+        };
+        let evaluation = evaluation(100.0, 850.0, figures);
+        let profile = [
+            Limit {
+                figure: Figure::BMean,
+                permissible: Permissible::Fixed { limit_mm: 0.002 },
+                source: LimitSource::CommandLine,
+            },
+            Limit {
+                figure: Figure::A,
+                permissible: per_length(10.0, Some(5.0)),
+                source: LimitSource::CommandLine,
+            },
+            Limit {
+                figure: Figure::R,
+                permissible: Permissible::Fixed { limit_mm: 0.004 },
+                source: LimitSource::CommandLine,
+            },
+        ];
+        let v = verdict(&evaluation, &profile).unwrap();
+        assert_eq!(v.travel_mm, 750.0);
+        let outcomes: Vec<(Figure, Outcome)> =
+            v.checks.iter().map(|c| (c.figure(), c.outcome)).collect();
+        assert_eq!(
+            outcomes,
+            [
+                (Figure::A, Outcome::Pass),
+                (Figure::R, Outcome::NotEvaluated),
+                (Figure::BMean, Outcome::Exceeds),
+            ]
+        );
+        assert!((mm_to_um(v.checks[0].limit_mm) - 7.5).abs() < 1e-12);
+        assert_eq!(v.checks[2].value_mm, Some(0.003));
+        assert!(!v.pass());
+        // Only A: pass. A value equal to its limit passes (F ≤ T).
+        let only_a = verdict(&evaluation, &profile[1..2]).unwrap();
+        assert!(only_a.pass());
+        let exact = command_line_limits(&[(Figure::A, 7.0)]).unwrap();
+        assert!(verdict(&evaluation, &exact).unwrap().pass());
+        let below = command_line_limits(&[(Figure::A, 6.99)]).unwrap();
+        assert!(!verdict(&evaluation, &below).unwrap().pass());
+        // No limits, no verdict.
+        assert_eq!(verdict(&evaluation, &[]), None);
+    }
+
+    #[test]
+    fn command_line_limits_are_checked_and_override_the_profile() {
+        assert_eq!(
+            command_line_limits(&[(Figure::A, 12.0), (Figure::A, 14.0)]),
+            Err(LimitError::Twice(Figure::A))
+        );
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(command_line_limits(&[(Figure::R, bad)]).is_err(), "{bad}");
+        }
+        let profile = AcceptanceProfile::from_toml_str("[acceptance]\nA = 10\nR = 4\n")
+            .unwrap()
+            .limits_for("X", "p.toml");
+        let cli = command_line_limits(&[(Figure::A, 14.0)]).unwrap();
+        let merged = with_overrides(profile, cli);
+        assert_eq!(merged.len(), 2);
+        assert_eq!(merged[0].source, LimitSource::CommandLine);
+        assert_eq!(
+            merged[0].permissible,
+            Permissible::Fixed {
+                limit_mm: um_to_mm(14.0)
+            }
+        );
+        assert_eq!(merged[1].source.to_string(), "p.toml [acceptance]");
+    }
+
+    #[test]
+    fn the_acceptance_table() {
+        let text = "name = \"M\"\n[controller]\nunits = \"mm\"\n\n[acceptance]\n\
+                    A = { per_1000_mm_um = 10, min_um = 5 }\nR = 4.5\nB_mean = { um = 2 }\n\n\
+                    [acceptance.axes.X]\nA = 12\n\n[acceptance.axes.Y]\nE = 3\n";
+        let profile = AcceptanceProfile::from_toml_str(text).unwrap();
+        assert_eq!(
+            profile.general,
+            [
+                (Figure::A, per_length(10.0, Some(5.0))),
+                (Figure::R, Permissible::Fixed { limit_mm: 0.0045 }),
+                (Figure::BMean, Permissible::Fixed { limit_mm: 0.002 }),
+            ]
+        );
+        let x = profile.limits_for("X", "m.toml");
+        let figures: Vec<Figure> = x.iter().map(|l| l.figure).collect();
+        assert_eq!(figures, [Figure::A, Figure::R, Figure::BMean]);
+        assert_eq!(x[0].source.to_string(), "m.toml [acceptance.axes.X]");
+        assert_eq!(x[1].source.to_string(), "m.toml [acceptance]");
+        // Z has no table of its own: the general limits.
+        let z = profile.limits_for("Z", "m.toml");
+        assert_eq!(z[0].permissible, per_length(10.0, Some(5.0)));
+        // No [acceptance]: empty, no error (a profile may have only [controller]).
+        assert!(
+            AcceptanceProfile::from_toml_str("[controller]\nunits = \"mm\"\n")
+                .unwrap()
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn acceptance_errors_name_line_and_column() {
+        let check = |text: &str, line: usize, column: usize, needle: &str| {
+            let error = AcceptanceProfile::from_toml_str(text).unwrap_err();
+            assert_eq!(
+                (error.position.line, error.position.column),
+                (line, column),
+                "{text:?}: {error}"
+            );
+            assert!(error.message.contains(needle), "{text:?}: {error}");
+        };
+        check(
+            "[acceptance]\nA = 3\nQ = 3\n",
+            3,
+            1,
+            "unknown figure `Q`; expected one of A, A_up, A_down",
+        );
+        check("[acceptance]\nR = -4\n", 2, 5, "above 0, found -4");
+        check("[acceptance]\nR = 0\n", 2, 5, "above 0, found 0");
+        check("[acceptance]\nR = nan\n", 2, 5, "above 0, found NaN");
+        check("[acceptance]\nR = \"4\"\n", 2, 5, "number of µm above 0");
+        check(
+            "[acceptance]\nA = { per_m_um = 10 }\n",
+            2,
+            7,
+            "unknown field `per_m_um`",
+        );
+        check(
+            "[acceptance]\nA = { um = 3, per_1000_mm_um = 10 }\n",
+            2,
+            5,
+            "not both",
+        );
+        check("[acceptance]\nA = { min_um = 5 }\n", 2, 5, "per_1000_mm_um");
+        check(
+            "[acceptance]\nA = { per_1000_mm_um = 10, min_um = -5 }\n",
+            2,
+            37,
+            "above 0",
+        );
+        check(
+            "[acceptance.axes.X]\naxes = 3\n",
+            2,
+            1,
+            "unknown figure `axes`",
+        );
+        check("[acceptance.axes.X]\nA = 0\n", 2, 5, "above 0");
+    }
+}

@@ -1,0 +1,450 @@
+//! The acceptance verdict as users and scripts read it: its `--json` wire
+//! format ([`VerdictJson`], the `verdict` key of `evaluate --json`), its
+//! terminal lines ([`terminal`]) and the report's verdict box ([`html_box`]).
+//!
+//! # Wire format
+//!
+//! Present only when acceptance limits are given (no limits, no verdict, and
+//! no `verdict` key); keys may be added, never renamed:
+//!
+//! ```text
+//! "verdict": { "pass": false, "decision": "simple acceptance", "travel_mm": 750.0,
+//!   "failed": ["A"],
+//!   "checks": [{ "figure": "A", "value_um": 13.19, "limit_um": 12.0, "pass": false,
+//!                "outcome": "exceeds",            // or "pass", "not evaluated"
+//!                "reason": "13.19 µm is above the limit 12 µm",   // null when it passes
+//!                "limit_source": "--limit",       // or "M.toml [acceptance]", "M.toml [acceptance.axes.X]"
+//!                "limit_derivation": "12 µm" }, …] }
+//! ```
+//!
+//! `value_um` is the value compared: the figure, |B̄| for `B_mean`, `null`
+//! when not evaluated (such a check fails). Checks come in the order of
+//! `figures_um`.
+
+use std::fmt::Write;
+
+use serde::Serialize;
+
+use crate::evaluate::Evaluation;
+use crate::evaluate::verdict::{Check, Limit, Outcome, Permissible, Verdict, verdict};
+use crate::report::acceptance::ReportInput;
+use crate::report::html::esc;
+use crate::report::terminal::um;
+use crate::units::mm_to_um;
+
+/// The decision rule (ISO 14253-1 "simple acceptance", `../shared/spec/standards.md` §5).
+pub const DECISION: &str = "simple acceptance";
+
+/// The verdict on an evaluation as JSON; `None` without limits.
+pub fn judge(evaluation: &Evaluation, limits: &[Limit]) -> Option<VerdictJson> {
+    verdict(evaluation, limits).map(|v| VerdictJson::from_verdict(&v))
+}
+
+/// The verdict on one test.
+#[derive(Clone, Debug, Serialize)]
+pub struct VerdictJson {
+    /// Every check passed.
+    pub pass: bool,
+    /// The decision rule: `simple acceptance` (value ≤ limit, uncertainty not considered).
+    pub decision: &'static str,
+    /// The measured travel per-length limits use, last − first target, mm.
+    pub travel_mm: f64,
+    /// The figures that did not pass, in check order.
+    pub failed: Vec<&'static str>,
+    /// One per limit.
+    pub checks: Vec<CheckJson>,
+}
+
+/// One figure against its limit.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckJson {
+    /// The figure, as in `figures_um`.
+    pub figure: &'static str,
+    /// The value compared, µm (|B̄| for B_mean); `null` when not evaluated.
+    pub value_um: Option<f64>,
+    /// The limit for this test, µm.
+    pub limit_um: f64,
+    /// Whether it passed.
+    pub pass: bool,
+    /// `pass`, `exceeds` or `not evaluated`.
+    pub outcome: &'static str,
+    /// Why it did not pass; `null` when it passed.
+    pub reason: Option<String>,
+    /// Where the limit was given.
+    pub limit_source: String,
+    /// How the limit for this test follows from what was given.
+    pub limit_derivation: String,
+}
+
+impl VerdictJson {
+    /// Converts a verdict to µm and sentences.
+    pub fn from_verdict(verdict: &Verdict) -> VerdictJson {
+        VerdictJson {
+            pass: verdict.pass(),
+            decision: DECISION,
+            travel_mm: verdict.travel_mm,
+            failed: verdict.failed().map(|c| c.figure().name()).collect(),
+            checks: verdict
+                .checks
+                .iter()
+                .map(|c| CheckJson::from_check(c, verdict.travel_mm))
+                .collect(),
+        }
+    }
+}
+
+impl CheckJson {
+    fn from_check(check: &Check, travel_mm: f64) -> CheckJson {
+        let figure = check.figure();
+        let limit_um = mm_to_um(check.limit_mm);
+        let value_um = check.value_mm.map(mm_to_um);
+        let reason = match (check.outcome, value_um) {
+            (Outcome::Pass, _) => None,
+            (Outcome::Exceeds, Some(value)) => Some(format!(
+                "{} µm is above the limit {} µm",
+                um(Some(value)),
+                short(limit_um)
+            )),
+            _ => Some(format!(
+                "{figure} is not evaluated for this test (see the warnings); \
+                 a figure that is not evaluated cannot pass"
+            )),
+        };
+        CheckJson {
+            figure: figure.name(),
+            value_um,
+            limit_um,
+            pass: check.pass(),
+            outcome: match check.outcome {
+                Outcome::Pass => "pass",
+                Outcome::Exceeds => "exceeds",
+                Outcome::NotEvaluated => "not evaluated",
+            },
+            reason,
+            limit_source: check.limit.source.to_string(),
+            limit_derivation: derivation(&check.limit.permissible, travel_mm),
+        }
+    }
+}
+
+/// A µm or mm number without trailing zeros, to three decimals: 7.5, 12, 0.125.
+fn short(value: f64) -> String {
+    let text = format!("{value:.3}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
+}
+
+/// "12 µm", or "10 µm per 1000 mm × 750 mm of travel = 7.5 µm (at least 5 µm)".
+fn derivation(permissible: &Permissible, travel_mm: f64) -> String {
+    match *permissible {
+        Permissible::Fixed { limit_mm } => format!("{} µm", short(mm_to_um(limit_mm))),
+        Permissible::PerLength {
+            per_1000_mm_mm,
+            min_mm,
+        } => {
+            let proportional = mm_to_um(per_1000_mm_mm * travel_mm / 1000.0);
+            let base = format!(
+                "{} µm per 1000 mm × {} mm of travel = {} µm",
+                short(mm_to_um(per_1000_mm_mm)),
+                short(travel_mm),
+                short(proportional)
+            );
+            match min_mm {
+                None => base,
+                Some(min) if permissible.minimum_applies(travel_mm) => {
+                    format!("{base}, raised to the minimum {} µm", short(mm_to_um(min)))
+                }
+                Some(min) => format!("{base} (at least {} µm)", short(mm_to_um(min))),
+            }
+        }
+    }
+}
+
+/// The one-line verdict: `PASS: A, R within their limits` or
+/// `FAIL: A above its limit; R not evaluated`.
+pub fn headline(verdict: &VerdictJson) -> String {
+    let figures = |checks: &[&CheckJson]| {
+        checks
+            .iter()
+            .map(|c| c.figure)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if verdict.pass {
+        let all: Vec<&CheckJson> = verdict.checks.iter().collect();
+        return format!("PASS: {} within the limits", figures(&all));
+    }
+    let of = |outcome: &str| -> Vec<&CheckJson> {
+        verdict
+            .checks
+            .iter()
+            .filter(|c| c.outcome == outcome)
+            .collect()
+    };
+    let mut parts = Vec::new();
+    let exceeds = of("exceeds");
+    if !exceeds.is_empty() {
+        parts.push(format!("{} above the limit", figures(&exceeds)));
+    }
+    let missing = of("not evaluated");
+    if !missing.is_empty() {
+        parts.push(format!("{} not evaluated (cannot pass)", figures(&missing)));
+    }
+    format!("FAIL: {}", parts.join("; "))
+}
+
+/// The terminal lines of `evaluate`: the checks and the verdict line.
+pub fn terminal(verdict: &VerdictJson) -> String {
+    use tabled::builder::Builder;
+    use tabled::settings::object::Columns;
+    use tabled::settings::{Alignment, Style};
+
+    let mut builder = Builder::default();
+    builder.push_record(["figure", "value", "limit", "result", "limit from"]);
+    for c in &verdict.checks {
+        builder.push_record([
+            c.figure.to_string(),
+            um(c.value_um),
+            um(Some(c.limit_um)),
+            result_word(c).to_string(),
+            format!("{}: {}", c.limit_source, c.limit_derivation),
+        ]);
+    }
+    let mut table = builder.build();
+    table
+        .with(Style::psql())
+        .modify(Columns::new(1..3), Alignment::right());
+    format!(
+        "\nAcceptance [µm] ({DECISION}: value ≤ limit, measurement uncertainty not considered)\n\
+         {table}\n{}\n",
+        headline(verdict)
+    )
+}
+
+fn result_word(check: &CheckJson) -> &'static str {
+    match check.outcome {
+        "pass" => "pass",
+        "exceeds" => "FAIL",
+        _ => "FAIL (not evaluated)",
+    }
+}
+
+/// The report's verdict box, at the top: the verdict on the re-test when
+/// there is one (the state being accepted), else on the test.
+pub fn html_section(out: &mut String, input: &ReportInput<'_>) {
+    let name = |what: &str, test: &crate::report::acceptance::TestRecord<'_>| match &test
+        .measurement
+        .metadata
+        .source_file
+    {
+        Some(file) => format!("{what} {}", file.display()),
+        None => what.to_string(),
+    };
+    let before = judge(input.before.evaluation, input.limits);
+    match &input.after {
+        Some(after) => {
+            let judged = judge(after.evaluation, input.limits);
+            let name = name("re-test", after);
+            html_box(
+                out,
+                judged.as_ref().map(|v| ("after", name.as_str(), v)),
+                before.as_ref(),
+            );
+        }
+        None => {
+            let name = name("test", &input.before);
+            html_box(
+                out,
+                before.as_ref().map(|v| ("before", name.as_str(), v)),
+                None,
+            );
+        }
+    }
+}
+
+/// The report's verdict box. `verdict` is the test being accepted (the
+/// re-test when there is one) with its `evaluate --json` key prefix
+/// (`before`, `after`) and a name for it; `first_test` the first test's
+/// verdict in a before/after report. Without limits the box says so: no
+/// verdict, never an implied pass.
+pub fn html_box(
+    out: &mut String,
+    verdict: Option<(&str, &str, &VerdictJson)>,
+    first_test: Option<&VerdictJson>,
+) {
+    let Some((prefix, test_name, verdict)) = verdict else {
+        out.push_str(
+            "<section id=\"verdict\" class=\"keep verdict none\" data-verdict=\"none\">\n\
+             <p class=\"verdict-line\">No acceptance limits given: no verdict.</p>\n\
+             <p class=\"note\">Give the permissible values with <code>--limit A=12</code> (µm) \
+             or in the machine profile's <code>[acceptance]</code> table (<code>--machine</code>).</p>\n\
+             </section>\n",
+        );
+        return;
+    };
+    let class = if verdict.pass { "pass" } else { "fail" };
+    let _ = write!(
+        out,
+        "<section id=\"verdict\" class=\"keep verdict {class}\" data-verdict=\"{class}\">\n\
+         <h2>Acceptance verdict: {word}</h2>\n<p class=\"verdict-line\">{line} <span class=\"note\">({test_name})</span></p>\n\
+         <table class=\"checks\"><thead><tr><th>figure</th><th>measured [µm]</th>\
+         <th>permissible [µm]</th><th>result</th><th>limit from</th></tr></thead><tbody>\n",
+        word = if verdict.pass { "PASS" } else { "FAIL" },
+        line = esc(&headline(verdict)),
+        test_name = esc(test_name),
+    );
+    for (index, c) in verdict.checks.iter().enumerate() {
+        let key = |what: &str| format!("{prefix}.verdict.checks.{index}.{what}");
+        let result_class = if c.pass { "pass" } else { "fail" };
+        let _ = writeln!(
+            out,
+            "<tr data-figure=\"{figure}\" data-figure-key=\"{prefix}.figures_um.{figure}\">\
+             <th>{label}</th>{value}{limit}<td class=\"{result_class}\">{result}</td>\
+             <td>{source}: {derivation}</td></tr>",
+            figure = c.figure,
+            label = if c.figure == "B_mean" {
+                "|B̄|".to_string()
+            } else {
+                c.figure.replace("_up", "↑").replace("_down", "↓")
+            },
+            value = crate::report::html::um_cell(&key("value_um"), c.value_um),
+            limit = crate::report::html::um_cell(&key("limit_um"), Some(c.limit_um)),
+            result = match &c.reason {
+                Some(reason) if !c.pass =>
+                    format!("{}<br><small>{}</small>", result_word(c), esc(reason)),
+                _ => result_word(c).to_string(),
+            },
+            source = esc(&c.limit_source),
+            derivation = esc(&c.limit_derivation),
+        );
+    }
+    out.push_str("</tbody></table>\n");
+    let mut notes = format!(
+        "Decision rule: {DECISION} (ISO 14253-1): a figure passes when its value is at most \
+         the limit, compared at full precision; the measurement uncertainty is not taken into \
+         account. A figure that is not evaluated cannot pass. Per-length limits use the measured \
+         travel, {} mm.",
+        short(verdict.travel_mm)
+    );
+    if let Some(first) = first_test {
+        let _ = write!(
+            notes,
+            " The first test, before compensation: {}.",
+            esc(&headline(first))
+        );
+    }
+    let _ = writeln!(out, "<p class=\"note\">{notes}</p>\n</section>");
+}
+
+/// The verdict box's CSS (appended to the report's).
+pub const CSS: &str =
+    "section.verdict { border: 3px solid #777; padding: 4px 14px 6px; margin: 14px 0; }
+section.verdict h2 { border: none; margin: 6px 0 4px; }
+section.verdict.pass { border-color: #1b7a30; background: #eef8f0; }
+section.verdict.pass h2 { color: #1b7a30; }
+section.verdict.fail { border-color: #c81414; background: #fdf0f0; }
+section.verdict.fail h2 { color: #c81414; }
+section.verdict.none { border-color: #999; border-style: dashed; }
+.verdict-line { font-weight: 600; }
+table.checks td.pass { color: #1b7a30; font-weight: 600; }
+table.checks td.fail { color: #c81414; font-weight: 600; }
+";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evaluate::AxisFigures;
+    use crate::evaluate::verdict::{Figure, Limit, LimitSource};
+    use crate::report::json::FiguresJson;
+    use crate::units::um_to_mm;
+
+    #[test]
+    fn derivations_say_how_the_limit_follows() {
+        let per = |per_um: f64, min_um: Option<f64>| Permissible::PerLength {
+            per_1000_mm_mm: um_to_mm(per_um),
+            min_mm: min_um.map(um_to_mm),
+        };
+        assert_eq!(
+            derivation(&Permissible::Fixed { limit_mm: 0.012 }, 750.0),
+            "12 µm"
+        );
+        assert_eq!(
+            derivation(&per(10.0, None), 750.0),
+            "10 µm per 1000 mm × 750 mm of travel = 7.5 µm"
+        );
+        assert_eq!(
+            derivation(&per(10.0, Some(5.0)), 200.0),
+            "10 µm per 1000 mm × 200 mm of travel = 2 µm, raised to the minimum 5 µm"
+        );
+        assert_eq!(
+            derivation(&per(10.0, Some(5.0)), 750.0),
+            "10 µm per 1000 mm × 750 mm of travel = 7.5 µm (at least 5 µm)"
+        );
+    }
+
+    #[test]
+    fn headlines_name_the_failing_figures() {
+        let figures = AxisFigures {
+            a_mm: Some(0.013),
+            e_mm: Some(0.004),
+            ..Default::default()
+        };
+        let evaluation = crate::evaluate::Evaluation {
+            per_target: Vec::new(),
+            figures,
+            runs_up: 1,
+            runs_down: 1,
+            outliers: Vec::new(),
+            warnings: Vec::new(),
+        };
+        let limit = |figure, um: f64| Limit {
+            figure,
+            permissible: Permissible::Fixed {
+                limit_mm: um_to_mm(um),
+            },
+            source: LimitSource::CommandLine,
+        };
+        let limits = [
+            limit(Figure::R, 7.0),
+            limit(Figure::A, 12.0),
+            limit(Figure::E, 5.0),
+        ];
+        let verdict = crate::evaluate::verdict::verdict(&evaluation, &limits).unwrap();
+        let json = VerdictJson::from_verdict(&verdict);
+        assert_eq!(
+            headline(&json),
+            "FAIL: A above the limit; R not evaluated (cannot pass)"
+        );
+        assert_eq!(json.failed, ["A", "R"]);
+        assert_eq!(json.checks[1].reason, None);
+        assert_eq!(
+            json.checks[0].reason.as_deref(),
+            Some("13.00 µm is above the limit 12 µm")
+        );
+        let passing = crate::evaluate::verdict::verdict(&evaluation, &limits[2..]).unwrap();
+        assert_eq!(
+            headline(&VerdictJson::from_verdict(&passing)),
+            "PASS: E within the limits"
+        );
+    }
+
+    #[test]
+    fn figure_names_are_the_keys_of_figures_um() {
+        let json =
+            serde_json::to_value(FiguresJson::from_figures(&AxisFigures::default())).unwrap();
+        let mut keys: Vec<&str> = json
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        let mut names: Vec<&str> = Figure::ALL.map(Figure::name).to_vec();
+        keys.sort_unstable();
+        names.sort_unstable();
+        assert_eq!(names, keys);
+    }
+}

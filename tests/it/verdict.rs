@@ -1,0 +1,379 @@
+//! The acceptance verdict end to end (issue 11): `--limit` and a machine
+//! profile's `[acceptance]` table give permissible values; `evaluate` prints
+//! a PASS/FAIL line and `"verdict"` in its JSON, `report` a verdict box at the
+//! top. A figure that is not evaluated fails; without limits there is no
+//! verdict anywhere. Expected figures are the README's for the sample (A =
+//! 13.19 µm, R = 6.26 µm) or computed by hand below.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json};
+
+use crate::report::{check_against_json, embedded_data};
+use crate::util::axcomp;
+
+const SAMPLE: &str = "fixtures/sample-x.rtl";
+
+/// `evaluate --json` with extra arguments (limits, a profile).
+pub fn evaluate_json_with(args: &[&str]) -> Value {
+    let mut all = vec!["evaluate", "--json"];
+    all.extend_from_slice(args);
+    let run = axcomp(all);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    serde_json::from_str(&run.stdout).unwrap()
+}
+
+/// A first test over 0–200 mm, 2 runs each way (µm):
+/// ↑ 0 4 8 / 2 6 10, ↓ 2 6 10 / 4 8 12. By hand: x̄↑ = 1, 5, 9; x̄↓ = 3, 7, 11;
+/// s↑ = s↓ = √2; E = 11 − 1 = 10; A = (11 + 2√2) − (1 − 2√2) = 10 + 4√2 = 15.657.
+const BEFORE: &str = "# axis: X\n# machine: Test mill\ntarget_mm,run,direction,deviation_um\n\
+    0,1,up,0\n100,1,up,4\n200,1,up,8\n0,2,up,2\n100,2,up,6\n200,2,up,10\n\
+    0,1,down,2\n100,1,down,6\n200,1,down,10\n0,2,down,4\n100,2,down,8\n200,2,down,12\n";
+
+/// Its re-test: ↑ and ↓ both 0 1 2 / 1 2 3. By hand: x̄ = 0.5, 1.5, 2.5,
+/// s = √0.5; E = 2; A = 2 + 4·√0.5 = 2 + 2√2 = 4.828.
+const AFTER: &str = "# axis: X\n# machine: Test mill\ntarget_mm,run,direction,deviation_um\n\
+    0,1,up,0\n100,1,up,1\n200,1,up,2\n0,2,up,1\n100,2,up,2\n200,2,up,3\n\
+    0,1,down,0\n100,1,down,1\n200,1,down,2\n0,2,down,1\n100,2,down,2\n200,2,down,3\n";
+
+/// One run each way: ↑ 0 4 8, ↓ 2 6 10. R is not evaluated; E = 10 − 0 = 10.
+const ONE_RUN: &str = "# axis: X\ntarget_mm,run,direction,deviation_um\n\
+    0,1,up,0\n100,1,up,4\n200,1,up,8\n0,1,down,2\n100,1,down,6\n200,1,down,10\n";
+
+/// A over 200 mm: 10 µm per 1000 mm gives 2 µm, raised to the 5 µm minimum;
+/// E: 60 µm per 1000 mm gives 12 µm.
+const PROFILE: &str = "[controller]\nunits = \"mm\"\n\n[acceptance]\n\
+    A = { per_1000_mm_um = 10, min_um = 5 }\nE = { per_1000_mm_um = 60 }\n\n\
+    [acceptance.axes.Y]\nA = 100\n";
+
+fn write(directory: &Path, name: &str, text: &str) -> PathBuf {
+    let path = directory.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn close(value: &Value, expected: f64) -> bool {
+    value.as_f64().is_some_and(|v| (v - expected).abs() < 1e-9)
+}
+
+#[test]
+fn a_limit_below_the_sample_fails_and_limits_above_pass() {
+    // A = 13.19 µm > 12: FAIL, named; the exit status stays 0.
+    let run = axcomp(["evaluate", SAMPLE, "--limit", "A=12", "-q"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stdout.ends_with("FAIL: A above the limit\n"),
+        "{}",
+        run.stdout
+    );
+    assert!(
+        run.stdout.contains(" A      | 13.19 | 12.00 | FAIL"),
+        "{}",
+        run.stdout
+    );
+    let json = evaluate_json_with(&[SAMPLE, "--limit", "A=12"]);
+    let verdict = &json["verdict"];
+    assert_eq!(verdict["pass"], json!(false));
+    assert_eq!(verdict["failed"], json!(["A"]));
+    assert_eq!(verdict["decision"], json!("simple acceptance"));
+    assert!(close(&verdict["travel_mm"], 750.0));
+    let check = &verdict["checks"][0];
+    assert_eq!(check["figure"], json!("A"));
+    assert_eq!(check["value_um"], json["figures_um"]["A"]);
+    assert!(close(&check["limit_um"], 12.0));
+    assert_eq!(check["pass"], json!(false));
+    assert_eq!(check["outcome"], json!("exceeds"));
+    assert_eq!(check["reason"], json!("13.19 µm is above the limit 12 µm"));
+    assert_eq!(check["limit_source"], json!("--limit"));
+    assert_eq!(check["limit_derivation"], json!("12 µm"));
+
+    // A = 13.19 ≤ 14 and R = 6.26 ≤ 7: PASS.
+    let run = axcomp([
+        "evaluate", SAMPLE, "--limit", "A=14", "--limit", "R=7", "-q",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stdout.ends_with("PASS: A, R within the limits\n"),
+        "{}",
+        run.stdout
+    );
+    let json = evaluate_json_with(&[SAMPLE, "--limit", "R=7", "--limit", "A=14"]);
+    let verdict = &json["verdict"];
+    assert_eq!(verdict["pass"], json!(true));
+    assert_eq!(verdict["failed"], json!([]));
+    let figures: Vec<&Value> = verdict["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| &c["figure"])
+        .collect();
+    assert_eq!(figures, [&json!("A"), &json!("R")], "in figures_um order");
+    let keys: Vec<&String> = verdict["checks"][1].as_object().unwrap().keys().collect();
+    for key in [
+        "figure",
+        "value_um",
+        "limit_um",
+        "pass",
+        "reason",
+        "limit_source",
+    ] {
+        assert!(keys.iter().any(|k| *k == key), "{key} in {keys:?}");
+    }
+    assert_eq!(verdict["checks"][1]["value_um"], json["figures_um"]["R"]);
+    assert_eq!(verdict["checks"][1]["reason"], Value::Null);
+
+    // B_mean compares |B̄| (B̄ = −3.18 µm): 3.18 > 3 fails.
+    let json = evaluate_json_with(&[SAMPLE, "--limit", "B_mean=3"]);
+    let b_mean = json["figures_um"]["B_mean"].as_f64().unwrap();
+    assert!(b_mean < 0.0);
+    assert_eq!(json["verdict"]["checks"][0]["value_um"], json!(-b_mean));
+    assert_eq!(json["verdict"]["pass"], json!(false));
+
+    // No limits: no verdict, in the JSON or on the terminal.
+    let json = evaluate_json_with(&[SAMPLE]);
+    assert!(json.get("verdict").is_none());
+    let run = axcomp(["evaluate", SAMPLE, "-q"]);
+    assert!(!run.stdout.contains("PASS") && !run.stdout.contains("FAIL"));
+}
+
+#[test]
+fn a_figure_that_is_not_evaluated_fails() {
+    let directory = tempfile::tempdir().unwrap();
+    let file = write(directory.path(), "one-run.csv", ONE_RUN);
+    let file = file.to_str().unwrap();
+    let run = axcomp(["evaluate", file, "--limit", "R=4", "--limit", "E=12", "-q"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stdout
+            .ends_with("FAIL: R not evaluated (cannot pass)\n"),
+        "{}",
+        run.stdout
+    );
+    let json = evaluate_json_with(&[file, "--limit", "R=4", "--limit", "E=12"]);
+    let verdict = &json["verdict"];
+    assert_eq!(verdict["pass"], json!(false));
+    assert_eq!(verdict["failed"], json!(["R"]));
+    // E = 10 by hand, within 12.
+    assert!(close(&verdict["checks"][0]["value_um"], 10.0));
+    assert_eq!(verdict["checks"][0]["pass"], json!(true));
+    let r = &verdict["checks"][1];
+    assert_eq!(r["figure"], json!("R"));
+    assert_eq!(r["value_um"], Value::Null);
+    assert_eq!(r["pass"], json!(false));
+    assert_eq!(r["outcome"], json!("not evaluated"));
+    assert!(r["reason"].as_str().unwrap().contains("cannot pass"));
+}
+
+#[test]
+fn a_profile_gives_per_length_limits_and_the_command_line_overrides_them() {
+    let directory = tempfile::tempdir().unwrap();
+    let before = write(directory.path(), "before.csv", BEFORE);
+    let profile = write(directory.path(), "machine.toml", PROFILE);
+    let (before, profile) = (before.to_str().unwrap(), profile.to_str().unwrap());
+    let json = evaluate_json_with(&[before, "--machine", profile]);
+    assert!(close(&json["figures_um"]["A"], 10.0 + 4.0 * 2f64.sqrt()));
+    assert!(close(&json["figures_um"]["E"], 10.0));
+    let verdict = &json["verdict"];
+    assert!(close(&verdict["travel_mm"], 200.0));
+    let (a, e) = (&verdict["checks"][0], &verdict["checks"][1]);
+    // A: 10 µm/1000 mm × 200 mm = 2 µm, raised to 5 µm; 15.66 > 5.
+    assert!(close(&a["limit_um"], 5.0));
+    assert_eq!(a["pass"], json!(false));
+    assert_eq!(a["limit_source"], json!(format!("{profile} [acceptance]")));
+    assert_eq!(
+        a["limit_derivation"],
+        json!("10 µm per 1000 mm × 200 mm of travel = 2 µm, raised to the minimum 5 µm")
+    );
+    // E: 60 µm/1000 mm × 200 mm = 12 µm; 10 ≤ 12.
+    assert!(close(&e["limit_um"], 12.0));
+    assert_eq!(e["pass"], json!(true));
+    assert_eq!(verdict["failed"], json!(["A"]));
+
+    // --limit A=16 replaces the profile's A (Y's own A is for another axis).
+    let json = evaluate_json_with(&[before, "--machine", profile, "--limit", "A=16"]);
+    let verdict = &json["verdict"];
+    assert_eq!(verdict["pass"], json!(true));
+    assert_eq!(verdict["checks"][0]["limit_source"], json!("--limit"));
+    assert_eq!(
+        verdict["checks"][1]["limit_source"],
+        json!(format!("{profile} [acceptance]"))
+    );
+
+    // The same file read as axis Y gets [acceptance.axes.Y]'s A = 100 µm.
+    let json = evaluate_json_with(&[before, "--machine", profile, "--axis", "Y"]);
+    let a = &json["verdict"]["checks"][0];
+    assert!(close(&a["limit_um"], 100.0));
+    assert_eq!(
+        a["limit_source"],
+        json!(format!("{profile} [acceptance.axes.Y]"))
+    );
+
+    // A profile without [acceptance]: no limits, no verdict.
+    let json = evaluate_json_with(&[before, "--machine", "fixtures/machines/mcv754-quick.toml"]);
+    assert!(json.get("verdict").is_none());
+}
+
+#[test]
+fn bad_limits_are_refused_with_exit_code_2() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("r.html");
+    let out = output.to_str().unwrap();
+    for (args, message) in [
+        (
+            vec!["evaluate", SAMPLE, "--limit", "Q=3"],
+            "unknown figure \"Q\"; the figures are A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B, B_mean",
+        ),
+        (
+            vec!["evaluate", SAMPLE, "--limit", "A=abc"],
+            "a number of µm above 0",
+        ),
+        (
+            vec!["evaluate", SAMPLE, "--limit", "A=0"],
+            "a number of µm above 0",
+        ),
+        (vec!["evaluate", SAMPLE, "--limit", "A"], "FIGURE=UM"),
+        (
+            vec!["evaluate", SAMPLE, "--limit", "A=3", "--limit", "A=4"],
+            "--limit A is given twice",
+        ),
+        (
+            vec!["report", SAMPLE, "--limit", "R_sideways=3", "-o", out],
+            "unknown figure \"R_sideways\"",
+        ),
+    ] {
+        let run = axcomp(&args);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(run.stderr.contains(message), "{args:?}: {}", run.stderr);
+        assert!(run.stdout.is_empty(), "{args:?}: {}", run.stdout);
+    }
+    // A profile with a typo: file, line and column; nothing written.
+    let profile = write(
+        directory.path(),
+        "typo.toml",
+        "[acceptance]\nA = { per_1000_mm_um = 10, mn_um = 5 }\n",
+    );
+    let profile = profile.to_str().unwrap();
+    for args in [
+        vec!["evaluate", SAMPLE, "--machine", profile],
+        vec!["report", SAMPLE, "--machine", profile, "-o", out],
+    ] {
+        let run = axcomp(&args);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(
+            run.stderr
+                .contains(&format!("{profile}:2:28: unknown field `mn_um`")),
+            "{}",
+            run.stderr
+        );
+    }
+    assert!(!output.exists());
+}
+
+/// The `<section id="verdict">` of a page.
+fn verdict_box(html: &str) -> &str {
+    let start = html.find("<section id=\"verdict\"").expect("a verdict box");
+    let end = start + html[start..].find("</section>").unwrap();
+    &html[start..end]
+}
+
+#[test]
+fn the_report_has_a_verdict_box_at_the_top() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("report.html");
+    let out = output.to_str().unwrap();
+    let limits = ["--limit", "A=12", "--limit", "R=7"];
+    let mut args = vec!["report", SAMPLE, "-o", out];
+    args.extend(limits);
+    let run = axcomp(&args);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&output).unwrap();
+    let verdict = verdict_box(&html);
+    assert!(verdict.contains("data-verdict=\"fail\""), "{verdict}");
+    assert!(verdict.contains("<h2>Acceptance verdict: FAIL</h2>"));
+    assert!(verdict.contains("FAIL: A above the limit"));
+    assert!(verdict.contains("--limit: 12 µm"));
+    assert!(verdict.contains("simple acceptance"));
+    // At the top: after the header, before everything else.
+    let at = |needle: &str| html.find(needle).unwrap();
+    assert!(
+        at("</header>") < at("id=\"verdict\"") && at("id=\"verdict\"") < at("id=\"conditions\"")
+    );
+    // Its cells are those of evaluate --json with the same limits: 12 figures,
+    // 16 × 9 per-target values and 2 × (value, limit) of the checks.
+    let mut evaluate_args = vec![SAMPLE];
+    evaluate_args.extend(limits);
+    let evaluation = evaluate_json_with(&evaluate_args);
+    assert_eq!(
+        check_against_json(&html, "before", &evaluation),
+        12 + 16 * 9 + 4
+    );
+    assert_eq!(embedded_data(&html)["before"], evaluation);
+    // Each check row names the figure cell it checks, which shows the same value.
+    let value_of = |key: &str| {
+        let pattern = format!("data-key=\"{key}\" data-um=\"");
+        let at = html.find(&pattern).unwrap_or_else(|| panic!("{key}"));
+        let rest = &html[at + pattern.len()..];
+        rest[..rest.find('"').unwrap()].to_string()
+    };
+    for (index, figure) in ["A", "R"].iter().enumerate() {
+        assert!(verdict.contains(&format!(
+            "data-figure=\"{figure}\" data-figure-key=\"before.figures_um.{figure}\""
+        )));
+        assert_eq!(
+            value_of(&format!("before.verdict.checks.{index}.value_um")),
+            value_of(&format!("before.figures_um.{figure}"))
+        );
+    }
+
+    // Without limits: no verdict, and the box says so.
+    let run = axcomp(["report", SAMPLE, "-o", out, "--force"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&output).unwrap();
+    let verdict = verdict_box(&html);
+    assert!(verdict.contains("data-verdict=\"none\""));
+    assert!(verdict.contains("No acceptance limits given: no verdict."));
+    assert!(!html.contains("PASS") && !html.contains("Acceptance verdict"));
+}
+
+#[test]
+fn a_before_after_report_judges_the_retest() {
+    let directory = tempfile::tempdir().unwrap();
+    let before = write(directory.path(), "before.csv", BEFORE);
+    let after = write(directory.path(), "after.csv", AFTER);
+    let profile = write(directory.path(), "machine.toml", PROFILE);
+    let output = directory.path().join("report.html");
+    let (before, after, profile) = (
+        before.to_str().unwrap(),
+        after.to_str().unwrap(),
+        profile.to_str().unwrap(),
+    );
+    let run = axcomp([
+        "report",
+        before,
+        "--after",
+        after,
+        "--machine",
+        profile,
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&output).unwrap();
+    let verdict = verdict_box(&html);
+    // The re-test: A = 2 + 2√2 = 4.83 ≤ 5 and E = 2 ≤ 12: PASS; the first
+    // test (A = 15.66 > 5) failed, and the box says so.
+    assert!(verdict.contains("data-verdict=\"pass\""), "{verdict}");
+    assert!(verdict.contains("PASS: A, E within the limits"));
+    assert!(verdict.contains(&format!("(re-test {after})")));
+    assert!(verdict.contains("The first test, before compensation: FAIL: A above the limit."));
+    assert!(
+        verdict.contains("data-key=\"after.verdict.checks.0.value_um\" data-um=\"4.82842712474619")
+    );
+    let data = embedded_data(&html);
+    assert_eq!(
+        data["after"],
+        evaluate_json_with(&[after, "--machine", profile])
+    );
+    assert_eq!(data["before"]["verdict"]["pass"], json!(false));
+    assert_eq!(data["after"]["verdict"]["pass"], json!(true));
+}
