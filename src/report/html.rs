@@ -41,7 +41,8 @@ use serde::Serialize;
 
 use crate::diagnose::{Diagnosis, ResidualStats};
 use crate::evaluate::AxisFigures;
-use crate::evaluate::conformance::Requirement;
+use crate::evaluate::TestConformance;
+use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{
     AGREEMENT_PPM, IndexAt, IndexComparison, RefractiveIndexCheck, check_refractive_index,
 };
@@ -302,10 +303,10 @@ fn conditions(out: &mut String, input: &ReportInput<'_>) {
     }
     out.push_str("</tr></thead>\n<tbody>\n");
     test_rows(out, &tests);
+    conformance_rows(out, &tests);
     setup_rows(out, &tests);
     environment_rows(out, &tests);
     out.push_str("</tbody></table>\n");
-    conformance_table(out, &tests);
     refractive_index_explained(out);
     for (name, test) in &tests {
         let check = check_refractive_index(&test.measurement.environment);
@@ -394,6 +395,19 @@ fn setup_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
             list.join(", ")
         }),
     ];
+    let nothing = tests.iter().all(|(_, t)| {
+        t.measurement.metadata.setup.is_empty()
+            && t.measurement.environment.vacuum_wavelength_um.is_none()
+    });
+    if nothing {
+        let _ = writeln!(
+            out,
+            "<tr><th>Instrument, set-up</th><td></td><td colspan=\"{}\">{}</td></tr>",
+            2 * tests.len(),
+            missing()
+        );
+        return;
+    }
     for (label, unit, cell) in rows {
         let _ = write!(out, "<tr><th>{label}</th><td>{unit}</td>");
         for (_, test) in tests {
@@ -403,52 +417,69 @@ fn setup_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
     }
 }
 
-/// The test against ISO 230-2 (`evaluate::conformance`): each requirement,
-/// what the test has and whether it is met.
-fn conformance_table(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
-    out.push_str("<h3>The test against ISO 230-2</h3>\n<table class=\"keep conformance\">\n<thead><tr><th></th>");
-    for (name, _) in tests {
-        let _ = write!(out, "<th colspan=\"2\">{name}</th>");
-    }
-    out.push_str("</tr></thead>\n<tbody>\n");
-    let rows = [
-        (Requirement::Runs, "Runs per direction (5; 1 over 2000 mm)"),
-        (Requirement::BothDirections, "Directions (both)"),
-        (Requirement::Targets, "Targets (at least 5)"),
-        (
-            Requirement::TargetsPerMetre,
-            "Targets per metre (at least 5)",
-        ),
-        (
-            Requirement::IrregularSpacing,
-            "Irregular spacing (recommended)",
-        ),
+/// The test against ISO 230-2 (`evaluate::conformance`): what the test has
+/// and whether it meets each requirement, three rows of the conditions table.
+fn conformance_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
+    let verdict = |checks: &[Option<&Check>]| {
+        if checks.iter().all(|c| c.is_some_and(|c| c.met)) {
+            "<span class=\"met\">met</span>"
+        } else if checks
+            .iter()
+            .all(|c| c.is_some_and(|c| c.requirement.is_recommendation()))
+        {
+            "<span class=\"missing\">not followed</span>"
+        } else {
+            "<span class=\"missing\">not met</span>"
+        }
+    };
+    type Cell<'a> = &'a dyn Fn(&TestConformance) -> String;
+    let rows: [(&str, Cell<'_>); 3] = [
+        ("Runs for ISO 230-2", &|c| {
+            let runs = c.check(Requirement::Runs);
+            let both = c.check(Requirement::BothDirections);
+            let directions = if both.is_some_and(|b| b.met) {
+                "both directions"
+            } else {
+                "one direction"
+            };
+            format!(
+                "{} per direction, {directions} (5 each way, 1 over 2000 mm): {}",
+                runs.and_then(|r| r.found).unwrap_or_default(),
+                verdict(&[runs, both])
+            )
+        }),
+        ("Targets for ISO 230-2", &|c| {
+            let count = c.check(Requirement::Targets);
+            let density = c.check(Requirement::TargetsPerMetre);
+            let per_metre = density
+                .and_then(|d| d.found)
+                .map_or_else(String::new, |d| format!(", {d:.1} per metre"));
+            format!(
+                "{}{per_metre} (at least 5, and 5 per metre): {}",
+                c.targets,
+                verdict(&[count, density])
+            )
+        }),
+        ("Spacing for ISO 230-2", &|c| {
+            let spacing = c.check(Requirement::IrregularSpacing);
+            let found = spacing.and_then(|s| s.found).map_or_else(
+                || "irregular".to_string(),
+                |step| format!("constant step {} mm", signed(step, 3)),
+            );
+            format!("{found}: {}", verdict(&[spacing]))
+        }),
     ];
-    for (requirement, label) in rows {
-        let _ = write!(out, "<tr><th>{label}</th>");
+    for (label, cell) in rows {
+        let _ = write!(out, "<tr><th>{label}</th><td></td>");
         for (_, test) in tests {
-            let check = test.evaluation.conformance.check(requirement);
-            let found = match (requirement, check.and_then(|c| c.found)) {
-                (Requirement::IrregularSpacing, Some(step)) => {
-                    format!("constant step {} mm", signed(step, 3))
-                }
-                (Requirement::IrregularSpacing, None) => "irregular".to_string(),
-                (Requirement::TargetsPerMetre, Some(density)) => format!("{density:.1}"),
-                (_, Some(value)) => format!("{value}"),
-                (_, None) => "—".to_string(),
-            };
-            let verdict = match check {
-                Some(c) if c.met => "<td class=\"met\">met</td>",
-                Some(c) if c.requirement.is_recommendation() => {
-                    "<td class=\"missing\">not followed</td>"
-                }
-                _ => "<td class=\"missing\">not met</td>",
-            };
-            let _ = write!(out, "<td class=\"num\">{found}</td>{verdict}");
+            let _ = write!(
+                out,
+                "<td colspan=\"2\">{}</td>",
+                cell(&test.evaluation.conformance)
+            );
         }
         out.push_str("</tr>\n");
     }
-    out.push_str("</tbody></table>\n");
 }
 
 fn environment_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
