@@ -168,6 +168,36 @@ pub enum Warning {
         /// The direction that was measured.
         measured: Direction,
     },
+    /// Fewer runs per direction than ISO 230-2's standard test (a long axis needs one).
+    TooFewRuns {
+        /// Runs ↑.
+        runs_up: usize,
+        /// Runs ↓.
+        runs_down: usize,
+        /// Runs the standard test has per direction.
+        required: usize,
+    },
+    /// Fewer targets than ISO 230-2 asks: 5 in all and 5 per metre of travel.
+    TooFewTargets {
+        /// Targets measured.
+        targets: usize,
+        /// Travel, mm.
+        length_mm: f64,
+        /// Targets the standard asks for this travel.
+        required: usize,
+    },
+    /// A travel over 2000 mm measured with more than one run: allowed, noted.
+    LongAxis {
+        /// Travel, mm.
+        length_mm: f64,
+        /// Runs per direction.
+        runs: usize,
+    },
+    /// Targets at one constant step, where a periodic error can alias.
+    EvenSpacing {
+        /// The step, mm.
+        step_mm: f64,
+    },
     /// A target lacks what a figure needs, so that figure is not evaluated.
     TargetNotEvaluated {
         /// The target.
@@ -201,13 +231,52 @@ impl fmt::Display for Warning {
                 "line {line}: laser status {status} ({meaning}); the reading is used, but check the beam path and re-measure if in doubt"
             ),
             Warning::InconsistentMetadata { message } => write!(f, "{message}"),
-            Warning::SingleRun { direction } => write!(
-                f,
-                "n = 1 run {direction}: s, R and A are not evaluated; measure ≥ 2 runs per direction (ISO 230-2 asks for 5)"
-            ),
+            Warning::SingleRun { direction } => {
+                write!(f, "n = 1 run {direction}: s, R and A are not evaluated")
+            }
             Warning::Unidirectional { measured } => write!(
                 f,
-                "unidirectional test ({measured} only): bidirectional figures A, E, M, R, B and B̄ are not evaluated"
+                "unidirectional test ({measured} only): bidirectional figures A, E, M, R, B and B̄ are not evaluated; \
+                 ISO 230-2's test approaches every target from both directions: measure both to get them"
+            ),
+            Warning::TooFewRuns {
+                runs_up,
+                runs_down,
+                required,
+            } => {
+                let runs = match (runs_up, runs_down) {
+                    (n, 0) | (0, n) => format!("{n}"),
+                    (up, down) if up == down => format!("{up}"),
+                    (up, down) => format!("{up}↑ {down}↓"),
+                };
+                write!(
+                    f,
+                    "{runs} run(s) per direction: ISO 230-2's test has {required} each way (fewer only on axes over 2000 mm), \
+                     and A and R from fewer runs are rough estimates; measure {required} runs each way"
+                )
+            }
+            Warning::TooFewTargets {
+                targets,
+                length_mm,
+                required,
+            } => write!(
+                f,
+                "{targets} target(s) over {} mm: ISO 230-2 asks for at least 5 targets and at least 5 per metre of travel, \
+                 {required} here; measure at least {required}, with a random part in the spacing",
+                mm_text(*length_mm)
+            ),
+            Warning::LongAxis { length_mm, runs } => write!(
+                f,
+                "note: travel {} mm is over 2000 mm, where ISO 230-2 needs only one run per direction \
+                 (then R and A are not evaluated); the {runs} runs of this test are more than it asks, and all are evaluated",
+                mm_text(*length_mm)
+            ),
+            Warning::EvenSpacing { step_mm } => write!(
+                f,
+                "targets evenly spaced every {} mm: a periodic error (screw lead, scale period) whose period divides the step \
+                 is read at the same phase at every target and hides in the figures, and shorter periods alias into slow waves; \
+                 ISO 230-2 recommends irregular spacing: give each target a different random offset",
+                mm_text(*step_mm)
             ),
             Warning::TargetNotEvaluated { target_mm, missing } => write!(
                 f,
@@ -215,6 +284,12 @@ impl fmt::Display for Warning {
             ),
         }
     }
+}
+
+/// A length in mm for a sentence: at most three decimals, no trailing zeros.
+pub(crate) fn mm_text(value_mm: f64) -> String {
+    let rounded = (value_mm * 1000.0).round() / 1000.0;
+    format!("{}", rounded + 0.0)
 }
 
 #[cfg(test)]

@@ -270,6 +270,34 @@ pub struct Metadata {
     pub extra: Vec<(String, String)>,
     /// Where the axis name came from (default: not recorded).
     pub axis_source: AxisSource,
+    /// The instrument and the test set-up, where the file records them.
+    pub setup: TestSetup,
+}
+
+/// The instrument and how the test was run, as far as the file records them:
+/// `None` (or empty) where it does not, never a guess. The laser's vacuum
+/// wavelength is in [`Environment::vacuum_wavelength_um`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TestSetup {
+    /// The measuring instrument as the file names it: a laser model, or the
+    /// reference-position signal of an ecmc test.
+    pub instrument: Option<String>,
+    /// The instrument's serial number.
+    pub instrument_serial: Option<String>,
+    /// Feed between targets, mm/min.
+    pub feed_mm_per_min: Option<f64>,
+    /// Dwell at each target, s.
+    pub dwell_s: Option<f64>,
+    /// Where the measuring line ran: the positions of the other axes during
+    /// the test, (axis name, mm), in the file's order.
+    pub other_axes_mm: Vec<(String, f64)>,
+}
+
+impl TestSetup {
+    /// Whether the file recorded nothing of it.
+    pub fn is_empty(&self) -> bool {
+        *self == TestSetup::default()
+    }
 }
 
 impl Metadata {

@@ -15,16 +15,20 @@
 //! target; otherwise it is `None` and a warning names the target. Suspected
 //! outlier runs are flagged ([`outliers`]) but stay in the figures.
 //! [`environment`] checks the test conditions: the refractive index the laser
-//! used against Edlén's equation.
+//! used against Edlén's equation. [`conformance`] checks the test itself
+//! against ISO 230-2 (targets, runs, directions, spacing); its warnings come
+//! first in [`Evaluation::warnings`].
 //!
 //! Pure: no I/O, no printing. All lengths in mm.
 
+pub mod conformance;
 pub mod environment;
 pub mod outliers;
 pub mod verdict;
 
 use crate::error::Warning;
 use crate::measurement::{Direction, Measurement};
+pub use conformance::TestConformance;
 pub use outliers::SuspectedOutlier;
 
 /// Statistics of one target in one direction.
@@ -142,7 +146,10 @@ pub struct Evaluation {
     pub runs_down: usize,
     /// Runs that deviate from the others far more than the scatter; included in the figures.
     pub outliers: Vec<SuspectedOutlier>,
-    /// What could not be evaluated, and why.
+    /// The test against ISO 230-2's conditions (targets, runs, directions, spacing).
+    pub conformance: TestConformance,
+    /// Where the test falls short of ISO 230-2 ([`conformance`]), then what
+    /// could not be evaluated, and why.
     pub warnings: Vec<Warning>,
 }
 
@@ -187,8 +194,11 @@ pub fn evaluate(measurement: &Measurement) -> Evaluation {
     let per_target = per_target_stats(measurement);
     let runs_up = measurement.run_count(Direction::Up);
     let runs_down = measurement.run_count(Direction::Down);
-    let warnings = coverage_warnings(&per_target, runs_up, runs_down);
+    let conformance = conformance::check_test(measurement);
+    let mut warnings = conformance.warnings();
+    warnings.extend(coverage_warnings(&per_target, runs_up, runs_down));
     Evaluation {
+        conformance,
         figures: axis_figures(&per_target),
         outliers: outliers::suspected_outliers(measurement),
         per_target,
@@ -294,8 +304,8 @@ fn axis_figures(per_target: &[TargetStats]) -> AxisFigures {
     }
 }
 
-/// Says what is not evaluated and why: one direction only, n = 1, or a target
-/// without enough readings.
+/// Says what is not evaluated and why: n = 1, or a target without enough
+/// readings (one direction only is said by [`conformance`]).
 fn coverage_warnings(per_target: &[TargetStats], runs_up: usize, runs_down: usize) -> Vec<Warning> {
     let mut warnings = Vec::new();
     let measured: Vec<Direction> = Direction::BOTH
@@ -305,9 +315,6 @@ fn coverage_warnings(per_target: &[TargetStats], runs_up: usize, runs_down: usiz
             Direction::Down => runs_down > 0,
         })
         .collect();
-    if let [only] = measured.as_slice() {
-        warnings.push(Warning::Unidirectional { measured: *only });
-    }
     for direction in measured {
         let most_readings = per_target
             .iter()

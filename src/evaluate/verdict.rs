@@ -685,6 +685,13 @@ mod tests {
             runs_up: 5,
             runs_down: 5,
             outliers: Vec::new(),
+            conformance: crate::evaluate::TestConformance {
+                length_mm: last_mm - first_mm,
+                targets: 2,
+                runs_up: 5,
+                runs_down: 5,
+                checks: Vec::new(),
+            },
             warnings: Vec::new(),
         }
     }

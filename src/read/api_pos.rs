@@ -548,8 +548,54 @@ fn metadata(
         length_unit: unit,
         extra,
         axis_source,
+        setup: test_setup(header, unit),
     };
     (axis, metadata)
+}
+
+/// The instrument and set-up the header records: the laser model from the
+/// title line (`API X-D Laser Measurement Linear Data Table`), `Instrument(S/N)`,
+/// `FeedRate` and `Dwell`, and `AxesLoc` (`(Y) 0  (Z) 0 …`, the other axes'
+/// positions in the file's unit). Read leniently: a value that is not a
+/// number (`FeedRate: None`) is "not recorded", never an error.
+/// \[reconstructed\] Dwell is in seconds and a numeric feed in the file's
+/// unit per minute; the real files have `Dwell: 3` and `FeedRate: None`.
+fn test_setup(header: &HeaderFields<'_>, unit: LengthUnit) -> crate::measurement::TestSetup {
+    let number = |key: &str| {
+        header
+            .text(key)
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+    };
+    let instrument = header
+        .fields
+        .iter()
+        .find(|(key, _, _)| key.starts_with("api "))
+        .and_then(|(_, _, line)| {
+            let title = line.text.trim();
+            let end = title.to_ascii_lowercase().find("laser")? + "laser".len();
+            Some(title[..end].to_string())
+        });
+    let other_axes_mm = header
+        .get("AxesLoc")
+        .map(|(_, line)| {
+            line.text
+                .split('\t')
+                .filter_map(|cell| {
+                    let (name, value) = cell.trim().strip_prefix('(')?.split_once(')')?;
+                    let value: f64 = value.trim().parse().ok().filter(|v: &f64| v.is_finite())?;
+                    Some((name.trim().to_string(), unit.to_mm(value)))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    crate::measurement::TestSetup {
+        instrument,
+        instrument_serial: header.text("Instrument(S/N)"),
+        feed_mm_per_min: number("FeedRate").map(|feed| unit.to_mm(feed)),
+        dwell_s: number("Dwell"),
+        other_axes_mm,
+    }
 }
 
 #[cfg(test)]

@@ -49,6 +49,24 @@ use crate::read::text::{
 };
 use crate::units::LengthUnit;
 
+/// What `evaluate` and the report say beside an ecmc file's figures: the
+/// ecmc script's own `report.md` differs, and why (README "ecmc's own
+/// reports", pinned by `tests/it/conformance.rs`).
+pub const VENDOR_REPORT_NOTE: &str = "ecmc's own report of this file will differ: \
+    it swaps ↑ and ↓ (REF_DATA_FWD is shown as backward, so B̄ changes sign and the ↑/↓ figures trade places), \
+    takes the lower end of E from one direction only (the higher of the two minima), \
+    and gives R as the larger of R↑ and R↓ without ISO 230-2's 2s↑ + 2s↓ + |B_i| term; \
+    axcomp follows ISO 230-2 (A, M and B agree)";
+
+/// The instrument an ecmc file names: the `REF_PV` its reference positions
+/// were read from.
+fn reference_instrument(extra: &[(String, String)]) -> Option<String> {
+    extra
+        .iter()
+        .find(|(key, value)| key.eq_ignore_ascii_case("REF_PV") && !value.trim().is_empty())
+        .map(|(_, pv)| format!("reference position {} (REF_PV)", pv.trim()))
+}
+
 /// Largest number of positions or cycles, and so largest index, accepted.
 const MAX_COUNT: u64 = 100_000;
 
@@ -338,6 +356,8 @@ impl EcmcFile {
             self.warnings.push(warning);
         }
         self.metadata.source_format = Some(SourceFormat::Ecmc);
+        // The reference measuring system is known only by the signal it was read from.
+        self.metadata.setup.instrument = reference_instrument(&self.metadata.extra);
         self.metadata.length_unit = unit;
         let axis = self.axis();
         let measurement = Measurement::new(

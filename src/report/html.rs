@@ -45,6 +45,8 @@ use serde::Serialize;
 
 use crate::diagnose::{Diagnosis, ResidualStats};
 use crate::evaluate::AxisFigures;
+use crate::evaluate::TestConformance;
+use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{
     AGREEMENT_PPM, IndexAt, IndexComparison, RefractiveIndexCheck, check_refractive_index,
 };
@@ -54,10 +56,11 @@ use crate::report::acceptance::{
     NamedChart, ReportInput, TableRecord, TestRecord, charts, prediction,
 };
 use crate::report::chart::chart;
+use crate::report::json::source_notes;
 use crate::report::json::{EvaluationJson, FiguresJson, PerTargetJson};
 use crate::report::plot::{FONT, PlotError, PlotFormat};
-use crate::report::terminal::um;
-use crate::units::mm_to_um;
+use crate::report::terminal::{inch_beside, inch_text, um};
+use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 
 /// The embedded `axcomp-data` block.
 #[derive(Debug, Serialize)]
@@ -220,18 +223,13 @@ fn text_or_missing(value: Option<&str>) -> String {
 fn header(out: &mut String, input: &ReportInput<'_>) {
     let measurement = input.before.measurement;
     let metadata = &measurement.metadata;
-    let kind = match (
-        measurement.run_count(Direction::Up),
-        measurement.run_count(Direction::Down),
-    ) {
-        (0, _) | (_, 0) => "unidirectional",
-        _ => "bidirectional",
-    };
+    // What the test is, and whether it meets ISO 230-2 (`evaluate::conformance`).
     let _ = write!(
         out,
         "<header>\n<h1>Accuracy and repeatability of positioning</h1>\n\
-         <p class=\"subtitle\">Acceptance report: linear axis {axis}, {kind} test to ISO 230-2:2014</p>\n</header>\n",
+         <p class=\"subtitle\">Acceptance report: linear axis {axis}, {kind}</p>\n</header>\n",
         axis = esc(&axis_shown(measurement)),
+        kind = esc(&input.before.evaluation.conformance.title()),
     );
     out.push_str("<table class=\"meta\">\n");
     let row = |out: &mut String, a: &str, b: String, c: &str, d: String| {
@@ -337,6 +335,8 @@ fn conditions(out: &mut String, input: &ReportInput<'_>) {
     }
     out.push_str("</tr></thead>\n<tbody>\n");
     test_rows(out, &tests);
+    conformance_rows(out, &tests);
+    setup_rows(out, &tests);
     environment_rows(out, &tests);
     out.push_str("</tbody></table>\n");
     refractive_index_explained(out);
@@ -378,6 +378,140 @@ fn test_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
             |s| format!("{:.0}", s / 60.0),
         )
     });
+}
+
+/// The instrument and set-up (`Metadata::setup`), in mm and, for an inch
+/// file, in inches beside; "not recorded" where the file does not say.
+fn setup_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
+    let missing = || "<span class=\"missing\">not recorded</span>".to_string();
+    let inch = |m: &Measurement, value_mm: f64| {
+        if m.metadata.length_unit == LengthUnit::Inch {
+            format!(" ({} in)", inch_text(LengthUnit::Inch.from_mm(value_mm)))
+        } else {
+            String::new()
+        }
+    };
+    type Cell<'a> = &'a dyn Fn(&Measurement) -> String;
+    let rows: [(&str, &str, Cell<'_>); 6] = [
+        ("Instrument", "", &|m| {
+            text_or_missing(m.metadata.setup.instrument.as_deref())
+        }),
+        ("Instrument serial number", "", &|m| {
+            text_or_missing(m.metadata.setup.instrument_serial.as_deref())
+        }),
+        ("Laser wavelength (vacuum)", "µm", &|m| {
+            m.environment
+                .vacuum_wavelength_um
+                .map_or_else(missing, |w| format!("{w:.6}"))
+        }),
+        ("Feed", "mm/min", &|m| {
+            m.metadata.setup.feed_mm_per_min.map_or_else(missing, |f| {
+                format!("{f}{}", inch(m, f).replace(" in)", " in/min)"))
+            })
+        }),
+        ("Dwell", "s", &|m| {
+            m.metadata
+                .setup
+                .dwell_s
+                .map_or_else(missing, |d| format!("{d}"))
+        }),
+        ("Measuring line: other axes at", "mm", &|m| {
+            let axes = &m.metadata.setup.other_axes_mm;
+            if axes.is_empty() {
+                return missing();
+            }
+            let list: Vec<String> = axes
+                .iter()
+                .map(|(axis, at)| format!("{} {at}{}", esc(axis), inch(m, *at)))
+                .collect();
+            list.join(", ")
+        }),
+    ];
+    let nothing = tests.iter().all(|(_, t)| {
+        t.measurement.metadata.setup.is_empty()
+            && t.measurement.environment.vacuum_wavelength_um.is_none()
+    });
+    if nothing {
+        let _ = writeln!(
+            out,
+            "<tr><th>Instrument, set-up</th><td></td><td colspan=\"{}\">{}</td></tr>",
+            2 * tests.len(),
+            missing()
+        );
+        return;
+    }
+    for (label, unit, cell) in rows {
+        let _ = write!(out, "<tr><th>{label}</th><td>{unit}</td>");
+        for (_, test) in tests {
+            let _ = write!(out, "<td colspan=\"2\">{}</td>", cell(test.measurement));
+        }
+        out.push_str("</tr>\n");
+    }
+}
+
+/// The test against ISO 230-2 (`evaluate::conformance`): what the test has
+/// and whether it meets each requirement, three rows of the conditions table.
+fn conformance_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
+    let verdict = |checks: &[Option<&Check>]| {
+        if checks.iter().all(|c| c.is_some_and(|c| c.met)) {
+            "<span class=\"met\">met</span>"
+        } else if checks
+            .iter()
+            .all(|c| c.is_some_and(|c| c.requirement.is_recommendation()))
+        {
+            "<span class=\"missing\">not followed</span>"
+        } else {
+            "<span class=\"missing\">not met</span>"
+        }
+    };
+    type Cell<'a> = &'a dyn Fn(&TestConformance) -> String;
+    let rows: [(&str, Cell<'_>); 3] = [
+        ("Runs for ISO 230-2", &|c| {
+            let runs = c.check(Requirement::Runs);
+            let both = c.check(Requirement::BothDirections);
+            let directions = if both.is_some_and(|b| b.met) {
+                "both directions"
+            } else {
+                "one direction"
+            };
+            format!(
+                "{} per direction, {directions} (5 each way, 1 over 2000 mm): {}",
+                runs.and_then(|r| r.found).unwrap_or_default(),
+                verdict(&[runs, both])
+            )
+        }),
+        ("Targets for ISO 230-2", &|c| {
+            let count = c.check(Requirement::Targets);
+            let density = c.check(Requirement::TargetsPerMetre);
+            let per_metre = density
+                .and_then(|d| d.found)
+                .map_or_else(String::new, |d| format!(", {d:.1} per metre"));
+            format!(
+                "{}{per_metre} (at least 5, and 5 per metre): {}",
+                c.targets,
+                verdict(&[count, density])
+            )
+        }),
+        ("Spacing for ISO 230-2", &|c| {
+            let spacing = c.check(Requirement::IrregularSpacing);
+            let found = spacing.and_then(|s| s.found).map_or_else(
+                || "irregular".to_string(),
+                |step| format!("constant step {} mm", signed(step, 3)),
+            );
+            format!("{found}: {}", verdict(&[spacing]))
+        }),
+    ];
+    for (label, cell) in rows {
+        let _ = write!(out, "<tr><th>{label}</th><td></td>");
+        for (_, test) in tests {
+            let _ = write!(
+                out,
+                "<td colspan=\"2\">{}</td>",
+                cell(&test.evaluation.conformance)
+            );
+        }
+        out.push_str("</tr>\n");
+    }
 }
 
 fn environment_rows(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
@@ -629,8 +763,57 @@ fn figures_section(out: &mut String, input: &ReportInput<'_>) {
          mean deviations x̄↑, x̄↓; R: the largest repeatability at a target, \
          max(2s↑ + 2s↓ + |B<sub>i</sub>|; 4s↑; 4s↓); M: of the bidirectional means x̄; B: the \
          largest |x̄↑ − x̄↓|; B̄: its signed mean (negative: the axis falls short in the \
-         direction it moves). — means not evaluated.</p>\n</section>\n",
+         direction it moves). — means not evaluated.</p>\n",
     );
+    inch_figures(out, &tests);
+    for note in source_notes(input.before.measurement.metadata.source_format) {
+        let _ = writeln!(
+            out,
+            "<p class=\"note\" id=\"source-note\">Note: {}.</p>",
+            esc(note)
+        );
+    }
+    out.push_str("</section>\n");
+}
+
+/// For an inch file, the bidirectional figures in inches too (the file's unit).
+fn inch_figures(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
+    for (name, test) in tests {
+        if test.measurement.metadata.length_unit != LengthUnit::Inch {
+            continue;
+        }
+        let f = FiguresJson::from_figures(&test.evaluation.figures);
+        let parts: Vec<String> = FIGURE_ROWS
+            .iter()
+            .flat_map(|(_, key, directional)| {
+                let keys = if *directional {
+                    vec![
+                        (key.to_string(), ""),
+                        (format!("{key}_up"), "↑"),
+                        (format!("{key}_down"), "↓"),
+                    ]
+                } else {
+                    vec![(key.to_string(), "")]
+                };
+                keys.into_iter().filter_map(move |(full, arrow)| {
+                    let um = figure_value(&f, &full)?;
+                    let name = if *key == "B_mean" { "B̄" } else { key };
+                    Some(format!(
+                        "{name}{arrow} {} in",
+                        inch_text(LengthUnit::Inch.from_mm(um_to_mm(um)))
+                    ))
+                })
+            })
+            .collect();
+        if parts.is_empty() {
+            continue;
+        }
+        let _ = writeln!(
+            out,
+            "<p class=\"note inch\">{name}, in inches (the unit of its file): {}.</p>",
+            parts.join(", ")
+        );
+    }
 }
 
 type SvgOf<'a> = dyn Fn(&str) -> Option<(&'a NamedChart, &'a str)> + 'a;
@@ -708,8 +891,14 @@ fn per_target_table(out: &mut String, test: &TestRecord<'_>, prefix: &str) {
         let key = |name: &str| format!("{prefix}.per_target.{index}.{name}");
         let _ = write!(
             out,
-            "<tr><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>",
-            t.target_mm, t.n_up, t.n_down
+            "<tr><td class=\"num\">{}{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>",
+            t.target_mm,
+            inch_beside(
+                test.measurement.metadata.length_unit.as_str(),
+                &[t.target_mm]
+            ),
+            t.n_up,
+            t.n_down
         );
         for (name, value) in [
             ("mean_up_um", t.mean_up_um),

@@ -19,8 +19,23 @@
 //!   "outliers": [{"run": 1, "direction": "down", "score": 48.2,
 //!                 "worst_target_mm": 15.0, "offset_um": 101.4}],
 //!   "environment": {…}, "metadata": {…}, "warnings": ["…"],
+//!   "test_conformance": {"title": "bidirectional test, 5 runs, 16 targets over 750 mm to ISO 230-2:2014",
+//!                        "meets_iso230_2": true, "length_mm": 750.0,
+//!                        "checks": [{"check": "runs", "recommendation": false, "met": true,
+//!                                    "found": 5.0, "required": 5.0}, …]},
+//!   "test_setup": {"instrument": "API X-D Laser", "instrument_serial": "4848",
+//!                  "feed_mm_per_min": null, "dwell_s": 3.0,
+//!                  "other_axes_mm": [{"axis": "Y", "position_mm": 0.0}, …]},
+//!   "notes": ["…"],
 //!   "verdict": {"pass": …, "checks": […], …} }
 //! ```
+//!
+//! `test_conformance.checks[].check` is `runs`, `both_directions`, `targets`,
+//! `targets_per_m` or `irregular_spacing` (`evaluate::conformance`); `found`
+//! and `required` are runs, directions, targets, targets per metre, or for
+//! spacing the constant step in mm (`null` when irregular). `test_setup`
+//! holds what the file records, `null` or `[]` where it does not. `notes`
+//! says where another program's report of the same file will differ.
 //!
 //! `verdict` is there only when acceptance limits are given (`--limit`, a
 //! profile's `[acceptance]`): no limits, no verdict. Its format is in
@@ -35,8 +50,10 @@
 use serde::Serialize;
 
 use crate::error::Warning;
-use crate::evaluate::{AxisFigures, Evaluation, SuspectedOutlier, TargetStats};
-use crate::measurement::{AxisSource, Environment, Measurement, RunSelector, StartEnd};
+use crate::evaluate::{AxisFigures, Evaluation, SuspectedOutlier, TargetStats, TestConformance};
+use crate::measurement::{
+    AxisSource, Environment, Measurement, RunSelector, SourceFormat, StartEnd, TestSetup,
+};
 use crate::units::{mm_to_um, opt_mm_to_um};
 
 /// The whole `evaluate --json` object.
@@ -70,6 +87,12 @@ pub struct EvaluationJson {
     pub metadata: MetadataJson,
     /// Reader and evaluator warnings, as sentences.
     pub warnings: Vec<String>,
+    /// The test against ISO 230-2's conditions.
+    pub test_conformance: ConformanceJson,
+    /// The instrument and set-up, where the file records them.
+    pub test_setup: TestSetupJson,
+    /// Where another program's report of the same file differs, and why.
+    pub notes: Vec<&'static str>,
     /// The acceptance verdict; absent without limits (see `report::verdict`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub verdict: Option<crate::report::verdict::VerdictJson>,
@@ -110,6 +133,108 @@ impl AxisSourceJson {
             AxisSourceJson::Given => format!("{axis} (--axis)"),
             AxisSourceJson::NotRecorded => "not recorded (give --axis)".to_string(),
         }
+    }
+}
+
+/// The test against ISO 230-2's conditions (`evaluate::conformance`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ConformanceJson {
+    /// What the test is, as the report's title says it.
+    pub title: String,
+    /// Whether every requirement (not the recommendations) is met.
+    pub meets_iso230_2: bool,
+    /// Travel, mm.
+    pub length_mm: f64,
+    /// Every check.
+    pub checks: Vec<CheckJson>,
+}
+
+/// One check of the test.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct CheckJson {
+    /// `runs`, `both_directions`, `targets`, `targets_per_m`, `irregular_spacing`.
+    pub check: &'static str,
+    /// Whether ISO 230-2 only recommends it.
+    pub recommendation: bool,
+    /// Whether the test meets it.
+    pub met: bool,
+    /// What the test has.
+    pub found: Option<f64>,
+    /// What the standard asks.
+    pub required: Option<f64>,
+}
+
+impl ConformanceJson {
+    /// Copies the checks.
+    pub fn from_conformance(c: &TestConformance) -> ConformanceJson {
+        ConformanceJson {
+            title: c.title(),
+            meets_iso230_2: c.meets_iso230_2(),
+            length_mm: c.length_mm,
+            checks: c
+                .checks
+                .iter()
+                .map(|check| CheckJson {
+                    check: check.requirement.name(),
+                    recommendation: check.requirement.is_recommendation(),
+                    met: check.met,
+                    found: check.found,
+                    required: check.required,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The instrument and set-up, mm, s.
+#[derive(Clone, Debug, Serialize)]
+pub struct TestSetupJson {
+    /// The instrument as the file names it.
+    pub instrument: Option<String>,
+    /// Its serial number.
+    pub instrument_serial: Option<String>,
+    /// Feed between targets, mm/min.
+    pub feed_mm_per_min: Option<f64>,
+    /// Dwell at each target, s.
+    pub dwell_s: Option<f64>,
+    /// The other axes' positions during the test.
+    pub other_axes_mm: Vec<AxisPositionJson>,
+}
+
+/// One other axis' position.
+#[derive(Clone, Debug, Serialize)]
+pub struct AxisPositionJson {
+    /// Axis name.
+    pub axis: String,
+    /// Position, mm.
+    pub position_mm: f64,
+}
+
+impl TestSetupJson {
+    /// Copies the set-up.
+    pub fn from_setup(s: &TestSetup) -> TestSetupJson {
+        TestSetupJson {
+            instrument: s.instrument.clone(),
+            instrument_serial: s.instrument_serial.clone(),
+            feed_mm_per_min: s.feed_mm_per_min,
+            dwell_s: s.dwell_s,
+            other_axes_mm: s
+                .other_axes_mm
+                .iter()
+                .map(|(axis, position_mm)| AxisPositionJson {
+                    axis: axis.clone(),
+                    position_mm: *position_mm,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Where another program's report of a file in this format will differ.
+pub fn source_notes(format: Option<SourceFormat>) -> Vec<&'static str> {
+    match format {
+        Some(SourceFormat::Ecmc) => vec![crate::read::ecmc::VENDOR_REPORT_NOTE],
+        _ => Vec::new(),
     }
 }
 
@@ -364,6 +489,9 @@ impl EvaluationJson {
             },
             warnings: warnings.iter().map(ToString::to_string).collect(),
             verdict: None,
+            test_conformance: ConformanceJson::from_conformance(&evaluation.conformance),
+            test_setup: TestSetupJson::from_setup(&metadata.setup),
+            notes: source_notes(metadata.source_format),
         }
     }
 }

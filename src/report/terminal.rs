@@ -10,6 +10,7 @@ use tabled::settings::object::Columns;
 use tabled::settings::{Alignment, Style};
 
 use crate::report::json::{EvaluationJson, StartEndJson};
+use crate::units::LengthUnit;
 
 /// How a not-evaluated value is shown.
 pub const NOT_EVALUATED: &str = "—";
@@ -46,7 +47,33 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     if let Some(verdict) = &report.verdict {
         out.push_str(&crate::report::verdict::terminal(verdict));
     }
+    for note in &report.notes {
+        let _ = writeln!(out, "\nNote: {note}.");
+    }
     out
+}
+
+/// A length in an inch file's own unit, ` (… in)`, beside the mm; empty for mm files.
+pub fn inch_beside(length_unit: &str, values_mm: &[f64]) -> String {
+    if LengthUnit::from_name(length_unit) != Some(LengthUnit::Inch) {
+        return String::new();
+    }
+    let inches: Vec<String> = values_mm
+        .iter()
+        .map(|v| inch_text(LengthUnit::Inch.from_mm(*v)))
+        .collect();
+    format!(" ({} in)", inches.join(" to "))
+}
+
+/// Inches with at most six decimals (0.025 µm), no trailing zeros.
+pub fn inch_text(value_in: f64) -> String {
+    let text = format!("{value_in:.6}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".to_string()
+    } else {
+        text.to_string()
+    }
 }
 
 fn header(out: &mut String, r: &EvaluationJson) {
@@ -86,8 +113,13 @@ fn header(out: &mut String, r: &EvaluationJson) {
     rows.push(("Runs", format!("{}↑ {}↓{excluded}", r.runs.up, r.runs.down)));
     rows.push((
         "Targets",
-        format!("{} from {first} to {last} mm", r.targets_mm.len()),
+        format!(
+            "{} from {first} to {last} mm{}",
+            r.targets_mm.len(),
+            inch_beside(r.length_unit, &[first, last])
+        ),
     ));
+    rows.push(("Test", r.test_conformance.title.clone()));
     rows.push(("Environment", environment_line(r)));
     for (key, value) in rows {
         let _ = writeln!(out, "{key:<12} {value}");

@@ -399,6 +399,13 @@ mod tests {
             runs_up: 1,
             runs_down: 1,
             outliers: Vec::new(),
+            conformance: crate::evaluate::TestConformance {
+                length_mm: 0.0,
+                targets: 0,
+                runs_up: 1,
+                runs_down: 1,
+                checks: Vec::new(),
+            },
             warnings: Vec::new(),
         };
         let limit = |figure, um: f64| Limit {

@@ -8,6 +8,7 @@ mod bad_input;
 mod browser;
 mod cli;
 mod close_loop;
+mod conformance;
 mod convert;
 mod demo;
 mod diagnose;
