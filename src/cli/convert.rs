@@ -241,6 +241,9 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         warning_texts,
     );
     report.effects = plan.notes;
+    if let Some(backlash_mm) = table.suggested_backlash_mm {
+        report.set_backlash(args.controller.backlash_parameter(backlash_mm, &options));
+    }
     print_warnings(&warnings, args.quiet);
     if args.json {
         print_json(&report)
