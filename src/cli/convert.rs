@@ -8,6 +8,7 @@ use axcomp::compensate::{self, Extrapolate, GridSpec, TableMode, TableOptions};
 use axcomp::diagnose::Effect;
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::evaluate;
+use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::measurement::{RunSelector, SourceFormat};
 use axcomp::output::write_new;
 use axcomp::read;
@@ -207,6 +208,22 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             &profile,
             Some(args.linuxcnc_type),
         )?;
+        // The table was active during the test: its axis, over the test's range.
+        let test_name = args
+            .files
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" + ");
+        warnings.extend(check_together(
+            Pairing::TableOnTest,
+            &Input::measurement(&measurement, test_name),
+            &Input::table(
+                &active.axis,
+                &active.positions_mm,
+                existing.display().to_string(),
+            ),
+        )?);
         measurement = compensate::add_existing_table(&measurement, &active)?;
     }
     let evaluation = evaluate(&measurement);

@@ -41,6 +41,7 @@ use crate::compensate::{CompensationTable, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
 use crate::error::{ParseError, describe_found};
 use crate::evaluate::{AxisFigures, Evaluation, evaluate};
+use crate::measurement::together::{Input, NotTogether, Pairing, check_together};
 use crate::measurement::{Direction, Measurement, Run};
 use along_axis::{Background, select_along_axis, target_levels};
 use between_runs::{
@@ -282,14 +283,10 @@ pub enum DiagnoseError {
     /// The first test has no usable means.
     #[error("the first test has no target with a mean deviation")]
     NoKnownError,
-    /// The two tests are of different axes.
-    #[error("the first test is of axis {before}, the re-test of axis {after}")]
-    AxisMismatch {
-        /// The first test's axis.
-        before: String,
-        /// The re-test's axis.
-        after: String,
-    },
+    /// The two tests (or the table) do not belong together: another axis,
+    /// ranges without a common stretch, the same readings twice.
+    #[error(transparent)]
+    NotTogether(#[from] NotTogether),
     /// A measurement could not be rebuilt (a bug).
     #[error("{0}")]
     Internal(String),
@@ -546,13 +543,14 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
     let after = input.after;
     let (times, time_assumed) = times_h(after, input.timing);
     let first = match input.before {
-        Some(before) if !before.axis().eq_ignore_ascii_case(after.axis()) => {
-            return Err(DiagnoseError::AxisMismatch {
-                before: before.axis().to_string(),
-                after: after.axis().to_string(),
-            });
-        }
         Some(before) => {
+            // The doubts (machine names, units, ranges) are the caller's to
+            // show: the CLI runs the same check with the file names.
+            check_together(
+                Pairing::BeforeAfter,
+                &Input::measurement(before, "the first test"),
+                &Input::measurement(after, "the re-test"),
+            )?;
             let evaluation = evaluate(before);
             let known =
                 KnownError::from_evaluation(&evaluation).ok_or(DiagnoseError::NoKnownError)?;

@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 use chrono::NaiveDateTime;
 
 use crate::error::{ParseError, ReadError, Warning};
+use crate::measurement::together::{Input, Pairing, check_together};
 use crate::measurement::{Measurement, Run, SourceFormat};
 
 /// A measurement read from one or more files, with what the readers noticed.
@@ -71,6 +72,17 @@ pub fn read_paths(
     let mut result = read_path(first, format)?;
     for path in rest {
         let next = read_path(path, format)?;
+        // Two files of one test: one axis, two files, the same stretch.
+        let doubts = check_together(
+            Pairing::OneTest,
+            &Input::measurement(&result.measurement, first.display().to_string()),
+            &Input::measurement(&next.measurement, path.display().to_string()),
+        )
+        .map_err(|error| ReadError::Merge {
+            path: path.clone(),
+            message: error.to_string(),
+        })?;
+        result.warnings.extend(doubts);
         let merged = result
             .measurement
             .merge(&next.measurement)

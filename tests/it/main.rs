@@ -18,4 +18,5 @@ mod predict;
 mod read_api_pos;
 mod report;
 mod servo;
+mod together;
 mod util;
