@@ -362,9 +362,11 @@ impl Effect {
                 } else {
                     "the axis overshoots in the direction it moves (a leading encoder, or an elastic preload released at reversal)"
                 };
+                // Controllers take the backlash parameter in mm (or inch), not µm:
+                // `convert` prints each one's own line (`Controller::backlash_parameter`).
                 format!(
-                    "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or set the backlash parameter to {:.2} µm.",
-                    -b_um
+                    "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or change the backlash parameter by {:.4} mm (convert prints it in the controller's own terms).",
+                    crate::units::um_to_mm(-b_um)
                 )
             }
             Effect::Scale { scale_um_per_m } => {

@@ -591,6 +591,40 @@ mod tests {
     }
 
     #[test]
+    fn backlash_values_are_rounded_in_the_controller_unit() {
+        let options = options(Controller::Sinumerik840d, LengthUnit::Millimetre);
+        // −B̄ = 3.179725 µm (fixtures/sample-x.rtl): 0.0032 mm to 4 decimals.
+        let BacklashAdvice::Parameter(mm) =
+            Controller::Sinumerik840d.backlash_parameter(0.003_179_725, &options)
+        else {
+            panic!("Sinumerik has MD32450")
+        };
+        assert_eq!((mm.value, mm.value_text().as_str()), (0.0032, "0.0032"));
+        assert_eq!(mm.name, "MD32450 $MA_BACKLASH[0,X1]");
+        // An overshooting axis gets a negative value; a rounded zero is 0, not -0.
+        let negative =
+            BacklashParameter::new(String::new(), -0.001, LengthUnit::Millimetre, 4, "", None);
+        assert_eq!(negative.value_text(), "-0.0010");
+        let tiny = BacklashParameter::new(
+            String::new(),
+            -0.000_01,
+            LengthUnit::Millimetre,
+            4,
+            "",
+            None,
+        );
+        assert_eq!(tiny.value_text(), "0.0000");
+        // 0.003179725 mm / 25.4 = 0.00012519 inch.
+        let inch =
+            BacklashParameter::new(String::new(), 0.003_179_725, LengthUnit::Inch, 6, "", None);
+        assert_eq!(inch.value_text(), "0.000125");
+        assert!(matches!(
+            Controller::LinuxCnc.backlash_parameter(0.003_179_725, &options),
+            BacklashAdvice::NoParameter(_)
+        ));
+    }
+
+    #[test]
     fn controller_names() {
         for controller in Controller::ALL {
             assert_eq!(Controller::from_name(controller.name()), Some(controller));

@@ -79,6 +79,13 @@ fn evaluate_refuses_one_file_twice_and_a_copy_of_it() {
     // Today's bug: 10↑ 10↓ runs from one 5↑ 5↓ file.
     let result = run(&[&"evaluate", &sample(), &sample()]);
     refused(&result, "fixtures/sample-x.rtl is given twice");
+    // Another spelling of the same path is the same file.
+    let result = run(&[
+        &"evaluate",
+        &sample(),
+        &root().join("fixtures/./sample-x.rtl"),
+    ]);
+    refused(&result, "fixtures/sample-x.rtl is given twice");
     let copy = write(dir.path(), "copy.rtl", &edited(&[]));
     let result = run(&[&"evaluate", &sample(), &copy]);
     refused(
