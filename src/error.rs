@@ -205,6 +205,9 @@ pub enum Warning {
         /// Which quantity is missing there.
         missing: String,
     },
+    /// Two inputs joined or compared may not belong together
+    /// (`measurement::together`).
+    Doubtful(crate::measurement::together::Doubt),
 }
 
 impl fmt::Display for Warning {
@@ -282,6 +285,7 @@ impl fmt::Display for Warning {
                 f,
                 "target {target_mm} mm has no {missing}; the axis figures that need it are not evaluated"
             ),
+            Warning::Doubtful(doubt) => write!(f, "{doubt}"),
         }
     }
 }

@@ -8,6 +8,7 @@ use axcomp::compensate::{self, Extrapolate, GridSpec, TableMode, TableOptions};
 use axcomp::diagnose::Effect;
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::evaluate;
+use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::measurement::{RunSelector, SourceFormat};
 use axcomp::output::write_new;
 use axcomp::read;
@@ -208,6 +209,22 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     options.max_points = args.max_points.or(options.max_points);
     if let Some(existing) = &args.existing {
         let (_, active) = read_table(existing, &axis, &profile, Some(args.linuxcnc_type))?;
+        // The table was active during the test: its axis, over the test's range.
+        let test_name = args
+            .files
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" + ");
+        warnings.extend(check_together(
+            Pairing::TableOnTest,
+            &Input::measurement(&measurement, test_name),
+            &Input::table(
+                &active.axis,
+                &active.positions_mm,
+                existing.display().to_string(),
+            ),
+        )?);
         measurement = compensate::add_existing_table(&measurement, &active)?;
     }
     let evaluation = evaluate(&measurement);
@@ -242,6 +259,9 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         warning_texts,
     );
     report.effects = plan.notes;
+    if let Some(backlash_mm) = table.suggested_backlash_mm {
+        report.set_backlash(args.controller.backlash_parameter(backlash_mm, &options));
+    }
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json {
         print_json(&report)

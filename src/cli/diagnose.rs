@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose, write_effects};
+use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
@@ -83,6 +84,12 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
             let mut result = read::read_path(path, None)?;
             print_warnings(&result.warnings, args.verbosity.quiet);
             name_axis(&mut result.measurement, args.axis.as_ref());
+            let doubts = check_together(
+                Pairing::BeforeAfter,
+                &Input::measurement(&result.measurement, path.display().to_string()),
+                &Input::measurement(&after.measurement, args.after.display().to_string()),
+            )?;
+            print_warnings(&doubts, args.verbosity.quiet);
             Some(result.measurement)
         }
         None => None,
@@ -91,7 +98,15 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         Some(path) => {
             let profile = load_profile(args.machine.as_deref())?;
             let axis = recorded_axis(&after.measurement, "to say which axis the table is for")?;
-            Some(read_table(path, axis, &profile, args.linuxcnc_type)?.1)
+            let (_, table) = read_table(path, axis, &profile, args.linuxcnc_type)?;
+            // The table was active during the re-test.
+            let doubts = check_together(
+                Pairing::TableOnTest,
+                &Input::measurement(&after.measurement, args.after.display().to_string()),
+                &Input::table(&table.axis, &table.positions_mm, path.display().to_string()),
+            )?;
+            print_warnings(&doubts, args.verbosity.quiet);
+            Some(table)
         }
         None => None,
     };

@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::diagnose::Effect;
 use axcomp::measurement::Measurement;
+use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::model::{GeometricErrors, ModelError, read_error_description};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
@@ -138,6 +139,26 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         .iter()
         .map(|spec| load_table(spec, &measurements, &profile, args.linuxcnc_type))
         .collect::<Result<Vec<CompensationTable>>>()?;
+    // Each table against the test of its axis: the range it is predicted over.
+    let mut doubts = Vec::new();
+    for (table, spec) in tables.iter().zip(&args.table) {
+        let Some((measurement, _)) = measurements
+            .iter()
+            .find(|(m, _)| m.axis().eq_ignore_ascii_case(&table.axis))
+        else {
+            continue;
+        };
+        let test_name = measurement.metadata.source_file.as_ref().map_or_else(
+            || format!("the test of {}", table.axis),
+            |p| p.display().to_string(),
+        );
+        doubts.extend(check_together(
+            Pairing::TableOnTest,
+            &Input::measurement(measurement, test_name),
+            &Input::table(&table.axis, &table.positions_mm, format!("--table {spec}")),
+        )?);
+    }
+    print_warnings(&doubts, args.verbosity.quiet);
     let tool = args
         .tool_offset
         .map(|offset| complete(Some(offset), machine.tool_offset_mm()));
@@ -154,6 +175,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     };
     let prediction = predict(&input)?;
     let mut notes = notes(&prediction, &effects);
+    notes.extend(doubts.iter().map(ToString::to_string));
     if args.machine.is_none() {
         notes.push("machine: the bundled MCV 754 Quick (give --machine for another)".to_string());
     }

@@ -9,6 +9,7 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::error::Warning;
 use axcomp::evaluate::{Evaluation, evaluate};
+use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::output::write_all_new;
 use axcomp::read;
@@ -138,21 +139,36 @@ impl Test {
 
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
-    let before = Test::read(&args.file, args.format, args.axis.as_ref())?;
+    let mut before = Test::read(&args.file, args.format, args.axis.as_ref())?;
     let limits = load_limits(
         args.machine.as_deref(),
         before.measurement.axis(),
         &args.acceptance,
     )?;
-    let after = match &args.after {
+    let mut after = match &args.after {
         Some(path) => Some(Test::read(path, args.format, args.axis.as_ref())?),
         None => None,
     };
+    if let (Some(after), Some(path)) = (&mut after, &args.after) {
+        // Refused, or its doubts shown with the re-test's warnings (terminal and report).
+        let doubts = check_together(
+            Pairing::BeforeAfter,
+            &Input::measurement(&before.measurement, args.file.display().to_string()),
+            &Input::measurement(&after.measurement, path.display().to_string()),
+        )?;
+        after.warnings.extend(doubts);
+    }
     let table = match &args.table {
         Some(path) => {
             let profile = load_profile(args.machine.as_deref())?;
             let axis = recorded_axis(&before.measurement, "to say which axis the table is for")?;
             let (controller, table) = read_table(path, axis, &profile, args.linuxcnc_type)?;
+            let doubts = check_together(
+                Pairing::TableOnTest,
+                &Input::measurement(&before.measurement, args.file.display().to_string()),
+                &Input::table(&table.axis, &table.positions_mm, path.display().to_string()),
+            )?;
+            before.warnings.extend(doubts);
             Some((path.display().to_string(), controller, table))
         }
         None => None,

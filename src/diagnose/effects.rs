@@ -361,13 +361,17 @@ impl Effect {
                 } else {
                     "the axis overshoots in the direction it moves (a leading encoder, or an elastic preload released at reversal)"
                 };
+                // Controllers take the backlash parameter in mm (or inch), not µm:
+                // `convert` prints each one's own line (`Controller::backlash_parameter`).
                 match context.first_test_reversal_um {
                     Some(before_um) => format!(
-                        "The reversal changed since the first test by B = {b_um:.2} µm (B̄ {before_um:.2} µm then, about {:.2} µm now; {how}); a bidirectional table from the re-test (convert --existing --effects) takes the new value out, or set the backlash parameter to the value convert --effects prints in the controller's unit.",
-                        before_um + b_um
+                        "The reversal changed since the first test by B = {b_um:.2} µm (B̄ {before_um:.2} µm then, about {:.2} µm now; {how}); a bidirectional table from the re-test (convert --existing --effects) takes the new value out, or change the backlash parameter by {:.4} mm (convert prints it in the controller's own terms).",
+                        before_um + b_um,
+                        crate::units::um_to_mm(-b_um)
                     ),
                     None => format!(
-                        "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or set the backlash parameter to the value convert prints in the controller's unit."
+                        "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or change the backlash parameter by {:.4} mm (convert prints it in the controller's own terms).",
+                        crate::units::um_to_mm(-b_um)
                     ),
                 }
             }

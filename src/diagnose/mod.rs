@@ -43,6 +43,7 @@ use crate::compensate::{CompensationTable, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
 use crate::error::{ParseError, describe_found};
 use crate::evaluate::{AxisFigures, Evaluation, evaluate};
+use crate::measurement::together::{Input, NotTogether, Pairing, check_together};
 use crate::measurement::{Direction, Measurement, Run};
 use along_axis::{Background, select_along_axis, target_levels};
 use between_runs::{
@@ -294,14 +295,10 @@ pub enum DiagnoseError {
     /// The backlash parameter cannot be applied as said.
     #[error("the backlash parameter {0}")]
     Backlash(#[from] BacklashError),
-    /// The two tests are of different axes.
-    #[error("the first test is of axis {before}, the re-test of axis {after}")]
-    AxisMismatch {
-        /// The first test's axis.
-        before: String,
-        /// The re-test's axis.
-        after: String,
-    },
+    /// The two tests (or the table) do not belong together: another axis,
+    /// ranges without a common stretch, the same readings twice.
+    #[error(transparent)]
+    NotTogether(#[from] NotTogether),
     /// A measurement could not be rebuilt (a bug).
     #[error("{0}")]
     Internal(String),
@@ -600,18 +597,14 @@ fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> 
     let after = input.after;
     let (times, time_assumed) = times_h(after, input.timing);
     let first = match input.before {
-        // A file that records no axis carries a placeholder name: nothing to compare.
-        Some(before)
-            if before.axis_recorded()
-                && after.axis_recorded()
-                && !before.axis().eq_ignore_ascii_case(after.axis()) =>
-        {
-            return Err(DiagnoseError::AxisMismatch {
-                before: before.axis().to_string(),
-                after: after.axis().to_string(),
-            });
-        }
         Some(before) => {
+            // The doubts (machine names, units, ranges) are the caller's to
+            // show: the CLI runs the same check with the file names.
+            check_together(
+                Pairing::BeforeAfter,
+                &Input::measurement(before, "the first test"),
+                &Input::measurement(after, "the re-test"),
+            )?;
             let evaluation = evaluate(before);
             let known =
                 KnownError::from_evaluation(&evaluation).ok_or(DiagnoseError::NoKnownError)?;

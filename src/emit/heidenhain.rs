@@ -7,6 +7,19 @@
 use crate::error::ParseError;
 use crate::read::text::{self, Line};
 
+/// What a positive Heidenhain backlash value means, in the technical
+/// manuals' words (iTNC 530 HSCI TM 07/2013 §6.4.1 p.647; TNC 426/430 TM
+/// p.6-36; MANUALplus 620 TM p.707, same NC family as the TNC 640): the same
+/// as axcomp's suggested backlash −B̄, which is positive when the axis falls
+/// short in the direction it moves.
+pub(crate) const BACKLASH_SIGN: &str = "positive when the rotary encoder reading is ahead of the table, so the table traverse is too short after a reversal (lost motion, the usual case); negative when it is behind";
+
+/// Heidenhain backlash parameters are entered in mm (\[seen\] "Input: [mm] or
+/// [°]" in the manuals above) to 4 decimals, whatever unit the machine
+/// displays: an inch machine gets mm too. \[reconstructed\] that the input
+/// stays mm on an inch machine: no manual gives the parameters an inch input.
+pub(crate) const BACKLASH_DECIMALS: usize = 4;
+
 /// A Heidenhain table split into its parts.
 pub(crate) struct Envelope<'a> {
     /// The `BEGIN …` line.

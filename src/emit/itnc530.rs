@@ -15,14 +15,15 @@
 //!
 //! Numbers carry an explicit sign and 4 decimals (0.1 µm); the value is the
 //! mean measured deviation (actual − target), not negated. One column per
-//! axis only: no backlash column (use the backlash parameter MP750).
+//! axis only: no backlash column (set the backlash parameter, [`backlash_parameter`]).
 
 use crate::compensate::{CompensationTable, TableValues};
-use crate::emit::heidenhain::{Envelope, empty_cell};
-use crate::emit::{EmitError, EmitOptions, signed_fixed};
+use crate::emit::heidenhain::{BACKLASH_DECIMALS, BACKLASH_SIGN, Envelope, empty_cell};
+use crate::emit::{BacklashAdvice, BacklashParameter, EmitError, EmitOptions, signed_fixed};
 use crate::error::ParseError;
 use crate::measurement::Direction;
 use crate::read::text::{self, Line};
+use crate::units::LengthUnit;
 
 const NR_WIDTH: usize = 5;
 const POSITION_WIDTH: usize = 12;
@@ -75,6 +76,42 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     }
     line("[END]".to_string());
     Ok(out)
+}
+
+/// The backlash parameter for the reversal a mean table leaves.
+///
+/// \[seen\] iTNC 530 HSCI technical manual (07/2013) §6.4.1: play outside
+/// the control loop (position from the rotary encoder) goes into MP710.x
+/// "Backlash compensation", input −1.0000 … +1.0000 mm (the TNC 426/430
+/// manual p.6-36 words it identically), x = 0 … 8 for axes 1 … 9 (the axis
+/// column number − 1); play within the loop, on an axis with a linear
+/// encoder, into MP750.x "Backlash", −9.9999 … +9.9999 mm, with MP752.x the
+/// time to traverse it (p.650). A laser test of a rotary-encoder axis sees
+/// the first; the second is named in the note.
+pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAdvice {
+    let indices: Vec<u32> = options
+        .axes
+        .iter()
+        .map(|axis| axis.itnc530_column.saturating_sub(1))
+        .collect();
+    let list = |mp: u32| {
+        indices
+            .iter()
+            .map(|index| format!("MP{mp}.{index}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    BacklashAdvice::Parameter(BacklashParameter::new(
+        list(710),
+        backlash_mm,
+        LengthUnit::Millimetre,
+        BACKLASH_DECIMALS,
+        BACKLASH_SIGN,
+        Some(format!(
+            "MP710 is for play outside the control loop (position from the rotary encoder); on an axis with a linear encoder enter it in {} (backlash within the loop) with MP752 as its compensation time instead",
+            list(750)
+        )),
+    ))
 }
 
 /// How to activate it: the `.COM` in the machine's `.CMA` and MP730 set for the axis.

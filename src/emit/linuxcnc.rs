@@ -17,7 +17,7 @@
 //! (`control.c`, `compute_screw_comp`).
 
 use crate::compensate::{CompensationTable, TableValues};
-use crate::emit::{EmitError, EmitOptions, minimal};
+use crate::emit::{BacklashAdvice, EmitError, EmitOptions, minimal};
 use crate::error::ParseError;
 use crate::measurement::Direction;
 use crate::read::text::{self, Line};
@@ -65,6 +65,23 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
         ));
     }
     Ok(out)
+}
+
+/// No backlash parameter: \[seen\] LinuxCNC 2.9 `ini-config.adoc`, "If
+/// `COMP_FILE` is specified for a joint, `BACKLASH` is not used"
+/// (`../shared/notes/controller-and-laser-formats.md` §6). The reversal goes
+/// into the file's forward and reverse columns instead.
+pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAdvice {
+    let joints: Vec<String> = options
+        .axes
+        .iter()
+        .map(|axis| format!("[JOINT_{}] BACKLASH", axis.linuxcnc_joint))
+        .collect();
+    BacklashAdvice::NoParameter(format!(
+        "no backlash parameter: {} is ignored once COMP_FILE is set, so this mean table leaves the reversal of {:.2} µm (−B̄) in place; write the table with --mode bidirectional to take it out (forward and reverse columns, COMP_FILE_TYPE 0 or 1)",
+        joints.join(", "),
+        crate::units::mm_to_um(backlash_mm)
+    ))
 }
 
 /// The INI lines that activate the file on a joint.

@@ -72,6 +72,21 @@ impl Controller {
         !matches!(self, Controller::Itnc530)
     }
 
+    /// What to do on this controller with the reversal a mean table leaves:
+    /// the backlash parameter to set, in the controller's own name, unit,
+    /// resolution and sign, or why there is none. `backlash_mm` is the
+    /// suggested backlash −B̄ (`CompensationTable::suggested_backlash_mm`),
+    /// positive for the usual lost motion; the knowledge of each parameter
+    /// lives in its controller's file.
+    pub fn backlash_parameter(self, backlash_mm: f64, options: &EmitOptions) -> BacklashAdvice {
+        match self {
+            Controller::Itnc530 => itnc530::backlash_parameter(backlash_mm, options),
+            Controller::Tnc640 => tnc640::backlash_parameter(backlash_mm, options),
+            Controller::Sinumerik840d => sinumerik840d::backlash_parameter(backlash_mm, options),
+            Controller::LinuxCnc => linuxcnc::backlash_parameter(backlash_mm, options),
+        }
+    }
+
     /// The most points the controller takes, when known.
     pub fn max_points(self) -> Option<usize> {
         match self {
@@ -82,6 +97,62 @@ impl Controller {
             // TNC 640: not documented publicly; Sinumerik: MD38000, machine-specific.
             Controller::Tnc640 | Controller::Sinumerik840d => None,
         }
+    }
+}
+
+/// What to do with the reversal a mean table leaves ([`Controller::backlash_parameter`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum BacklashAdvice {
+    /// Set this parameter of the controller.
+    Parameter(BacklashParameter),
+    /// The controller has no parameter that works next to the table; the
+    /// sentence says why and what to do instead.
+    NoParameter(String),
+}
+
+/// A controller's backlash parameter with the value to type into it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BacklashParameter {
+    /// Where it is set, in the controller's own words (`MD32450 $MA_BACKLASH[0,X1]`).
+    pub name: String,
+    /// The value to type, in `unit`, already rounded to `decimals`.
+    pub value: f64,
+    /// The unit the controller reads it in.
+    pub unit: LengthUnit,
+    /// Decimals the value is given to (the controller's input resolution).
+    pub decimals: usize,
+    /// What a positive value means, in the controller's documentation's words.
+    pub sign: String,
+    /// What else to know (another parameter for another set-up, when it acts).
+    pub note: Option<String>,
+}
+
+impl BacklashParameter {
+    /// A parameter whose value is `backlash_mm` in `unit`, rounded to `decimals`.
+    pub fn new(
+        name: String,
+        backlash_mm: f64,
+        unit: LengthUnit,
+        decimals: usize,
+        sign: &str,
+        note: Option<String>,
+    ) -> BacklashParameter {
+        let scale = 10f64.powi(decimals as i32);
+        let value = (unit.from_mm(backlash_mm) * scale).round() / scale;
+        BacklashParameter {
+            name,
+            // Never -0.
+            value: if value == 0.0 { 0.0 } else { value },
+            unit,
+            decimals,
+            sign: sign.to_string(),
+            note,
+        }
+    }
+
+    /// The value as the user types it: `0.0032`, `-0.0010`.
+    pub fn value_text(&self) -> String {
+        format!("{:.*}", self.decimals, self.value)
     }
 }
 
@@ -517,6 +588,40 @@ mod tests {
         assert_eq!(minimal(-200.0, 6), "-200");
         assert_eq!(minimal(0.0030000001, 6), "0.003");
         assert_eq!(minimal(-0.0000001, 6), "0");
+    }
+
+    #[test]
+    fn backlash_values_are_rounded_in_the_controller_unit() {
+        let options = options(Controller::Sinumerik840d, LengthUnit::Millimetre);
+        // −B̄ = 3.179725 µm (fixtures/sample-x.rtl): 0.0032 mm to 4 decimals.
+        let BacklashAdvice::Parameter(mm) =
+            Controller::Sinumerik840d.backlash_parameter(0.003_179_725, &options)
+        else {
+            panic!("Sinumerik has MD32450")
+        };
+        assert_eq!((mm.value, mm.value_text().as_str()), (0.0032, "0.0032"));
+        assert_eq!(mm.name, "MD32450 $MA_BACKLASH[0,X1]");
+        // An overshooting axis gets a negative value; a rounded zero is 0, not -0.
+        let negative =
+            BacklashParameter::new(String::new(), -0.001, LengthUnit::Millimetre, 4, "", None);
+        assert_eq!(negative.value_text(), "-0.0010");
+        let tiny = BacklashParameter::new(
+            String::new(),
+            -0.000_01,
+            LengthUnit::Millimetre,
+            4,
+            "",
+            None,
+        );
+        assert_eq!(tiny.value_text(), "0.0000");
+        // 0.003179725 mm / 25.4 = 0.00012519 inch.
+        let inch =
+            BacklashParameter::new(String::new(), 0.003_179_725, LengthUnit::Inch, 6, "", None);
+        assert_eq!(inch.value_text(), "0.000125");
+        assert!(matches!(
+            Controller::LinuxCnc.backlash_parameter(0.003_179_725, &options),
+            BacklashAdvice::NoParameter(_)
+        ));
     }
 
     #[test]

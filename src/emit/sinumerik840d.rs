@@ -19,9 +19,10 @@
 use std::collections::BTreeMap;
 
 use crate::compensate::{CompensationTable, TableValues};
-use crate::emit::{EmitError, EmitOptions, minimal};
+use crate::emit::{BacklashAdvice, BacklashParameter, EmitError, EmitOptions, minimal};
 use crate::error::ParseError;
 use crate::read::text::{self, Line};
+use crate::units::LengthUnit;
 
 /// Decimals written (1 nm).
 const DECIMALS: usize = 6;
@@ -93,6 +94,48 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     }
     line("M17".to_string());
     Ok(out)
+}
+
+/// The backlash parameter for the reversal a mean (LEC) table leaves.
+///
+/// \[seen\] SINUMERIK 808D Advanced parameter manual (08/2013) p.228/241:
+/// MD32450 `$MA_BACKLASH[n]`, one per measuring system n, in mm (degrees on
+/// rotary axes), "positive, if the encoder is leading the machine part
+/// (normal situation); negative, if the encoder is behind the machine part",
+/// active after the reference point approach. p.33: with MD10240
+/// `$MN_SCALING_SYSTEM_IS_METRIC` = 0 length machine data are read in inch,
+/// so an inch machine gets inch. Decimals: 0.1 µm (4 in mm, 6 in inch, the
+/// nearest), finer than the measurement of B̄ and than the default
+/// computational resolution (MD10200 `INT_INCR_PER_MM` = 1000, 1 µm).
+pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAdvice {
+    let names: Vec<String> = options
+        .axes
+        .iter()
+        .map(|axis| {
+            format!(
+                "$MA_BACKLASH[{},{}]",
+                axis.sinumerik_encoder, axis.sinumerik_axis
+            )
+        })
+        .collect();
+    let unit = options.machine_unit;
+    let (decimals, unit_note) = match unit {
+        LengthUnit::Millimetre => (4, ""),
+        LengthUnit::Inch => (
+            6,
+            " The value is in inch because the machine profile says inch (MD10240 $MN_SCALING_SYSTEM_IS_METRIC = 0); on a metric control enter it in mm.",
+        ),
+    };
+    BacklashAdvice::Parameter(BacklashParameter::new(
+        format!("MD32450 {}", names.join(", ")),
+        backlash_mm,
+        unit,
+        decimals,
+        "positive when the encoder is leading the machine part (the normal situation: the axis falls short after a reversal); negative when it is behind",
+        Some(format!(
+            "active after the axis is referenced; or write the table with --mode bidirectional (two CEC tables, one per direction) instead.{unit_note}"
+        )),
+    ))
 }
 
 /// What the machine needs before the program loads, and how to activate it.

@@ -16,11 +16,14 @@
 //! after-test confirms the sign (A 9.7 µm → 2.3 µm).
 
 use crate::compensate::{CompensationTable, TableValues};
-use crate::emit::heidenhain::{Envelope, empty_cell};
-use crate::emit::{EmitError, EmitOptions, signed_fixed, signed_minimal};
+use crate::emit::heidenhain::{BACKLASH_DECIMALS, BACKLASH_SIGN, Envelope, empty_cell};
+use crate::emit::{
+    BacklashAdvice, BacklashParameter, EmitError, EmitOptions, signed_fixed, signed_minimal,
+};
 use crate::error::ParseError;
 use crate::measurement::Direction;
 use crate::read::text;
+use crate::units::LengthUnit;
 
 /// Width of the NR column.
 const NR_WIDTH: usize = 5;
@@ -108,6 +111,37 @@ pub fn activation(file_name: &str, options: &EmitOptions) -> String {
         "config.cma: a line with {file_name} in column {column} and * in column ACTIVE, e.g.\n{:<5}{:<8}{column}\n{:<5}{:<8}{file_name}",
         "NR", "ACTIVE", "0", "*"
     )
+}
+
+/// The backlash parameter for the reversal a mean table leaves.
+///
+/// \[seen\] MANUALplus 620 technical manual (01/2012) §6.10.1 p.707–708,
+/// the TNC 640's NC family: `backLash` (MP 401802) in `CfgAxisComp` of the
+/// axis's parameter set, "added to the position value at every reversal of
+/// direction (even if it results from nonlinear axis-error compensation)",
+/// so it acts next to the `.COM` table; `filterTime` (401805) is the time to
+/// traverse it. \[reconstructed\] the same key on the TNC 640 (its
+/// configuration editor has the same CfgAxisComp object).
+pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAdvice {
+    let axes: Vec<&str> = options
+        .axes
+        .iter()
+        .map(|axis| axis.tnc640_column.as_str())
+        .collect();
+    BacklashAdvice::Parameter(BacklashParameter::new(
+        format!(
+            "CfgAxisComp/backLash (MP 401802) of axis {}",
+            axes.join(", ")
+        ),
+        backlash_mm,
+        LengthUnit::Millimetre,
+        BACKLASH_DECIMALS,
+        BACKLASH_SIGN,
+        Some(
+            "filterTime (MP 401805) sets how fast it is traversed; or write the table with --mode bidirectional, which puts the ↓ values in the BACKLASH column instead"
+                .to_string(),
+        ),
+    ))
 }
 
 /// Reads a TNC 640 `.COM` table: the values of `column`, and BACKLASH as the ↓ values.

@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 use chrono::NaiveDateTime;
 
 use crate::error::{ParseError, ReadError, Warning};
+use crate::measurement::together::{Input, Pairing, check_together};
 use crate::measurement::{Measurement, Run, SourceFormat};
 
 /// A measurement read from one or more files, with what the readers noticed.
@@ -78,6 +79,27 @@ pub fn read_paths(
     let mut result = read_path(first, format)?;
     for path in rest {
         let next = read_path(path, format)?;
+        // Two files of one test: one axis, two files, the same stretch. The
+        // files are compared by their canonical paths (`a.rtl` and `./a.rtl`
+        // are one file); a copy is caught by its readings.
+        let canonical = [
+            std::fs::canonicalize(first).ok(),
+            std::fs::canonicalize(path).ok(),
+        ];
+        let mut inputs = [
+            Input::measurement(&result.measurement, first.display().to_string()),
+            Input::measurement(&next.measurement, path.display().to_string()),
+        ];
+        for (input, canonical) in inputs.iter_mut().zip(&canonical) {
+            input.file = canonical.as_deref().or(input.file);
+        }
+        let doubts = check_together(Pairing::OneTest, &inputs[0], &inputs[1]).map_err(|error| {
+            ReadError::Merge {
+                path: path.clone(),
+                message: error.to_string(),
+            }
+        })?;
+        result.warnings.extend(doubts);
         let merged = result
             .measurement
             .merge(&next.measurement)

@@ -7,17 +7,25 @@
 //!   "mode": "mean" | "bidirectional", "positions_mm": [...], "count": 16,
 //!   "start_mm": 0.0, "step_mm": 50.0 | null, "reference_mm": 0.0,
 //!   "values_um": {"mean": [...]} | {"up": [...], "down": [...]},
-//!   "suggested_backlash_um": 3.2 | null, "activation": "…",
+//!   "suggested_backlash_um": 3.2 | null,
+//!   "backlash_parameter": {"name": "MD32450 $MA_BACKLASH[0,X1]", "value": 0.0032,
+//!                          "unit": "mm" | "inch", "sign": "…", "note": "…" | null} | null,
+//!   "backlash_note": "…" | null, "activation": "…",
 //!   "effects": ["…what --effects changed…"], "warnings": [...] }
 //! ```
 //! Values are the axis error actual − target in µm, zero at the reference,
 //! before each controller's own sign convention (see `formats/`).
+//! `suggested_backlash_um` is −B̄ (mean mode); `backlash_parameter` is the
+//! same reversal as the value to type into the controller, in its unit
+//! (`value` in `unit`), and is null where the controller has no parameter
+//! that works next to the table (LinuxCNC), when `backlash_note` says why.
 
 use std::fmt::Write;
 
 use serde::Serialize;
 
 use crate::compensate::{CompensationTable, TableValues};
+use crate::emit::BacklashAdvice;
 use crate::report::terminal::um;
 use crate::units::mm_to_um;
 
@@ -37,6 +45,24 @@ pub enum ValuesJson {
         /// Moving −.
         down: Vec<f64>,
     },
+}
+
+/// A controller's backlash parameter and the value to type into it.
+#[derive(Clone, Debug, Serialize)]
+pub struct BacklashParameterJson {
+    /// The parameter, in the controller's words.
+    pub name: String,
+    /// The value to type, in `unit`, rounded to the controller's input resolution.
+    pub value: f64,
+    /// `mm` or `inch`: the unit the controller reads the parameter in.
+    pub unit: &'static str,
+    /// What a positive value means.
+    pub sign: String,
+    /// What else to know, or null.
+    pub note: Option<String>,
+    /// The value as text with the controller's decimals (`0.0032`), for the terminal.
+    #[serde(skip)]
+    pub value_text: String,
 }
 
 /// The whole `convert --json` object.
@@ -64,8 +90,13 @@ pub struct ConvertJson {
     pub reference_mm: f64,
     /// The values, µm.
     pub values_um: ValuesJson,
-    /// Suggested backlash parameter, µm (mean mode).
+    /// Suggested backlash parameter, µm (mean mode): −B̄.
     pub suggested_backlash_um: Option<f64>,
+    /// The same as the controller's parameter, in its unit; null without a
+    /// suggestion or where the controller has none (then `backlash_note`).
+    pub backlash_parameter: Option<BacklashParameterJson>,
+    /// Why the controller has no backlash parameter for the table, and what to do instead.
+    pub backlash_note: Option<String>,
     /// How to activate the table on the controller.
     pub activation: String,
     /// What `--effects` changed, as sentences (empty without it).
@@ -106,9 +137,33 @@ impl ConvertJson {
                 },
             },
             suggested_backlash_um: table.suggested_backlash_mm.map(mm_to_um),
+            backlash_parameter: None,
+            backlash_note: None,
             activation,
             effects: Vec::new(),
             warnings,
+        }
+    }
+
+    /// Sets what the controller does with the suggested backlash
+    /// ([`crate::emit::Controller::backlash_parameter`]).
+    pub fn set_backlash(&mut self, advice: BacklashAdvice) {
+        match advice {
+            BacklashAdvice::Parameter(parameter) => {
+                self.backlash_parameter = Some(BacklashParameterJson {
+                    value_text: parameter.value_text(),
+                    name: parameter.name,
+                    value: parameter.value,
+                    unit: parameter.unit.as_str(),
+                    sign: parameter.sign,
+                    note: parameter.note,
+                });
+                self.backlash_note = None;
+            }
+            BacklashAdvice::NoParameter(note) => {
+                self.backlash_parameter = None;
+                self.backlash_note = Some(note);
+            }
         }
     }
 
@@ -138,11 +193,28 @@ impl ConvertJson {
         for effect in &self.effects {
             let _ = writeln!(out, "Effect: {effect}");
         }
-        if let Some(backlash) = self.suggested_backlash_um {
-            let _ = writeln!(
-                out,
-                "Suggested backlash parameter: {backlash:.2} µm (−B̄; Heidenhain backlash MP, Siemens MD32450 $MA_BACKLASH)"
-            );
+        if let Some(backlash_um) = self.suggested_backlash_um {
+            match (&self.backlash_parameter, &self.backlash_note) {
+                (Some(parameter), _) => {
+                    let _ = writeln!(
+                        out,
+                        "Backlash parameter: {} = {} {} (−B̄ = {backlash_um:.2} µm)\n  sign: {}",
+                        parameter.name, parameter.value_text, parameter.unit, parameter.sign
+                    );
+                    if let Some(note) = &parameter.note {
+                        let _ = writeln!(out, "  note: {note}");
+                    }
+                }
+                (None, Some(note)) => {
+                    let _ = writeln!(out, "Backlash: {note}");
+                }
+                (None, None) => {
+                    let _ = writeln!(
+                        out,
+                        "Reversal left by the mean table: −B̄ = {backlash_um:.2} µm (set the controller's backlash parameter to it, in the controller's unit)"
+                    );
+                }
+            }
         }
         let _ = writeln!(
             out,

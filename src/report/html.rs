@@ -931,9 +931,13 @@ fn table_section(
     let spacing = table
         .regular_step_mm()
         .map_or_else(|| "uneven spacing".to_string(), |s| format!("every {s} mm"));
+    // A table read from its file carries no suggestion (only one built from
+    // the test does); the value to type is in the controller's unit, which
+    // `convert` prints (`Controller::backlash_parameter`), so the µm here is
+    // labelled as the reversal, not as a parameter value.
     let backlash = table.suggested_backlash_mm.map_or_else(String::new, |b| {
         format!(
-            "<tr><th>Suggested backlash parameter</th><td>{} µm</td></tr>",
+            "<tr><th>Reversal the table leaves</th><td>−B̄ = {} µm: set the controller's backlash parameter (<code>axcomp convert</code> prints it in the controller's unit)</td></tr>",
             signed(mm_to_um(b), 2)
         )
     });

@@ -607,7 +607,7 @@ fn tests_of_different_axes_are_refused() {
     let error = diagnose(&input).unwrap_err();
     assert_eq!(
         error.to_string(),
-        "the first test is of axis Y, the re-test of axis X"
+        "the first test is of axis Y, the re-test of axis X: a re-test must be of the axis of the first test, and a new test"
     );
 }
 

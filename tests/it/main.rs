@@ -4,6 +4,7 @@
 //! into the repository); small inputs and expected outputs live in `tests/data`.
 
 mod axis_identity;
+mod backlash;
 mod bad_input;
 mod browser;
 mod cli;
@@ -21,5 +22,6 @@ mod predict;
 mod read_api_pos;
 mod report;
 mod servo;
+mod together;
 mod util;
 mod verdict;

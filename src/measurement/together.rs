@@ -1,0 +1,444 @@
+//! Whether two inputs belong together before they are joined or compared.
+//!
+//! Every place that puts two inputs side by side asks [`check_together`]:
+//! the two files of one test that `read::read_paths` joins (forward and
+//! reverse `.pos`), a first test and its re-test (`report --after`,
+//! `diagnose --before`), and a compensation table and the test it is
+//! applied to (`convert --existing`, `predict --table`). A clear mismatch is
+//! refused ([`NotTogether`]): another axis, target ranges with nothing in
+//! common, the same file or the same readings twice. A doubtful one is a
+//! [`Warning::Doubtful`]: other machine names, other units in the original
+//! files, a range that only partly overlaps. Plain data in and out: the
+//! caller describes each input as an [`Input`] and names it as the user knows
+//! it (a file name, or "the first test").
+
+use std::fmt;
+use std::path::Path;
+
+use crate::error::Warning;
+use crate::measurement::Measurement;
+use crate::units::LengthUnit;
+
+/// What the two inputs are to each other: it decides what is refused and
+/// what is only doubtful.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pairing {
+    /// Two files of one test, joined into one measurement (e.g. the forward
+    /// and reverse `.pos` files of one axis).
+    OneTest,
+    /// A first test and its re-test, compared.
+    BeforeAfter,
+    /// A test (first) and a compensation table applied to it (second): the
+    /// table active during the test, or the table predicted for its re-test.
+    TableOnTest,
+}
+
+/// What one input says about itself, as far as belonging together goes.
+#[derive(Clone, Debug)]
+pub struct Input<'a> {
+    /// How the user knows it: the file name, or "the first test".
+    pub label: String,
+    /// The axis it is of; `None` when the file does not record it (its name
+    /// is then a placeholder, and nothing can be compared).
+    pub axis: Option<&'a str>,
+    /// The machine name it records, if any.
+    pub machine: Option<&'a str>,
+    /// The length unit of the original file, when it is a measurement file.
+    pub length_unit: Option<LengthUnit>,
+    /// First and last target (or compensation point), mm.
+    pub range_mm: (f64, f64),
+    /// The file it was read from, if known.
+    pub file: Option<&'a Path>,
+    /// The readings, to recognise the same test given twice (tables have none).
+    pub readings: Option<&'a Measurement>,
+}
+
+impl<'a> Input<'a> {
+    /// A measurement, named `label` in messages.
+    pub fn measurement(measurement: &'a Measurement, label: impl Into<String>) -> Input<'a> {
+        let targets = measurement.targets_mm();
+        Input {
+            label: label.into(),
+            axis: measurement.axis_recorded().then(|| measurement.axis()),
+            machine: measurement.metadata.machine.as_deref(),
+            length_unit: Some(measurement.metadata.length_unit),
+            range_mm: (targets[0], targets[targets.len() - 1]),
+            file: measurement.metadata.source_file.as_deref(),
+            readings: Some(measurement),
+        }
+    }
+
+    /// A compensation table of `axis` with its points, named `label` in
+    /// messages. `positions_mm` must not be empty (a table has points).
+    pub fn table(axis: &'a str, positions_mm: &[f64], label: impl Into<String>) -> Input<'a> {
+        let first = positions_mm.first().copied().unwrap_or(f64::NAN);
+        let last = positions_mm.last().copied().unwrap_or(f64::NAN);
+        Input {
+            label: label.into(),
+            axis: Some(axis),
+            machine: None,
+            length_unit: None,
+            range_mm: (first, last),
+            file: None,
+            readings: None,
+        }
+    }
+}
+
+/// Why two inputs are refused together.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum NotTogether {
+    /// They are of different axes.
+    #[error("{first} is of axis {first_axis}, {second} of axis {second_axis}: {what}")]
+    DifferentAxes {
+        /// The first input.
+        first: String,
+        /// Its axis.
+        first_axis: String,
+        /// The second input.
+        second: String,
+        /// Its axis.
+        second_axis: String,
+        /// What this means for the pairing.
+        what: &'static str,
+    },
+    /// The same file twice.
+    #[error("{first} is given twice: {what}")]
+    SameFile {
+        /// The file.
+        first: String,
+        /// What this means for the pairing.
+        what: &'static str,
+    },
+    /// Two files with the very same readings.
+    #[error("{first} and {second} hold the same readings (the same file, or a copy of it): {what}")]
+    SameReadings {
+        /// The first input.
+        first: String,
+        /// The second input.
+        second: String,
+        /// What this means for the pairing.
+        what: &'static str,
+    },
+    /// The target ranges have nothing in common.
+    #[error(
+        "{first} covers {first_from} … {first_to} mm, {second} {second_from} … {second_to} mm: the ranges do not overlap, so they are not {what}"
+    )]
+    DisjointRanges {
+        /// The first input.
+        first: String,
+        /// Its first target, mm.
+        first_from: f64,
+        /// Its last target, mm.
+        first_to: f64,
+        /// The second input.
+        second: String,
+        /// Its first point, mm.
+        second_from: f64,
+        /// Its last point, mm.
+        second_to: f64,
+        /// What they would have to be.
+        what: &'static str,
+    },
+}
+
+/// Something that makes two inputs doubtful together; the user decides.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Doubt {
+    /// The files name different machines.
+    DifferentMachines {
+        /// The first input.
+        first: String,
+        /// Its machine.
+        first_machine: String,
+        /// The second input.
+        second: String,
+        /// Its machine.
+        second_machine: String,
+    },
+    /// The original files were written in different length units.
+    DifferentUnits {
+        /// The first input.
+        first: String,
+        /// Its unit.
+        first_unit: LengthUnit,
+        /// The second input.
+        second: String,
+        /// Its unit.
+        second_unit: LengthUnit,
+    },
+    /// The ranges overlap only in part.
+    PartialOverlap {
+        /// The first input.
+        first: String,
+        /// Its range, mm.
+        first_mm: (f64, f64),
+        /// The second input.
+        second: String,
+        /// Its range, mm.
+        second_mm: (f64, f64),
+        /// What happens outside the common part.
+        consequence: &'static str,
+    },
+}
+
+impl fmt::Display for Doubt {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Doubt::DifferentMachines {
+                first,
+                first_machine,
+                second,
+                second_machine,
+            } => write!(
+                f,
+                "{first} names machine {first_machine:?}, {second} {second_machine:?}: check that both are of the same machine"
+            ),
+            Doubt::DifferentUnits {
+                first,
+                first_unit,
+                second,
+                second_unit,
+            } => write!(
+                f,
+                "{first} was written in {}, {second} in {}: both are converted to mm, but check that they come from the same set-up",
+                first_unit.as_str(),
+                second_unit.as_str()
+            ),
+            Doubt::PartialOverlap {
+                first,
+                first_mm,
+                second,
+                second_mm,
+                consequence,
+            } => write!(
+                f,
+                "{first} covers {} … {} mm, {second} {} … {} mm: they overlap only in part; {consequence}",
+                first_mm.0, first_mm.1, second_mm.0, second_mm.1
+            ),
+        }
+    }
+}
+
+/// Checks that two inputs belong together for `pairing`: the refusal, or
+/// the doubts as warnings (empty when nothing is odd).
+///
+/// Refused: another axis (compared case-insensitively); the same file
+/// (same path) or the same readings twice (one test is not two, and a
+/// re-test never repeats a test to the last digit); ranges without a common
+/// stretch. Doubtful: other machine names; other units of the original files;
+/// ranges that differ by more than 1 % of the longer one, or, for a table,
+/// a test that reaches beyond the table's points (the controller holds the
+/// end values there).
+///
+/// # Example
+/// ```
+/// use axcomp::measurement::together::{Input, Pairing, check_together};
+/// let before = Input::table("X", &[0.0, 500.0], "X.COM");
+/// let after = Input::table("Y", &[0.0, 500.0], "Y.COM");
+/// let error = check_together(Pairing::BeforeAfter, &before, &after).unwrap_err();
+/// assert!(error.to_string().starts_with("X.COM is of axis X, Y.COM of axis Y"));
+/// ```
+pub fn check_together(
+    pairing: Pairing,
+    first: &Input<'_>,
+    second: &Input<'_>,
+) -> Result<Vec<Warning>, NotTogether> {
+    let what = match pairing {
+        Pairing::OneTest => "two files of one test must be of one axis, from two different files",
+        Pairing::BeforeAfter => "a re-test must be of the axis of the first test, and a new test",
+        Pairing::TableOnTest => "a table applies to its own axis only",
+    };
+    if let (Some(first_axis), Some(second_axis)) = (first.axis, second.axis)
+        && !first_axis.eq_ignore_ascii_case(second_axis)
+    {
+        return Err(NotTogether::DifferentAxes {
+            first: first.label.clone(),
+            first_axis: first_axis.to_string(),
+            second: second.label.clone(),
+            second_axis: second_axis.to_string(),
+            what,
+        });
+    }
+    if let (Some(a), Some(b)) = (first.file, second.file)
+        && a == b
+    {
+        return Err(NotTogether::SameFile {
+            first: first.label.clone(),
+            what,
+        });
+    }
+    if let (Some(a), Some(b)) = (first.readings, second.readings)
+        && same_readings(a, b)
+    {
+        return Err(NotTogether::SameReadings {
+            first: first.label.clone(),
+            second: second.label.clone(),
+            what,
+        });
+    }
+    let (a_from, a_to) = first.range_mm;
+    let (b_from, b_to) = second.range_mm;
+    let common_mm = a_to.min(b_to) - a_from.max(b_from);
+    // A single common point is no common stretch (a table's end point on a test's start).
+    let tolerance_mm = 1e-6;
+    if common_mm.is_nan() || common_mm <= tolerance_mm {
+        return Err(NotTogether::DisjointRanges {
+            first: first.label.clone(),
+            first_from: a_from,
+            first_to: a_to,
+            second: second.label.clone(),
+            second_from: b_from,
+            second_to: b_to,
+            what: match pairing {
+                Pairing::OneTest => "one test",
+                Pairing::BeforeAfter => "a test and its re-test",
+                Pairing::TableOnTest => "a table and a test it applies to",
+            },
+        });
+    }
+    let mut warnings = Vec::new();
+    if let (Some(a), Some(b)) = (first.machine, second.machine)
+        && !a.trim().eq_ignore_ascii_case(b.trim())
+    {
+        warnings.push(Warning::Doubtful(Doubt::DifferentMachines {
+            first: first.label.clone(),
+            first_machine: a.to_string(),
+            second: second.label.clone(),
+            second_machine: b.to_string(),
+        }));
+    }
+    if let (Some(a), Some(b)) = (first.length_unit, second.length_unit)
+        && a != b
+    {
+        warnings.push(Warning::Doubtful(Doubt::DifferentUnits {
+            first: first.label.clone(),
+            first_unit: a,
+            second: second.label.clone(),
+            second_unit: b,
+        }));
+    }
+    // 1 % of the longer range: the same test program gives the same targets;
+    // a re-test over another stretch of the axis compares different things.
+    let slack_mm = 0.01 * (a_to - a_from).max(b_to - b_from);
+    let partial = match pairing {
+        Pairing::OneTest | Pairing::BeforeAfter => {
+            (a_from - b_from).abs() > slack_mm || (a_to - b_to).abs() > slack_mm
+        }
+        // A table longer than the test is normal; a test beyond the table is not.
+        Pairing::TableOnTest => a_from < b_from - slack_mm || a_to > b_to + slack_mm,
+    };
+    if partial {
+        warnings.push(Warning::Doubtful(Doubt::PartialOverlap {
+            first: first.label.clone(),
+            first_mm: first.range_mm,
+            second: second.label.clone(),
+            second_mm: second.range_mm,
+            consequence: match pairing {
+                Pairing::OneTest => "only common targets can be joined",
+                Pairing::BeforeAfter => {
+                    "the comparison covers different stretches of the axis; measure the re-test over the first test's targets"
+                }
+                Pairing::TableOnTest => {
+                    "beyond the table's points the controller holds its end values"
+                }
+            },
+        }));
+    }
+    Ok(warnings)
+}
+
+/// The same targets and the same runs, reading for reading.
+fn same_readings(a: &Measurement, b: &Measurement) -> bool {
+    a.targets_mm() == b.targets_mm() && a.runs() == b.runs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measurement::{Direction, Environment, Metadata, Run};
+
+    fn test(axis: &str, targets: Vec<f64>, offset_mm: f64, machine: &str) -> Measurement {
+        let runs = Direction::BOTH
+            .iter()
+            .map(|&direction| Run {
+                direction,
+                number: 1,
+                start_time_s: None,
+                deviations_mm: targets.iter().map(|_| Some(offset_mm)).collect(),
+            })
+            .collect();
+        let metadata = Metadata {
+            machine: Some(machine.to_string()),
+            ..Metadata::default()
+        };
+        Measurement::new(axis, targets, runs, Environment::default(), metadata).unwrap()
+    }
+
+    fn check(
+        pairing: Pairing,
+        a: &Measurement,
+        b: &Measurement,
+    ) -> Result<Vec<Warning>, NotTogether> {
+        check_together(
+            pairing,
+            &Input::measurement(a, "a.rtl"),
+            &Input::measurement(b, "b.rtl"),
+        )
+    }
+
+    #[test]
+    fn clear_mismatches_are_refused() {
+        let x = test("X", vec![0.0, 500.0, 1000.0], 0.001, "M1");
+        let y = test("y", vec![0.0, 500.0, 1000.0], 0.002, "M1");
+        assert!(matches!(
+            check(Pairing::BeforeAfter, &x, &y),
+            Err(NotTogether::DifferentAxes { .. })
+        ));
+        // Case does not make another axis.
+        let lower_x = test("x", vec![0.0, 500.0, 1000.0], 0.002, "M1");
+        assert_eq!(check(Pairing::BeforeAfter, &x, &lower_x), Ok(Vec::new()));
+        assert!(matches!(
+            check(Pairing::OneTest, &x, &x.clone()),
+            Err(NotTogether::SameReadings { .. })
+        ));
+        let far = test("X", vec![1500.0, 2000.0], 0.002, "M1");
+        let error = check(Pairing::BeforeAfter, &x, &far).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "a.rtl covers 0 … 1000 mm, b.rtl 1500 … 2000 mm: the ranges do not overlap, so they are not a test and its re-test"
+        );
+        // Touching at one point is no overlap.
+        let touching = test("X", vec![1000.0, 2000.0], 0.002, "M1");
+        assert!(check(Pairing::BeforeAfter, &x, &touching).is_err());
+    }
+
+    #[test]
+    fn doubts_are_warnings() {
+        let a = test("X", vec![0.0, 500.0, 1000.0], 0.001, "MCV 754");
+        let mut b = test("X", vec![400.0, 1400.0], 0.002, "Other mill");
+        b.metadata.length_unit = LengthUnit::Inch;
+        let warnings = check(Pairing::BeforeAfter, &a, &b).unwrap();
+        let texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+        assert_eq!(texts.len(), 3, "{texts:?}");
+        assert!(texts[0].contains("\"MCV 754\", b.rtl \"Other mill\""));
+        assert!(texts[1].contains("a.rtl was written in mm, b.rtl in inch"));
+        assert!(texts[2].starts_with("a.rtl covers 0 … 1000 mm, b.rtl 400 … 1400 mm"));
+    }
+
+    #[test]
+    fn a_table_may_be_longer_than_the_test_but_not_shorter() {
+        let test_x = test("X", vec![0.0, 500.0, 1000.0], 0.001, "M1");
+        let long = Input::table("X", &[-100.0, 1200.0], "T.COM");
+        let short = Input::table("X", &[0.0, 600.0], "T.COM");
+        let off = Input::table("X", &[1100.0, 1200.0], "T.COM");
+        let measured = Input::measurement(&test_x, "a.rtl");
+        assert_eq!(
+            check_together(Pairing::TableOnTest, &measured, &long),
+            Ok(Vec::new())
+        );
+        let warnings = check_together(Pairing::TableOnTest, &measured, &short).unwrap();
+        assert!(warnings[0].to_string().contains("holds its end values"));
+        assert!(check_together(Pairing::TableOnTest, &measured, &off).is_err());
+    }
+}
