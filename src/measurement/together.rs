@@ -356,7 +356,7 @@ fn same_readings(a: &Measurement, b: &Measurement) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::measurement::{Direction, Environment, Metadata, Run};
+    use crate::measurement::{AxisSource, Direction, Environment, Metadata, Run};
 
     fn test(axis: &str, targets: Vec<f64>, offset_mm: f64, machine: &str) -> Measurement {
         let runs = Direction::BOTH
@@ -370,9 +370,19 @@ mod tests {
             .collect();
         let metadata = Metadata {
             machine: Some(machine.to_string()),
+            axis_source: AxisSource::Given,
             ..Metadata::default()
         };
         Measurement::new(axis, targets, runs, Environment::default(), metadata).unwrap()
+    }
+
+    #[test]
+    fn an_unrecorded_axis_is_compared_with_nothing() {
+        let z = test("Z", vec![0.0, 500.0, 1000.0], 0.001, "M1");
+        let mut unnamed = test("X", vec![0.0, 500.0, 1000.0], 0.002, "M1");
+        unnamed.metadata.axis_source = AxisSource::NotRecorded;
+        // Its "X" is a placeholder: not another axis than Z.
+        assert_eq!(check(Pairing::BeforeAfter, &z, &unnamed), Ok(Vec::new()));
     }
 
     fn check(

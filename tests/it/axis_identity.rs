@@ -343,9 +343,20 @@ fn predict_diagnose_and_report_need_the_axis_only_where_it_matters() {
     ]);
     assert_eq!(accepted.code, 0, "{}", accepted.stderr);
 
-    // diagnose and report read the table for the file's axis.
+    // diagnose and report read the table for the file's axis. The re-test: the
+    // later run of the same Axis1 test (another file: one file twice is refused).
+    let retest_arg =
+        shared_data("ecmc/ecmccfg/examples__ESS__mcu1025_fat_sat__report.md_ISO230.dat")
+            .display()
+            .to_string();
     let diagnose = axcomp([
-        "diagnose", "--before", &file_arg, "--after", &file_arg, "--table", &table_arg,
+        "diagnose",
+        "--before",
+        &file_arg,
+        "--after",
+        &retest_arg,
+        "--table",
+        &table_arg,
     ]);
     assert_eq!(diagnose.code, 2, "{}", diagnose.stderr);
     assert!(
@@ -354,7 +365,14 @@ fn predict_diagnose_and_report_need_the_axis_only_where_it_matters() {
         diagnose.stderr
     );
     let diagnose = axcomp([
-        "diagnose", "--before", &file_arg, "--after", &file_arg, "--table", &table_arg, "--axis",
+        "diagnose",
+        "--before",
+        &file_arg,
+        "--after",
+        &retest_arg,
+        "--table",
+        &table_arg,
+        "--axis",
         "X",
     ]);
     assert_eq!(diagnose.code, 0, "{}", diagnose.stderr);

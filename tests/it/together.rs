@@ -203,13 +203,15 @@ fn report_shows_doubts_as_warnings_in_the_terminal_and_the_report() {
             "the report lacks {warning:?}"
         );
     }
-    // Real ESS files: −20 … 20 mm against −15 … 5 mm.
+    // Real ESS files of two X axes (both state TARGET_DU:X…): −20 … 20 mm against −4 … 4 mm.
     let html2 = dir.path().join("ess.html");
     let result = run(&[
         &"report",
         &shared_data("ecmc/ecmc_target_muts_logger/b02__x__target_x.md_ISO230.dat"),
         &"--after",
-        &shared_data("ecmc/ecmc_target_muts_logger/b02__z__report_z.md_ISO230.dat"),
+        &shared_data(
+            "ecmc/ecmc_target_muts_logger/muts__data__week42_22__xyz__target_x_report_ILD50.md_ISO230.dat",
+        ),
         &"-o",
         &html2,
     ]);
