@@ -10,6 +10,7 @@ use axcomp::compensate::CompensationTable;
 use axcomp::diagnose::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
+use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 
@@ -118,6 +119,27 @@ pub fn read_table(
             None => Err(error),
         })
         .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+}
+
+/// The table that was active during `test` (named `test_label` in messages),
+/// read for the test's axis, and the doubts about the two together: refused
+/// when the test records no axis, or when the table cannot belong to it
+/// (`measurement::together`).
+pub fn read_active_table(
+    path: &Path,
+    test: &Measurement,
+    test_label: String,
+    profile: &MachineProfile,
+    linuxcnc_type: Option<u8>,
+) -> Result<(Controller, CompensationTable, Vec<Warning>)> {
+    let axis = recorded_axis(test, "to say which axis the table is for")?;
+    let (controller, table) = read_table(path, axis, profile, linuxcnc_type)?;
+    let doubts = check_together(
+        Pairing::TableOnTest,
+        &Input::measurement(test, test_label),
+        &Input::table(&table.axis, &table.positions_mm, path.display().to_string()),
+    )?;
+    Ok((controller, table, doubts))
 }
 
 /// Names the measured axis with `--axis`, when given (its source is then "given").

@@ -8,7 +8,6 @@ use axcomp::compensate::{self, Extrapolate, GridSpec, TableMode, TableOptions};
 use axcomp::diagnose::Effect;
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::evaluate;
-use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::measurement::{RunSelector, SourceFormat};
 use axcomp::output::write_new;
 use axcomp::read;
@@ -17,7 +16,7 @@ use axcomp::units::LengthUnit;
 
 use super::common::{
     Verbosity, load_effects, name_axis, parse_format, parse_run_selector, print_json, print_text,
-    print_warnings, read_table, recorded_axis,
+    print_warnings, read_active_table, recorded_axis,
 };
 use super::evaluate::check_selectors;
 
@@ -208,7 +207,6 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     options.linuxcnc_type = args.linuxcnc_type;
     options.max_points = args.max_points.or(options.max_points);
     if let Some(existing) = &args.existing {
-        let (_, active) = read_table(existing, &axis, &profile, Some(args.linuxcnc_type))?;
         // The table was active during the test: its axis, over the test's range.
         let test_name = args
             .files
@@ -216,15 +214,14 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
             .join(" + ");
-        warnings.extend(check_together(
-            Pairing::TableOnTest,
-            &Input::measurement(&measurement, test_name),
-            &Input::table(
-                &active.axis,
-                &active.positions_mm,
-                existing.display().to_string(),
-            ),
-        )?);
+        let (_, active, doubts) = read_active_table(
+            existing,
+            &measurement,
+            test_name,
+            &profile,
+            Some(args.linuxcnc_type),
+        )?;
+        warnings.extend(doubts);
         measurement = compensate::add_existing_table(&measurement, &active)?;
     }
     let evaluation = evaluate(&measurement);

@@ -13,8 +13,7 @@ use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
 
 use super::common::{
-    Verbosity, load_profile, name_axis, print_json, print_text, print_warnings, read_table,
-    recorded_axis,
+    Verbosity, load_profile, name_axis, print_json, print_text, print_warnings, read_active_table,
 };
 
 /// Flags of `axcomp diagnose`.
@@ -97,13 +96,13 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let table = match &args.table {
         Some(path) => {
             let profile = load_profile(args.machine.as_deref())?;
-            let axis = recorded_axis(&after.measurement, "to say which axis the table is for")?;
-            let (_, table) = read_table(path, axis, &profile, args.linuxcnc_type)?;
             // The table was active during the re-test.
-            let doubts = check_together(
-                Pairing::TableOnTest,
-                &Input::measurement(&after.measurement, args.after.display().to_string()),
-                &Input::table(&table.axis, &table.positions_mm, path.display().to_string()),
+            let (_, table, doubts) = read_active_table(
+                path,
+                &after.measurement,
+                args.after.display().to_string(),
+                &profile,
+                args.linuxcnc_type,
             )?;
             print_warnings(&doubts, args.verbosity.quiet);
             Some(table)

@@ -20,8 +20,7 @@ use axcomp::report::plot::PlotFormat;
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    Verbosity, load_profile, name_axis, parse_format, print_text, print_warnings, read_table,
-    recorded_axis,
+    Verbosity, load_profile, name_axis, parse_format, print_text, print_warnings, read_active_table,
 };
 
 /// Flags of `axcomp report`.
@@ -161,12 +160,12 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let table = match &args.table {
         Some(path) => {
             let profile = load_profile(args.machine.as_deref())?;
-            let axis = recorded_axis(&before.measurement, "to say which axis the table is for")?;
-            let (controller, table) = read_table(path, axis, &profile, args.linuxcnc_type)?;
-            let doubts = check_together(
-                Pairing::TableOnTest,
-                &Input::measurement(&before.measurement, args.file.display().to_string()),
-                &Input::table(&table.axis, &table.positions_mm, path.display().to_string()),
+            let (controller, table, doubts) = read_active_table(
+                path,
+                &before.measurement,
+                args.file.display().to_string(),
+                &profile,
+                args.linuxcnc_type,
             )?;
             before.warnings.extend(doubts);
             Some((path.display().to_string(), controller, table))
