@@ -52,6 +52,7 @@
 pub mod compensate;
 pub mod cycle;
 pub mod diagnose;
+pub mod effects;
 pub mod emit;
 pub mod error;
 pub mod evaluate;

@@ -133,6 +133,17 @@ pub fn mm_to_m(value_mm: Mm) -> f64 {
     value_mm / MM_PER_M
 }
 
+/// What a rate per metre (µm/m, ppm) gives over `length_mm`, in the rate's
+/// unit (µm/m over 250 mm: µm).
+pub fn per_m_over_mm(rate_per_m: f64, length_mm: Mm) -> f64 {
+    rate_per_m * length_mm / MM_PER_M
+}
+
+/// An angle in µrad times a lever in mm, in µm (µrad · mm = nm).
+pub fn urad_times_mm_to_um(value_urad_mm: f64) -> Um {
+    value_urad_mm / UM_PER_MM
+}
+
 /// An optional length in millimetres to micrometres; `None` stays `None`.
 pub fn opt_mm_to_um(value_mm: Option<Mm>) -> Option<Um> {
     value_mm.map(mm_to_um)

@@ -5,7 +5,8 @@
 
 use libfuzzer_sys::fuzz_target;
 
-use axcomp::diagnose::{AngularProfile, read_effects};
+use axcomp::diagnose::AngularProfile;
+use axcomp::effects::read_effects;
 use axcomp::model::{Machine, read_error_description};
 use axcomp::read::decode;
 use axcomp::synth::Truth;

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use axcomp::compensate::CompensationTable;
-use axcomp::diagnose::{Effect, read_effects};
+use axcomp::effects::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
 use axcomp::measurement::together::{Input, Pairing, check_together};

@@ -2,17 +2,16 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
-use axcomp::compensate::{self, Extrapolate, GridSpec, TableMode, TableOptions};
-use axcomp::diagnose::Effect;
+use axcomp::compensate::plan::{Request, plan};
+use axcomp::compensate::{self, Extrapolate, TableMode};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::{RunSelector, SourceFormat};
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::convert::ConvertJson;
-use axcomp::units::LengthUnit;
 
 use super::common::{
     Verbosity, load_effects, name_axis, parse_format, parse_run_selector, print_json, print_text,
@@ -230,15 +229,25 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         Some(path) => load_effects(path)?,
         None => Vec::new(),
     };
-    let plan = EffectsPlan::new(args, &effects, profile.machine_unit());
-    let table_options = TableOptions {
-        mode: plan.mode,
-        grid: grid(args, measurement.targets_mm(), plan.step_mm)?,
-        reference_mm: args.reference,
-        extrapolate: args.extrapolate.unwrap_or(Extrapolate::Refuse),
-    };
-    let table =
-        compensate::effects::build_table_with_effects(&measurement, &table_options, &effects)?;
+    let plan = plan(
+        measurement.targets_mm(),
+        &effects,
+        &args.controller.capabilities(profile.machine_unit()),
+        &Request {
+            mode: args.mode,
+            step_mm: args.step,
+            start_mm: args.start,
+            count: args.count,
+            reference_mm: args.reference,
+            extrapolate: args.extrapolate,
+        },
+    )?;
+    let table = compensate::effects::build_table_with_effects(
+        &measurement,
+        &evaluation,
+        &plan.options,
+        &effects,
+    )?;
     let text = emit::write(args.controller, &table, &options)?;
     write_new(&args.output, text.as_bytes(), args.force)?;
     let file_name = args.output.file_name().map_or_else(
@@ -265,100 +274,6 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     } else {
         print_text(&report.summary())
     }
-}
-
-/// What `--effects` decides: the table mode, a finer step, and what to say.
-struct EffectsPlan {
-    mode: TableMode,
-    step_mm: Option<f64>,
-    notes: Vec<String>,
-}
-
-impl EffectsPlan {
-    fn new(args: &ConvertArgs, effects: &[Effect], unit: LengthUnit) -> EffectsPlan {
-        let mut notes = Vec::new();
-        let reversal = effects.iter().find_map(|e| match e {
-            Effect::Reversal { b_um } => Some(*b_um),
-            _ => None,
-        });
-        let mode = match (args.mode, reversal) {
-            (Some(mode), _) => mode,
-            (None, Some(_)) if args.controller.supports_bidirectional() => {
-                notes
-                    .push("reversal: a bidirectional table (one column per direction)".to_string());
-                TableMode::Bidirectional
-            }
-            (None, Some(b)) => {
-                notes.push(format!(
-                    "reversal: {} takes no bidirectional table; set the backlash parameter (the suggested value below; the diagnosis found B = {b:.2} µm)",
-                    args.controller.name()
-                ));
-                TableMode::Mean
-            }
-            (None, None) => TableMode::Mean,
-        };
-        // A step the format writes exactly, at most period / 10.
-        let resolution = emit::resolution_mm(args.controller, unit);
-        let step_mm = compensate::effects::finest_step_mm(effects).map(|finest| {
-            let step = ((finest / resolution).floor() * resolution).max(resolution);
-            let chosen = args.step.map_or(step, |given| given.min(step));
-            notes.push(format!(
-                "periodic: points every {chosen} mm (at most a tenth of the period), the periodic error at each point"
-            ));
-            chosen
-        });
-        for effect in effects {
-            let note = match effect {
-                Effect::Scale { scale_um_per_m } => format!(
-                    "scale: {scale_um_per_m:.2} µm/m taken out; the table stays referred to the first test's conditions"
-                ),
-                Effect::Drift { rate_um_per_h } => format!(
-                    "drift of {rate_um_per_h:.2} µm/h: not a table's business; measure again with the machine warm"
-                ),
-                Effect::OutlierRun { run, direction, .. } => format!(
-                    "outlier run {run}{direction}: left in; give --exclude-run {run}:{} if it was the start-up run",
-                    direction.as_str()
-                ),
-                Effect::Abbe { .. } => "abbe: not a table's business; measure on the functional line or compensate pitch and yaw".to_string(),
-                Effect::Reversal { .. } | Effect::Periodic { .. } => continue,
-            };
-            notes.push(note);
-        }
-        EffectsPlan {
-            mode,
-            step_mm,
-            notes,
-        }
-    }
-}
-
-/// The grid: `--step` (with `--start`, `--count`) or the effects' finer step,
-/// else the measured targets when the controller takes them.
-fn grid(args: &ConvertArgs, targets_mm: &[f64], effects_step: Option<f64>) -> Result<GridSpec> {
-    let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
-    let Some(step_mm) = effects_step.or(args.step) else {
-        if args.controller.accepts_free_positions()
-            || compensate::regular_step(targets_mm).is_some()
-        {
-            return Ok(GridSpec::Targets);
-        }
-        bail!(
-            "the targets are unevenly spaced ({} targets from {first} to {last} mm) and {} needs one step: give --step (and optionally --start, --count)",
-            targets_mm.len(),
-            args.controller.name()
-        );
-    };
-    let start_mm = args.start.unwrap_or(first);
-    // A --count belongs to the --step it was given with, not to a finer step of the effects.
-    let count = match args.count.filter(|_| Some(step_mm) == args.step) {
-        Some(count) => count,
-        None => ((last - start_mm) / step_mm + 1e-9).floor().max(0.0) as usize + 1,
-    };
-    Ok(GridSpec::Regular {
-        start_mm,
-        step_mm,
-        count,
-    })
 }
 
 /// The name inside Heidenhain files: the output file name, upper case.

@@ -15,9 +15,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::effects::build_table_with_effects;
+use axcomp::compensate::plan::{Request, plan};
 use axcomp::compensate::{self, CompensationTable, Extrapolate, GridSpec, TableMode, TableOptions};
 use axcomp::cycle::CycleTiming;
-use axcomp::diagnose::{DiagnoseInput, Diagnosis, Effect, diagnose, write_effects};
+use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
+use axcomp::effects::{Effect, Parameter, ParameterValue};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::{Evaluation, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
@@ -33,7 +35,7 @@ use axcomp::report::json::EvaluationJson;
 use axcomp::report::plot::PlotFormat;
 use axcomp::report::predict::PredictJson;
 use axcomp::synth::{EffectSpec, Truth};
-use axcomp::units::mm_to_um;
+use axcomp::units::{LengthUnit, mm_to_um};
 
 use super::common::{Verbosity, print_text};
 use super::progress;
@@ -153,7 +155,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     ));
     files.push((
         "effects.toml".into(),
-        write_effects(&diagnosis.accepted, "after.rtl").into_bytes(),
+        diagnosis.effects_file("after.rtl").into_bytes(),
     ));
     steps.inc(1);
 
@@ -251,19 +253,23 @@ fn next_table(
     effects: &[Effect],
 ) -> Result<CompensationTable> {
     let without = compensate::add_existing_table(after, active)?;
-    let reversal = compensate::measured_reversal_mm(&evaluate(&without)).is_some()
-        || effects.iter().any(|e| matches!(e, Effect::Reversal { .. }));
-    let options = TableOptions {
-        mode: if reversal {
-            TableMode::Bidirectional
-        } else {
-            TableMode::Mean
+    let evaluation = evaluate(&without);
+    let measured = compensate::measured_reversal_mm(&evaluation).is_some();
+    let plan = plan(
+        without.targets_mm(),
+        effects,
+        &Controller::Tnc640.capabilities(LengthUnit::Millimetre),
+        &Request {
+            mode: measured.then_some(TableMode::Bidirectional),
+            ..Request::default()
         },
-        grid: GridSpec::Targets,
-        reference_mm: None,
-        extrapolate: Extrapolate::Refuse,
-    };
-    Ok(build_table_with_effects(&without, &options, effects)?)
+    )?;
+    Ok(build_table_with_effects(
+        &without,
+        &evaluation,
+        &plan.options,
+        effects,
+    )?)
 }
 
 /// Writes every file under `out`, refusing to replace any without `force`
@@ -312,13 +318,14 @@ fn summary(s: &Summary<'_>) -> String {
         .accepted
         .iter()
         .map(|accepted| {
-            let (key, value) = accepted.effect.parameters()[0];
+            let Parameter { key, value, .. } = accepted.effect.parameters()[0];
             let truth = truth_value(s.truth, &accepted.effect)
-                .map_or(String::new(), |t| format!(" (truth {t})"));
-            format!(
-                "{} {key} = {value:.2}{truth}",
-                accepted.effect.kind().name()
-            )
+                .map_or(String::new(), |t| format!(" (truth {})", text(t)));
+            let value = match value {
+                ParameterValue::Number(v) => format!("{v:.2}"),
+                ParameterValue::Run(run) => run.to_string(),
+            };
+            format!("{} {key} = {value}{truth}", accepted.effect.kind().name())
         })
         .collect();
     let unexplained = if s.diagnosis.unexplained.significant {
@@ -394,15 +401,21 @@ fn summary(s: &Summary<'_>) -> String {
     out
 }
 
-/// The truth's value of the parameter the summary shows, when the truth has that kind.
-fn truth_value(truth: &Truth, effect: &Effect) -> Option<f64> {
-    truth.effects.iter().find_map(|spec| match (spec, effect) {
-        (EffectSpec::Reversal { B_um, .. }, Effect::Reversal { .. }) => Some(*B_um),
-        (EffectSpec::Scale { scale_um_per_m, .. }, Effect::Scale { .. }) => Some(*scale_um_per_m),
-        (EffectSpec::Drift { rate_um_per_h, .. }, Effect::Drift { .. }) => Some(*rate_um_per_h),
-        (EffectSpec::Periodic { period_mm, .. }, Effect::Periodic { .. }) => Some(*period_mm),
-        (EffectSpec::OutlierRun { run, .. }, Effect::OutlierRun { .. }) => Some(f64::from(*run)),
-        (EffectSpec::Abbe { offset_mm, .. }, Effect::Abbe { .. }) => Some(*offset_mm),
-        _ => None,
-    })
+/// A parameter's value as the summary prints the truth's.
+fn text(value: ParameterValue) -> String {
+    match value {
+        ParameterValue::Number(v) => v.to_string(),
+        ParameterValue::Run(run) => run.to_string(),
+    }
+}
+
+/// The truth's value of the parameter the summary shows (the first), when
+/// the truth has an effect of that kind.
+fn truth_value(truth: &Truth, effect: &Effect) -> Option<ParameterValue> {
+    truth
+        .effects
+        .iter()
+        .filter_map(EffectSpec::as_effect)
+        .find(|planted| planted.kind() == effect.kind())
+        .map(|planted| planted.parameters()[0].value)
 }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use axcomp::cycle::CycleTiming;
-use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose, write_effects};
+use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
 use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::output::write_new;
 use axcomp::read;
@@ -121,7 +121,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let diagnosis = diagnose(&input)?;
     let name = |p: &Path| p.display().to_string();
     if let Some(path) = &args.write_effects {
-        let text = write_effects(&diagnosis.accepted, &name(&args.after));
+        let text = diagnosis.effects_file(&name(&args.after));
         write_new(path, text.as_bytes(), args.force)?;
     }
     let report = DiagnoseJson::new(

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::{CompensationTable, TableMode};
-use axcomp::diagnose::Effect;
+use axcomp::effects::Effect;
 use axcomp::measurement::Measurement;
 use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::model::{GeometricErrors, ModelError, read_error_description};
@@ -275,7 +275,7 @@ fn notes(prediction: &Prediction, effects: &[Effect]) -> Vec<String> {
         };
         notes.push(note);
     }
-    if effects.iter().any(|e| matches!(e, Effect::Reversal { .. })) {
+    if effects.iter().any(|e| matches!(e, Effect::Reversal(_))) {
         notes.push(
             "the reversal in --effects is added to the one the first test measured (diagnose reports the change)"
                 .to_string(),

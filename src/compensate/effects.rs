@@ -19,52 +19,60 @@
 //! The table is zero at its reference point afterwards, as every table.
 
 use super::{CompensateError, CompensationTable, TableOptions, build_table};
-use crate::diagnose::Effect;
-use crate::evaluate::evaluate;
+use crate::effects::{Effect, TableRole};
+use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::Measurement;
+use crate::units::{per_m_over_mm, um_to_mm};
 
 /// The finest step the periodic effects ask for: the shortest period / 10, mm.
 pub fn finest_step_mm(effects: &[Effect]) -> Option<f64> {
     effects
         .iter()
-        .filter_map(|e| match e {
-            Effect::Periodic { period_mm, .. } => Some(period_mm / 10.0),
+        .filter_map(|e| match e.in_table() {
+            TableRole::AtPoints { finest_step_mm } => Some(finest_step_mm),
             _ => None,
         })
         .min_by(f64::total_cmp)
 }
 
-/// The table from `measurement` with the periodic and scale effects accounted for.
+/// The table from `measurement` (whose evaluation is `evaluation`) with the
+/// periodic and scale effects accounted for.
 pub fn build_table_with_effects(
     measurement: &Measurement,
+    evaluation: &Evaluation,
     options: &TableOptions,
     effects: &[Effect],
 ) -> Result<CompensationTable, CompensateError> {
     let periodic_um = |x: f64| -> f64 {
         effects
             .iter()
-            .filter(|e| matches!(e, Effect::Periodic { .. }))
+            .filter(|e| matches!(e.in_table(), TableRole::AtPoints { .. }))
             .filter_map(|e| e.systematic_um(x, crate::measurement::Direction::Up, 0.0))
             .sum()
     };
     let scale_um_per_m: f64 = effects
         .iter()
         .map(|e| match e {
-            Effect::Scale { scale_um_per_m } => *scale_um_per_m,
+            Effect::Scale(scale) => scale.scale_um_per_m,
             _ => 0.0,
         })
         .sum();
-    // The readings less the periodic error at their targets.
-    let targets = measurement.targets_mm();
-    let smooth = measurement
-        .map_readings(|_, i, v| v - periodic_um(targets[i]) / 1000.0)
-        .map_err(|e| CompensateError::Measurement(e.to_string()))?;
-    let mut table = build_table(&smooth, &evaluate(&smooth), options)?;
+    let mut table = if finest_step_mm(effects).is_some() {
+        // The readings less the periodic error at their targets.
+        let targets = measurement.targets_mm();
+        let smooth = measurement
+            .map_readings(|_, i, v| v - um_to_mm(periodic_um(targets[i])))
+            .map_err(|e| CompensateError::Measurement(e.to_string()))?;
+        build_table(&smooth, &evaluate(&smooth), options)?
+    } else {
+        build_table(measurement, evaluation, options)?
+    };
     let reference = table.reference_mm;
     // What the effects add at a point, relative to the reference, mm.
     let added = |p: f64| {
-        (periodic_um(p) - periodic_um(reference) - scale_um_per_m * (p - reference) / 1000.0)
-            / 1000.0
+        um_to_mm(
+            periodic_um(p) - periodic_um(reference) - per_m_over_mm(scale_um_per_m, p - reference),
+        )
     };
     let positions = table.positions_mm.clone();
     table.values = table.values.map(|column| {
@@ -81,6 +89,7 @@ pub fn build_table_with_effects(
 mod tests {
     use super::*;
     use crate::compensate::{Extrapolate, GridSpec, TableMode};
+    use crate::effects::{Periodic, Scale};
     use crate::measurement::{Direction, Run};
 
     /// Two runs each way of e(x) = 2 µm · sin(2πx/5) + 10 µm/m · x at 0, 1, … 20 mm.
@@ -107,11 +116,11 @@ mod tests {
 
     #[test]
     fn the_periodic_error_is_put_back_at_the_finer_points_by_hand() {
-        let effects = [Effect::Periodic {
+        let effects = [Effect::Periodic(Periodic {
             period_mm: 5.0,
             amplitude_um: 2.0,
             phase_rad: 0.0,
-        }];
+        })];
         assert_eq!(finest_step_mm(&effects), Some(0.5));
         let options = TableOptions {
             mode: TableMode::Mean,
@@ -123,7 +132,8 @@ mod tests {
             reference_mm: None,
             extrapolate: Extrapolate::Refuse,
         };
-        let table = build_table_with_effects(&screw(), &options, &effects).unwrap();
+        let table =
+            build_table_with_effects(&screw(), &evaluate(&screw()), &options, &effects).unwrap();
         // At the point 0.5 mm, between the targets 0 and 1 mm:
         // 2 µm · sin(π/5) + 10 µm/m · 0.5 mm = 1.175571 + 0.005 µm.
         let expected = (2.0 * (std::f64::consts::PI / 5.0).sin() + 0.005) / 1000.0;
@@ -142,11 +152,12 @@ mod tests {
             reference_mm: None,
             extrapolate: Extrapolate::Refuse,
         };
-        let effects = [Effect::Scale {
+        let effects = [Effect::Scale(Scale {
             scale_um_per_m: 10.0,
-        }];
+        })];
         let plain = build_table(&screw(), &evaluate(&screw()), &options).unwrap();
-        let table = build_table_with_effects(&screw(), &options, &effects).unwrap();
+        let table =
+            build_table_with_effects(&screw(), &evaluate(&screw()), &options, &effects).unwrap();
         // 10 µm/m over 20 mm: 0.2 µm less at the end, nothing at the reference (0 mm).
         let difference = plain.value_at(20.0, Direction::Up) - table.value_at(20.0, Direction::Up);
         assert!((difference - 0.0002).abs() < 1e-12, "{difference}");

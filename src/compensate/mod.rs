@@ -30,6 +30,7 @@
 //! Pure: no I/O. Lengths in mm.
 
 pub mod effects;
+pub mod plan;
 pub mod retest;
 
 use crate::evaluate::Evaluation;
@@ -219,6 +220,20 @@ pub enum CompensateError {
     /// No target has a mean deviation.
     #[error("no target has a mean deviation to compensate")]
     NoData,
+    /// The controller needs one step and the targets have none.
+    #[error(
+        "the targets are unevenly spaced ({count} targets from {first_mm} to {last_mm} mm) and {controller} needs one step: give --step (and optionally --start, --count)"
+    )]
+    UnevenTargets {
+        /// How many targets.
+        count: usize,
+        /// The first, mm.
+        first_mm: f64,
+        /// The last, mm.
+        last_mm: f64,
+        /// The controller's name.
+        controller: &'static str,
+    },
     /// A compensation point lies outside the measured range.
     #[error(
         "compensation point {position_mm} mm is outside the measured range {first_mm} … {last_mm} mm; use --extrapolate hold or --extrapolate zero, or a grid inside the range"

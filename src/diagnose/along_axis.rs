@@ -13,13 +13,13 @@
 use nalgebra::DMatrix;
 
 use super::between_runs::Fold;
-use super::effects::{self, Reading};
 use super::fit::{Design, WeightedFit, fit_gls};
 use super::stats::chi2_p;
 use super::{
     Cell, Chosen, Evidence, Kind, LACK_OF_FIT_P, Level, Problem, RejectedEffect, Shape, best_of,
     period_range, predicts_better, set_rejection, shapes, strong_evidence,
 };
+use crate::effects::Reading;
 use crate::measurement::Direction;
 
 /// Covariance of the per-target levels, µm²: each level's own scatter on the
@@ -132,12 +132,7 @@ fn level_columns(problem: &Problem, levels: &[Level], shape: Shape) -> Vec<Vec<f
             time_h: 0.0,
         })
         .collect();
-    effects::columns(
-        shape,
-        &readings,
-        problem.first_target_mm(),
-        problem.angle_urad.as_deref(),
-    )
+    crate::effects::columns(shape, &readings, &problem.line())
 }
 
 /// Forward selection of scale, periodic and Abbe on the per-target levels.
@@ -355,7 +350,7 @@ pub(super) fn along_axis_cv(
         );
         for (target, direction, value) in &fold.held_out {
             if let Some(at) = fold.levels.iter().position(|l| l.target_index == *target) {
-                let half = effects::reversal_share_um(reversal_b, *direction);
+                let half = direction.reversal_share(reversal_b);
                 sum += (value - fitted.fitted[at] - half).powi(2);
                 count += 1;
             }

@@ -3,7 +3,6 @@
 //! on those cell levels. No position-dependent error can pose as one of them:
 //! every cell has its own level.
 
-use super::effects::reversal_share_um;
 use super::fit::{self, Design, Fit, bic, leave_one_run_out_rmse};
 use super::stats::{chi2_p, partial_f_p};
 use super::{
@@ -271,7 +270,7 @@ pub(super) fn select_reversal(
                 let Some(level) = fold.levels.iter().find(|l| l.target_index == *target) else {
                     continue;
                 };
-                let half = reversal_share_um(b_fold, *direction);
+                let half = direction.reversal_share(b_fold);
                 sum += (value - level.value_um - half).powi(2);
                 count += 1;
             }

@@ -31,8 +31,6 @@
 
 mod along_axis;
 mod between_runs;
-pub mod effects;
-mod effects_file;
 pub mod fit;
 mod stats;
 
@@ -41,6 +39,9 @@ use crate::compensate::retest::{
 };
 use crate::compensate::{CompensationTable, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
+use crate::effects::{
+    Context, Effect, FileEntry, FitSummary, Kind, Line, Reading, Reversal, Shape,
+};
 use crate::error::{ParseError, describe_found};
 use crate::evaluate::{AxisFigures, Evaluation, evaluate};
 use crate::measurement::together::{Input, NotTogether, Pairing, check_together};
@@ -49,8 +50,6 @@ use along_axis::{Background, select_along_axis, target_levels};
 use between_runs::{
     cell_levels, cross_validation_folds, reversals, select_between_runs, select_reversal,
 };
-pub use effects::{Context, Effect, Kind, Reading, Shape};
-pub use effects_file::{read_effects, write_effects};
 use fit::{Design, WeightedFit};
 use stats::chi2_p;
 
@@ -269,6 +268,21 @@ pub struct Diagnosis {
     pub readings: Vec<ReadingResidual>,
 }
 
+impl Diagnosis {
+    /// The accepted effects as an effects file (`--write-effects`), for
+    /// `predict --effects` and `convert --effects`; `source` names the re-test.
+    pub fn effects_file(&self, source: &str) -> String {
+        crate::effects::write_effects(
+            self.accepted.iter().map(|a| FileEntry {
+                effect: &a.effect,
+                uncertainty: &a.uncertainty,
+                explanation: &a.explanation,
+            }),
+            source,
+        )
+    }
+}
+
 /// One reading of the re-test and what the diagnosis made of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReadingResidual {
@@ -355,13 +369,16 @@ impl Problem {
         self.shared_reversal_variance_um2(t, t)
     }
 
+    /// What the effects need of the test besides a reading.
+    fn line(&self) -> Line<'_> {
+        Line {
+            first_target_mm: self.first_target_mm(),
+            angle_urad: self.angle_urad.as_deref(),
+        }
+    }
+
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
-        effects::columns(
-            shape,
-            &self.readings,
-            self.first_target_mm(),
-            self.angle_urad.as_deref(),
-        )
+        crate::effects::columns(shape, &self.readings, &self.line())
     }
 
     fn run_of(&self) -> Vec<usize> {
@@ -470,7 +487,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
 
     let mut accepted: Vec<AcceptedEffect> = Vec::new();
     if let Some(r) = reversal {
-        let effect = Effect::Reversal { b_um: r.b_um };
+        let effect = Effect::Reversal(Reversal { b_um: r.b_um });
         accepted.push(AcceptedEffect {
             explanation: effect.explanation(&context),
             effect,
@@ -513,7 +530,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             level.value_um
         };
     }
-    let half_reversal = |d: Direction| effects::reversal_share_um(reversal_b, d);
+    let half_reversal = |d: Direction| d.reversal_share(reversal_b);
     let between_um: Vec<f64> = (0..n)
         .map(|i| {
             between
@@ -800,7 +817,7 @@ fn times_h(measurement: &Measurement, timing: CycleTiming) -> (Vec<Vec<f64>>, bo
 fn applicable_kinds(input: &DiagnoseInput<'_>, rejected: &mut Vec<RejectedEffect>) -> Vec<Kind> {
     let after = input.after;
     let mut kinds = Vec::new();
-    for kind in Kind::ALL {
+    for &kind in Kind::ALL {
         let reason = match kind {
             Kind::Reversal if after.run_count(Direction::Up) == 0 || after.run_count(Direction::Down) == 0 => {
                 Some("needs runs in both directions".to_string())
@@ -1010,43 +1027,14 @@ fn accepted_effect(
     };
     let coefficients = &coefficients[chosen.first_column..chosen.first_column + width];
     let errors = &errors[chosen.first_column..chosen.first_column + width];
-    let effect = Effect::from_fit(chosen.shape, coefficients, problem.angle_urad.as_deref());
-    let mut warnings = Vec::new();
-    let uncertainty = match effect {
-        Effect::Periodic {
-            period_mm,
-            amplitude_um,
-            ..
-        } => {
-            // Amplitude from its two coefficients; period from the frequency
-            // estimate's variance 6σ²/(π²A²T²N) (Rife & Boorstyn 1974), σ² from
-            // the fit (χ²/dof with known variances, RSS/dof otherwise).
-            let (a, b) = (coefficients[0], coefficients[1]);
-            let sigma_amplitude = ((a * errors[0]).powi(2) + (b * errors[1]).powi(2)).sqrt()
-                / amplitude_um.max(1e-12);
-            let span = problem.targets_mm[problem.targets_mm.len() - 1] - problem.targets_mm[0];
-            let noise = sigma_amplitude * (n as f64 / 2.0).sqrt();
-            let sigma_frequency = 6f64.sqrt() * noise
-                / (std::f64::consts::PI * amplitude_um.max(1e-12) * span * (n as f64).sqrt());
-            if let Some(spacing) = context.target_spacing_mm {
-                let aliases: Vec<String> = (1..=2)
-                    .map(|k| 1.0 / (f64::from(k) / spacing - 1.0 / period_mm).abs())
-                    .filter(|p| p.is_finite())
-                    .map(|p| format!("{p:.2} mm"))
-                    .collect();
-                warnings.push(format!(
-                    "the targets are evenly spaced ({spacing} mm): periods {} give the same readings (aliasing); measure with irregular spacing to tell them apart",
-                    aliases.join(", ")
-                ));
-            }
-            vec![
-                ("period_mm", period_mm * period_mm * sigma_frequency),
-                ("amplitude_um", sigma_amplitude),
-            ]
-        }
-        Effect::OutlierRun { .. } => vec![("offset_um", errors[0])],
-        ref other => vec![(other.parameters()[0].0, errors[0])],
-    };
+    let effect = Effect::from_fit(chosen.shape, coefficients, &problem.line());
+    let (uncertainty, mut warnings) = effect.uncertainty(&FitSummary {
+        coefficients,
+        errors,
+        span_mm: problem.targets_mm[problem.targets_mm.len() - 1] - problem.targets_mm[0],
+        n,
+        target_spacing_mm: context.target_spacing_mm,
+    });
     if context.time_assumed && effect.kind() == Kind::Drift {
         warnings.push("the file records no test duration: times assume a typical cycle (3 s dwell, 2000 mm/min)".to_string());
     }

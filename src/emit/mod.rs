@@ -18,6 +18,7 @@ pub mod profile;
 pub mod sinumerik840d;
 pub mod tnc640;
 
+use crate::compensate::plan::Capabilities;
 use crate::compensate::{CompensationTable, TableMode};
 use crate::error::ParseError;
 use crate::units::LengthUnit;
@@ -70,6 +71,17 @@ impl Controller {
     /// Whether the format holds separate ↑ and ↓ values.
     pub fn supports_bidirectional(self) -> bool {
         !matches!(self, Controller::Itnc530)
+    }
+
+    /// What a table's plan needs to know of this controller
+    /// (`compensate::plan`), for a machine in `machine_unit`.
+    pub fn capabilities(self, machine_unit: LengthUnit) -> Capabilities {
+        Capabilities {
+            name: self.name(),
+            bidirectional: self.supports_bidirectional(),
+            free_positions: self.accepts_free_positions(),
+            resolution_mm: resolution_mm(self, machine_unit),
+        }
     }
 
     /// What to do on this controller with the reversal a mean table leaves:

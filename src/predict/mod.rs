@@ -63,7 +63,7 @@
 
 use crate::compensate::retest::{Applied, BacklashError, KnownError};
 use crate::compensate::{CompensationTable, TableMode};
-use crate::diagnose::Effect;
+use crate::effects::Effect;
 use crate::evaluate::{AxisFigures, evaluate};
 use crate::measurement::{Direction, Measurement, Run};
 use crate::model::{

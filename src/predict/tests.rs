@@ -5,6 +5,7 @@
 use super::*;
 use crate::compensate::retest::{Applied, predicted_deviation_mm};
 use crate::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
+use crate::effects::Reversal;
 use crate::synth::{self, Truth};
 
 /// A synthetic X test on the bundled machine (0 … 750 mm, 16 irregular targets).
@@ -89,7 +90,7 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         let b_measured = first.b_mean_mm.unwrap() * 1000.0;
         assert!((retest.measured_mean_reversal_mm.unwrap() * 1000.0 - b_measured).abs() < 1e-9);
         let b_with_effect = predict(&PredictInput {
-            effects: &[Effect::Reversal { b_um: -1.0 }],
+            effects: &[Effect::Reversal(Reversal { b_um: -1.0 })],
             ..input(&machine, &errors, &measured, &tables, line)
         })
         .unwrap()

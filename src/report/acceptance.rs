@@ -11,6 +11,7 @@
 use crate::compensate::CompensationTable;
 use crate::compensate::retest::{Applied, KnownError, predicted_deviation_mm, with_scatter};
 use crate::diagnose::{Diagnosis, ReadingResidual};
+use crate::effects::{Abbe, Drift, Effect, Line, OutlierRun, Periodic, Reversal, Scale};
 use crate::emit::Controller;
 use crate::error::Warning;
 use crate::evaluate::{AxisFigures, DirectionStats, Evaluation, TargetStats, evaluate};
@@ -664,7 +665,13 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
             .map(|(i, r)| {
                 (
                     (i + 1) as f64,
-                    accepted.effect.value_um(&r.reading, first_target_mm, None),
+                    accepted.effect.value_um(
+                        &r.reading,
+                        &Line {
+                            first_target_mm,
+                            angle_urad: None,
+                        },
+                    ),
                 )
             })
             .collect();
@@ -685,27 +692,28 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
 }
 
 /// A short legend label with the fitted parameters, in the plot font's characters.
-pub fn effect_label(effect: &crate::diagnose::Effect) -> String {
-    use crate::diagnose::Effect;
+pub fn effect_label(effect: &Effect) -> String {
     let signed = |v: f64| crate::report::chart::tick_label((v * 100.0).round() / 100.0);
     match *effect {
-        Effect::Reversal { b_um } => format!("reversal B = {} µm", signed(b_um)),
-        Effect::Scale { scale_um_per_m } => format!("scale {} µm/m", signed(scale_um_per_m)),
-        Effect::Drift { rate_um_per_h } => format!("drift {} µm/h", signed(rate_um_per_h)),
-        Effect::Periodic {
+        Effect::Reversal(Reversal { b_um }) => format!("reversal B = {} µm", signed(b_um)),
+        Effect::Scale(Scale { scale_um_per_m }) => {
+            format!("scale {} µm/m", signed(scale_um_per_m))
+        }
+        Effect::Drift(Drift { rate_um_per_h }) => format!("drift {} µm/h", signed(rate_um_per_h)),
+        Effect::Periodic(Periodic {
             period_mm,
             amplitude_um,
             ..
-        } => format!(
+        }) => format!(
             "periodic {} µm, period {} mm",
             signed(amplitude_um),
             signed(period_mm)
         ),
-        Effect::OutlierRun {
+        Effect::OutlierRun(OutlierRun {
             run,
             direction,
             offset_um,
-        } => format!("run {run}{direction} offset {} µm", signed(offset_um)),
-        Effect::Abbe { offset_mm, .. } => format!("Abbe, offset {} mm", signed(offset_mm)),
+        }) => format!("run {run}{direction} offset {} µm", signed(offset_um)),
+        Effect::Abbe(Abbe { offset_mm, .. }) => format!("Abbe, offset {} mm", signed(offset_mm)),
     }
 }

@@ -30,7 +30,8 @@ use std::fmt::Write;
 use serde::Serialize;
 use serde_json::{Map, Value};
 
-use crate::diagnose::{AcceptedEffect, Diagnosis, Effect, ResidualStats};
+use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
+use crate::effects::{Effect, ParameterValue};
 use crate::report::json::FiguresJson;
 use crate::report::terminal::um;
 
@@ -88,16 +89,15 @@ impl EffectJson {
     /// From an accepted effect.
     pub fn new(a: &AcceptedEffect) -> EffectJson {
         let mut params = Map::new();
-        for (key, value) in a.effect.parameters() {
-            let value = if key == "run" {
-                Value::from(value as u64)
-            } else {
-                Value::from(value)
+        for parameter in a.effect.parameters() {
+            let value = match parameter.value {
+                ParameterValue::Run(run) => Value::from(run),
+                ParameterValue::Number(value) => Value::from(value),
             };
-            params.insert(key.to_string(), value);
+            params.insert(parameter.key.to_string(), value);
         }
-        if let Effect::OutlierRun { direction, .. } = a.effect {
-            params.insert("direction".into(), Value::from(direction.as_str()));
+        if let Effect::OutlierRun(run) = &a.effect {
+            params.insert("direction".into(), Value::from(run.direction.as_str()));
         }
         let uncertainty = a
             .uncertainty
@@ -255,7 +255,8 @@ pub fn render(report: &DiagnoseJson) -> String {
             .iter()
             .map(
                 |(key, value)| match (value.as_f64(), effect.uncertainty.get(key)) {
-                    (Some(v), Some(u)) if key != "run" => {
+                    // A run has no uncertainty: it is shown as it is.
+                    (Some(v), Some(u)) => {
                         format!("{key} = {v:.2} ± {:.2}", u.as_f64().unwrap_or(f64::NAN))
                     }
                     _ => format!("{key} = {value}"),

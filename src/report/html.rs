@@ -44,6 +44,7 @@ use std::fmt::Write;
 use serde::Serialize;
 
 use crate::diagnose::{Diagnosis, ResidualStats};
+use crate::effects::{Parameter, ParameterValue};
 use crate::evaluate::AxisFigures;
 use crate::evaluate::TestConformance;
 use crate::evaluate::conformance::{Check, Requirement};
@@ -1116,7 +1117,7 @@ fn accepted_effects(out: &mut String, diagnosis: &Diagnosis) {
             .effect
             .parameters()
             .into_iter()
-            .map(|(key, value)| parameter_text(index, key, value, &accepted.uncertainty))
+            .map(|parameter| parameter_text(index, &parameter, &accepted.uncertainty))
             .collect::<Vec<_>>()
             .join("<br>");
         let evidence = &accepted.evidence;
@@ -1146,31 +1147,21 @@ fn accepted_effects(out: &mut String, diagnosis: &Diagnosis) {
 }
 
 /// One parameter with its standard uncertainty; µm values carry their data key.
-fn parameter_text(index: usize, key: &str, value: f64, uncertainty: &[(&str, f64)]) -> String {
+fn parameter_text(index: usize, parameter: &Parameter, uncertainty: &[(&str, f64)]) -> String {
+    let (key, name, unit) = (parameter.key, parameter.name, parameter.unit);
     let plus_minus = uncertainty
         .iter()
         .find(|(k, _)| *k == key)
         .map(|(_, u)| format!(" ± {u:.2}"))
         .unwrap_or_default();
-    if key == "run" {
-        return format!("run {value}");
-    }
-    if let Some(name) = key.strip_suffix("_um") {
-        return format!(
+    match parameter.value {
+        ParameterValue::Run(run) => format!("run {run}"),
+        ParameterValue::Number(value) if unit == "µm" => format!(
             "{name} = <span data-key=\"diagnosis.accepted.{index}.{key}\" data-um=\"{value}\">{}</span>{plus_minus} µm",
             um(Some(value))
-        );
+        ),
+        ParameterValue::Number(value) => format!("{name} = {value:.2}{plus_minus} {unit}"),
     }
-    let (name, unit) = match key {
-        "scale_um_per_m" => ("scale", "µm/m"),
-        "rate_um_per_h" => ("rate", "µm/h"),
-        "period_mm" => ("period", "mm"),
-        "phase_rad" => ("phase", "rad"),
-        "offset_mm" => ("offset", "mm"),
-        "angle_urad" => ("angle", "µrad"),
-        other => (other, ""),
-    };
-    format!("{name} = {value:.2}{plus_minus} {unit}")
 }
 
 /// `< 0.0001` or `= 0.1262`, to follow a "p".

@@ -45,7 +45,9 @@
 
 use serde::Deserialize;
 
+use crate::effects::{Abbe, Drift, Effect, OutlierRun, Periodic, Reversal, Scale};
 use crate::error::ParseError;
+use crate::measurement::Direction;
 
 /// The whole truth file.
 #[derive(Clone, Debug, Deserialize)]
@@ -350,6 +352,49 @@ pub enum EffectSpec {
 }
 
 impl EffectSpec {
+    /// The effect `diagnose` should find for this truth, with the truth's
+    /// parameters (`None` for what no kind describes: a sag, a step).
+    pub fn as_effect(&self) -> Option<Effect> {
+        Some(match *self {
+            EffectSpec::Reversal { B_um, .. } => Effect::Reversal(Reversal { b_um: B_um }),
+            EffectSpec::Scale { scale_um_per_m, .. } => Effect::Scale(Scale { scale_um_per_m }),
+            EffectSpec::Drift { rate_um_per_h, .. } => Effect::Drift(Drift { rate_um_per_h }),
+            EffectSpec::Periodic {
+                period_mm,
+                amplitude_um,
+                phase_rad,
+                ..
+            } => Effect::Periodic(Periodic {
+                period_mm,
+                amplitude_um,
+                phase_rad,
+            }),
+            EffectSpec::OutlierRun {
+                run,
+                ref direction,
+                offset_um,
+                ..
+            } => Effect::OutlierRun(OutlierRun {
+                run,
+                direction: if direction == "up" {
+                    Direction::Up
+                } else {
+                    Direction::Down
+                },
+                offset_um,
+            }),
+            EffectSpec::Abbe {
+                offset_mm,
+                angle_urad,
+                ..
+            } => Effect::Abbe(Abbe {
+                offset_mm,
+                angle_urad,
+            }),
+            EffectSpec::Quadratic { .. } | EffectSpec::Step { .. } => return None,
+        })
+    }
+
     /// Whether the effect acts in a test.
     pub fn acts_in(&self, test: TestKind) -> bool {
         let tests = match self {

@@ -13,7 +13,8 @@
 
 use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use axcomp::cycle::CycleTiming;
-use axcomp::diagnose::{AngularProfile, DiagnoseInput, Diagnosis, Effect, diagnose};
+use axcomp::diagnose::{AngularProfile, DiagnoseInput, Diagnosis, diagnose};
+use axcomp::effects::{Abbe, Drift, Effect, OutlierRun, Periodic, Reversal, Scale};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::Direction;
 use axcomp::read::read_path;
@@ -220,7 +221,7 @@ fn reversal_is_found_and_measured() {
             &d,
             &[(
                 "reversal",
-                &|e| matches!(e, Effect::Reversal { b_um } if within(*b_um, -4.0)),
+                &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -4.0)),
             )],
             seed,
             sigma,
@@ -268,7 +269,7 @@ fn a_reversal_both_tests_measured_is_carried_and_only_its_change_is_found() {
             &d,
             &[(
                 "reversal",
-                &|e| matches!(e, Effect::Reversal { b_um } if within(*b_um, -2.0)),
+                &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -2.0)),
             )],
             seed,
             sigma,
@@ -299,7 +300,7 @@ fn thermal_scale_is_found_and_measured() {
             &d,
             &[(
                 "scale",
-                &|e| matches!(e, Effect::Scale { scale_um_per_m } if within(*scale_um_per_m, 6.0)),
+                &|e| matches!(e, Effect::Scale(Scale { scale_um_per_m }) if within(*scale_um_per_m, 6.0)),
             )],
             seed,
             sigma,
@@ -326,7 +327,7 @@ fn warm_up_drift_is_found_and_measured() {
             &d,
             &[(
                 "drift",
-                &|e| matches!(e, Effect::Drift { rate_um_per_h } if within(*rate_um_per_h, 15.0)),
+                &|e| matches!(e, Effect::Drift(Drift { rate_um_per_h }) if within(*rate_um_per_h, 15.0)),
             )],
             seed,
             sigma,
@@ -341,7 +342,7 @@ fn an_outlier_run_is_found_and_measured() {
     for_each_seed(|seed, sigma| {
         let effect = "[[effect]]\nkind = \"outlier-run\"\nrun = 1\ndirection = \"down\"\noffset_um = 5.0\ntests = [\"after\"]\n";
         let d = run(&truth(sigma, "", effect), seed, false);
-        let ok = |e: &Effect| matches!(e, Effect::OutlierRun { run: 1, direction: Direction::Down, offset_um } if within(*offset_um, 5.0));
+        let ok = |e: &Effect| matches!(e, Effect::OutlierRun(OutlierRun { run: 1, direction: Direction::Down, offset_um }) if within(*offset_um, 5.0));
         extras.check("outlier-run", &d, &[("outlier-run", &ok)], seed, sigma);
     });
     extras.finish();
@@ -352,7 +353,7 @@ fn a_screw_lead_error_is_found_and_measured() {
     let mut extras = Extras::default();
     for_each_seed(|seed, sigma| {
         let d = run(&periodic_truth(sigma, ""), seed, false);
-        let ok = |e: &Effect| matches!(e, Effect::Periodic { period_mm, amplitude_um, .. } if within(*period_mm, 5.0) && within(*amplitude_um, 1.0));
+        let ok = |e: &Effect| matches!(e, Effect::Periodic(Periodic { period_mm, amplitude_um, .. }) if within(*period_mm, 5.0) && within(*amplitude_um, 1.0));
         extras.check("periodic", &d, &[("periodic", &ok)], seed, sigma);
     });
     extras.finish();
@@ -363,7 +364,7 @@ fn a_screw_lead_error_is_found_in_the_retest_alone() {
     let mut extras = Extras::default();
     for_each_seed(|seed, sigma| {
         let d = run_alone(&periodic_truth(sigma, ""), seed);
-        let ok = |e: &Effect| matches!(e, Effect::Periodic { period_mm, amplitude_um, .. } if within(*period_mm, 5.0) && within(*amplitude_um, 1.0));
+        let ok = |e: &Effect| matches!(e, Effect::Periodic(Periodic { period_mm, amplitude_um, .. }) if within(*period_mm, 5.0) && within(*amplitude_um, 1.0));
         extras.check("periodic alone", &d, &[("periodic", &ok)], seed, sigma);
     });
     extras.finish();
@@ -409,7 +410,7 @@ fn an_abbe_offset_is_found_and_measured_with_angular_data() {
             &d,
             &[(
                 "abbe",
-                &|e| matches!(e, Effect::Abbe { offset_mm, .. } if within(*offset_mm, 100.0)),
+                &|e| matches!(e, Effect::Abbe(Abbe { offset_mm, .. }) if within(*offset_mm, 100.0)),
             )],
             seed,
             sigma,
@@ -435,8 +436,8 @@ fn two_effects_at_once() {
             "reversal + drift",
             &d,
             &[
-                ("reversal", &|e| matches!(e, Effect::Reversal { b_um } if within(*b_um, -3.0))),
-                ("drift", &|e| matches!(e, Effect::Drift { rate_um_per_h } if within(*rate_um_per_h, 15.0))),
+                ("reversal", &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -3.0))),
+                ("drift", &|e| matches!(e, Effect::Drift(Drift { rate_um_per_h }) if within(*rate_um_per_h, 15.0))),
             ],
             seed,
             sigma,
@@ -447,8 +448,8 @@ fn two_effects_at_once() {
             "scale + outlier-run",
             &d,
             &[
-                ("scale", &|e| matches!(e, Effect::Scale { scale_um_per_m } if within(*scale_um_per_m, 8.0))),
-                ("outlier-run", &|e| matches!(e, Effect::OutlierRun { run: 2, direction: Direction::Up, offset_um } if within(*offset_um, -4.0))),
+                ("scale", &|e| matches!(e, Effect::Scale(Scale { scale_um_per_m }) if within(*scale_um_per_m, 8.0))),
+                ("outlier-run", &|e| matches!(e, Effect::OutlierRun(OutlierRun { run: 2, direction: Direction::Up, offset_um }) if within(*offset_um, -4.0))),
             ],
             seed,
             sigma,
@@ -465,8 +466,8 @@ fn two_effects_at_once() {
             "periodic + reversal",
             &d,
             &[
-                ("periodic", &|e| matches!(e, Effect::Periodic { period_mm, amplitude_um, .. } if within(*period_mm, 5.0) && within(*amplitude_um, 1.0))),
-                ("reversal", &|e| matches!(e, Effect::Reversal { b_um } if within(*b_um, -2.0))),
+                ("periodic", &|e| matches!(e, Effect::Periodic(Periodic { period_mm, amplitude_um, .. }) if within(*period_mm, 5.0) && within(*amplitude_um, 1.0))),
+                ("reversal", &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -2.0))),
             ],
             seed,
             sigma,
@@ -554,7 +555,7 @@ fn real_ess_files_get_a_stated_diagnosis() {
                 !effect.explanation.is_empty()
                     && !matches!(
                         effect.effect,
-                        Effect::Scale { .. } | Effect::Periodic { .. }
+                        Effect::Scale(Scale { .. }) | Effect::Periodic(Periodic { .. })
                     )
             );
         }
@@ -570,11 +571,11 @@ fn real_ess_files_get_a_stated_diagnosis() {
         {
             // The start-up run (anchors-and-standards.md §3.1, DS2): run 1↑ here.
             let outlier = d.accepted.iter().find_map(|a| {
-                if let Effect::OutlierRun {
+                if let Effect::OutlierRun(OutlierRun {
                     run,
                     direction,
                     offset_um,
-                } = a.effect
+                }) = a.effect
                 {
                     Some((run, direction, offset_um))
                 } else {

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
+use axcomp::effects::ParameterValue;
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::evaluate;
 use axcomp::read::{read_path, rtl};
@@ -252,7 +253,13 @@ fn diagnosis_json(d: &Diagnosis) -> serde_json::Value {
                 .effect
                 .parameters()
                 .into_iter()
-                .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+                .map(|p| {
+                    let v = match p.value {
+                        ParameterValue::Number(v) => v,
+                        ParameterValue::Run(run) => f64::from(run),
+                    };
+                    (p.key.to_string(), serde_json::json!(v))
+                })
                 .collect();
             serde_json::Value::Object(map)
         })

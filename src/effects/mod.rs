@@ -1,0 +1,387 @@
+//! The effects: parametric models of what a re-test shows beyond the
+//! geometric model (issue 6), each in its own file, below every stage that
+//! closes the loop. `diagnose` fits them, `compensate` and `predict` account
+//! for them, `report` shows them, `synth` plants them; all through this
+//! module, which depends only on `measurement` and `units`.
+//!
+//! | kind          | column(s) over the readings                  | parameter                |
+//! |---------------|----------------------------------------------|--------------------------|
+//! | `reversal`    | +½ moving ↑, −½ moving ↓                      | B (↑ − ↓), µm            |
+//! | `scale`       | (x − first target) in m                      | µm/m                     |
+//! | `drift`       | time of the reading in h                     | µm/h                     |
+//! | `periodic`    | sin(2πx/p), cos(2πx/p) for a scanned period p | amplitude µm, phase      |
+//! | `outlier-run` | 1 on the readings of one run, else 0         | offset µm                |
+//! | `abbe`        | the angular error ε(x) in µrad / 1000        | offset of the line, mm   |
+//!
+//! Each kind's file declares, in one place, what the effect is: its
+//! parameters (a typed struct, which is also its TOML form), its columns,
+//! its value at a reading, its systematic value at a position (what a table
+//! or a prediction can take), what it does to a table, the uncertainty of
+//! its parameters and its one-sentence explanation ([`Model`], [`Fit`]).
+//! Adding a kind is a new file here, a line in the registry below and its
+//! synthetic truth (`synth::truth`); the compiler then names every match
+//! that must decide something about it (there is no catch-all arm).
+
+pub mod abbe;
+pub mod drift;
+pub mod file;
+pub mod outlier_run;
+pub mod periodic;
+pub mod reversal;
+pub mod scale;
+
+use serde::Deserialize;
+
+use crate::measurement::Direction;
+
+pub use abbe::Abbe;
+pub use drift::Drift;
+pub use file::{FileEntry, read_effects, write_effects};
+pub use outlier_run::OutlierRun;
+pub use periodic::Periodic;
+pub use reversal::Reversal;
+pub use scale::Scale;
+
+/// One reading, as the effects see it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reading {
+    /// Index of its target.
+    pub target_index: usize,
+    /// Target, mm.
+    pub target_mm: f64,
+    /// ↑ or ↓.
+    pub direction: Direction,
+    /// Run number within its direction.
+    pub run: u32,
+    /// Index of its run in the order measured.
+    pub run_index: usize,
+    /// Time from the start of the test, h.
+    pub time_h: f64,
+}
+
+/// What the effects need to know of the test besides a reading: where the
+/// stroke starts (scale is zero there) and the angular profile (Abbe).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Line<'a> {
+    /// The first target, mm.
+    pub first_target_mm: f64,
+    /// The angular error at each target, µrad (Abbe), if given.
+    pub angle_urad: Option<&'a [f64]>,
+}
+
+/// The nonlinear part of an effect's shape, fixed before the linear fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// No free shape.
+    Fixed(Kind),
+    /// A periodic error of this period, mm.
+    Period(f64),
+    /// One run: (direction, number).
+    Run(Direction, u32),
+}
+
+impl Shape {
+    /// The kind of effect.
+    pub fn kind(self) -> Kind {
+        match self {
+            Shape::Fixed(kind) => kind,
+            Shape::Period(_) => Kind::Periodic,
+            Shape::Run(..) => Kind::OutlierRun,
+        }
+    }
+}
+
+/// Context for the sentence a user reads.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Context {
+    /// The table's step, mm, if a regular table was applied.
+    pub table_step_mm: Option<f64>,
+    /// Spacing of the targets, when regular, mm.
+    pub target_spacing_mm: Option<f64>,
+    /// Expansion coefficient the laser used, ppm/K.
+    pub expansion_coefficient_ppm_per_k: Option<f64>,
+    /// Material temperature change between the tests, K, if both recorded.
+    pub material_change_k: Option<f64>,
+    /// Whether the times of the readings are assumed (no recorded duration).
+    pub time_assumed: bool,
+    /// The first test's mean reversal B̄, µm, which the prediction carries (a
+    /// reversal found is then the change since that test).
+    pub first_test_reversal_um: Option<f64>,
+}
+
+/// What the fit knows that a parameter's uncertainty needs.
+#[derive(Clone, Copy, Debug)]
+pub struct FitSummary<'a> {
+    /// The fitted coefficients of this effect's columns.
+    pub coefficients: &'a [f64],
+    /// Their standard errors.
+    pub errors: &'a [f64],
+    /// The stroke, last − first target, mm.
+    pub span_mm: f64,
+    /// Number of readings.
+    pub n: usize,
+    /// Spacing of the targets, when regular, mm.
+    pub target_spacing_mm: Option<f64>,
+}
+
+/// One parameter as it is shown and saved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Parameter {
+    /// Its key in JSON and TOML, with the unit (`B_um`, `period_mm`, `run`).
+    pub key: &'static str,
+    /// Its name in a sentence or a table (`B`, `period`, `run`).
+    pub name: &'static str,
+    /// The unit of a number as a reader writes it (`µm`, `µm/m`), empty for a run.
+    pub unit: &'static str,
+    /// Its value.
+    pub value: ParameterValue,
+}
+
+/// A parameter's value: a number in the key's unit, or a run's number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParameterValue {
+    /// A measured quantity, in the unit its key names.
+    Number(f64),
+    /// A run, by its number within its direction.
+    Run(u32),
+}
+
+impl Parameter {
+    /// A measured quantity.
+    pub fn number(
+        key: &'static str,
+        name: &'static str,
+        unit: &'static str,
+        value: f64,
+    ) -> Parameter {
+        Parameter {
+            key,
+            name,
+            unit,
+            value: ParameterValue::Number(value),
+        }
+    }
+}
+
+/// The standard uncertainty of one parameter, by its key.
+pub type Uncertainty = (&'static str, f64);
+
+/// What an effect does to a compensation table (`compensate::plan`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum TableRole {
+    /// A direction-dependent offset B, µm: a bidirectional table, or the
+    /// backlash parameter where the controller takes no such table.
+    Bidirectional {
+        /// B = ↑ − ↓, µm.
+        b_um: f64,
+    },
+    /// An error the table's points must follow: put back at each point, the
+    /// points at most `finest_step_mm` apart.
+    AtPoints {
+        /// The largest step that still follows it, mm.
+        finest_step_mm: f64,
+    },
+    /// Taken out of the table; the note says why.
+    TakenOut {
+        /// What the user reads.
+        note: String,
+    },
+    /// Not a table's business; the note says what to do instead.
+    NotATable {
+        /// What the user reads.
+        note: String,
+    },
+}
+
+/// What an effect with its parameters is: the part every user of an effect
+/// asks of it.
+pub trait Model {
+    /// The effect's contribution to one reading, µm.
+    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64;
+
+    /// The effect's systematic part at `x_mm` moving in `direction`, µm: what
+    /// a table or a prediction can account for (`predict --effects`). `None`
+    /// for what is not systematic in position.
+    fn systematic_um(&self, x_mm: f64, direction: Direction, first_target_mm: f64) -> Option<f64>;
+
+    /// What it does to a compensation table.
+    fn in_table(&self) -> TableRole;
+
+    /// What it is physically and what to do about it at the machine, in one sentence.
+    fn explanation(&self, context: &Context) -> String;
+
+    /// The parameters, in the order they are shown and saved.
+    fn parameters(&self) -> Vec<Parameter>;
+
+    /// A check beyond the types, for an effect read from a file.
+    fn check(&self) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// How a kind is fitted: the part `diagnose` asks of it.
+pub trait Fit: Model + Sized {
+    /// The name used in JSON and TOML.
+    const NAME: &'static str;
+
+    /// Whether it depends on position only (and so competes with the
+    /// position-dependent systematic error in a lack-of-fit test).
+    const POSITIONAL: bool;
+
+    /// Its columns over the readings for a shape of its kind.
+    fn columns(shape: Shape, readings: &[Reading], line: &Line<'_>) -> Vec<Vec<f64>>;
+
+    /// The effect from a shape of its kind and its fitted coefficients.
+    fn from_fit(shape: Shape, coefficients: &[f64], line: &Line<'_>) -> Self;
+
+    /// The standard uncertainty of its parameters, and caveats.
+    fn uncertainty(&self, fit: &FitSummary<'_>) -> (Vec<Uncertainty>, Vec<String>) {
+        let key = self.parameters()[0].key;
+        (vec![(key, fit.errors[0])], Vec::new())
+    }
+}
+
+/// The registry: one line a kind, in the order they are tried and listed.
+macro_rules! registry {
+    ($($variant:ident => $ty:ty),* $(,)?) => {
+        /// The kinds, in the order they are tried and listed.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum Kind {
+            $(
+                #[doc = concat!("See [`", stringify!($ty), "`].")]
+                $variant,
+            )*
+        }
+
+        /// An effect with its fitted parameters.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum Effect {
+            $(
+                #[doc = concat!("See [`", stringify!($ty), "`].")]
+                $variant($ty),
+            )*
+        }
+
+        impl Kind {
+            /// All kinds.
+            pub const ALL: &'static [Kind] = &[$(Kind::$variant),*];
+
+            /// The name used in JSON and TOML.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Kind::$variant => <$ty as Fit>::NAME,)*
+                }
+            }
+
+            /// Whether the effect depends on position only (and so competes
+            /// with the position-dependent systematic error in a lack-of-fit test).
+            pub fn is_positional(self) -> bool {
+                match self {
+                    $(Kind::$variant => <$ty as Fit>::POSITIONAL,)*
+                }
+            }
+        }
+
+        impl Effect {
+            /// The kind.
+            pub fn kind(&self) -> Kind {
+                match self {
+                    $(Effect::$variant(_) => Kind::$variant,)*
+                }
+            }
+
+            /// The effect as its kind's [`Model`].
+            pub fn model(&self) -> &dyn Model {
+                match self {
+                    $(Effect::$variant(effect) => effect,)*
+                }
+            }
+
+            /// The effect from a shape and its fitted coefficients.
+            pub fn from_fit(shape: Shape, coefficients: &[f64], line: &Line<'_>) -> Effect {
+                match shape.kind() {
+                    $(Kind::$variant => Effect::$variant(<$ty>::from_fit(shape, coefficients, line)),)*
+                }
+            }
+
+            /// The standard uncertainty of its parameters, and caveats.
+            pub fn uncertainty(&self, fit: &FitSummary<'_>) -> (Vec<Uncertainty>, Vec<String>) {
+                match self {
+                    $(Effect::$variant(effect) => effect.uncertainty(fit),)*
+                }
+            }
+        }
+
+        /// The columns of an effect of a given shape over the readings.
+        pub fn columns(shape: Shape, readings: &[Reading], line: &Line<'_>) -> Vec<Vec<f64>> {
+            match shape.kind() {
+                $(Kind::$variant => <$ty>::columns(shape, readings, line),)*
+            }
+        }
+
+        /// An `[[effect]]` of a file, by its `kind`.
+        #[derive(Deserialize)]
+        #[serde(tag = "kind", rename_all = "kebab-case")]
+        enum Entry {
+            $($variant(file::Tested<$ty>),)*
+        }
+
+        impl From<Entry> for Effect {
+            fn from(entry: Entry) -> Effect {
+                match entry {
+                    $(Entry::$variant(tested) => Effect::$variant(tested.0),)*
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    Reversal => Reversal,
+    Scale => Scale,
+    Drift => Drift,
+    Periodic => Periodic,
+    OutlierRun => OutlierRun,
+    Abbe => Abbe,
+}
+
+impl Effect {
+    /// The effect's contribution to one reading, µm.
+    pub fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+        self.model().value_um(reading, line)
+    }
+
+    /// The effect's systematic part at `x_mm` moving in `direction`, µm
+    /// ([`Model::systematic_um`]).
+    pub fn systematic_um(
+        &self,
+        x_mm: f64,
+        direction: Direction,
+        first_target_mm: f64,
+    ) -> Option<f64> {
+        self.model().systematic_um(x_mm, direction, first_target_mm)
+    }
+
+    /// What it does to a compensation table.
+    pub fn in_table(&self) -> TableRole {
+        self.model().in_table()
+    }
+
+    /// What it is physically and what to do about it at the machine, in one sentence.
+    pub fn explanation(&self, context: &Context) -> String {
+        self.model().explanation(context)
+    }
+
+    /// The parameters, in the order they are shown and saved.
+    pub fn parameters(&self) -> Vec<Parameter> {
+        self.model().parameters()
+    }
+}
+
+/// The columns of a single-column effect: `f` of each reading.
+fn column(readings: &[Reading], f: impl Fn(&Reading) -> f64) -> Vec<Vec<f64>> {
+    vec![readings.iter().map(f).collect()]
+}
+
+#[cfg(test)]
+mod tests;

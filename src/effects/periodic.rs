@@ -1,0 +1,145 @@
+//! Periodic error in position: `amplitude · sin(2πx/period + phase)` (a screw
+//! lead, a scale period).
+
+use std::f64::consts::{PI, TAU};
+
+use serde::Deserialize;
+
+use super::{
+    Context, Fit, FitSummary, Line, Model, Parameter, Reading, Shape, TableRole, Uncertainty,
+};
+use crate::measurement::Direction;
+
+/// Periodic error `amplitude · sin(2πx/period + phase)`.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Periodic {
+    /// mm.
+    pub period_mm: f64,
+    /// µm.
+    pub amplitude_um: f64,
+    /// rad.
+    #[serde(default)]
+    pub phase_rad: f64,
+}
+
+impl Periodic {
+    fn at_um(&self, x_mm: f64) -> f64 {
+        self.amplitude_um * (TAU * x_mm / self.period_mm + self.phase_rad).sin()
+    }
+}
+
+impl Model for Periodic {
+    fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
+        self.at_um(reading.target_mm)
+    }
+
+    fn systematic_um(&self, x_mm: f64, _: Direction, _: f64) -> Option<f64> {
+        Some(self.at_um(x_mm))
+    }
+
+    /// Linear interpolation between points h apart leaves up to
+    /// A·(1 − cos(πh/p)) of a sine: under 5 % of A for h ≤ p/10.
+    fn in_table(&self) -> TableRole {
+        TableRole::AtPoints {
+            finest_step_mm: self.period_mm / 10.0,
+        }
+    }
+
+    fn explanation(&self, context: &Context) -> String {
+        let table = context
+            .table_step_mm
+            .map(|s| format!("; the table's step of {s} mm cannot follow it"))
+            .unwrap_or_default();
+        format!(
+            "Periodic error of {:.2} µm amplitude and {:.2} mm period (screw lead or scale period){table}; compensate with a step of at most {:.2} mm (convert --effects) or the control's pitch compensation, or check the screw.",
+            self.amplitude_um,
+            self.period_mm,
+            self.period_mm / 10.0
+        )
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        vec![
+            Parameter::number("period_mm", "period", "mm", self.period_mm),
+            Parameter::number("amplitude_um", "amplitude", "µm", self.amplitude_um),
+            Parameter::number("phase_rad", "phase", "rad", self.phase_rad),
+        ]
+    }
+
+    fn check(&self) -> Result<(), String> {
+        if self.period_mm > 0.0 && self.period_mm.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("period_mm must be > 0, found {}", self.period_mm))
+        }
+    }
+}
+
+impl Fit for Periodic {
+    const NAME: &'static str = "periodic";
+    const POSITIONAL: bool = true;
+
+    fn columns(shape: Shape, readings: &[Reading], _: &Line<'_>) -> Vec<Vec<f64>> {
+        let Shape::Period(period) = shape else {
+            return Vec::new();
+        };
+        vec![
+            readings
+                .iter()
+                .map(|r| (TAU * r.target_mm / period).sin())
+                .collect(),
+            readings
+                .iter()
+                .map(|r| (TAU * r.target_mm / period).cos())
+                .collect(),
+        ]
+    }
+
+    fn from_fit(shape: Shape, coefficients: &[f64], _: &Line<'_>) -> Periodic {
+        let Shape::Period(period_mm) = shape else {
+            unreachable!("a periodic effect's shape is its period")
+        };
+        // a·sin θ + b·cos θ = A·sin(θ + φ) with A cos φ = a, A sin φ = b.
+        let (a, b) = (coefficients[0], coefficients[1]);
+        Periodic {
+            period_mm,
+            amplitude_um: a.hypot(b),
+            phase_rad: b.atan2(a),
+        }
+    }
+
+    /// Amplitude from its two coefficients; period from the frequency
+    /// estimate's variance 6σ²/(π²A²T²N) (Rife & Boorstyn 1974), σ² from the
+    /// fit (χ²/dof with known variances, RSS/dof otherwise). Evenly spaced
+    /// targets alias: the caveat names the periods that give the same readings.
+    fn uncertainty(&self, fit: &FitSummary<'_>) -> (Vec<Uncertainty>, Vec<String>) {
+        let (coefficients, errors, n) = (fit.coefficients, fit.errors, fit.n);
+        let (a, b) = (coefficients[0], coefficients[1]);
+        let sigma_amplitude = ((a * errors[0]).powi(2) + (b * errors[1]).powi(2)).sqrt()
+            / self.amplitude_um.max(1e-12);
+        let noise = sigma_amplitude * (n as f64 / 2.0).sqrt();
+        let sigma_frequency = 6f64.sqrt() * noise
+            / (PI * self.amplitude_um.max(1e-12) * fit.span_mm * (n as f64).sqrt());
+        let mut warnings = Vec::new();
+        if let Some(spacing) = fit.target_spacing_mm {
+            let aliases: Vec<String> = (1..=2)
+                .map(|k| 1.0 / (f64::from(k) / spacing - 1.0 / self.period_mm).abs())
+                .filter(|p| p.is_finite())
+                .map(|p| format!("{p:.2} mm"))
+                .collect();
+            warnings.push(format!(
+                "the targets are evenly spaced ({spacing} mm): periods {} give the same readings (aliasing); measure with irregular spacing to tell them apart",
+                aliases.join(", ")
+            ));
+        }
+        let uncertainty = vec![
+            (
+                "period_mm",
+                self.period_mm * self.period_mm * sigma_frequency,
+            ),
+            ("amplitude_um", sigma_amplitude),
+        ];
+        (uncertainty, warnings)
+    }
+}

@@ -1,0 +1,213 @@
+use super::*;
+
+fn reading(target_mm: f64, direction: Direction, run: u32, time_h: f64) -> Reading {
+    Reading {
+        target_index: 0,
+        target_mm,
+        direction,
+        run,
+        run_index: 0,
+        time_h,
+    }
+}
+
+const ORIGIN: Line<'static> = Line {
+    first_target_mm: 0.0,
+    angle_urad: None,
+};
+
+/// One effect of every kind (the registry's order).
+fn one_of_each() -> Vec<Effect> {
+    vec![
+        Effect::Reversal(Reversal { b_um: -3.0 }),
+        Effect::Scale(Scale {
+            scale_um_per_m: 11.5,
+        }),
+        Effect::Drift(Drift { rate_um_per_h: 2.0 }),
+        Effect::Periodic(Periodic {
+            period_mm: 5.0,
+            amplitude_um: 1.25,
+            phase_rad: 0.5,
+        }),
+        Effect::OutlierRun(OutlierRun {
+            run: 2,
+            direction: Direction::Down,
+            offset_um: 4.5,
+        }),
+        Effect::Abbe(Abbe {
+            offset_mm: 100.0,
+            angle_urad: 40.0,
+        }),
+    ]
+}
+
+#[test]
+fn the_examples_cover_every_kind_of_the_registry() {
+    let kinds: Vec<Kind> = one_of_each().iter().map(Effect::kind).collect();
+    assert_eq!(kinds, Kind::ALL);
+}
+
+#[test]
+fn columns_and_values_agree() {
+    let readings = [
+        reading(100.0, Direction::Up, 1, 0.5),
+        reading(300.0, Direction::Down, 2, 1.0),
+    ];
+    let angles = [30.0];
+    let line = Line {
+        first_target_mm: 0.0,
+        angle_urad: Some(&angles),
+    };
+    let cases = [
+        (Shape::Fixed(Kind::Reversal), vec![4.0]),
+        (Shape::Fixed(Kind::Scale), vec![10.0]),
+        (Shape::Fixed(Kind::Drift), vec![2.0]),
+        (Shape::Period(160.0), vec![1.0, -0.5]),
+        (Shape::Run(Direction::Down, 2), vec![3.0]),
+        (Shape::Fixed(Kind::Abbe), vec![50.0]),
+    ];
+    assert_eq!(cases.len(), Kind::ALL.len(), "every kind");
+    for (shape, coefficients) in cases {
+        let columns = columns(shape, &readings, &line);
+        let effect = Effect::from_fit(shape, &coefficients, &line);
+        assert_eq!(effect.kind(), shape.kind());
+        for (i, r) in readings.iter().enumerate() {
+            let from_columns: f64 = columns
+                .iter()
+                .zip(&coefficients)
+                .map(|(c, b)| c[i] * b)
+                .sum();
+            assert!(
+                (effect.value_um(r, &line) - from_columns).abs() < 1e-12,
+                "{shape:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn values_by_hand() {
+    let up = reading(250.0, Direction::Up, 1, 0.25);
+    assert_eq!(
+        Effect::Reversal(Reversal { b_um: -3.0 }).value_um(&up, &ORIGIN),
+        -1.5
+    );
+    let from_50 = Line {
+        first_target_mm: 50.0,
+        angle_urad: None,
+    };
+    assert_eq!(
+        Effect::Scale(Scale {
+            scale_um_per_m: 8.0
+        })
+        .value_um(&up, &from_50),
+        1.6
+    );
+    assert_eq!(
+        Effect::Drift(Drift { rate_um_per_h: 4.0 }).value_um(&up, &ORIGIN),
+        1.0
+    );
+    let periodic = Effect::Periodic(Periodic {
+        period_mm: 1000.0,
+        amplitude_um: 2.0,
+        phase_rad: 0.0,
+    });
+    assert!(
+        (periodic.value_um(&up, &ORIGIN) - 2.0).abs() < 1e-12,
+        "quarter period: the crest"
+    );
+}
+
+#[test]
+fn every_explanation_is_one_sentence_with_an_action() {
+    let context = Context {
+        expansion_coefficient_ppm_per_k: Some(11.5),
+        table_step_mm: Some(50.0),
+        ..Context::default()
+    };
+    for effect in one_of_each() {
+        let text = effect.explanation(&context);
+        assert_eq!(text.matches(". ").count(), 0, "one sentence: {text}");
+        assert!(text.ends_with('.'), "{text}");
+        assert!(text.contains(';'), "what it is; what to do: {text}");
+    }
+    let scale = Effect::Scale(Scale {
+        scale_um_per_m: 11.5,
+    })
+    .explanation(&context);
+    assert!(scale.contains("+1.00 K"), "{scale}");
+}
+
+#[test]
+fn every_kind_says_what_it_does_to_a_table() {
+    let roles: Vec<TableRole> = one_of_each().iter().map(Effect::in_table).collect();
+    assert_eq!(roles[0], TableRole::Bidirectional { b_um: -3.0 });
+    assert!(matches!(roles[1], TableRole::TakenOut { .. }));
+    assert!(matches!(roles[2], TableRole::NotATable { .. }));
+    // A tenth of the period: linear interpolation leaves < 5 % of a sine.
+    assert_eq!(
+        roles[3],
+        TableRole::AtPoints {
+            finest_step_mm: 0.5
+        }
+    );
+    assert!(
+        matches!(roles[4], TableRole::NotATable { ref note } if note.contains("--exclude-run 2:down"))
+    );
+    assert!(matches!(roles[5], TableRole::NotATable { .. }));
+}
+
+#[test]
+fn every_kind_is_written_and_read_back() {
+    let effects = one_of_each();
+    let uncertainty: Vec<Vec<Uncertainty>> = effects
+        .iter()
+        .map(|e| vec![(e.parameters()[0].key, 0.05)])
+        .collect();
+    let text = write_effects(
+        effects
+            .iter()
+            .zip(&uncertainty)
+            .map(|(effect, u)| FileEntry {
+                effect,
+                uncertainty: u,
+                explanation: "What it is; what to do.",
+            }),
+        "after.rtl",
+    );
+    assert_eq!(read_effects(&text).unwrap(), effects, "{text}");
+    assert!(text.contains("B_um = -3.0000      # ± 0.0500"), "{text}");
+    assert!(text.contains("run = 2            # ± 0.0500"), "{text}");
+}
+
+#[test]
+fn bad_effects_are_refused_with_a_position() {
+    let unknown = read_effects("[[effect]]\nkind = \"wobble\"\n").unwrap_err();
+    assert_eq!(unknown.position.line, 2, "{unknown}");
+    let missing = read_effects("[[effect]]\nkind = \"scale\"\n").unwrap_err();
+    assert!(missing.message.contains("scale_um_per_m"), "{missing}");
+    let direction = read_effects(
+        "[[effect]]\nkind = \"outlier-run\"\nrun = 1\ndirection = \"left\"\noffset_um = 1.0\n",
+    )
+    .unwrap_err();
+    assert!(
+        direction.message.contains("\"up\" or \"down\""),
+        "{direction}"
+    );
+    let typo = read_effects("[[effect]]\nkind = \"scale\"\nscale_um_per_m = 1.0\nsclae = 2\n")
+        .unwrap_err();
+    assert!(typo.message.contains("sclae"), "{typo}");
+    let tests =
+        read_effects("[[effect]]\nkind = \"drift\"\nrate_um_per_h = 1.0\ntests = [\"after\"]\n");
+    assert_eq!(
+        tests.unwrap(),
+        [Effect::Drift(Drift { rate_um_per_h: 1.0 })]
+    );
+    let period =
+        read_effects("[[effect]]\nkind = \"periodic\"\nperiod_mm = 0.0\namplitude_um = 1.0\n")
+            .unwrap_err();
+    assert!(period.message.contains("period_mm must be > 0"), "{period}");
+    let infinite = read_effects("[[effect]]\nkind = \"drift\"\nrate_um_per_h = inf\n").unwrap_err();
+    assert!(infinite.message.contains("finite"), "{infinite}");
+    assert!(read_effects("").unwrap().is_empty());
+}
