@@ -12,13 +12,13 @@
 
 use nalgebra::DMatrix;
 
-use super::between_runs::Fold;
 use super::fit::{Design, WeightedFit, fit_gls};
+use super::gates::{period_range, set_rejection};
+use super::levels::{Fold, Level};
+use super::problem::Problem;
+use super::selection::{Chosen, Search, forward_selection, shapes};
 use super::stats::chi2_p;
-use super::{
-    Cell, Chosen, Evidence, Kind, LACK_OF_FIT_P, Level, Problem, RejectedEffect, Shape, best_of,
-    period_range, predicts_better, set_rejection, shapes, strong_evidence,
-};
+use super::{Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
 use crate::effects::Reading;
 use crate::measurement::Direction;
 
@@ -44,33 +44,6 @@ pub(super) fn level_covariance(problem: &Problem, levels: &[Level]) -> DMatrix<f
         }
     }
     covariance
-}
-
-/// The per-target levels: both directions pooled (their mean), with the
-/// variance of the scatter and of the prediction.
-pub(super) fn target_levels(problem: &Problem, cells: &[Cell]) -> Vec<Level> {
-    let mut levels = Vec::new();
-    for t in 0..problem.targets_mm.len() {
-        let here: Vec<&Cell> = cells.iter().filter(|c| c.target_index == t).collect();
-        if here.is_empty() {
-            continue;
-        }
-        let k = here.len() as f64;
-        let value = here.iter().map(|c| c.value_um).sum::<f64>() / k;
-        let scatter = here.iter().map(|c| c.variance_um2).sum::<f64>() / (k * k);
-        let prediction: f64 = problem.prediction_weights[t]
-            .iter()
-            .map(|(i, w)| w * w * problem.first_test_variance_um2[*i])
-            .sum();
-        levels.push(Level {
-            target_index: t,
-            target_mm: problem.targets_mm[t],
-            value_um: value,
-            scatter_variance_um2: scatter,
-            variance_um2: scatter + prediction,
-        });
-    }
-    levels
 }
 
 /// What the effects along the axis are fitted against.
@@ -158,89 +131,21 @@ pub(super) fn select_along_axis(
         let dof = m.saturating_sub(fit.rank).max(1) as f64;
         covariance *= (fit.chi2 / dof).max(1.0);
     }
-    let mut model = base.clone();
-    let mut model_fit = fit_gls(&model, &values, &covariance, None);
-    let mut chosen: Vec<Chosen> = Vec::new();
     let min_periods = match background {
         Background::Constant => super::MIN_PERIODS_IN_SPAN,
         Background::Smooth => super::MIN_PERIODS_IN_CURVE,
     };
-    let range = period_range(&problem.targets_mm, min_periods);
-    loop {
-        let mut candidates: Vec<(Shape, usize, f64, WeightedFit)> = Vec::new();
-        for &kind in kinds.iter().filter(|k| k.is_positional()) {
-            if chosen.iter().any(|c| c.shape.kind() == kind) {
-                continue;
-            }
-            let shapes = shapes(kind, &problem.targets_mm, range, &[], &chosen);
-            let Some((shape, chi2, trial_fit)) = best_of(&shapes, range, |shape| {
-                let f = fit_gls(
-                    &model.with(&level_columns(problem, levels, shape)),
-                    &values,
-                    &covariance,
-                    None,
-                );
-                (f.chi2, f)
-            }) else {
-                continue;
-            };
-            let added = level_columns(problem, levels, shape).len();
-            let look_elsewhere = if shapes.len() > 1 {
-                2.0 * (shapes.len() as f64).ln()
-            } else {
-                0.0
-            };
-            // −2 ln L = χ² with a known covariance: ΔBIC = Δχ² + Δk·ln m.
-            let delta = chi2 - model_fit.chi2 + added as f64 * (m as f64).ln() + look_elsewhere;
-            candidates.push((shape, shapes.len(), delta, trial_fit));
-        }
-        candidates.sort_by(|a, b| a.2.total_cmp(&b.2));
-        let cv_without = along_axis_cv(problem, levels, &model, folds, reversal_b);
-        let mut accepted = None;
-        for (shape, trials, delta, trial_fit) in candidates {
-            if !strong_evidence(rejected, shape.kind(), delta) {
-                continue;
-            }
-            if let Some(why) =
-                inconsistent_along_axis(problem, levels, &values, &covariance, background, shape)
-            {
-                set_rejection(rejected, shape.kind(), why);
-                continue;
-            }
-            let with = model.with(&level_columns(problem, levels, shape));
-            let cv_with = along_axis_cv(problem, levels, &with, folds, reversal_b);
-            if !predicts_better(rejected, shape.kind(), cv_with, cv_without) {
-                continue;
-            }
-            let evidence = Evidence {
-                delta_bic: delta,
-                trials,
-                p_value: chi2_p(
-                    model_fit.chi2 - trial_fit.chi2,
-                    with.parameters() - model.parameters(),
-                ),
-                cv_rmse_without_um: cv_without,
-                cv_rmse_with_um: cv_with,
-            };
-            accepted = Some((
-                Chosen {
-                    shape,
-                    first_column: model.parameters(),
-                    evidence,
-                },
-                with,
-                trial_fit,
-            ));
-            break;
-        }
-        let Some((c, with, with_fit)) = accepted else {
-            break;
-        };
-        rejected.retain(|r| r.kind != c.shape.kind());
-        chosen.push(c);
-        model = with;
-        model_fit = with_fit;
-    }
+    let search = AlongAxis {
+        problem,
+        levels,
+        folds,
+        reversal_b,
+        background,
+        values: &values,
+        covariance: &covariance,
+        periods: period_range(&problem.targets_mm, min_periods),
+    };
+    let (mut chosen, mut model_fit) = forward_selection(&search, base.clone(), kinds, rejected);
     // Never the nearest kind: what is accepted along the axis must leave no
     // structure there (against a prediction; a test's own curve is the table's).
     let p = chi2_p(model_fit.chi2, m.saturating_sub(model_fit.rank));
@@ -258,6 +163,79 @@ pub(super) fn select_along_axis(
         model_fit = fit_gls(&base, &values, &covariance, None);
     }
     (chosen, model_fit)
+}
+
+/// The search along the axis: generalised least squares on the per-target
+/// levels with their known covariance, judged by χ².
+struct AlongAxis<'a> {
+    problem: &'a Problem,
+    levels: &'a [Level],
+    folds: &'a [Fold],
+    reversal_b: f64,
+    background: Background,
+    values: &'a [f64],
+    covariance: &'a DMatrix<f64>,
+    periods: Option<(f64, f64)>,
+}
+
+impl Search for AlongAxis<'_> {
+    type Fit = WeightedFit;
+
+    /// Each position-dependent kind once.
+    fn tries(&self, kind: Kind, chosen: &[Chosen]) -> bool {
+        kind.is_positional() && !chosen.iter().any(|c| c.shape.kind() == kind)
+    }
+
+    fn shapes(&self, kind: Kind, chosen: &[Chosen]) -> Vec<Shape> {
+        shapes(kind, &self.problem.targets_mm, self.periods, &[], chosen)
+    }
+
+    fn periods(&self) -> Option<(f64, f64)> {
+        self.periods
+    }
+
+    fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
+        level_columns(self.problem, self.levels, shape)
+    }
+
+    fn fit(&self, design: &Design) -> WeightedFit {
+        fit_gls(design, self.values, self.covariance, None)
+    }
+
+    fn statistic(fit: &WeightedFit) -> f64 {
+        fit.chi2
+    }
+
+    /// −2 ln L = χ² with a known covariance: ΔBIC = Δχ² + Δk·ln m.
+    fn delta_bic(&self, model: &WeightedFit, trial: &WeightedFit, shape: Shape) -> f64 {
+        let added = self.columns(shape).len();
+        trial.chi2 - model.chi2 + added as f64 * (self.levels.len() as f64).ln()
+    }
+
+    fn p_value(&self, model: &WeightedFit, trial: &WeightedFit, added: usize) -> f64 {
+        chi2_p(model.chi2 - trial.chi2, added)
+    }
+
+    fn cross_validated_rmse(&self, design: &Design) -> f64 {
+        along_axis_cv(
+            self.problem,
+            self.levels,
+            design,
+            self.folds,
+            self.reversal_b,
+        )
+    }
+
+    fn inconsistency(&self, shape: Shape) -> Option<String> {
+        inconsistent_along_axis(
+            self.problem,
+            self.levels,
+            self.values,
+            self.covariance,
+            self.background,
+            shape,
+        )
+    }
 }
 
 /// A position-dependent effect must be the same along the whole axis: its

@@ -4,15 +4,15 @@
 //! every cell has its own level.
 
 use super::fit::{self, Design, Fit, bic, leave_one_run_out_rmse};
+use super::gates::{predicts_better, set_rejection, strong_evidence};
+use super::levels::{Cell, Fold, reversals};
+use super::problem::Problem;
+use super::selection::{Chosen, Search, forward_selection, shapes};
 use super::stats::{chi2_p, partial_f_p};
-use super::{
-    Cell, Chosen, Evidence, Kind, LACK_OF_FIT_P, Level, Problem, RejectedEffect, Shape, best_of,
-    predicts_better, set_rejection, shapes, strong_evidence,
-};
-use crate::diagnose::along_axis::target_levels;
+use super::{Evidence, Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
 use nalgebra::{DMatrix, DVector};
 
-use crate::measurement::{Direction, Run};
+use crate::measurement::Run;
 
 /// The reversal found between the directions, from the cell levels.
 #[derive(Clone, Copy, Debug)]
@@ -29,82 +29,72 @@ pub(super) fn select_between_runs(
     kinds: &[Kind],
     rejected: &mut Vec<RejectedEffect>,
 ) -> (Vec<Chosen>, Fit) {
-    let n = y.len();
-    let mut chosen: Vec<Chosen> = Vec::new();
-    let mut model = problem.cell_design.clone();
-    let mut model_fit = fit::fit(&model, y, None);
-    let runs = runs_of(problem);
-    loop {
-        let mut candidates: Vec<(Shape, usize, f64, Fit)> = Vec::new();
-        for &kind in kinds
-            .iter()
-            .filter(|k| matches!(k, Kind::Drift | Kind::OutlierRun))
-        {
-            if kind != Kind::OutlierRun && chosen.iter().any(|c| c.shape.kind() == kind) {
-                continue;
-            }
-            let shapes = shapes(kind, &problem.targets_mm, None, &runs, &chosen);
-            let Some((shape, rss, trial_fit)) = best_of(&shapes, None, |shape| {
-                let f = fit::fit(&model.with(&problem.columns(shape)), y, None);
-                (f.rss, f)
-            }) else {
-                continue;
-            };
-            let added = trial_fit.rank.saturating_sub(model_fit.rank).max(1);
-            let look_elsewhere = if shapes.len() > 1 {
-                2.0 * (shapes.len() as f64).ln()
-            } else {
-                0.0
-            };
-            let delta = bic(rss, n, model_fit.rank + added) - bic(model_fit.rss, n, model_fit.rank)
-                + look_elsewhere;
-            candidates.push((shape, shapes.len(), delta, trial_fit));
+    let search = BetweenRuns {
+        problem,
+        y,
+        runs: runs_of(problem),
+    };
+    forward_selection(&search, problem.cell_design.clone(), kinds, rejected)
+}
+
+/// The search between runs: least squares on the readings, judged by the
+/// residual sum of squares.
+struct BetweenRuns<'a> {
+    problem: &'a Problem,
+    y: &'a [f64],
+    runs: Vec<Run>,
+}
+
+impl Search for BetweenRuns<'_> {
+    type Fit = Fit;
+
+    /// Drift once; outlier runs as many as there are.
+    fn tries(&self, kind: Kind, chosen: &[Chosen]) -> bool {
+        match kind {
+            Kind::OutlierRun => true,
+            Kind::Drift => !chosen.iter().any(|c| c.shape.kind() == kind),
+            _ => false,
         }
-        candidates.sort_by(|a, b| a.2.total_cmp(&b.2));
-        let cv_without = leave_one_run_out_rmse(&model, y, &problem.run_of(), problem.run_count);
-        let mut accepted = None;
-        for (shape, trials, delta, trial_fit) in candidates {
-            if !strong_evidence(rejected, shape.kind(), delta) {
-                continue;
-            }
-            let with = model.with(&problem.columns(shape));
-            let cv_with = leave_one_run_out_rmse(&with, y, &problem.run_of(), problem.run_count);
-            if !predicts_better(rejected, shape.kind(), cv_with, cv_without) {
-                continue;
-            }
-            let evidence = Evidence {
-                delta_bic: delta,
-                trials,
-                p_value: partial_f_p(
-                    model_fit.rss,
-                    trial_fit.rss,
-                    with.parameters() - model.parameters(),
-                    n,
-                    trial_fit.rank,
-                ),
-                cv_rmse_without_um: cv_without,
-                cv_rmse_with_um: cv_with,
-            };
-            accepted = Some((
-                Chosen {
-                    shape,
-                    first_column: model.parameters(),
-                    evidence,
-                },
-                with,
-                trial_fit,
-            ));
-            break;
-        }
-        let Some((c, with, with_fit)) = accepted else {
-            break;
-        };
-        rejected.retain(|r| r.kind != c.shape.kind());
-        chosen.push(c);
-        model = with;
-        model_fit = with_fit;
     }
-    (chosen, model_fit)
+
+    fn shapes(&self, kind: Kind, chosen: &[Chosen]) -> Vec<Shape> {
+        shapes(kind, &self.problem.targets_mm, None, &self.runs, chosen)
+    }
+
+    fn periods(&self) -> Option<(f64, f64)> {
+        None
+    }
+
+    fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
+        self.problem.columns(shape)
+    }
+
+    fn fit(&self, design: &Design) -> Fit {
+        fit::fit(design, self.y, None)
+    }
+
+    fn statistic(fit: &Fit) -> f64 {
+        fit.rss
+    }
+
+    fn delta_bic(&self, model: &Fit, trial: &Fit, _: Shape) -> f64 {
+        let n = self.y.len();
+        let added = trial.rank.saturating_sub(model.rank).max(1);
+        bic(trial.rss, n, model.rank + added) - bic(model.rss, n, model.rank)
+    }
+
+    fn p_value(&self, model: &Fit, trial: &Fit, added: usize) -> f64 {
+        partial_f_p(model.rss, trial.rss, added, self.y.len(), trial.rank)
+    }
+
+    fn cross_validated_rmse(&self, design: &Design) -> f64 {
+        leave_one_run_out_rmse(
+            design,
+            self.y,
+            &self.problem.run_of(),
+            self.problem.run_count,
+        )
+    }
 }
 
 /// The runs as the readings name them (direction, number), in order.
@@ -124,43 +114,6 @@ fn runs_of(problem: &Problem) -> Vec<Run> {
         }
     }
     runs
-}
-
-/// The cell levels of a between-runs fit, with their variance from the scatter.
-pub(super) fn cell_levels(problem: &Problem, fitted: &Fit) -> Vec<Cell> {
-    problem
-        .cells
-        .iter()
-        .enumerate()
-        .map(|(c, (t, d))| Cell {
-            target_index: *t,
-            direction: *d,
-            value_um: fitted.coefficients[c],
-            variance_um2: fitted.standard_errors[c].powi(2),
-            reversal_prediction_variance_um2: problem.reversal_prediction_variance_um2(*t) / 2.0,
-        })
-        .collect()
-}
-
-/// The per-target difference ↑ − ↓ of the cell levels and its variance.
-pub(super) fn reversals(cells: &[Cell]) -> Vec<(usize, f64, f64)> {
-    let mut list = Vec::new();
-    for up in cells.iter().filter(|c| c.direction == Direction::Up) {
-        if let Some(down) = cells
-            .iter()
-            .find(|c| c.direction == Direction::Down && c.target_index == up.target_index)
-        {
-            list.push((
-                up.target_index,
-                up.value_um - down.value_um,
-                up.variance_um2
-                    + down.variance_um2
-                    + up.reversal_prediction_variance_um2
-                    + down.reversal_prediction_variance_um2,
-            ));
-        }
-    }
-    list
 }
 
 /// The generalised-least-squares mean of the per-target reversals, its
@@ -300,48 +253,4 @@ pub(super) fn select_reversal(
         }),
         p_with,
     )
-}
-
-/// For each run held out: the cell and per-target levels fitted on the other
-/// runs, and the held-out readings less the between-runs effects fitted without them.
-pub(super) struct Fold {
-    pub(super) cells: Vec<Cell>,
-    pub(super) levels: Vec<Level>,
-    pub(super) held_out: Vec<(usize, Direction, f64)>,
-}
-
-pub(super) fn cross_validation_folds(
-    problem: &Problem,
-    y: &[f64],
-    between_model: &Design,
-    between: &[Chosen],
-) -> Vec<Fold> {
-    let run_of = problem.run_of();
-    let mut folds = Vec::new();
-    for held_out in 0..problem.run_count {
-        let training: Vec<bool> = run_of.iter().map(|&r| r != held_out).collect();
-        if !training.iter().any(|t| *t) {
-            continue;
-        }
-        let fitted = fit::fit(between_model, y, Some(&training));
-        let cells = cell_levels(problem, &fitted);
-        let levels = target_levels(problem, &cells);
-        let held: Vec<(usize, Direction, f64)> = (0..y.len())
-            .filter(|&i| run_of[i] == held_out)
-            .map(|i| {
-                let effects: f64 = between
-                    .iter()
-                    .map(|c| problem.contribution(c, &fitted.coefficients, i))
-                    .sum();
-                let r = &problem.readings[i];
-                (r.target_index, r.direction, y[i] - effects)
-            })
-            .collect();
-        folds.push(Fold {
-            cells,
-            levels,
-            held_out: held,
-        });
-    }
-    folds
 }

@@ -1,0 +1,120 @@
+//! What a diagnosis reports of its effects: the accepted effect with its
+//! uncertainty and sentence, the context the sentences need, the residual's
+//! statistics and the ISO 230-2 figures with and without the effects.
+
+use super::problem::Problem;
+use super::selection::Chosen;
+use super::{AcceptedEffect, DiagnoseError, DiagnoseInput, FigureSet, ResidualStats};
+use crate::compensate::CompensationTable;
+use crate::compensate::retest::KnownError;
+use crate::effects::{Context, Effect, FitSummary, Kind, Shape};
+use crate::evaluate::evaluate;
+use crate::measurement::{Measurement, Run};
+
+/// The mean reversal B̄ of the first test, µm, when it measured both directions.
+pub(super) fn first_test_reversal_um(input: &DiagnoseInput<'_>) -> Option<f64> {
+    let before = input.before?;
+    let known = KnownError::from_evaluation(&evaluate(before))?;
+    known
+        .is_bidirectional()
+        .then(|| crate::units::mm_to_um(known.mean_reversal_mm()))
+}
+
+pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context {
+    let material = |m: &Measurement| m.environment.material_temperature_c[0].start;
+    let material_change_k = match (input.before, material(input.after)) {
+        (Some(before), Some(after)) => material(before).map(|b| after - b),
+        _ => None,
+    };
+    Context {
+        table_step_mm: input.table.and_then(CompensationTable::regular_step_mm),
+        target_spacing_mm: crate::compensate::regular_step(input.after.targets_mm()),
+        expansion_coefficient_ppm_per_k: input.after.environment.expansion_coefficient_ppm_per_k,
+        material_change_k,
+        time_assumed,
+        first_test_reversal_um: first_test_reversal_um(input),
+    }
+}
+
+pub(super) fn accepted_effect(
+    chosen: Chosen,
+    coefficients: &[f64],
+    errors: &[f64],
+    problem: &Problem,
+    context: &Context,
+    n: usize,
+) -> AcceptedEffect {
+    let width = match chosen.shape {
+        Shape::Period(_) => 2,
+        _ => 1,
+    };
+    let coefficients = &coefficients[chosen.first_column..chosen.first_column + width];
+    let errors = &errors[chosen.first_column..chosen.first_column + width];
+    let effect = Effect::from_fit(chosen.shape, coefficients, &problem.line());
+    let (uncertainty, mut warnings) = effect.uncertainty(&FitSummary {
+        coefficients,
+        errors,
+        span_mm: problem.targets_mm[problem.targets_mm.len() - 1] - problem.targets_mm[0],
+        n,
+        target_spacing_mm: context.target_spacing_mm,
+    });
+    if context.time_assumed && effect.kind() == Kind::Drift {
+        warnings.push("the file records no test duration: times assume a typical cycle (3 s dwell, 2000 mm/min)".to_string());
+    }
+    AcceptedEffect {
+        explanation: effect.explanation(context),
+        effect,
+        uncertainty,
+        evidence: chosen.evidence,
+        warnings,
+    }
+}
+
+pub(super) fn stats(values: &[f64]) -> ResidualStats {
+    let n = values.len().max(1) as f64;
+    ResidualStats {
+        rms_um: (values.iter().map(|v| v * v).sum::<f64>() / n).sqrt(),
+        max_abs_um: values.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+    }
+}
+
+/// ISO figures of the re-test as measured, as predicted and as predicted with
+/// the effects; `value(i, with_effects)` gives reading i of the model (µm,
+/// with the measured scatter, so A and R stay comparable).
+pub(super) fn figures(
+    after: &Measurement,
+    problem: &Problem,
+    value: impl Fn(usize, bool) -> f64,
+) -> Result<FigureSet, DiagnoseError> {
+    let build = |with_effects: bool| -> Result<Measurement, DiagnoseError> {
+        let mut runs: Vec<Run> = after
+            .runs()
+            .iter()
+            .map(|run| Run {
+                deviations_mm: vec![None; after.targets_mm().len()],
+                ..run.clone()
+            })
+            .collect();
+        for (i, reading) in problem.readings.iter().enumerate() {
+            runs[reading.run_index].deviations_mm[reading.target_index] =
+                Some(value(i, with_effects) / 1000.0);
+        }
+        Measurement::new(
+            after.axis(),
+            after.targets_mm().to_vec(),
+            runs,
+            after.environment.clone(),
+            after.metadata.clone(),
+        )
+        .map_err(|e| DiagnoseError::Internal(e.to_string()))
+    };
+    let predicted = match &problem.first_test_prediction {
+        Some(prediction) => evaluate(prediction).figures,
+        None => evaluate(&build(false)?).figures,
+    };
+    Ok(FigureSet {
+        measured: evaluate(after).figures,
+        predicted,
+        predicted_with_effects: evaluate(&build(true)?).figures,
+    })
+}

@@ -1,0 +1,298 @@
+//! The problem a diagnosis solves: the re-test's readings, the prediction
+//! at each and its covariance (from the first test's scatter), the times of
+//! the readings, and the design of one level per cell.
+
+use super::fit::Design;
+use super::selection::Chosen;
+use super::{DiagnoseError, DiagnoseInput};
+use crate::compensate::interpolate_hold;
+use crate::compensate::retest::{
+    Applied, BacklashError, KnownError, predicted_deviation_mm, with_scatter,
+};
+use crate::cycle::{self, CycleTiming};
+use crate::effects::{Line, Reading, Shape};
+use crate::evaluate::{Evaluation, evaluate};
+use crate::measurement::together::{Input, Pairing, check_together};
+use crate::measurement::{Direction, Measurement};
+
+/// The readings with their prediction, as one table.
+pub(super) struct Problem {
+    pub(super) readings: Vec<Reading>,
+    pub(super) measured_um: Vec<f64>,
+    pub(super) predicted_um: Vec<f64>,
+    /// The prediction at each target of the re-test interpolates the first
+    /// test's means: (index into `first_test_variance_um2`, weight) pairs.
+    pub(super) prediction_weights: Vec<Vec<(usize, f64)>>,
+    /// The predicted re-test as `predict` gives it on the measured line: the
+    /// first test's readings with the predicted systematic error.
+    pub(super) first_test_prediction: Option<Measurement>,
+    /// Variance of the first test's bidirectional mean at each of its targets, µm².
+    pub(super) first_test_variance_um2: Vec<f64>,
+    /// Variance of the first test's reversal x̄↑ − x̄↓ at each of its targets
+    /// (which the prediction carries), µm²; 0 for a unidirectional test.
+    pub(super) first_test_reversal_variance_um2: Vec<f64>,
+    pub(super) run_count: usize,
+    pub(super) targets_mm: Vec<f64>,
+    pub(super) angle_urad: Option<Vec<f64>>,
+    /// The cells (target, direction) that have readings, in column order.
+    pub(super) cells: Vec<(usize, Direction)>,
+    /// One column per cell: the ISO 230-2 systematic model x̄_i↑, x̄_i↓.
+    pub(super) cell_design: Design,
+}
+
+impl Problem {
+    pub(super) fn first_target_mm(&self) -> f64 {
+        self.targets_mm[0]
+    }
+
+    /// Covariance of the predicted reversals at the re-test's targets `a` and
+    /// `b`, µm²: what they share of the first test's reversals.
+    pub(super) fn shared_reversal_variance_um2(&self, a: usize, b: usize) -> f64 {
+        self.prediction_weights[a]
+            .iter()
+            .flat_map(|(ka, wa)| {
+                self.prediction_weights[b]
+                    .iter()
+                    .filter(move |(kb, _)| kb == ka)
+                    .map(move |(_, wb)| wa * wb * self.first_test_reversal_variance_um2[*ka])
+            })
+            .sum()
+    }
+
+    /// Variance of the predicted reversal at the re-test's target `t`, µm²:
+    /// the first test's reversals through the spline weights (independent
+    /// between the first test's targets).
+    pub(super) fn reversal_prediction_variance_um2(&self, t: usize) -> f64 {
+        self.shared_reversal_variance_um2(t, t)
+    }
+
+    /// What the effects need of the test besides a reading.
+    pub(super) fn line(&self) -> Line<'_> {
+        Line {
+            first_target_mm: self.first_target_mm(),
+            angle_urad: self.angle_urad.as_deref(),
+        }
+    }
+
+    pub(super) fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
+        crate::effects::columns(shape, &self.readings, &self.line())
+    }
+
+    pub(super) fn run_of(&self) -> Vec<usize> {
+        self.readings.iter().map(|r| r.run_index).collect()
+    }
+
+    /// The contribution of a between-runs effect (drift, outlier run) to reading `i`.
+    pub(super) fn contribution(&self, chosen: &Chosen, coefficients: &[f64], i: usize) -> f64 {
+        let columns = self.columns(chosen.shape);
+        columns
+            .iter()
+            .enumerate()
+            .map(|(j, column)| column[i] * coefficients[chosen.first_column + j])
+            .sum()
+    }
+}
+
+/// Builds the readings, their prediction and its covariance, and the cells.
+pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> {
+    let after = input.after;
+    let (times, time_assumed) = times_h(after, input.timing);
+    let first = match input.before {
+        Some(before) => {
+            // The doubts (machine names, units, ranges) are the caller's to
+            // show: the CLI runs the same check with the file names.
+            check_together(
+                Pairing::BeforeAfter,
+                &Input::measurement(before, "the first test"),
+                &Input::measurement(after, "the re-test"),
+            )?;
+            let evaluation = evaluate(before);
+            let known =
+                KnownError::from_evaluation(&evaluation).ok_or(DiagnoseError::NoKnownError)?;
+            Some((known, mean_variances(&evaluation)))
+        }
+        None if input.backlash_set => return Err(BacklashError::NoMeasuredReversal.into()),
+        None => None,
+    };
+    let applied = Applied::with_backlash(
+        input.table,
+        first.as_ref().map(|(known, _)| known),
+        input.backlash_set,
+    )?;
+    let first_test_prediction = match (input.before, &first) {
+        (Some(before), Some((known, _))) => Some(
+            with_scatter(before, &evaluate(before), |i, direction| {
+                predicted_deviation_mm(known, applied, before.targets_mm()[i], direction)
+            })
+            .map_err(|e| DiagnoseError::Internal(e.to_string()))?,
+        ),
+        _ => None,
+    };
+    let mut readings = Vec::new();
+    let mut measured_um = Vec::new();
+    let mut predicted_um = Vec::new();
+    for (run_index, run) in after.runs().iter().enumerate() {
+        for (target_index, (value, &target_mm)) in
+            run.deviations_mm.iter().zip(after.targets_mm()).enumerate()
+        {
+            let Some(value) = value else { continue };
+            readings.push(Reading {
+                target_index,
+                target_mm,
+                direction: run.direction,
+                run: run.number,
+                run_index,
+                time_h: times[run_index][target_index],
+            });
+            measured_um.push(value * 1000.0);
+            let predicted = first.as_ref().map_or(0.0, |(known, _)| {
+                predicted_deviation_mm(known, applied, target_mm, run.direction) * 1000.0
+            });
+            predicted_um.push(predicted);
+        }
+    }
+    if readings.len() < 4 || after.runs().len() < 2 {
+        return Err(DiagnoseError::TooFewReadings(readings.len()));
+    }
+    let (prediction_weights, first_test_variance_um2, first_test_reversal_variance_um2) =
+        match &first {
+            Some((_, variances)) => (
+                after
+                    .targets_mm()
+                    .iter()
+                    .map(|&x| interpolation_weights(&variances.positions_mm, x))
+                    .collect(),
+                variances.mean_um2.clone(),
+                variances.reversal_um2.clone(),
+            ),
+            None => (
+                vec![Vec::new(); after.targets_mm().len()],
+                Vec::new(),
+                Vec::new(),
+            ),
+        };
+    let mut cells: Vec<(usize, Direction)> = Vec::new();
+    for t in 0..after.targets_mm().len() {
+        for direction in Direction::BOTH {
+            if readings
+                .iter()
+                .any(|r| r.target_index == t && r.direction == direction)
+            {
+                cells.push((t, direction));
+            }
+        }
+    }
+    let cell_design = Design {
+        columns: cells
+            .iter()
+            .map(|(t, d)| {
+                readings
+                    .iter()
+                    .map(|r| f64::from(u8::from(r.target_index == *t && r.direction == *d)))
+                    .collect()
+            })
+            .collect(),
+    };
+    let angle_urad = input.angular.map(|profile| {
+        after
+            .targets_mm()
+            .iter()
+            .map(|&x| interpolate_hold(&profile.positions_mm, &profile.angle_urad, x))
+            .collect()
+    });
+    let problem = Problem {
+        readings,
+        measured_um,
+        predicted_um,
+        prediction_weights,
+        first_test_prediction,
+        first_test_variance_um2,
+        first_test_reversal_variance_um2,
+        run_count: after.runs().len(),
+        targets_mm: after.targets_mm().to_vec(),
+        angle_urad,
+        cells,
+        cell_design,
+    };
+    Ok((problem, time_assumed))
+}
+
+/// The first test's uncertainty, per target where it has a mean.
+pub(super) struct FirstTestVariances {
+    /// The targets, mm.
+    pub(super) positions_mm: Vec<f64>,
+    /// Variance of the bidirectional mean, µm².
+    pub(super) mean_um2: Vec<f64>,
+    /// Variance of the reversal x̄↑ − x̄↓, µm².
+    pub(super) reversal_um2: Vec<f64>,
+}
+
+/// Variance of the first test's means at each of its targets, µm²: of the
+/// bidirectional mean σ²·(1/n↑ + 1/n↓)/4 and of the reversal σ²·(1/n↑ + 1/n↓),
+/// or, for a unidirectional test, of its one direction's mean σ²/n and no
+/// reversal; σ pooled over all targets and directions (each target's own s
+/// rests on a handful of readings and would make the weights as noisy as the
+/// data). The targets are those of `KnownError::from_evaluation`.
+pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
+    let both = evaluation.runs_up > 0 && evaluation.runs_down > 0;
+    let pooled_um2 = evaluation
+        .pooled_variance_mm2()
+        .map_or(0.0, crate::units::mm2_to_um2);
+    let inverse = |n: usize| if n == 0 { 0.0 } else { 1.0 / n as f64 };
+    let mut variances = FirstTestVariances {
+        positions_mm: Vec::new(),
+        mean_um2: Vec::new(),
+        reversal_um2: Vec::new(),
+    };
+    for t in &evaluation.per_target {
+        let has_mean = if both {
+            t.mean_mm.is_some()
+        } else {
+            t.up.mean_mm.or(t.down.mean_mm).is_some()
+        };
+        if !has_mean {
+            continue;
+        }
+        let sum_of_inverses = inverse(t.up.n) + inverse(t.down.n);
+        variances.positions_mm.push(t.target_mm);
+        if both {
+            variances.mean_um2.push(pooled_um2 * sum_of_inverses / 4.0);
+            variances.reversal_um2.push(pooled_um2 * sum_of_inverses);
+        } else {
+            variances.mean_um2.push(pooled_um2 * sum_of_inverses);
+            variances.reversal_um2.push(0.0);
+        }
+    }
+    variances
+}
+
+/// The weights with which the prediction at `x` combines the first test's
+/// means: a row of the not-a-knot spline basis (as `KnownError::at`
+/// interpolates), as (index, weight) pairs.
+pub(super) fn interpolation_weights(positions: &[f64], x: f64) -> Vec<(usize, f64)> {
+    crate::spline::basis_matrix(positions, &[x])
+        .into_iter()
+        .enumerate()
+        .filter(|(_, w)| *w != 0.0)
+        .collect()
+}
+
+/// Reading times in hours from the cycle model, scaled to the recorded
+/// duration when the file records one that differs from the model's by more
+/// than its one-minute resolution.
+pub(super) fn times_h(measurement: &Measurement, timing: CycleTiming) -> (Vec<Vec<f64>>, bool) {
+    let seconds = cycle::reading_times(measurement, timing);
+    let model = cycle::duration_s(&seconds);
+    let (scale, assumed) = match measurement.metadata.duration_s() {
+        Some(recorded) if (recorded - model).abs() > 60.0 && model > 0.0 => {
+            (recorded / model, false)
+        }
+        Some(_) => (1.0, false),
+        None => (1.0, true),
+    };
+    let hours = seconds
+        .iter()
+        .map(|run| run.iter().map(|t| t * scale / 3600.0).collect())
+        .collect();
+    (hours, assumed)
+}
