@@ -65,156 +65,17 @@
 use serde::Deserialize;
 
 use super::ModelError;
-use super::components::{Axis, SquarenessPair};
+use super::components::Axis;
+use super::components::GeometricErrors;
+use super::description::{
+    AxisDescription, BranchDeviations, ChainCode, Description, ErrorFrame, MappingSigns,
+};
 use super::guideway::{Guideway, GuidewayMap, THESIS_STIFFNESS_N_PER_MM};
-use super::volumetric::Kinematics;
+use super::volumetric::{ErrorMap, Grid, Kinematics, Method, VolumetricError};
 use crate::error::ParseError;
 
 /// The bundled description of seed 000's machine.
 const BUNDLED_TOML: &str = include_str!("../../fixtures/machines/mcv754-quick.toml");
-
-/// How the deviations of the tool and workpiece branches combine (eq. 67).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum BranchDeviations {
-    /// E = Δtool + Δworkpiece, as the thesis writes eq. 67 ("superposition").
-    Sum,
-    /// E = Δtool − Δworkpiece: the tool relative to the workpiece.
-    Difference,
-}
-
-/// Where an axis's error motion is referred to (see [`super::volumetric`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ErrorFrame {
-    /// A point on the moving body (the centre of its carriages): Y and Z in eqs 63/64.
-    Moving,
-    /// A point on the carrying body under the functional point: X in eq. 64.
-    Fixed,
-}
-
-/// Signs of the mapping from guideway outputs to ISO 230-1 errors (±1).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MappingSigns {
-    /// z5 → translation along the normal direction.
-    pub normal: f64,
-    /// y5 → translation along the lateral direction.
-    pub lateral: f64,
-    /// roll → rotation about the axis itself.
-    pub roll: f64,
-    /// pitch → rotation about the lateral direction.
-    pub pitch: f64,
-    /// yaw → rotation about the normal direction.
-    pub yaw: f64,
-}
-
-impl MappingSigns {
-    /// All +1, as the peer applies Tab. 3.2.
-    pub const POSITIVE: MappingSigns = MappingSigns {
-        normal: 1.0,
-        lateral: 1.0,
-        roll: 1.0,
-        pitch: 1.0,
-        yaw: 1.0,
-    };
-}
-
-/// One linear axis of the machine.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AxisDescription {
-    /// Lowest and highest position, mm.
-    pub stroke_mm: [f64; 2],
-    /// From the previous joint's error frame (or the frame origin) to this axis's, mm.
-    pub offset_mm: [f64; 3],
-    /// +1 or −1: the direction the body moves when the coordinate grows.
-    pub motion: f64,
-    /// Where the error motion is referred to.
-    pub error_frame: ErrorFrame,
-    /// The direction normal to the rail mounting face ("vertical" straightness).
-    pub normal: Axis,
-    /// The guideway: rail spacing, carriage pitch, stiffness, load.
-    pub guideway: Guideway,
-    /// Signs of the mapping of its outputs to the ISO errors.
-    pub signs: MappingSigns,
-}
-
-impl AxisDescription {
-    /// The lateral ("horizontal") direction: neither the axis nor the normal.
-    pub fn lateral(&self, axis: Axis) -> Axis {
-        Axis::ALL
-            .into_iter()
-            .find(|other| *other != axis && *other != self.normal)
-            .unwrap_or(axis)
-    }
-}
-
-/// A validated chain code such as `ZFYX`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ChainCode {
-    code: String,
-    tool: Vec<Axis>,
-    workpiece: Vec<Axis>,
-}
-
-impl ChainCode {
-    /// Parses a code: X, Y and Z once each and one F, nothing else.
-    pub fn parse(code: &str) -> Result<ChainCode, ModelError> {
-        let expected = "X, Y and Z once each around one F, like ZFYX, FXYZ or YFXZ";
-        let invalid = || ModelError::invalid("chain", expected, format!("{code:?}"));
-        let letters: Vec<char> = code.trim().chars().collect();
-        let frame = letters.iter().position(|c| *c == 'F').ok_or_else(invalid)?;
-        let to_axes = |part: &[char]| -> Option<Vec<Axis>> {
-            part.iter().map(|c| Axis::from_letter(*c)).collect()
-        };
-        let mut tool = to_axes(&letters[..frame]).ok_or_else(invalid)?;
-        tool.reverse();
-        let workpiece = to_axes(&letters[frame + 1..]).ok_or_else(invalid)?;
-        let mut all: Vec<Axis> = tool.iter().chain(&workpiece).copied().collect();
-        all.sort();
-        if all != Axis::ALL {
-            return Err(invalid());
-        }
-        Ok(ChainCode {
-            code: letters.iter().collect(),
-            tool,
-            workpiece,
-        })
-    }
-
-    /// The code as written.
-    pub fn as_str(&self) -> &str {
-        &self.code
-    }
-
-    /// The tool-side axes, from the frame outwards.
-    pub fn tool_axes(&self) -> &[Axis] {
-        &self.tool
-    }
-
-    /// The workpiece-side axes, from the frame outwards.
-    pub fn workpiece_axes(&self) -> &[Axis] {
-        &self.workpiece
-    }
-
-    /// The axis whose joint carries a squareness error: the outer of the two
-    /// when both are on one side, otherwise the tool-side one (eqs 63/64).
-    pub fn squareness_axis(&self, pair: SquarenessPair) -> Axis {
-        let (first, second) = pair.axes();
-        let tool_position = |axis: Axis| self.tool.iter().position(|a| *a == axis);
-        let workpiece_position = |axis: Axis| self.workpiece.iter().position(|a| *a == axis);
-        match (tool_position(first), tool_position(second)) {
-            (Some(a), Some(b)) => return if a > b { first } else { second },
-            (Some(_), None) => return first,
-            (None, Some(_)) => return second,
-            (None, None) => {}
-        }
-        if workpiece_position(first) > workpiece_position(second) {
-            first
-        } else {
-            second
-        }
-    }
-}
 
 /// A validated machine description with its compiled chain.
 #[derive(Clone, Debug, PartialEq)]
@@ -222,19 +83,6 @@ pub struct Machine {
     description: Description,
     guideways: [GuidewayMap; 3],
     kinematics: Kinematics,
-}
-
-/// What a description file says, validated.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Description {
-    pub name: String,
-    pub chain: ChainCode,
-    pub axes: [AxisDescription; 3],
-    pub tool_offset_mm: [f64; 3],
-    pub workpiece_offset_mm: [f64; 3],
-    pub workpiece_point_mm: [f64; 3],
-    pub reference_mm: [f64; 3],
-    pub branch_deviations: BranchDeviations,
 }
 
 impl Machine {
@@ -367,6 +215,77 @@ impl Machine {
     /// The compiled chain.
     pub(crate) fn kinematics(&self) -> &Kinematics {
         &self.kinematics
+    }
+}
+
+impl Machine {
+    /// The volumetric error at `position_mm` (X, Y, Z), zeroed at the
+    /// machine's reference position (eq. 68).
+    ///
+    /// # Example
+    ///
+    /// A constant pitch of X of 10 µrad on the bundled machine: the
+    /// workpiece point is z4 + 550 + Z mm above the X error frame (notes
+    /// §2.5, `EBX·(Z + z4 + 550)`), so 500 mm below the reference (Z = 0)
+    /// E_X is 10 µrad × (−500 mm) = −5 µm.
+    ///
+    /// ```
+    /// use axcomp::model::{ErrorFunction, ErrorName, GeometricErrors, Machine, Method};
+    ///
+    /// let machine = Machine::bundled();
+    /// let mut errors = GeometricErrors::default();
+    /// errors.set(ErrorName::EBX, ErrorFunction::Constant(10e-6))?;
+    /// let error = machine.volumetric_error(&errors, [0.0, 0.0, -500.0], Method::FirstOrder);
+    /// assert!((error.translation_mm.x - 10e-6 * -500.0).abs() < 1e-15);
+    /// assert!((error.rotation_rad.y - 10e-6).abs() < 1e-18);
+    /// # Ok::<(), axcomp::model::ModelError>(())
+    /// ```
+    pub fn volumetric_error(
+        &self,
+        errors: &GeometricErrors,
+        position_mm: [f64; 3],
+        method: Method,
+    ) -> VolumetricError {
+        self.kinematics
+            .volumetric_error(errors, position_mm, method)
+    }
+
+    /// The volumetric error at every point of `grid`.
+    pub fn error_map(&self, errors: &GeometricErrors, grid: &Grid, method: Method) -> ErrorMap {
+        self.kinematics.error_map(errors, grid, method)
+    }
+}
+
+impl Grid {
+    /// A grid over the machine's strokes with `step_mm` between points,
+    /// starting at each stroke's lower end. The upper end is always included
+    /// (as an extra, closer point when the stroke is not a multiple of the
+    /// step), so the maximum is taken over the whole volume.
+    pub fn over_strokes(machine: &Machine, step_mm: f64) -> Result<Grid, ModelError> {
+        if !(step_mm.is_finite() && step_mm > 0.0) {
+            return Err(ModelError::invalid(
+                "grid step",
+                "a positive length in mm",
+                step_mm.to_string(),
+            ));
+        }
+        let axes_mm = Axis::ALL.map(|axis| {
+            let [low, high] = machine.axis(axis).stroke_mm;
+            let mut points = Vec::new();
+            let mut index = 0.0;
+            loop {
+                let point = low + index * step_mm;
+                // Points closer than a millionth of a step to the end are the end.
+                if point >= high - 1e-6 * step_mm {
+                    break;
+                }
+                points.push(point);
+                index += 1.0;
+            }
+            points.push(high);
+            points
+        });
+        Ok(Grid::of_points(axes_mm))
     }
 }
 
@@ -565,6 +484,7 @@ impl RawAxis {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::components::SquarenessPair;
 
     #[test]
     fn chain_codes() {

@@ -61,6 +61,7 @@
 //! for the tool-relative-to-workpiece convention instead of the thesis's sum.
 
 pub mod components;
+pub mod description;
 pub mod error_description;
 pub mod guideway;
 pub mod machine;
@@ -73,13 +74,12 @@ pub use components::{
     Axis, AxisErrors, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, ErrorValues,
     GeometricErrors, Interpolation, Squareness, SquarenessPair,
 };
+pub use description::{AxisDescription, BranchDeviations, ChainCode, ErrorFrame, MappingSigns};
 pub use error_description::read_error_description;
 pub use guideway::{
     CarriageDeviations, Guideway, GuidewayMap, GuidewayResponse, OutputWeights, RailProfiles,
 };
-pub use machine::{
-    AxisDescription, BranchDeviations, ChainCode, ErrorFrame, Machine, MappingSigns,
-};
+pub use machine::Machine;
 pub use profile::ProfileShape;
 pub use volumetric::{ErrorMap, Grid, Method, VolumetricError};
 

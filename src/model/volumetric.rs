@@ -54,7 +54,7 @@ use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 
 use super::ModelError;
 use super::components::{Axis, ErrorValues, GeometricErrors, SquarenessPair};
-use super::machine::{BranchDeviations, Description, ErrorFrame, Machine};
+use super::description::{BranchDeviations, Description, ErrorFrame};
 
 /// How to evaluate the chain.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,35 +81,10 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// A grid over the machine's strokes with `step_mm` between points,
-    /// starting at each stroke's lower end. The upper end is always included
-    /// (as an extra, closer point when the stroke is not a multiple of the
-    /// step), so the maximum is taken over the whole volume.
-    pub fn over_strokes(machine: &Machine, step_mm: f64) -> Result<Grid, ModelError> {
-        if !(step_mm.is_finite() && step_mm > 0.0) {
-            return Err(ModelError::invalid(
-                "grid step",
-                "a positive length in mm",
-                step_mm.to_string(),
-            ));
-        }
-        let axes_mm = Axis::ALL.map(|axis| {
-            let [low, high] = machine.axis(axis).stroke_mm;
-            let mut points = Vec::new();
-            let mut index = 0.0;
-            loop {
-                let point = low + index * step_mm;
-                // Points closer than a millionth of a step to the end are the end.
-                if point >= high - 1e-6 * step_mm {
-                    break;
-                }
-                points.push(point);
-                index += 1.0;
-            }
-            points.push(high);
-            points
-        });
-        Ok(Grid { axes_mm })
+    /// A grid with these points along X, Y and Z, mm, as they are (the
+    /// caller made them in order).
+    pub(crate) fn of_points(axes_mm: [Vec<f64>; 3]) -> Grid {
+        Grid { axes_mm }
     }
 
     /// A grid from explicit positions per axis (finite, strictly increasing, at least one each).
@@ -184,35 +159,15 @@ impl ErrorMap {
     }
 }
 
-impl Machine {
-    /// The volumetric error at `position_mm` (X, Y, Z), zeroed at the
-    /// machine's reference position (eq. 68).
-    ///
-    /// # Example
-    ///
-    /// A constant pitch of X of 10 µrad on the bundled machine: the
-    /// workpiece point is z4 + 550 + Z mm above the X error frame (notes
-    /// §2.5, `EBX·(Z + z4 + 550)`), so 500 mm below the reference (Z = 0)
-    /// E_X is 10 µrad × (−500 mm) = −5 µm.
-    ///
-    /// ```
-    /// use axcomp::model::{ErrorFunction, ErrorName, GeometricErrors, Machine, Method};
-    ///
-    /// let machine = Machine::bundled();
-    /// let mut errors = GeometricErrors::default();
-    /// errors.set(ErrorName::EBX, ErrorFunction::Constant(10e-6))?;
-    /// let error = machine.volumetric_error(&errors, [0.0, 0.0, -500.0], Method::FirstOrder);
-    /// assert!((error.translation_mm.x - 10e-6 * -500.0).abs() < 1e-15);
-    /// assert!((error.rotation_rad.y - 10e-6).abs() < 1e-18);
-    /// # Ok::<(), axcomp::model::ModelError>(())
-    /// ```
-    pub fn volumetric_error(
+impl Kinematics {
+    /// The volumetric error at `position_mm`, zeroed at the reference (eq. 68).
+    pub(crate) fn volumetric_error(
         &self,
         errors: &GeometricErrors,
         position_mm: [f64; 3],
         method: Method,
     ) -> VolumetricError {
-        let kinematics = self.kinematics();
+        let kinematics = self;
         let at = kinematics.raw_error(&errors.values_at(position_mm), position_mm, method);
         let reference = kinematics.reference_mm;
         let at_reference = kinematics.raw_error(&errors.values_at(reference), reference, method);
@@ -223,8 +178,13 @@ impl Machine {
     }
 
     /// The volumetric error at every point of `grid`.
-    pub fn error_map(&self, errors: &GeometricErrors, grid: &Grid, method: Method) -> ErrorMap {
-        let kinematics = self.kinematics();
+    pub(crate) fn error_map(
+        &self,
+        errors: &GeometricErrors,
+        grid: &Grid,
+        method: Method,
+    ) -> ErrorMap {
+        let kinematics = self;
         let reference = kinematics.reference_mm;
         let at_reference = kinematics.raw_error(&errors.values_at(reference), reference, method);
         let errors = (0..grid.len())
