@@ -12,6 +12,7 @@ use std::fmt;
 use std::path::PathBuf;
 
 use crate::measurement::Direction;
+use crate::units::LengthUnit;
 
 /// A position in a text file. Both fields start at 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -206,8 +207,86 @@ pub enum Warning {
         missing: String,
     },
     /// Two inputs joined or compared may not belong together
-    /// (`measurement::together`).
-    Doubtful(crate::measurement::together::Doubt),
+    /// (`together`).
+    Doubtful(Doubt),
+}
+
+/// Something that makes two inputs doubtful together; the user decides.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Doubt {
+    /// The files name different machines.
+    DifferentMachines {
+        /// The first input.
+        first: String,
+        /// Its machine.
+        first_machine: String,
+        /// The second input.
+        second: String,
+        /// Its machine.
+        second_machine: String,
+    },
+    /// The original files were written in different length units.
+    DifferentUnits {
+        /// The first input.
+        first: String,
+        /// Its unit.
+        first_unit: LengthUnit,
+        /// The second input.
+        second: String,
+        /// Its unit.
+        second_unit: LengthUnit,
+    },
+    /// The ranges overlap only in part.
+    PartialOverlap {
+        /// The first input.
+        first: String,
+        /// Its range, mm.
+        first_mm: (f64, f64),
+        /// The second input.
+        second: String,
+        /// Its range, mm.
+        second_mm: (f64, f64),
+        /// What happens outside the common part.
+        consequence: &'static str,
+    },
+}
+
+impl fmt::Display for Doubt {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Doubt::DifferentMachines {
+                first,
+                first_machine,
+                second,
+                second_machine,
+            } => write!(
+                f,
+                "{first} names machine {first_machine:?}, {second} {second_machine:?}: check that both are of the same machine"
+            ),
+            Doubt::DifferentUnits {
+                first,
+                first_unit,
+                second,
+                second_unit,
+            } => write!(
+                f,
+                "{first} was written in {}, {second} in {}: both are converted to mm, but check that they come from the same set-up",
+                first_unit.as_str(),
+                second_unit.as_str()
+            ),
+            Doubt::PartialOverlap {
+                first,
+                first_mm,
+                second,
+                second_mm,
+                consequence,
+            } => write!(
+                f,
+                "{first} covers {} … {} mm, {second} {} … {} mm: they overlap only in part; {consequence}",
+                first_mm.0, first_mm.1, second_mm.0, second_mm.1
+            ),
+        }
+    }
 }
 
 impl fmt::Display for Warning {

@@ -65,4 +65,5 @@ pub mod report;
 pub mod servo;
 pub mod spline;
 pub mod synth;
+pub mod together;
 pub mod units;

@@ -11,8 +11,6 @@
 //! Deviations are positional deviations x_ij = P_ij − P_i (actual minus
 //! target, `../shared/spec/iso230-2.md` "Data"), stored in mm.
 
-pub mod together;
-
 use std::fmt;
 use std::path::PathBuf;
 

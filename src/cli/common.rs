@@ -10,9 +10,9 @@ use axcomp::compensate::CompensationTable;
 use axcomp::effects::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::error::Warning;
-use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
+use axcomp::together::{Input, Pairing, check_together};
 
 /// `--format NAME`: one of the input formats.
 pub fn parse_format(name: &str) -> Result<SourceFormat, String> {
@@ -124,7 +124,7 @@ pub fn read_table(
 /// The table that was active during `test` (named `test_label` in messages),
 /// read for the test's axis, and the doubts about the two together: refused
 /// when the test records no axis, or when the table cannot belong to it
-/// (`measurement::together`).
+/// (`together`).
 pub fn read_active_table(
     path: &Path,
     test: &Measurement,

@@ -7,10 +7,10 @@ use anyhow::{Context, Result};
 
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
-use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
+use axcomp::together::{Input, Pairing, check_together};
 
 use super::common::{
     Verbosity, load_profile, name_axis, print_json, print_text, print_warnings, read_active_table,

@@ -8,11 +8,11 @@ use anyhow::{Context, Result, bail};
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
 use axcomp::measurement::Measurement;
-use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::model::{GeometricErrors, ModelError, read_error_description};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
 use axcomp::report::predict::{PredictJson, render};
+use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::mm_to_um;
 
 use super::common::{

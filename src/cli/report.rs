@@ -9,7 +9,6 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::error::Warning;
 use axcomp::evaluate::{Evaluation, evaluate};
-use axcomp::measurement::together::{Input, Pairing, check_together};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::output::write_all_new;
 use axcomp::read;
@@ -17,6 +16,7 @@ use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
 use axcomp::report::chart::chart;
 use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
+use axcomp::together::{Input, Pairing, check_together};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{

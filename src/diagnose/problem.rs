@@ -12,8 +12,8 @@ use crate::compensate::retest::{
 use crate::cycle::{self, CycleTiming};
 use crate::effects::{Line, Reading, Shape};
 use crate::evaluate::{Evaluation, evaluate};
-use crate::measurement::together::{Input, Pairing, check_together};
 use crate::measurement::{Direction, Measurement};
+use crate::together::{Input, Pairing, check_together};
 
 /// The readings with their prediction, as one table.
 pub(super) struct Problem {

@@ -22,8 +22,8 @@ use std::path::{Path, PathBuf};
 use chrono::NaiveDateTime;
 
 use crate::error::{ParseError, ReadError, Warning};
-use crate::measurement::together::{Input, Pairing, check_together};
 use crate::measurement::{Measurement, Run, SourceFormat};
+use crate::together::{Input, Pairing, check_together};
 
 /// A measurement read from one or more files, with what the readers noticed.
 #[derive(Clone, Debug)]

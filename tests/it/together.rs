@@ -1,5 +1,5 @@
 //! Inputs that are joined or compared must belong together
-//! (`measurement::together`): every command that takes two of them refuses a
+//! (`together`): every command that takes two of them refuses a
 //! clear mismatch with exit code 2 and the reason (another axis, ranges
 //! without a common stretch, the same file or the same readings twice) and
 //! shows a doubtful one as a warning, on stderr and in the report (other

@@ -12,10 +12,9 @@
 //! caller describes each input as an [`Input`] and names it as the user knows
 //! it (a file name, or "the first test").
 
-use std::fmt;
 use std::path::Path;
 
-use crate::error::Warning;
+use crate::error::{Doubt, Warning};
 use crate::measurement::Measurement;
 use crate::units::LengthUnit;
 
@@ -142,84 +141,6 @@ pub enum NotTogether {
     },
 }
 
-/// Something that makes two inputs doubtful together; the user decides.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Doubt {
-    /// The files name different machines.
-    DifferentMachines {
-        /// The first input.
-        first: String,
-        /// Its machine.
-        first_machine: String,
-        /// The second input.
-        second: String,
-        /// Its machine.
-        second_machine: String,
-    },
-    /// The original files were written in different length units.
-    DifferentUnits {
-        /// The first input.
-        first: String,
-        /// Its unit.
-        first_unit: LengthUnit,
-        /// The second input.
-        second: String,
-        /// Its unit.
-        second_unit: LengthUnit,
-    },
-    /// The ranges overlap only in part.
-    PartialOverlap {
-        /// The first input.
-        first: String,
-        /// Its range, mm.
-        first_mm: (f64, f64),
-        /// The second input.
-        second: String,
-        /// Its range, mm.
-        second_mm: (f64, f64),
-        /// What happens outside the common part.
-        consequence: &'static str,
-    },
-}
-
-impl fmt::Display for Doubt {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Doubt::DifferentMachines {
-                first,
-                first_machine,
-                second,
-                second_machine,
-            } => write!(
-                f,
-                "{first} names machine {first_machine:?}, {second} {second_machine:?}: check that both are of the same machine"
-            ),
-            Doubt::DifferentUnits {
-                first,
-                first_unit,
-                second,
-                second_unit,
-            } => write!(
-                f,
-                "{first} was written in {}, {second} in {}: both are converted to mm, but check that they come from the same set-up",
-                first_unit.as_str(),
-                second_unit.as_str()
-            ),
-            Doubt::PartialOverlap {
-                first,
-                first_mm,
-                second,
-                second_mm,
-                consequence,
-            } => write!(
-                f,
-                "{first} covers {} … {} mm, {second} {} … {} mm: they overlap only in part; {consequence}",
-                first_mm.0, first_mm.1, second_mm.0, second_mm.1
-            ),
-        }
-    }
-}
-
 /// Checks that two inputs belong together for `pairing`: the refusal, or
 /// the doubts as warnings (empty when nothing is odd).
 ///
@@ -233,7 +154,7 @@ impl fmt::Display for Doubt {
 ///
 /// # Example
 /// ```
-/// use axcomp::measurement::together::{Input, Pairing, check_together};
+/// use axcomp::together::{Input, Pairing, check_together};
 /// let before = Input::table("X", &[0.0, 500.0], "X.COM");
 /// let after = Input::table("Y", &[0.0, 500.0], "Y.COM");
 /// let error = check_together(Pairing::BeforeAfter, &before, &after).unwrap_err();
