@@ -3,6 +3,7 @@
 //! Real third-party data is read by path from `../shared/data` (never copied
 //! into the repository); small inputs and expected outputs live in `tests/data`.
 
+mod architecture;
 mod axis_identity;
 mod backlash;
 mod bad_input;
