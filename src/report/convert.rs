@@ -26,7 +26,7 @@ use serde::Serialize;
 
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::BacklashAdvice;
-use crate::report::terminal::um;
+use crate::report::format::um;
 use crate::units::mm_to_um;
 
 /// The table's values, µm.

@@ -32,8 +32,8 @@ use serde_json::{Map, Value};
 
 use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
 use crate::effects::{Effect, ParameterValue};
+use crate::report::format::um;
 use crate::report::json::FiguresJson;
-use crate::report::terminal::um;
 
 /// RMS and largest |value|, µm.
 #[derive(Clone, Copy, Debug, Serialize)]

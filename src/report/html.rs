@@ -57,10 +57,10 @@ use crate::report::acceptance::{
     NamedChart, ReportInput, TableRecord, TestRecord, charts, prediction,
 };
 use crate::report::chart::chart;
+use crate::report::format::{esc, inch_beside, inch_text, source, um, um_cell};
 use crate::report::json::source_notes;
 use crate::report::json::{EvaluationJson, FiguresJson, PerTargetJson};
 use crate::report::plot::{FONT, PlotError, PlotFormat};
-use crate::report::terminal::{inch_beside, inch_text, um};
 use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 
 /// The embedded `axcomp-data` block.
@@ -155,22 +155,6 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
     ))
 }
 
-/// Escapes text for HTML content and attribute values.
-pub fn esc(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            _ => out.push(c),
-        }
-    }
-    out
-}
-
 /// JSON inside `<script>`: `<` as `\u003c`, so no text from a file can close
 /// the element (`</script>`) or open a comment.
 fn json_in_script(json: &str) -> String {
@@ -184,24 +168,9 @@ fn evaluation_json(test: &TestRecord<'_>, limits: &[Limit]) -> EvaluationJson {
     json
 }
 
-/// A µm cell with its source (see the module doc).
-pub(crate) fn um_cell(key: &str, value: Option<f64>) -> String {
-    format!(
-        "<td class=\"num\" {}>{}</td>",
-        source(key, value),
-        um(value)
-    )
-}
-
 /// A µm value in running text, with its source.
 fn um_strong(key: &str, value: Option<f64>) -> String {
     format!("<strong {}>{}</strong>", source(key, value), um(value))
-}
-
-/// The `data-key` and `data-um` attributes of a µm value.
-fn source(key: &str, value: Option<f64>) -> String {
-    let full = value.map_or_else(|| "null".to_string(), |v| v.to_string());
-    format!("data-key=\"{}\" data-um=\"{full}\"", esc(key))
 }
 
 /// The axis name, or "not recorded" when the file does not state it (the

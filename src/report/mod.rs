@@ -18,6 +18,7 @@ pub mod acceptance;
 pub mod chart;
 pub mod convert;
 pub mod diagnose;
+pub mod format;
 pub mod html;
 pub mod json;
 pub mod plot;

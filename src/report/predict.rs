@@ -30,8 +30,8 @@ use std::fmt::Write;
 use serde::Serialize;
 
 use crate::predict::{PredictedRetest, Prediction};
+use crate::report::format::um;
 use crate::report::json::FiguresJson;
-use crate::report::terminal::um;
 use crate::units::mm_to_um;
 
 /// A machine position, mm.

@@ -9,20 +9,8 @@ use tabled::builder::Builder;
 use tabled::settings::object::Columns;
 use tabled::settings::{Alignment, Style};
 
+use crate::report::format::{NOT_EVALUATED, inch_beside, um};
 use crate::report::json::{EvaluationJson, StartEndJson};
-use crate::units::LengthUnit;
-
-/// How a not-evaluated value is shown.
-pub const NOT_EVALUATED: &str = "—";
-
-/// Formats an optional µm value with two decimals, or `—`.
-pub fn um(value: Option<f64>) -> String {
-    value.map_or_else(
-        || NOT_EVALUATED.to_string(),
-        // −0.004 µm is 0.00, not "-0.00".
-        |v| format!("{:.2}", if v.abs() < 0.005 { 0.0 } else { v }),
-    )
-}
 
 /// Renders the whole evaluation report.
 pub fn evaluation_report(report: &EvaluationJson) -> String {
@@ -51,29 +39,6 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
         let _ = writeln!(out, "\nNote: {note}.");
     }
     out
-}
-
-/// A length in an inch file's own unit, ` (… in)`, beside the mm; empty for mm files.
-pub fn inch_beside(length_unit: &str, values_mm: &[f64]) -> String {
-    if LengthUnit::from_name(length_unit) != Some(LengthUnit::Inch) {
-        return String::new();
-    }
-    let inches: Vec<String> = values_mm
-        .iter()
-        .map(|v| inch_text(LengthUnit::Inch.from_mm(*v)))
-        .collect();
-    format!(" ({} in)", inches.join(" to "))
-}
-
-/// Inches with at most six decimals (0.025 µm), no trailing zeros.
-pub fn inch_text(value_in: f64) -> String {
-    let text = format!("{value_in:.6}");
-    let text = text.trim_end_matches('0').trim_end_matches('.');
-    if text == "-0" {
-        "0".to_string()
-    } else {
-        text.to_string()
-    }
 }
 
 fn header(out: &mut String, r: &EvaluationJson) {

@@ -28,8 +28,8 @@ use serde::Serialize;
 use crate::evaluate::Evaluation;
 use crate::evaluate::verdict::{Check, Limit, Outcome, Permissible, Verdict, verdict};
 use crate::report::acceptance::ReportInput;
-use crate::report::html::esc;
-use crate::report::terminal::um;
+use crate::report::format::esc;
+use crate::report::format::um;
 use crate::units::mm_to_um;
 
 /// The decision rule (ISO 14253-1 "simple acceptance", `../shared/spec/standards.md` §5).
@@ -311,8 +311,8 @@ pub fn html_box(
             } else {
                 c.figure.replace("_up", "↑").replace("_down", "↓")
             },
-            value = crate::report::html::um_cell(&key("value_um"), c.value_um),
-            limit = crate::report::html::um_cell(&key("limit_um"), Some(c.limit_um)),
+            value = crate::report::format::um_cell(&key("value_um"), c.value_um),
+            limit = crate::report::format::um_cell(&key("limit_um"), Some(c.limit_um)),
             result = match &c.reason {
                 Some(reason) if !c.pass =>
                     format!("{}<br><small>{}</small>", result_word(c), esc(reason)),
