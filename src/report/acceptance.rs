@@ -358,7 +358,7 @@ fn means_um(per_target: &[TargetStats], direction: Direction) -> Vec<(f64, f64)>
 
 /// (target, x̄ − 2s, x̄ + 2s) in µm, where both are defined.
 fn band(target_mm: f64, stats: &DirectionStats) -> Option<(f64, f64, f64)> {
-    let (low, high) = stats.band()?;
+    let (low, high) = stats.band(crate::evaluate::ISO_230_2.k)?;
     Some((target_mm, mm_to_um(low), mm_to_um(high)))
 }
 

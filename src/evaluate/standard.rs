@@ -1,0 +1,193 @@
+//! A standard: what derives the axis figures from the statistics of each
+//! target. [`evaluate`](super::evaluate) applies [`ISO_230_2`] (the 2014
+//! edition, `../shared/spec/iso230-2.md`); another standard is another
+//! [`Standard`] beside it, and another edition of ISO 230-2 another value of
+//! [`Iso230_2`] (the 1988 edition is the same formulas with k = 3:
+//! `../shared/spec/standards.md` §2), not a fork of [`evaluate`](super::evaluate).
+//!
+//! ISO 230-2 (1997, 2006, 2014): per target x̄_i = (x̄_i↑ + x̄_i↓)/2, the
+//! reversal value B_i = x̄_i↑ − x̄_i↓, the repeatabilities R_i↑ = 2k·s_i↑,
+//! R_i↓ = 2k·s_i↓, R_i = max(k·s_i↑ + k·s_i↓ + |B_i|; R_i↑; R_i↓); per axis A,
+//! A↑, A↓ (the span of x̄ ± k·s), E, E↑, E↓, M, R, R↑, R↓, B = max |B_i| and
+//! the signed mean reversal B̄ (seed 001 eq. (22) swaps two signs in A; the
+//! spec's form is used), with k = 2. An axis figure is evaluated only when
+//! what it needs is defined at every target.
+
+use super::AxisFigures;
+use super::targets::{DirectionStats, TargetStats};
+use crate::measurement::Direction;
+
+/// What derives a test's figures from the statistics of each target.
+pub trait Standard {
+    /// Its name and edition, as a report cites it.
+    fn name(&self) -> &'static str;
+
+    /// What it defines at one target from the statistics of each direction.
+    fn target_stats(&self, target_mm: f64, up: DirectionStats, down: DirectionStats)
+    -> TargetStats;
+
+    /// The axis figures from every target's.
+    fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures;
+}
+
+/// ISO 230-2, one edition: the figures with the band x̄ ± k·s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Iso230_2 {
+    /// The name and edition.
+    pub name: &'static str,
+    /// The multiple of s in a band (A) and half the one in a repeatability (R).
+    pub k: f64,
+}
+
+/// ISO 230-2:2014 (the same figures as 1997 and 2006): k = 2.
+pub const ISO_230_2: Iso230_2 = Iso230_2 {
+    name: "ISO 230-2:2014",
+    k: 2.0,
+};
+
+impl Standard for Iso230_2 {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn target_stats(
+        &self,
+        target_mm: f64,
+        up: DirectionStats,
+        down: DirectionStats,
+    ) -> TargetStats {
+        target_stats(self.k, target_mm, up, down)
+    }
+
+    fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures {
+        axis_figures(self.k, per_target)
+    }
+}
+
+fn target_stats(k: f64, target_mm: f64, up: DirectionStats, down: DirectionStats) -> TargetStats {
+    let both_means = up.mean_mm.zip(down.mean_mm);
+    let reversal_mm = both_means.map(|(u, d)| u - d);
+    let repeatability_mm = match (up.s_mm, down.s_mm, reversal_mm) {
+        (Some(s_up), Some(s_down), Some(b)) => Some(
+            (k * s_up + k * s_down + b.abs())
+                .max(2.0 * k * s_up)
+                .max(2.0 * k * s_down),
+        ),
+        _ => None,
+    };
+    TargetStats {
+        target_mm,
+        mean_mm: both_means.map(|(u, d)| (u + d) / 2.0),
+        reversal_mm,
+        repeatability_up_mm: up.repeatability(k),
+        repeatability_down_mm: down.repeatability(k),
+        repeatability_mm,
+        up,
+        down,
+    }
+}
+
+/// Collects one value per target, or `None` if any target lacks it.
+fn every_target<T>(
+    per_target: &[TargetStats],
+    value: impl Fn(&TargetStats) -> Option<T>,
+) -> Option<Vec<T>> {
+    per_target.iter().map(value).collect()
+}
+
+/// max(high) − min(low) over a set of (low, high) intervals.
+fn span(intervals: impl IntoIterator<Item = (f64, f64)>) -> Option<f64> {
+    let mut bounds: Option<(f64, f64)> = None;
+    for (low, high) in intervals {
+        bounds = Some(match bounds {
+            None => (low, high),
+            Some((lo, hi)) => (lo.min(low), hi.max(high)),
+        });
+    }
+    bounds.map(|(lo, hi)| hi - lo)
+}
+
+fn max_of(values: Option<Vec<f64>>) -> Option<f64> {
+    values?.into_iter().reduce(f64::max)
+}
+
+fn axis_figures(k: f64, per_target: &[TargetStats]) -> AxisFigures {
+    let points =
+        |d: Direction| every_target(per_target, |t| t.direction(d).mean_mm.map(|m| (m, m)));
+    let bands = |d: Direction| every_target(per_target, |t| t.direction(d).band(k));
+    let pooled = |a: Option<Vec<(f64, f64)>>, b: Option<Vec<(f64, f64)>>| {
+        let (a, b) = (a?, b?);
+        span(a.into_iter().chain(b))
+    };
+    let reversals = every_target(per_target, |t| t.reversal_mm);
+    AxisFigures {
+        a_mm: pooled(bands(Direction::Up), bands(Direction::Down)),
+        a_up_mm: bands(Direction::Up).and_then(span),
+        a_down_mm: bands(Direction::Down).and_then(span),
+        e_mm: pooled(points(Direction::Up), points(Direction::Down)),
+        e_up_mm: points(Direction::Up).and_then(span),
+        e_down_mm: points(Direction::Down).and_then(span),
+        m_mm: every_target(per_target, |t| t.mean_mm.map(|m| (m, m))).and_then(span),
+        r_mm: max_of(every_target(per_target, |t| t.repeatability_mm)),
+        r_up_mm: max_of(every_target(per_target, |t| t.repeatability_up_mm)),
+        r_down_mm: max_of(every_target(per_target, |t| t.repeatability_down_mm)),
+        b_mm: max_of(
+            reversals
+                .clone()
+                .map(|b| b.into_iter().map(f64::abs).collect()),
+        ),
+        b_mean_mm: reversals.map(|b| b.iter().sum::<f64>() / b.len() as f64),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evaluate::evaluate_with;
+    use crate::measurement::{Measurement, Run};
+
+    /// Two runs each way at 0 and 100 mm: ↑ 0, 4 and 2, 6 µm; ↓ −2, 2 and 0, 4 µm.
+    fn two_by_two() -> Measurement {
+        let run = |direction, number, values: [f64; 2]| Run {
+            direction,
+            number,
+            start_time_s: None,
+            deviations_mm: values.iter().map(|v| Some(v / 1000.0)).collect(),
+        };
+        Measurement::new(
+            "X",
+            vec![0.0, 100.0],
+            vec![
+                run(Direction::Up, 1, [0.0, 4.0]),
+                run(Direction::Down, 1, [-2.0, 2.0]),
+                run(Direction::Up, 2, [2.0, 6.0]),
+                run(Direction::Down, 2, [0.0, 4.0]),
+            ],
+            Default::default(),
+            Default::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn an_edition_is_a_value_not_a_fork() {
+        // s = √2 µm in every cell (two readings 2 µm apart); B_i = 2 µm.
+        let s = 2f64.sqrt();
+        let edition_1988 = Iso230_2 {
+            name: "ISO 230-2:1988",
+            k: 3.0,
+        };
+        for (standard, k) in [(ISO_230_2, 2.0), (edition_1988, 3.0)] {
+            let f = evaluate_with(&two_by_two(), &standard).figures;
+            let um = |v: Option<f64>| v.unwrap() * 1000.0;
+            // R_i↑ = 2k·s; R_i = max(k·s + k·s + |B_i|, 2k·s) = 2k·s + 2.
+            assert!((um(f.r_up_mm) - 2.0 * k * s).abs() < 1e-9, "{}", standard.name);
+            assert!((um(f.r_mm) - (2.0 * k * s + 2.0)).abs() < 1e-9);
+            // A: from x̄↓ − k·s at 0 mm (−1 µm) to x̄↑ + k·s at 100 mm (5 µm).
+            assert!((um(f.a_mm) - (6.0 + 2.0 * k * s)).abs() < 1e-9);
+            // E and B do not depend on k.
+            assert!((um(f.e_mm) - 6.0).abs() < 1e-9);
+            assert!((um(f.b_mm) - 2.0).abs() < 1e-9);
+        }
+    }
+}

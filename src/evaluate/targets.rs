@@ -1,0 +1,108 @@
+//! The statistics of each target (ISO 230-2 §2, `../shared/spec/iso230-2.md`):
+//! per direction the number of readings n, the mean positional deviation x̄
+//! and the estimator of the standard uncertainty s (n − 1 in the
+//! denominator, inside the square root: seed 001 eq. (8)/(9) has a typo
+//! there). What a standard derives from them (reversal, repeatability, the
+//! axis figures) is the [`Standard`](super::standard::Standard)'s.
+
+use super::standard::Standard;
+use crate::measurement::{Direction, Measurement};
+
+/// Statistics of one target in one direction.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DirectionStats {
+    /// Number of readings n.
+    pub n: usize,
+    /// Mean positional deviation x̄, mm (`None` when n = 0).
+    pub mean_mm: Option<f64>,
+    /// Estimator of the standard uncertainty s, mm (`None` when n < 2).
+    pub s_mm: Option<f64>,
+}
+
+impl DirectionStats {
+    /// Mean and s of the readings (two-pass, for accuracy with offsets much larger than the scatter).
+    pub fn of(values: &[f64]) -> DirectionStats {
+        let n = values.len();
+        if n == 0 {
+            return DirectionStats::default();
+        }
+        let mean = values.iter().sum::<f64>() / n as f64;
+        let s = (n >= 2).then(|| {
+            let sum_sq: f64 = values.iter().map(|v| (v - mean) * (v - mean)).sum();
+            (sum_sq / (n - 1) as f64).sqrt()
+        });
+        DirectionStats {
+            n,
+            mean_mm: Some(mean),
+            s_mm: s,
+        }
+    }
+
+    /// The band x̄ ± k·s, as (low, high), mm: A spans it (k = 2 in ISO
+    /// 230-2 since 1997, 3 in 1988: [`super::standard::Iso230_2::k`]).
+    pub fn band(&self, k: f64) -> Option<(f64, f64)> {
+        let (mean, s) = (self.mean_mm?, self.s_mm?);
+        Some((mean - k * s, mean + k * s))
+    }
+
+    /// The unidirectional repeatability R_i = 2k·s_i (4 s_i for k = 2).
+    pub(super) fn repeatability(&self, k: f64) -> Option<f64> {
+        self.s_mm.map(|s| 2.0 * k * s)
+    }
+}
+
+/// Everything ISO 230-2 defines at one target (with the standard's k).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetStats {
+    /// Target P_i, mm.
+    pub target_mm: f64,
+    /// ↑ statistics.
+    pub up: DirectionStats,
+    /// ↓ statistics.
+    pub down: DirectionStats,
+    /// Mean bidirectional positional deviation x̄_i = (x̄_i↑ + x̄_i↓)/2, mm.
+    pub mean_mm: Option<f64>,
+    /// Reversal value B_i = x̄_i↑ − x̄_i↓, mm (signed).
+    pub reversal_mm: Option<f64>,
+    /// R_i↑ = 4 s_i↑, mm.
+    pub repeatability_up_mm: Option<f64>,
+    /// R_i↓ = 4 s_i↓, mm.
+    pub repeatability_down_mm: Option<f64>,
+    /// R_i = max(2 s_i↑ + 2 s_i↓ + |B_i|; R_i↑; R_i↓), mm.
+    pub repeatability_mm: Option<f64>,
+}
+
+impl TargetStats {
+    /// Statistics of one direction.
+    pub fn direction(&self, direction: Direction) -> &DirectionStats {
+        match direction {
+            Direction::Up => &self.up,
+            Direction::Down => &self.down,
+        }
+    }
+}
+
+/// The statistics of every target, in target order, with what `standard`
+/// derives at each.
+pub(super) fn per_target_stats(
+    measurement: &Measurement,
+    standard: &dyn Standard,
+) -> Vec<TargetStats> {
+    let mut readings: Vec<f64> = Vec::with_capacity(measurement.runs().len());
+    let mut stats_of = |target_index: usize, direction: Direction| {
+        readings.clear();
+        readings.extend(
+            measurement
+                .runs_in(direction)
+                .filter_map(|run| run.deviations_mm[target_index]),
+        );
+        DirectionStats::of(&readings)
+    };
+    let mut per_target = Vec::with_capacity(measurement.targets_mm().len());
+    for (index, &target_mm) in measurement.targets_mm().iter().enumerate() {
+        let up = stats_of(index, Direction::Up);
+        let down = stats_of(index, Direction::Down);
+        per_target.push(standard.target_stats(target_mm, up, down));
+    }
+    per_target
+}
