@@ -181,7 +181,11 @@ mod tests {
             let f = evaluate_with(&two_by_two(), &standard).figures;
             let um = |v: Option<f64>| v.unwrap() * 1000.0;
             // R_i↑ = 2k·s; R_i = max(k·s + k·s + |B_i|, 2k·s) = 2k·s + 2.
-            assert!((um(f.r_up_mm) - 2.0 * k * s).abs() < 1e-9, "{}", standard.name);
+            assert!(
+                (um(f.r_up_mm) - 2.0 * k * s).abs() < 1e-9,
+                "{}",
+                standard.name
+            );
             assert!((um(f.r_mm) - (2.0 * k * s + 2.0)).abs() < 1e-9);
             // A: from x̄↓ − k·s at 0 mm (−1 µm) to x̄↑ + k·s at 100 mm (5 µm).
             assert!((um(f.a_mm) - (6.0 + 2.0 * k * s)).abs() < 1e-9);

@@ -689,55 +689,24 @@ mod tests {
 
     #[test]
     fn positioned_errors() {
+        #[rustfmt::skip]
         let cases = [
             ("TGT_DATA[1]=1,5\n", (1, 13), "decimal comma"),
-            (
-                "POSITIONS=1\nTGT_DATA[2]=1\nREF_DATA_FWD[2,1]=1\n",
-                (2, 10),
-                "beyond POSITIONS=1",
-            ),
-            (
-                "TGT_DATA[1]=1\nTGT_DATA[1]=2\nREF_DATA_FWD[1,1]=1\n",
-                (2, 10),
-                "given twice",
-            ),
-            (
-                "TGT_DATA[1]=1\nTGT_DATA[2]=1\nREF_DATA_FWD[1,1]=1\n",
-                (2, 10),
-                "duplicate target",
-            ),
+            ("POSITIONS=1\nTGT_DATA[2]=1\nREF_DATA_FWD[2,1]=1\n", (2, 10), "beyond POSITIONS=1"),
+            ("TGT_DATA[1]=1\nTGT_DATA[1]=2\nREF_DATA_FWD[1,1]=1\n", (2, 10), "given twice"),
+            ("TGT_DATA[1]=1\nTGT_DATA[2]=1\nREF_DATA_FWD[1,1]=1\n", (2, 10), "duplicate target"),
             ("UNIT=deg\n", (1, 6), "rotary"),
             // Found by fuzzing: an index that sized a table of gigabytes.
-            (
-                "TGT_DATA[99239814]=5\n",
-                (1, 10),
-                "index 99239814 is too large",
-            ),
+            ("TGT_DATA[99239814]=5\n", (1, 10), "index 99239814 is too large"),
             ("TGT_DATA[1,2]=1\n", (1, 1), "takes 1 index"),
             ("TGT_DATA[x]=1\n", (1, 10), "whole number"),
             ("just words\n", (1, 1), "KEY=VALUE"),
             // A truncated file: cycle 2 went forward but never came back.
-            (
-                "CYCLES=2\nTGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1\nREF_DATA_BWD[1,1]=1\nREF_DATA_FWD[1,2]=1\n",
-                (1, 8),
-                "CYCLES=2 but the file holds no REF_DATA_BWD cycle(s) 2: the file looks truncated",
-            ),
-            (
-                "TGT_DATA[1]=2e5\nREF_DATA_FWD[1,1]=1\n",
-                (1, 13),
-                "within ±100000 mm",
-            ),
-            (
-                "TGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1001.5\n",
-                (2, 19),
-                "found 1000500 µm",
-            ),
+            ("CYCLES=2\nTGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1\nREF_DATA_BWD[1,1]=1\nREF_DATA_FWD[1,2]=1\n", (1, 8), "CYCLES=2 but the file holds no REF_DATA_BWD cycle(s) 2: the file looks truncated"),
+            ("TGT_DATA[1]=2e5\nREF_DATA_FWD[1,1]=1\n", (1, 13), "within ±100000 mm"),
+            ("TGT_DATA[1]=1\nREF_DATA_FWD[1,1]=1001.5\n", (2, 19), "found 1000500 µm"),
             ("TGT_DATA[1]=nan\n", (1, 13), "expected a number"),
-            (
-                "CYCLES=1\nTGT_DATA[1]=1\nREF_DATA_BWD[1,2]=1\n",
-                (3, 14),
-                "beyond CYCLES=1",
-            ),
+            ("CYCLES=1\nTGT_DATA[1]=1\nREF_DATA_BWD[1,2]=1\n", (3, 14), "beyond CYCLES=1"),
         ];
         for (text, (line, column), needle) in cases {
             let error = parse(text).unwrap_err();

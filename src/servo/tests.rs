@@ -22,6 +22,7 @@ const FEEDS_M_PER_MIN: [f64; 5] = [3.2, 8.0, 16.0, 24.0, 48.0];
 const CURRENT_PRINTED_HALF_STEP_A: f64 = 0.05;
 
 /// One row of Tab. 6.4 per model (A, B1, B2, C): simulated error µm and current A.
+#[derive(serde::Deserialize)]
 struct Tab64 {
     error_um: [[f64; 5]; 4],
     current_a: [[f64; 5]; 4],
@@ -32,66 +33,16 @@ struct Tab64 {
     check_current_a: [[f64; 5]; 4],
 }
 
-/// Tab. 6.4, X axis (xe, Ix), and notes §10.
-const TAB_6_4_X: Tab64 = Tab64 {
-    error_um: [
-        [9.0, 11.0, 12.0, 13.0, 16.0],
-        [1.0, 3.0, 8.0, 11.0, 15.0],
-        [2.0, 4.0, 7.0, 9.0, 14.0],
-        [2.0, 4.0, 7.0, 10.0, 16.0],
-    ],
-    current_a: [
-        [1.5, 2.2, 3.8, 6.2, 19.2],
-        [1.2, 1.8, 3.3, 5.9, 19.1],
-        [1.2, 1.8, 3.3, 5.7, 19.0],
-        [1.3, 1.8, 3.3, 5.7, 19.4],
-    ],
-    measured_error_um: [2.0, 4.5, 7.0, 9.0, 17.0],
-    measured_current_a: [1.7, 2.1, 3.6, 5.7, 19.5],
-    check_error_um: [
-        [8.76, 11.29, 12.43, 12.84, 15.58],
-        [0.66, 2.59, 8.23, 11.29, 15.08],
-        [2.03, 4.28, 6.89, 9.04, 14.35],
-        [2.13, 4.34, 7.65, 10.39, 16.01],
-    ],
-    check_current_a: [
-        [1.47, 2.17, 3.77, 6.20, 19.13],
-        [1.27, 1.81, 3.32, 5.93, 19.07],
-        [1.27, 1.84, 3.30, 5.68, 18.97],
-        [1.31, 1.85, 3.36, 5.81, 19.30],
-    ],
-};
+/// Tab. 6.4 and notes §10, both axes (X: xe, Ix; Y: ye, Iy).
+#[derive(serde::Deserialize)]
+struct Tab64Axes {
+    x: Tab64,
+    y: Tab64,
+}
 
-/// Tab. 6.4, Y axis (ye, Iy), and notes §10. LuGre Iy at 3.2 m/min is only
-/// partly legible in the thesis (3.2 A, notes §5.3.6).
-const TAB_6_4_Y: Tab64 = Tab64 {
-    error_um: [
-        [10.0, 13.0, 14.0, 15.0, 18.0],
-        [1.0, 3.0, 9.0, 13.0, 18.0],
-        [3.0, 5.0, 8.0, 11.0, 18.0],
-        [2.0, 5.0, 9.0, 12.0, 18.0],
-    ],
-    current_a: [
-        [3.6, 5.4, 9.3, 14.9, 45.0],
-        [3.0, 4.3, 7.9, 14.2, 44.7],
-        [3.2, 4.7, 8.2, 13.9, 45.0],
-        [3.2, 4.4, 8.0, 13.8, 45.4],
-    ],
-    measured_error_um: [2.5, 5.0, 8.5, 10.5, 18.0],
-    measured_current_a: [4.7, 5.1, 8.3, 13.5, 46.8],
-    check_error_um: [
-        [9.67, 12.87, 14.40, 14.84, 18.00],
-        [0.72, 2.78, 9.07, 12.88, 17.31],
-        [2.44, 5.19, 8.41, 11.07, 17.80],
-        [2.27, 4.70, 8.71, 11.88, 18.32],
-    ],
-    check_current_a: [
-        [3.66, 5.47, 9.24, 14.76, 44.93],
-        [3.10, 4.42, 7.94, 14.14, 44.65],
-        [3.36, 4.78, 8.22, 13.69, 44.87],
-        [3.19, 4.51, 8.04, 13.80, 45.28],
-    ],
-};
+fn tab_6_4() -> Tab64Axes {
+    toml::from_str(include_str!("../../fixtures/servo/tab-6-4.toml")).unwrap()
+}
 
 /// Simulates every model and feed on one axis: [model][feed] → (µm, A).
 fn circle_table(axis_name: &str, circle_axis: CircleAxis) -> [[(f64, f64); 5]; 4] {
@@ -203,12 +154,12 @@ fn check_tab_6_4(axis_name: &str, circle_axis: CircleAxis, expected: &Tab64) {
 
 #[test]
 fn tab_6_4_x_axis_all_models_all_feeds() {
-    check_tab_6_4("mcfv5050-x", CircleAxis::X, &TAB_6_4_X);
+    check_tab_6_4("mcfv5050-x", CircleAxis::X, &tab_6_4().x);
 }
 
 #[test]
 fn tab_6_4_y_axis_all_models_all_feeds() {
-    check_tab_6_4("mcfv5050-y", CircleAxis::Y, &TAB_6_4_Y);
+    check_tab_6_4("mcfv5050-y", CircleAxis::Y, &tab_6_4().y);
 }
 
 /// The short cycle of the scheme test: 3 targets over 12 mm, 1 run, 0.4 s dwell, 2 m/min.
