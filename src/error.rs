@@ -9,10 +9,10 @@
 //! their `Display` says what to do about them.
 
 use std::fmt;
-use std::path::PathBuf;
 
 use crate::measurement::Direction;
 use crate::units::LengthUnit;
+use crate::units::{mm_to_um, um_to_mm};
 
 /// A position in a text file. Both fields start at 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -87,38 +87,6 @@ pub fn describe_found(token: &str) -> String {
         shown.push('…');
     }
     format!("{shown:?}")
-}
-
-/// An error from reading a measurement file: the parse error plus the path.
-#[derive(Debug, thiserror::Error)]
-pub enum ReadError {
-    /// The file could not be read at all.
-    ///
-    /// The operating system's message is part of the text, not a `source`:
-    /// an error chain printed with both said it twice.
-    #[error("cannot read {path}: {error}", path = path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What the operating system said.
-        error: std::io::Error,
-    },
-    /// The file was read but its content is wrong at a position.
-    #[error("{path}:{error}", path = path.display())]
-    Parse {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong, and where.
-        error: ParseError,
-    },
-    /// Two files that cannot be one measurement.
-    #[error("{path}: {message}", path = path.display())]
-    Merge {
-        /// The second file.
-        path: PathBuf,
-        /// Why they do not fit together.
-        message: String,
-    },
 }
 
 /// Something odd that is not fatal. `Display` says what it means and what to do.
@@ -371,13 +339,15 @@ impl fmt::Display for Warning {
 
 /// A length in mm for a sentence: at most three decimals, no trailing zeros.
 pub(crate) fn mm_text(value_mm: f64) -> String {
-    let rounded = (value_mm * 1000.0).round() / 1000.0;
+    let rounded = um_to_mm(mm_to_um(value_mm).round());
     format!("{}", rounded + 0.0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::read::ReadError;
+    use std::path::PathBuf;
 
     #[test]
     fn parse_error_reads_as_path_line_column() {

@@ -313,6 +313,24 @@ impl Metadata {
 /// Why a set of targets and runs is not a valid measurement.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MeasurementError {
+    /// Two files to join have other targets.
+    #[error(
+        "cannot join the files: targets differ ({count} targets {first_mm:?}…{last_mm:?} mm against {other_count} targets {other_first_mm:?}…{other_last_mm:?} mm)"
+    )]
+    TargetsDiffer {
+        /// Targets of the first.
+        count: usize,
+        /// Its first target, mm.
+        first_mm: f64,
+        /// Its last target, mm.
+        last_mm: f64,
+        /// Targets of the second.
+        other_count: usize,
+        /// Its first target, mm.
+        other_first_mm: f64,
+        /// Its last target, mm.
+        other_last_mm: f64,
+    },
     /// No targets.
     #[error("no targets")]
     NoTargets,
@@ -554,7 +572,7 @@ impl Measurement {
     /// Joins two measurements of the same axis and targets (e.g. the forward
     /// and reverse `.pos` files of one test). Runs of `other` follow those of
     /// `self` and are renumbered after them, per direction.
-    pub fn merge(&self, other: &Measurement) -> Result<Measurement, String> {
+    pub fn merge(&self, other: &Measurement) -> Result<Measurement, MeasurementError> {
         const SAME_TARGET_MM: f64 = 1e-6;
         if self.targets_mm.len() != other.targets_mm.len()
             || self
@@ -563,15 +581,14 @@ impl Measurement {
                 .zip(&other.targets_mm)
                 .any(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
         {
-            return Err(format!(
-                "cannot join the files: targets differ ({} targets {:?}…{:?} mm against {} targets {:?}…{:?} mm)",
-                self.targets_mm.len(),
-                self.targets_mm.first().copied().unwrap_or_default(),
-                self.targets_mm.last().copied().unwrap_or_default(),
-                other.targets_mm.len(),
-                other.targets_mm.first().copied().unwrap_or_default(),
-                other.targets_mm.last().copied().unwrap_or_default(),
-            ));
+            return Err(MeasurementError::TargetsDiffer {
+                count: self.targets_mm.len(),
+                first_mm: self.targets_mm.first().copied().unwrap_or_default(),
+                last_mm: self.targets_mm.last().copied().unwrap_or_default(),
+                other_count: other.targets_mm.len(),
+                other_first_mm: other.targets_mm.first().copied().unwrap_or_default(),
+                other_last_mm: other.targets_mm.last().copied().unwrap_or_default(),
+            });
         }
         let mut runs = self.runs.clone();
         for run in &other.runs {
@@ -588,7 +605,6 @@ impl Measurement {
             self.environment.clone(),
             self.metadata.clone(),
         )
-        .map_err(|error| error.to_string())
     }
 }
 
@@ -773,6 +789,7 @@ mod tests {
             forward
                 .merge(&other)
                 .unwrap_err()
+                .to_string()
                 .contains("targets differ")
         );
     }

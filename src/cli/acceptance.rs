@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use super::common::load;
+use anyhow::Result;
 
 use axcomp::evaluate::verdict::{
     AcceptanceProfile, Figure, Limit, command_line_limits, with_overrides,
@@ -50,12 +51,8 @@ pub fn parse_limit(text: &str) -> Result<(Figure, f64), String> {
 /// given), with the command line's on top. Empty: no verdict.
 pub fn load_limits(profile: Option<&Path>, axis: &str, args: &LimitArgs) -> Result<Vec<Limit>> {
     let from_profile = match profile {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-            AcceptanceProfile::from_toml_str(&text)
-                .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?
-                .limits_for(axis, &path.display().to_string())
-        }
+        Some(path) => load(path, AcceptanceProfile::from_toml_str)?
+            .limits_for(axis, &path.display().to_string()),
         None => Vec::new(),
     };
     let from_command_line = command_line_limits(&args.limits)?;

@@ -8,10 +8,12 @@ use serde::Serialize;
 
 use axcomp::compensate::CompensationTable;
 use axcomp::effects::{Effect, read_effects};
-use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
-use axcomp::error::Warning;
+use axcomp::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
+use axcomp::error::{ParseError, Warning};
 use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
+use axcomp::servo::axis::AxisError;
+use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
 
 /// `--format NAME`: one of the input formats.
@@ -72,17 +74,79 @@ pub fn parse_position(text: &str) -> Result<[Option<f64>; 3], String> {
     Ok(position)
 }
 
+/// What went wrong in a file the user named: at a position, or in the file
+/// as a whole.
+pub enum FileError {
+    /// At a line and column.
+    At(ParseError),
+    /// In the file as a whole.
+    Whole(String),
+}
+
+impl From<ParseError> for FileError {
+    fn from(error: ParseError) -> FileError {
+        FileError::At(error)
+    }
+}
+
+impl From<ModelError> for FileError {
+    fn from(error: ModelError) -> FileError {
+        match error {
+            ModelError::Toml(parse) => FileError::At(parse),
+            other => FileError::Whole(other.to_string()),
+        }
+    }
+}
+
+impl From<AxisError> for FileError {
+    fn from(error: AxisError) -> FileError {
+        match error {
+            AxisError::Parse(parse) => FileError::At(parse),
+            other => FileError::Whole(other.to_string()),
+        }
+    }
+}
+
+impl From<SynthError> for FileError {
+    fn from(error: SynthError) -> FileError {
+        match error {
+            SynthError::Toml(parse) => FileError::At(parse),
+            other => FileError::Whole(other.to_string()),
+        }
+    }
+}
+
+impl From<EmitError> for FileError {
+    fn from(error: EmitError) -> FileError {
+        FileError::Whole(error.to_string())
+    }
+}
+
+/// An error in a file the user named, said the same way by every command:
+/// `PATH:LINE:COL: message` at a position, `PATH: message` otherwise.
+pub fn in_file(path: &Path, error: impl Into<FileError>) -> anyhow::Error {
+    match error.into() {
+        FileError::At(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
+        FileError::Whole(message) => anyhow::anyhow!("{}: {message}", path.display()),
+    }
+}
+
+/// Reads the text file `path` and parses it with `parse`; an error names the file ([`in_file`]).
+pub fn load<T, E: Into<FileError>>(
+    path: &Path,
+    parse: impl FnOnce(&str) -> Result<T, E>,
+) -> Result<T> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    parse(&text).map_err(|error| in_file(path, error))
+}
+
 /// The machine's kinematics from `path`, or the bundled MCV 754 Quick. The
 /// path goes in front of the error, with the line and column for TOML errors.
 pub fn load_machine(path: Option<&Path>) -> Result<Machine> {
     let Some(path) = path else {
         return Ok(Machine::bundled());
     };
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    Machine::from_toml_str(&text).map_err(|error| match error {
-        ModelError::Toml(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
-        other => anyhow::anyhow!("{}: {other}", path.display()),
-    })
+    load(path, Machine::from_toml_str)
 }
 
 /// The machine profile's `[controller]` part from `path`, or the defaults.
@@ -90,15 +154,13 @@ pub fn load_profile(path: Option<&Path>) -> Result<MachineProfile> {
     let Some(path) = path else {
         return Ok(MachineProfile::default());
     };
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    MachineProfile::from_toml_str(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+    load(path, MachineProfile::from_toml_str)
 }
 
 /// The effects a diagnosis wrote (`diagnose --write-effects`), for
 /// `convert --effects` and `predict --effects`.
 pub fn load_effects(path: &Path) -> Result<Vec<Effect>> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    read_effects(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+    load(path, read_effects)
 }
 
 /// A compensation table for `axis` in any format `convert` writes; the
@@ -110,15 +172,14 @@ pub fn read_table(
     profile: &MachineProfile,
     linuxcnc_type: Option<u8>,
 ) -> Result<(Controller, CompensationTable)> {
-    let mut options = EmitOptions::for_axis(profile, axis, "").map_err(anyhow::Error::msg)?;
+    let mut options = EmitOptions::for_axis(profile, axis, "")?;
     options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    emit::read_any(&text, &options, None)
-        .or_else(|error| match linuxcnc_type {
-            Some(kind) => emit::read_any(&text, &options, Some(kind)),
+    load(path, |text| {
+        emit::read_any(text, &options, None).or_else(|error| match linuxcnc_type {
+            Some(kind) => emit::read_any(text, &options, Some(kind)),
             None => Err(error),
         })
-        .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+    })
 }
 
 /// The table that was active during `test` (named `test_label` in messages),

@@ -2,11 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use axcomp::compensate::plan::{Request, plan};
 use axcomp::compensate::{self, Extrapolate, TableMode};
-use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
+use axcomp::emit::{self, Controller, EmitOptions};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::{RunSelector, SourceFormat};
 use axcomp::output::write_new;
@@ -14,8 +14,8 @@ use axcomp::read;
 use axcomp::report::convert::ConvertJson;
 
 use super::common::{
-    Verbosity, load_effects, name_axis, parse_format, parse_run_selector, print_json, print_text,
-    print_warnings, read_active_table, recorded_axis,
+    Verbosity, load_effects, load_profile, name_axis, parse_format, parse_run_selector, print_json,
+    print_text, print_warnings, read_active_table, recorded_axis,
 };
 use super::evaluate::check_selectors;
 
@@ -175,15 +175,7 @@ fn parse_extrapolate(name: &str) -> Result<Extrapolate, String> {
 
 /// Runs `axcomp convert`.
 pub fn run(args: &ConvertArgs) -> Result<()> {
-    let profile = match &args.machine {
-        Some(path) => {
-            let text =
-                std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-            MachineProfile::from_toml_str(&text)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
-        }
-        None => MachineProfile::default(),
-    };
+    let profile = load_profile(args.machine.as_deref())?;
     let read::ReadResult {
         mut measurement,
         mut warnings,
@@ -196,12 +188,9 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     .to_string();
     check_selectors(&measurement, &args.exclude_runs)?;
     let mut measurement = measurement.without_runs(&args.exclude_runs)?;
-    let mut options = EmitOptions::for_axis(&profile, &axis, &table_name(&args.output))
-        .map_err(anyhow::Error::msg)?;
+    let mut options = EmitOptions::for_axis(&profile, &axis, &table_name(&args.output))?;
     for also in &args.also {
-        options
-            .axes
-            .push(profile.axis(also).map_err(anyhow::Error::msg)?);
+        options.axes.push(profile.axis(also)?);
     }
     options.linuxcnc_type = args.linuxcnc_type;
     options.max_points = args.max_points.or(options.max_points);

@@ -229,8 +229,11 @@ fn bundled(text: &str, name: &str) -> Result<Measurement> {
 }
 
 fn emit_options(axis: &str) -> Result<EmitOptions> {
-    EmitOptions::for_axis(&MachineProfile::default(), axis, &format!("{axis}.COM"))
-        .map_err(anyhow::Error::msg)
+    Ok(EmitOptions::for_axis(
+        &MachineProfile::default(),
+        axis,
+        &format!("{axis}.COM"),
+    )?)
 }
 
 /// Where a controller's table goes: one folder per controller, its usual extension.

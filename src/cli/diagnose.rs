@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
@@ -13,7 +13,8 @@ use axcomp::report::diagnose::{DiagnoseJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 
 use super::common::{
-    Verbosity, load_profile, name_axis, print_json, print_text, print_warnings, read_active_table,
+    Verbosity, load, load_profile, name_axis, print_json, print_text, print_warnings,
+    read_active_table,
 };
 
 /// Flags of `axcomp diagnose`.
@@ -138,6 +139,5 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
 }
 
 fn load_angular(path: &Path) -> Result<AngularProfile> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    AngularProfile::from_csv_str(&text).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))
+    load(path, AngularProfile::from_csv_str)
 }

@@ -3,12 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
 use axcomp::measurement::Measurement;
-use axcomp::model::{GeometricErrors, ModelError, read_error_description};
+use axcomp::model::{GeometricErrors, read_error_description};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
 use axcomp::report::predict::{PredictJson, render};
@@ -16,8 +16,8 @@ use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::mm_to_um;
 
 use super::common::{
-    Verbosity, load_effects, load_machine, load_profile, name_axis, parse_position, print_json,
-    print_text, print_warnings, read_table,
+    Verbosity, load, load_effects, load_machine, load_profile, name_axis, parse_position,
+    print_json, print_text, print_warnings, read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -221,11 +221,7 @@ fn split_measured(spec: &str) -> Result<(PathBuf, Option<[Option<f64>; 3]>)> {
 }
 
 fn load_errors(path: &Path) -> Result<GeometricErrors> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    read_error_description(&text).map_err(|error| match error {
-        ModelError::Toml(parse) => anyhow::anyhow!("{}:{parse}", path.display()),
-        other => anyhow::anyhow!("{}: {other}", path.display()),
-    })
+    load(path, read_error_description)
 }
 
 /// `[AXIS=]FILE`: the axis defaults to the one measured axis.

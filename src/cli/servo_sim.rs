@@ -20,7 +20,7 @@ use axcomp::servo::simulate::{ForceStep, Stepping};
 use axcomp::servo::trajectory::{Circle, CircleAxis, MoveLimits};
 use axcomp::units::{mm_to_m, um_to_mm};
 
-use super::common::{Verbosity, print_json, print_text};
+use super::common::{Verbosity, in_file, print_json, print_text};
 use super::progress;
 
 /// Which test to simulate.
@@ -236,12 +236,8 @@ fn load_axis(source: &str) -> Result<Axis> {
         bail!("--axis {source:?}: not a bundled axis (mcfv5050-x, mcfv5050-y) and no such file");
     }
     let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
-    let text =
-        axcomp::read::decode(&bytes).map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?;
-    Axis::from_toml_str(&text).map_err(|e| match e {
-        axcomp::servo::axis::AxisError::Parse(p) => anyhow::anyhow!("{}:{p}", path.display()),
-        other => anyhow::anyhow!("{}: {other}", path.display()),
-    })
+    let text = axcomp::read::decode(&bytes).map_err(|e| in_file(path, e))?;
+    Axis::from_toml_str(&text).map_err(|e| in_file(path, e))
 }
 
 fn positive(flag: &str, value: f64) -> Result<f64> {

@@ -2,14 +2,14 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 
 use axcomp::measurement::Measurement;
 use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
 use axcomp::synth::{self, Truth};
 
-use super::common::{Verbosity, load_profile, print_text, read_table};
+use super::common::{Verbosity, load, load_profile, print_text, read_table};
 
 /// Flags of `axcomp synth`.
 #[derive(Debug, clap::Args)]
@@ -53,10 +53,7 @@ pub struct SynthArgs {
 
 /// Runs `axcomp synth`.
 pub fn run(args: &SynthArgs) -> Result<()> {
-    let text =
-        std::fs::read_to_string(&args.truth).with_context(|| args.truth.display().to_string())?;
-    let truth = Truth::from_toml_str(&text)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.truth.display()))?;
+    let truth = load(&args.truth, Truth::from_toml_str)?;
     // Render everything before writing anything, so a bad table leaves no half result.
     let first = synth::before(&truth, args.seed)?;
     let first_text = render(&first, &args.output)?;

@@ -60,9 +60,7 @@ pub fn build_table_with_effects(
     let mut table = if finest_step_mm(effects).is_some() {
         // The readings less the periodic error at their targets.
         let targets = measurement.targets_mm();
-        let smooth = measurement
-            .map_readings(|_, i, v| v - um_to_mm(periodic_um(targets[i])))
-            .map_err(|e| CompensateError::Measurement(e.to_string()))?;
+        let smooth = measurement.map_readings(|_, i, v| v - um_to_mm(periodic_um(targets[i])))?;
         build_table(&smooth, &evaluate(&smooth), options)?
     } else {
         build_table(measurement, evaluation, options)?

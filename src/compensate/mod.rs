@@ -261,7 +261,7 @@ pub enum CompensateError {
     Grid(String),
     /// A measurement could not be rebuilt with the effects taken out (a bug).
     #[error("internal error, please report: {0}")]
-    Measurement(String),
+    Measurement(#[from] crate::measurement::MeasurementError),
 }
 
 /// The spacing of evenly spaced positions (within 1 nm), or `None`.

@@ -22,7 +22,7 @@ use crate::compensate::plan::Capabilities;
 use crate::compensate::{CompensationTable, TableMode};
 use crate::error::ParseError;
 use crate::units::LengthUnit;
-pub use profile::{AxisProfile, MachineProfile};
+pub use profile::{AxisProfile, CecValues, MachineProfile};
 
 /// The controllers axcomp writes tables for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -203,7 +203,7 @@ impl EmitOptions {
         profile: &MachineProfile,
         axis: &str,
         table_name: &str,
-    ) -> Result<EmitOptions, String> {
+    ) -> Result<EmitOptions, EmitError> {
         Ok(EmitOptions {
             axes: vec![profile.axis(axis)?],
             table_name: table_name.to_string(),
@@ -212,7 +212,7 @@ impl EmitOptions {
             max_points: profile.controller.max_points,
             max_value_mm: profile.controller.max_value_mm,
             cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
-            cec_values_are_corrections: profile.controller.cec_values.as_deref() != Some("error"),
+            cec_values_are_corrections: profile.controller.cec_values != Some(CecValues::Error),
             tnc640_columns: profile
                 .controller
                 .tnc640_columns
@@ -225,6 +225,16 @@ impl EmitOptions {
 /// Why a table is refused for a controller.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EmitError {
+    /// An axis whose letter gives no default for a name the controller needs.
+    #[error(
+        "axis {axis:?} has no default {what}; give it in the machine profile under [controller.axes.{axis}]"
+    )]
+    NoDefault {
+        /// The axis.
+        axis: String,
+        /// The profile key it needs.
+        what: &'static str,
+    },
     /// More points than the controller takes.
     #[error(
         "{controller} takes at most {max} compensation points, the table has {count}; use a larger --step"
@@ -587,6 +597,7 @@ mod tests {
 
     use super::*;
     use crate::compensate::TableValues;
+    use crate::units::um_to_mm;
 
     #[test]
     fn number_formats() {
@@ -669,7 +680,7 @@ mod tests {
         )
             .prop_flat_map(|(start_um, step_um, count, both)| {
                 // Start and step on the 0.1 µm grid every format writes exactly.
-                let (start, step) = (f64::from(start_um) / 1000.0, f64::from(step_um) / 1000.0);
+                let (start, step) = (um_to_mm(f64::from(start_um)), um_to_mm(f64::from(step_um)));
                 let column = || prop::collection::vec(-0.5f64..0.5, count);
                 (column(), column()).prop_map(move |(mut up, mut down)| {
                     up[0] = 0.0;

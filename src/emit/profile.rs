@@ -28,6 +28,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
+use super::EmitError;
 use crate::error::ParseError;
 use crate::units::LengthUnit;
 
@@ -44,7 +45,8 @@ pub struct MachineProfile {
 #[serde(deny_unknown_fields)]
 pub struct ControllerProfile {
     /// Machine units: `mm` or `inch`.
-    pub units: Option<String>,
+    #[serde(default, deserialize_with = "machine_unit")]
+    pub units: Option<LengthUnit>,
     /// Largest number of compensation points the machine takes.
     pub max_points: Option<usize>,
     /// Largest |value| allowed, mm.
@@ -52,12 +54,47 @@ pub struct ControllerProfile {
     /// Sinumerik CEC: first table index.
     pub cec_first_table: Option<usize>,
     /// Sinumerik CEC sign: `correction` or `error`.
-    pub cec_values: Option<String>,
+    #[serde(default, deserialize_with = "cec_values")]
+    pub cec_values: Option<CecValues>,
     /// TNC 640: the machine's axis columns, in order.
     pub tnc640_columns: Option<Vec<String>>,
     /// Per-axis names and numbers.
     #[serde(default)]
     pub axes: BTreeMap<String, AxisProfileToml>,
+}
+
+/// What a Sinumerik CEC table holds (`cec_values`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CecValues {
+    /// The correction the control adds (the default).
+    Correction,
+    /// The error the control subtracts.
+    Error,
+}
+
+/// `units = "mm"` or `"inch"`, with the message the user reads otherwise.
+fn machine_unit<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Option<LengthUnit>, D::Error> {
+    let name = String::deserialize(deserializer)?;
+    LengthUnit::from_name(&name).map(Some).ok_or_else(|| {
+        serde::de::Error::custom(format!(
+            "controller.units must be \"mm\" or \"inch\", found {name:?}"
+        ))
+    })
+}
+
+/// `cec_values = "correction"` or `"error"`, with the message the user reads otherwise.
+fn cec_values<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Option<CecValues>, D::Error> {
+    match String::deserialize(deserializer)?.as_str() {
+        "correction" => Ok(Some(CecValues::Correction)),
+        "error" => Ok(Some(CecValues::Error)),
+        other => Err(serde::de::Error::custom(format!(
+            "controller.cec_values must be \"correction\" or \"error\", found {other:?}"
+        ))),
+    }
 }
 
 /// One axis as written in the profile; every field optional.
@@ -100,44 +137,24 @@ impl MachineProfile {
     /// Parses a profile; unknown keys under `[controller]` are errors (a typo
     /// must not silently fall back to a default), other top-level tables are
     /// left to their own readers.
-    pub fn from_toml_str(text: &str) -> Result<MachineProfile, String> {
-        let profile: MachineProfile =
-            toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e).to_string())?;
-        if let Some(units) = &profile.controller.units {
-            LengthUnit::from_name(units).ok_or_else(|| {
-                format!("controller.units must be \"mm\" or \"inch\", found {units:?}")
-            })?;
-        }
-        if let Some(sign) = &profile.controller.cec_values
-            && sign != "correction"
-            && sign != "error"
-        {
-            return Err(format!(
-                "controller.cec_values must be \"correction\" or \"error\", found {sign:?}"
-            ));
-        }
-        Ok(profile)
+    pub fn from_toml_str(text: &str) -> Result<MachineProfile, ParseError> {
+        toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e))
     }
 
     /// The machine unit (default mm).
     pub fn machine_unit(&self) -> LengthUnit {
-        self.controller
-            .units
-            .as_deref()
-            .and_then(LengthUnit::from_name)
-            .unwrap_or(LengthUnit::Millimetre)
+        self.controller.units.unwrap_or(LengthUnit::Millimetre)
     }
 
     /// The resolved names of an axis: profile entries first, defaults from the letter.
-    pub fn axis(&self, axis: &str) -> Result<AxisProfile, String> {
+    pub fn axis(&self, axis: &str) -> Result<AxisProfile, EmitError> {
         let entry = self.controller.axes.get(axis).cloned().unwrap_or_default();
         let index = AXIS_LETTERS
             .iter()
             .position(|l| l.eq_ignore_ascii_case(axis));
-        let need = |what: &str| {
-            format!(
-                "axis {axis:?} has no default {what}; give it in the machine profile under [controller.axes.{axis}]"
-            )
+        let need = |what: &'static str| EmitError::NoDefault {
+            axis: axis.to_string(),
+            what,
         };
         Ok(AxisProfile {
             axis: axis.to_string(),
@@ -185,6 +202,7 @@ mod tests {
             profile
                 .axis("Q")
                 .unwrap_err()
+                .to_string()
                 .contains("[controller.axes.Q]")
         );
     }

@@ -70,6 +70,7 @@ use crate::model::{
     Axis, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid, Interpolation, Machine,
     Method, ModelError,
 };
+use crate::units::um_to_mm;
 
 /// A measured file and the line it was measured on.
 #[derive(Clone, Copy, Debug)]
@@ -231,6 +232,9 @@ pub enum PredictError {
     /// A bug.
     #[error("internal error, please report: {0}")]
     Internal(String),
+    /// A predicted re-test could not be built (a bug).
+    #[error("internal error, please report: {0}")]
+    Measurement(#[from] crate::measurement::MeasurementError),
 }
 
 /// Predicts the re-tests and the residual volumetric error.
@@ -439,7 +443,7 @@ fn predicted_retest(
         let reversal = known
             .as_ref()
             .map_or(0.0, |k| k.reversal_share_at(x, direction));
-        line_deviation(machine, errors, axis, sign, line_mm, x) + reversal + effects_um / 1000.0
+        line_deviation(machine, errors, axis, sign, line_mm, x) + reversal + um_to_mm(effects_um)
     };
     let compensated = |x: f64, direction: Direction| {
         let v = applied.value_at(x, direction);
@@ -485,8 +489,11 @@ fn with_scatter(
     measured: &Measurement,
     systematic: impl Fn(usize, Direction) -> f64,
 ) -> Result<Measurement, PredictError> {
-    crate::compensate::retest::with_scatter(measured, &evaluate(measured), systematic)
-        .map_err(|e| PredictError::Internal(e.to_string()))
+    Ok(crate::compensate::retest::with_scatter(
+        measured,
+        &evaluate(measured),
+        systematic,
+    )?)
 }
 
 /// A re-test of one run each way holding the predicted values.
@@ -518,7 +525,7 @@ fn one_run_each_way(
         Default::default(),
         metadata,
     )
-    .map_err(|e| PredictError::Internal(e.to_string()))
+    .map_err(PredictError::from)
 }
 
 /// The errors with each table applied to its axis's positioning error, for

@@ -21,9 +21,9 @@ use std::path::{Path, PathBuf};
 
 use chrono::NaiveDateTime;
 
-use crate::error::{ParseError, ReadError, Warning};
-use crate::measurement::{Measurement, Run, SourceFormat};
-use crate::together::{Input, Pairing, check_together};
+use crate::error::{ParseError, Warning};
+use crate::measurement::{Measurement, MeasurementError, Run, SourceFormat};
+use crate::together::{Input, NotTogether, Pairing, check_together};
 
 /// A measurement read from one or more files, with what the readers noticed.
 #[derive(Clone, Debug)]
@@ -64,6 +64,49 @@ pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult
     })
 }
 
+/// An error from reading a measurement file: the parse error plus the path.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    /// The file could not be read at all.
+    ///
+    /// The operating system's message is part of the text, not a `source`:
+    /// an error chain printed with both said it twice.
+    #[error("cannot read {path}: {error}", path = path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        error: std::io::Error,
+    },
+    /// The file was read but its content is wrong at a position.
+    #[error("{path}:{error}", path = path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, and where.
+        error: ParseError,
+    },
+    /// No file was given.
+    #[error("no input file given")]
+    NoInput,
+    /// Two files that do not belong to one test.
+    #[error("{path}: {error}", path = path.display())]
+    NotTogether {
+        /// The second file.
+        path: PathBuf,
+        /// Why they do not belong together.
+        error: Box<NotTogether>,
+    },
+    /// Two files of one test whose readings cannot be one measurement.
+    #[error("{path}: {error}", path = path.display())]
+    Merge {
+        /// The second file.
+        path: PathBuf,
+        /// Why they do not fit together.
+        error: MeasurementError,
+    },
+}
+
 /// Reads one file, or two files of one axis that together make one
 /// bidirectional measurement (e.g. the forward and reverse `.pos` files).
 pub fn read_paths(
@@ -71,10 +114,7 @@ pub fn read_paths(
     format: Option<SourceFormat>,
 ) -> Result<ReadResult, ReadError> {
     let Some((first, rest)) = paths.split_first() else {
-        return Err(ReadError::Merge {
-            path: PathBuf::from("-"),
-            message: "no input file given".to_string(),
-        });
+        return Err(ReadError::NoInput);
     };
     let mut result = read_path(first, format)?;
     for path in rest {
@@ -94,18 +134,18 @@ pub fn read_paths(
             input.file = canonical.as_deref().or(input.file);
         }
         let doubts = check_together(Pairing::OneTest, &inputs[0], &inputs[1]).map_err(|error| {
-            ReadError::Merge {
+            ReadError::NotTogether {
                 path: path.clone(),
-                message: error.to_string(),
+                error: Box::new(error),
             }
         })?;
         result.warnings.extend(doubts);
         let merged = result
             .measurement
             .merge(&next.measurement)
-            .map_err(|message| ReadError::Merge {
+            .map_err(|error| ReadError::Merge {
                 path: path.clone(),
-                message,
+                error,
             })?;
         result.measurement = merged;
         result.warnings.extend(next.warnings);

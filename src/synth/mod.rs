@@ -33,21 +33,34 @@ use rand_distr::{Distribution, Normal, Uniform};
 
 use crate::compensate::{CompensationTable, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
+use crate::error::ParseError;
 use crate::evaluate::environment::{
     ASSUMED_VACUUM_WAVELENGTH_UM, REFERENCE_TEMPERATURE_C, environmental_factor_um,
 };
-use crate::measurement::{Direction, Environment, Measurement, Metadata, Run, StartEnd, TestDate};
+use crate::measurement::{
+    Direction, Environment, Measurement, MeasurementError, Metadata, Run, StartEnd, TestDate,
+};
+use crate::units::{mm_to_m, mm_to_um, per_m_over_mm, um_to_mm, urad_times_mm_to_um};
 pub use truth::{EffectSpec, TargetSpec, TestKind, Truth};
 
 /// Why a truth cannot be turned into measurements.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SynthError {
+    /// The truth file is not valid TOML of its form, at a position.
+    #[error(transparent)]
+    Toml(#[from] ParseError),
+    /// The truth file's values contradict each other.
+    #[error("{0}")]
+    Truth(String),
     /// The targets are not usable.
     #[error("{0}")]
     Targets(String),
+    /// The noise cannot be drawn (checked when the truth is read).
+    #[error("noise: {0}")]
+    Noise(#[from] rand_distr::NormalError),
     /// The measurement would be invalid (a bug in the truth).
     #[error("{0}")]
-    Measurement(String),
+    Measurement(#[from] MeasurementError),
 }
 
 /// Random streams, one per purpose (`ChaCha8Rng::set_stream`).
@@ -168,7 +181,7 @@ fn targets(
             nominal + offset.sample(rng)
         };
         // Targets as a laser program writes them: 0.001 mm.
-        list.push((moved * 1000.0).round() / 1000.0);
+        list.push(um_to_mm(mm_to_um(moved).round()));
     }
     Ok(list)
 }
@@ -198,8 +211,7 @@ fn simulate(
         overrun_mm: truth.cycle.overrun_mm,
     };
     let times = cycle::reading_times_for(targets, &directions, timing);
-    let noise = Normal::new(0.0, truth.noise.sigma_um)
-        .map_err(|e| SynthError::Measurement(e.to_string()))?;
+    let noise = Normal::new(0.0, truth.noise.sigma_um)?;
     let stroke = (targets[0], targets[targets.len() - 1]);
     let datum_um = declared_error_um(truth, targets[0]);
     let mut runs = Vec::with_capacity(directions.len());
@@ -218,7 +230,7 @@ fn simulate(
             let commanded_mm = x - applied_mm;
             let error_um = declared_error_um(truth, commanded_mm) - datum_um
                 + effects_um(truth, test, &reading, commanded_mm, stroke);
-            let deviation_um = error_um - applied_mm * 1000.0 + noise.sample(rng);
+            let deviation_um = error_um - mm_to_um(applied_mm) + noise.sample(rng);
             // A laser's resolution, 0.001 µm; converted as a reader converts it.
             deviations_mm.push(Some(crate::units::um_to_mm(
                 (deviation_um * 1000.0).round() / 1000.0,
@@ -241,13 +253,13 @@ fn simulate(
         environment,
         metadata,
     )
-    .map_err(|e| SynthError::Measurement(e.to_string()))
+    .map_err(SynthError::from)
 }
 
 /// The axis error the model declares, µm, at a position.
 pub fn declared_error_um(truth: &Truth, x_mm: f64) -> f64 {
     let error = &truth.error;
-    let mut value = error.scale_um_per_m * x_mm / 1000.0;
+    let mut value = per_m_over_mm(error.scale_um_per_m, x_mm);
     for p in &error.periodic {
         value += p.amplitude_um * (std::f64::consts::TAU * x_mm / p.period_mm + p.phase_rad).sin();
     }
@@ -274,7 +286,9 @@ fn effects_um(
                 Direction::Up => B_um / 2.0,
                 Direction::Down => -B_um / 2.0,
             },
-            EffectSpec::Scale { scale_um_per_m, .. } => scale_um_per_m * (at_mm - first) / 1000.0,
+            EffectSpec::Scale { scale_um_per_m, .. } => {
+                per_m_over_mm(*scale_um_per_m, at_mm - first)
+            }
             EffectSpec::Drift { rate_um_per_h, .. } => rate_um_per_h * reading.time_s / 3600.0,
             EffectSpec::Periodic {
                 period_mm,
@@ -295,7 +309,7 @@ fn effects_um(
                 offset_mm,
                 angle_urad,
                 ..
-            } => offset_mm * abbe_angle_urad(*angle_urad, at_mm, stroke) / 1000.0,
+            } => urad_times_mm_to_um(offset_mm * abbe_angle_urad(*angle_urad, at_mm, stroke)),
             EffectSpec::Quadratic { sag_um, .. } => {
                 sag_um * 4.0 * (at_mm - first) * (last - at_mm) / ((last - first) * (last - first))
             }
@@ -325,7 +339,7 @@ pub fn abbe_angle_urad(angle_urad: f64, x_mm: f64, stroke: (f64, f64)) -> f64 {
 fn environment(truth: &Truth, test: TestKind, duration_s: f64, stroke: (f64, f64)) -> Environment {
     let spec = truth.environment;
     let alpha = spec.expansion_coefficient_ppm_per_k;
-    let stroke_m = (stroke.1 - stroke.0) / 1000.0;
+    let stroke_m = mm_to_m(stroke.1 - stroke.0);
     let mut material_start = spec.material_temperature_c;
     let mut warming = 0.0;
     for effect in truth.effects.iter().filter(|e| e.acts_in(test)) {

@@ -207,7 +207,7 @@ fn bad_truths_are_refused() {
             "unknown field",
         ),
     ] {
-        let error = Truth::from_toml_str(text).unwrap_err();
+        let error = Truth::from_toml_str(text).unwrap_err().to_string();
         assert!(error.contains(needle), "{error}");
     }
     let jittery = Truth::from_toml_str("[cycle]\nstart_mm = 0.0\nend_mm = 10.0\ncount = 3\njitter_mm = 4.0\n[noise]\nsigma_um = 1.0\n").unwrap();

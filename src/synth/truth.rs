@@ -45,6 +45,7 @@
 
 use serde::Deserialize;
 
+use super::SynthError;
 use crate::effects::{Abbe, Drift, Effect, OutlierRun, Periodic, Reversal, Scale};
 use crate::error::ParseError;
 use crate::measurement::Direction;
@@ -413,10 +414,9 @@ impl EffectSpec {
 
 impl Truth {
     /// Parses a truth file.
-    pub fn from_toml_str(text: &str) -> Result<Truth, String> {
-        let truth: Truth =
-            toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e).to_string())?;
-        truth.check()?;
+    pub fn from_toml_str(text: &str) -> Result<Truth, SynthError> {
+        let truth: Truth = toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e))?;
+        truth.check().map_err(SynthError::Truth)?;
         Ok(truth)
     }
 
