@@ -10,6 +10,7 @@ use crate::compensate::retest::KnownError;
 use crate::effects::{Context, Effect, FitSummary, Kind, Shape};
 use crate::evaluate::evaluate;
 use crate::measurement::{Measurement, Run};
+use crate::units::um_to_mm;
 
 /// The mean reversal B̄ of the first test, µm, when it measured both directions.
 pub(super) fn first_test_reversal_um(input: &DiagnoseInput<'_>) -> Option<f64> {
@@ -97,7 +98,7 @@ pub(super) fn figures(
             .collect();
         for (i, reading) in problem.readings.iter().enumerate() {
             runs[reading.run_index].deviations_mm[reading.target_index] =
-                Some(value(i, with_effects) / 1000.0);
+                Some(um_to_mm(value(i, with_effects)));
         }
         Measurement::new(
             after.axis(),

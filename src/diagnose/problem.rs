@@ -14,6 +14,7 @@ use crate::effects::{Line, Reading, Shape};
 use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::{Direction, Measurement};
 use crate::together::{Input, Pairing, check_together};
+use crate::units::mm_to_um;
 
 /// The readings with their prediction, as one table.
 pub(super) struct Problem {
@@ -144,9 +145,14 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
                 run_index,
                 time_h: times[run_index][target_index],
             });
-            measured_um.push(value * 1000.0);
+            measured_um.push(mm_to_um(*value));
             let predicted = first.as_ref().map_or(0.0, |(known, _)| {
-                predicted_deviation_mm(known, applied, target_mm, run.direction) * 1000.0
+                mm_to_um(predicted_deviation_mm(
+                    known,
+                    applied,
+                    target_mm,
+                    run.direction,
+                ))
             });
             predicted_um.push(predicted);
         }

@@ -28,6 +28,7 @@ pub mod verdict;
 use crate::error::Warning;
 use crate::measurement::{Direction, Measurement};
 pub use conformance::TestConformance;
+use environment::{RefractiveIndexCheck, check_refractive_index};
 pub use outliers::SuspectedOutlier;
 pub use standard::{ISO_230_2, Standard};
 use targets::per_target_stats;
@@ -77,6 +78,9 @@ pub struct Evaluation {
     pub outliers: Vec<SuspectedOutlier>,
     /// The test against ISO 230-2's conditions (targets, runs, directions, spacing).
     pub conformance: TestConformance,
+    /// The laser's refractive index against Edlén's equation, at the start
+    /// and the end of the test ([`environment`]).
+    pub refractive_index: RefractiveIndexCheck,
     /// Where the test falls short of ISO 230-2 ([`conformance`]), then what
     /// could not be evaluated, and why.
     pub warnings: Vec<Warning>,
@@ -125,7 +129,9 @@ pub fn evaluate(measurement: &Measurement) -> Evaluation {
 
 /// Evaluates a measurement per `standard`.
 pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Evaluation {
-    let per_target = per_target_stats(measurement, standard);
+    let per_target = per_target_stats(measurement, |target_mm, up, down| {
+        standard.target_stats(target_mm, up, down)
+    });
     let runs_up = measurement.run_count(Direction::Up);
     let runs_down = measurement.run_count(Direction::Down);
     let conformance = conformance::check_test(measurement);
@@ -133,6 +139,7 @@ pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Eval
     warnings.extend(coverage_warnings(&per_target, runs_up, runs_down));
     Evaluation {
         conformance,
+        refractive_index: check_refractive_index(&measurement.environment),
         figures: standard.axis_figures(&per_target),
         outliers: outliers::suspected_outliers(measurement),
         per_target,

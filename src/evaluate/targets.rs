@@ -5,7 +5,6 @@
 //! there). What a standard derives from them (reversal, repeatability, the
 //! axis figures) is the [`Standard`](super::standard::Standard)'s.
 
-use super::standard::Standard;
 use crate::measurement::{Direction, Measurement};
 
 /// Statistics of one target in one direction.
@@ -82,12 +81,12 @@ impl TargetStats {
     }
 }
 
-/// The statistics of every target, in target order, with what `standard`
-/// derives at each.
-pub(super) fn per_target_stats(
+/// The statistics of every target, in target order, handed to `at_target`
+/// with the target (a standard derives its quantities there).
+pub(super) fn per_target_stats<T>(
     measurement: &Measurement,
-    standard: &dyn Standard,
-) -> Vec<TargetStats> {
+    mut at_target: impl FnMut(f64, DirectionStats, DirectionStats) -> T,
+) -> Vec<T> {
     let mut readings: Vec<f64> = Vec::with_capacity(measurement.runs().len());
     let mut stats_of = |target_index: usize, direction: Direction| {
         readings.clear();
@@ -102,7 +101,7 @@ pub(super) fn per_target_stats(
     for (index, &target_mm) in measurement.targets_mm().iter().enumerate() {
         let up = stats_of(index, Direction::Up);
         let down = stats_of(index, Direction::Down);
-        per_target.push(standard.target_stats(target_mm, up, down));
+        per_target.push(at_target(target_mm, up, down));
     }
     per_target
 }

@@ -47,6 +47,7 @@ use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 
 use crate::error::ParseError;
 use crate::evaluate::{AxisFigures, Evaluation};
+use crate::units::per_m_over_mm;
 use crate::units::um_to_mm;
 
 /// An ISO 230-2 axis figure a limit can be set on.
@@ -177,7 +178,7 @@ impl Permissible {
                 per_1000_mm_mm,
                 min_mm,
             } => {
-                let proportional = per_1000_mm_mm * travel_mm / 1000.0;
+                let proportional = per_m_over_mm(per_1000_mm_mm, travel_mm);
                 proportional.max(min_mm.unwrap_or(0.0))
             }
         }
@@ -190,7 +191,7 @@ impl Permissible {
             Permissible::PerLength {
                 per_1000_mm_mm,
                 min_mm,
-            } => min_mm.is_some_and(|min| min > per_1000_mm_mm * travel_mm / 1000.0),
+            } => min_mm.is_some_and(|min| min > per_m_over_mm(per_1000_mm_mm, travel_mm)),
         }
     }
 }
@@ -692,6 +693,9 @@ mod tests {
                 runs_down: 5,
                 checks: Vec::new(),
             },
+            refractive_index: crate::evaluate::environment::check_refractive_index(
+                &Default::default(),
+            ),
             warnings: Vec::new(),
         }
     }

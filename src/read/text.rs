@@ -18,6 +18,7 @@ use nom::sequence::pair;
 use nom::{IResult, Parser};
 
 use crate::error::{ParseError, describe_found};
+use crate::units::mm_to_um;
 
 /// One line of a file: its 1-based number and its text without the line end.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,8 +163,8 @@ pub fn check_deviation_mm(value_mm: f64, line: usize, column: usize) -> Result<f
         return Ok(value_mm);
     }
     // In µm, as deviations are read, unless that overflows (a value near f64::MAX in mm).
-    let found = if (value_mm * 1000.0).is_finite() {
-        format!("{} µm", shown(value_mm * 1000.0))
+    let found = if mm_to_um(value_mm).is_finite() {
+        format!("{} µm", shown(mm_to_um(value_mm)))
     } else {
         format!("{} mm", shown(value_mm))
     };
@@ -172,7 +173,7 @@ pub fn check_deviation_mm(value_mm: f64, line: usize, column: usize) -> Result<f
         column,
         format!(
             "expected a deviation within ±{} µm (±1 m), found {found}: check the unit and the column of the file",
-            MAX_DEVIATION_MM * 1000.0,
+            mm_to_um(MAX_DEVIATION_MM),
         ),
     ))
 }

@@ -48,9 +48,7 @@ use crate::effects::{Parameter, ParameterValue};
 use crate::evaluate::AxisFigures;
 use crate::evaluate::TestConformance;
 use crate::evaluate::conformance::{Check, Requirement};
-use crate::evaluate::environment::{
-    AGREEMENT_PPM, IndexAt, IndexComparison, RefractiveIndexCheck, check_refractive_index,
-};
+use crate::evaluate::environment::{AGREEMENT_PPM, IndexAt, IndexComparison, RefractiveIndexCheck};
 use crate::evaluate::verdict::Limit;
 use crate::measurement::{Direction, Measurement, StartEnd};
 use crate::report::acceptance::{
@@ -311,9 +309,8 @@ fn conditions(out: &mut String, input: &ReportInput<'_>) {
     out.push_str("</tbody></table>\n");
     refractive_index_explained(out);
     for (name, test) in &tests {
-        let check = check_refractive_index(&test.measurement.environment);
         let heading = if tests.len() > 1 { Some(*name) } else { None };
-        refractive_index(out, heading, &check);
+        refractive_index(out, heading, &test.evaluation.refractive_index);
     }
     out.push_str("</section>\n");
 }

@@ -39,12 +39,10 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use crate::measurement::Direction;
 use crate::report::json::FiguresJson;
 use crate::servo::circle::CircleResult;
 use crate::servo::force_step::{ConstantVelocityResult, ForceStepResult};
 use crate::servo::iso_cycle::{IsoCycle, IsoResult};
-use crate::servo::reversal::reversal_from_friction_um;
 use crate::servo::simulate::{Snapshot, StepCounts};
 use crate::units::{m_to_mm, m_to_um};
 
@@ -274,20 +272,7 @@ impl ConstantVelocityJson {
 impl IsoJson {
     /// From a simulated cycle.
     pub fn new(cycle: &IsoCycle, compliance_n_per_um: Option<f64>, result: &IsoResult) -> IsoJson {
-        let mean_friction = |direction: Direction| {
-            let forces: Vec<f64> = result
-                .readings
-                .iter()
-                .filter(|r| r.direction == direction)
-                .map(|r| r.friction_force_n)
-                .collect();
-            forces.iter().sum::<f64>() / forces.len().max(1) as f64
-        };
-        let residual = ResidualJson {
-            up: mean_friction(Direction::Up),
-            down: mean_friction(Direction::Down),
-        };
-        let residual_magnitude_n = (residual.up - residual.down) / 2.0;
+        let residual = result.residual_friction();
         IsoJson {
             targets_mm: cycle.targets_m.iter().map(|m| m_to_mm(*m)).collect(),
             runs: cycle.runs,
@@ -296,9 +281,11 @@ impl IsoJson {
             feed_m_min: cycle.limits.feed_m_per_s * 60.0,
             compliance_n_per_um,
             figures_um: FiguresJson::from_figures(&result.evaluation.figures),
-            residual_friction_n: residual,
-            reversal_from_friction_um: compliance_n_per_um
-                .map(|k| reversal_from_friction_um(residual_magnitude_n, k)),
+            residual_friction_n: ResidualJson {
+                up: residual.up_n,
+                down: residual.down_n,
+            },
+            reversal_from_friction_um: compliance_n_per_um.map(|k| residual.reversal_um(k)),
             readings: result
                 .readings
                 .iter()

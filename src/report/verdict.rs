@@ -31,6 +31,7 @@ use crate::report::acceptance::ReportInput;
 use crate::report::format::esc;
 use crate::report::format::um;
 use crate::units::mm_to_um;
+use crate::units::per_m_over_mm;
 
 /// The decision rule (ISO 14253-1 "simple acceptance", `../shared/spec/standards.md` §5).
 pub const DECISION: &str = "simple acceptance";
@@ -146,7 +147,7 @@ fn derivation(permissible: &Permissible, travel_mm: f64) -> String {
             per_1000_mm_mm,
             min_mm,
         } => {
-            let proportional = mm_to_um(per_1000_mm_mm * travel_mm / 1000.0);
+            let proportional = mm_to_um(per_m_over_mm(per_1000_mm_mm, travel_mm));
             let base = format!(
                 "{} µm per 1000 mm × {} mm of travel = {} µm",
                 short(mm_to_um(per_1000_mm_mm)),
@@ -406,6 +407,9 @@ mod tests {
                 runs_down: 1,
                 checks: Vec::new(),
             },
+            refractive_index: crate::evaluate::environment::check_refractive_index(
+                &Default::default(),
+            ),
             warnings: Vec::new(),
         };
         let limit = |figure, um: f64| Limit {

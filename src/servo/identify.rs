@@ -3,8 +3,9 @@
 //!
 //! These are the closed forms the thesis uses to get friction, mass and
 //! stiffness from currents, dial-gauge readings and catalogue data; the unit
-//! tests check each against the thesis's own numbers (notes §9). They are the
-//! building blocks a later fit (issue 6) starts from.
+//! tests check each against the thesis's own numbers (notes §9). Only the
+//! LuGre damping has a caller (`axis`, for the bundled axes); the rest waits
+//! for the fit a later issue builds from them.
 
 /// Guide friction estimate (eq. 5.1, 5.2): equivalent load per carriage
 /// P = F_p + (F_mag + F_g)/p, friction μ·P·p, N. Seals and covers excluded.

@@ -33,6 +33,7 @@ use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::{Direction, Environment, Measurement, MeasurementError, Metadata, Run};
 use crate::servo::axis::Axis;
 use crate::servo::friction::Friction;
+use crate::servo::reversal::reversal_from_friction_um;
 use crate::servo::simulate::{Simulator, StepCounts, Stepping};
 use crate::servo::trajectory::{MoveLimits, ProfileBuilder, Trajectory};
 use crate::units::m_to_mm;
@@ -98,6 +99,50 @@ pub struct IsoResult {
     pub simulated_s: f64,
     /// How the time was stepped.
     pub counts: StepCounts,
+}
+
+/// The friction force the drive holds at the readings, per approach
+/// direction (the mean over that direction's readings), N: what is left of
+/// friction at standstill, which a structural compliance turns into a
+/// reversal ([`super::reversal`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ResidualFriction {
+    /// After ↑ approaches, N.
+    pub up_n: f64,
+    /// After ↓ approaches, N.
+    pub down_n: f64,
+}
+
+impl ResidualFriction {
+    /// Its magnitude, (↑ − ↓)/2, N.
+    pub fn magnitude_n(&self) -> f64 {
+        (self.up_n - self.down_n) / 2.0
+    }
+
+    /// The reversal it leaves through a structure of `stiffness_n_per_um`,
+    /// B ≈ 2·F_res/k_c, µm.
+    pub fn reversal_um(&self, stiffness_n_per_um: f64) -> f64 {
+        reversal_from_friction_um(self.magnitude_n(), stiffness_n_per_um)
+    }
+}
+
+impl IsoResult {
+    /// The friction held at the readings, per approach direction.
+    pub fn residual_friction(&self) -> ResidualFriction {
+        let mean = |direction: Direction| {
+            let forces: Vec<f64> = self
+                .readings
+                .iter()
+                .filter(|r| r.direction == direction)
+                .map(|r| r.friction_force_n)
+                .collect();
+            forces.iter().sum::<f64>() / forces.len().max(1) as f64
+        };
+        ResidualFriction {
+            up_n: mean(Direction::Up),
+            down_n: mean(Direction::Down),
+        }
+    }
 }
 
 /// Why a cycle cannot be simulated.

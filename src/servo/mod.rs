@@ -15,10 +15,14 @@
 //! - [`circle`]: the circular test and its reversal figures (Tab. 6.4).
 //! - [`iso_cycle`]: a simulated ISO 230-2 linear test (a `Measurement`,
 //!   evaluated), with a structural compliance between drive and laser.
-//! - [`reversal`]: B ≈ 2·F_res/k_c and its inverse, for `diagnose`.
+//! - [`reversal`]: B ≈ 2·F_res/k_c (the simulated ISO cycle's report uses
+//!   it) and its inverse (no caller yet: a later issue reads a measured B
+//!   as a friction force with it).
 //! - [`force_step`]: the force-step (impact compliance) test; and a
 //!   constant-velocity run.
-//! - [`identify`]: the thesis's identification arithmetic.
+//! - [`identify`]: the thesis's identification arithmetic (the bundled
+//!   axes use the LuGre damping; the rest is checked against the thesis but
+//!   has no caller yet).
 //!
 //! Lengths are metres inside this module (the model is SI throughout);
 //! results that leave it for a `Measurement` are converted to mm through

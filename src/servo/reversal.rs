@@ -19,9 +19,10 @@
 //!
 //! on top of whatever the scale itself contributes (up to one position
 //! increment from where the quantised loop comes to rest). `iso_cycle`
-//! simulates this in full; these two functions are the closed form that
-//! `diagnose` (issue 6) uses to read a measured B as a friction force or a
-//! compliance. Both work with magnitudes: B ≥ 0, F ≥ 0, k_c > 0.
+//! simulates this in full; these two functions are the closed form. The
+//! first turns a simulated cycle's residual friction into a reversal
+//! ([`super::iso_cycle::ResidualFriction`]); the inverse has no caller yet
+//! (nothing reads a measured B as a friction force or a compliance so far). Both work with magnitudes: B ≥ 0, F ≥ 0, k_c > 0.
 
 /// B ≈ 2·F_res/k_c, µm, for a residual friction force in N and a structural
 /// stiffness in N/µm.
