@@ -1,7 +1,7 @@
 //! Flag parsers and printing helpers shared by several subcommands.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -12,7 +12,7 @@ use axcomp::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
 use axcomp::error::{ParseError, Warning};
 use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
-use axcomp::servo::axis::AxisError;
+use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
 
@@ -98,10 +98,10 @@ impl From<ModelError> for FileError {
     }
 }
 
-impl From<AxisError> for FileError {
-    fn from(error: AxisError) -> FileError {
+impl From<ServoError> for FileError {
+    fn from(error: ServoError) -> FileError {
         match error {
-            AxisError::Parse(parse) => FileError::At(parse),
+            ServoError::Parse(parse) => FileError::At(parse),
             other => FileError::Whole(other.to_string()),
         }
     }
@@ -235,6 +235,49 @@ pub struct Verbosity {
     /// No warnings and no progress bars on stderr (results and errors are unchanged).
     #[arg(long, short = 'q', help_heading = "Output")]
     pub quiet: bool,
+}
+
+/// `--json`, the same in every command that has it.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct JsonOutput {
+    /// Print one JSON object (units in the keys) instead of the report.
+    #[arg(long, help_heading = "Output")]
+    pub json: bool,
+}
+
+/// `--force`, the same in every command that writes files.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct Overwrite {
+    /// Replace existing output files (without it an existing file is refused).
+    #[arg(long, help_heading = "Output")]
+    pub force: bool,
+}
+
+/// `--format`, the same in every command that reads measurements.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct InputFormat {
+    /// Input format, instead of detecting it: rtl, ecmc, api-pos, csv.
+    #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
+    pub format: Option<SourceFormat>,
+}
+
+/// `--machine`: one machine profile, of which each command reads its part.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MachineFile {
+    /// Machine profile (TOML): [controller] the tables' axis names and units,
+    /// [kinematics] the model (default: the bundled MCV 754 Quick),
+    /// [acceptance] the permissible values (README.md).
+    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
+    pub machine: Option<PathBuf>,
+}
+
+/// `--linuxcnc-type` for reading a LinuxCNC table (`convert` has its own: the
+/// type it writes).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct LinuxCncType {
+    /// LinuxCNC table type (COMP_FILE_TYPE 0 or 1), when a table's numbers do not tell it.
+    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Machine")]
+    pub linuxcnc_type: Option<u8>,
 }
 
 /// Prints warnings to stderr unless `quiet`.

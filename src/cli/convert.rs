@@ -8,14 +8,15 @@ use axcomp::compensate::plan::{Request, plan};
 use axcomp::compensate::{self, Extrapolate, TableMode};
 use axcomp::emit::{self, Controller, EmitOptions};
 use axcomp::evaluate::evaluate;
-use axcomp::measurement::{RunSelector, SourceFormat};
+use axcomp::measurement::RunSelector;
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::convert::ConvertJson;
 
 use super::common::{
-    Verbosity, load_effects, load_profile, name_axis, parse_format, parse_run_selector, print_json,
-    print_text, print_warnings, read_active_table, recorded_axis,
+    InputFormat, JsonOutput, MachineFile, Overwrite, Verbosity, load_effects, load_profile,
+    name_axis, parse_run_selector, print_json, print_text, print_warnings, read_active_table,
+    recorded_axis,
 };
 use super::evaluate::check_selectors;
 
@@ -40,8 +41,8 @@ pub struct ConvertArgs {
     pub output: PathBuf,
 
     /// Replace an existing output file.
-    #[arg(long, help_heading = "Output")]
-    pub force: bool,
+    #[command(flatten)]
+    pub overwrite: Overwrite,
 
     /// The compensated axis, instead of the one the file names.
     ///
@@ -119,8 +120,8 @@ pub struct ConvertArgs {
     pub also: Vec<String>,
 
     /// Machine profile (TOML): axis names and numbers per controller, units, limits.
-    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
-    pub machine: Option<PathBuf>,
+    #[command(flatten)]
+    pub machine_file: MachineFile,
 
     /// Most compensation points the machine takes (Sinumerik MD38000 / MD18342).
     #[arg(long = "max-points", value_name = "N", help_heading = "Machine")]
@@ -131,16 +132,16 @@ pub struct ConvertArgs {
     pub linuxcnc_type: u8,
 
     /// Input format, instead of detecting it: rtl, ecmc, api-pos, csv.
-    #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
-    pub format: Option<SourceFormat>,
+    #[command(flatten)]
+    pub input_format: InputFormat,
 
     /// Leave a run out: RUN, RUN:up or RUN:down (as in evaluate).
     #[arg(long = "exclude-run", value_name = "RUN[:DIR]", value_parser = parse_run_selector, help_heading = "Input")]
     pub exclude_runs: Vec<RunSelector>,
 
     /// Print the table as one JSON object instead of the summary.
-    #[arg(long, help_heading = "Output")]
-    pub json: bool,
+    #[command(flatten)]
+    pub json_output: JsonOutput,
 
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
@@ -175,11 +176,11 @@ fn parse_extrapolate(name: &str) -> Result<Extrapolate, String> {
 
 /// Runs `axcomp convert`.
 pub fn run(args: &ConvertArgs) -> Result<()> {
-    let profile = load_profile(args.machine.as_deref())?;
+    let profile = load_profile(args.machine_file.machine.as_deref())?;
     let read::ReadResult {
         mut measurement,
         mut warnings,
-    } = read::read_paths(&args.files, args.format)?;
+    } = read::read_paths(&args.files, args.input_format.format)?;
     name_axis(&mut measurement, args.axis.as_ref());
     let axis = recorded_axis(
         &measurement,
@@ -238,7 +239,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         &effects,
     )?;
     let text = emit::write(args.controller, &table, &options)?;
-    write_new(&args.output, text.as_bytes(), args.force)?;
+    write_new(&args.output, text.as_bytes(), args.overwrite.force)?;
     let file_name = args.output.file_name().map_or_else(
         || args.output.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
@@ -258,7 +259,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         report.set_backlash(args.controller.backlash_parameter(backlash_mm, &options));
     }
     print_warnings(&warnings, args.verbosity.quiet);
-    if args.json {
+    if args.json_output.json {
         print_json(&report)
     } else {
         print_text(&report.summary())

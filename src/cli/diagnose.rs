@@ -13,8 +13,8 @@ use axcomp::report::diagnose::{DiagnoseJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 
 use super::common::{
-    Verbosity, load, load_profile, name_axis, print_json, print_text, print_warnings,
-    read_active_table,
+    JsonOutput, LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_profile, name_axis,
+    print_json, print_text, print_warnings, read_active_table,
 };
 
 /// Flags of `axcomp diagnose`.
@@ -45,8 +45,8 @@ pub struct DiagnoseArgs {
     pub axis: Option<String>,
 
     /// Machine profile, to read the table's axis names (as in convert).
-    #[arg(long, value_name = "M.toml")]
-    pub machine: Option<PathBuf>,
+    #[command(flatten)]
+    pub machine_file: MachineFile,
 
     /// The axis's pitch or yaw along the stroke (CSV: position_mm,angle_urad),
     /// to tell an Abbe error.
@@ -58,16 +58,16 @@ pub struct DiagnoseArgs {
     pub write_effects: Option<PathBuf>,
 
     /// Replace an existing --write-effects file.
-    #[arg(long)]
-    pub force: bool,
+    #[command(flatten)]
+    pub overwrite: Overwrite,
 
     /// LinuxCNC table type, when its numbers do not tell it.
-    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1))]
-    pub linuxcnc_type: Option<u8>,
+    #[command(flatten)]
+    pub table_type: LinuxCncType,
 
     /// Print JSON instead of the report.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub json_output: JsonOutput,
 
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
@@ -96,14 +96,14 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     };
     let table = match &args.table {
         Some(path) => {
-            let profile = load_profile(args.machine.as_deref())?;
+            let profile = load_profile(args.machine_file.machine.as_deref())?;
             // The table was active during the re-test.
             let (_, table, doubts) = read_active_table(
                 path,
                 &after.measurement,
                 args.after.display().to_string(),
                 &profile,
-                args.linuxcnc_type,
+                args.table_type.linuxcnc_type,
             )?;
             print_warnings(&doubts, args.verbosity.quiet);
             Some(table)
@@ -123,7 +123,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let name = |p: &Path| p.display().to_string();
     if let Some(path) = &args.write_effects {
         let text = diagnosis.effects_file(&name(&args.after));
-        write_new(path, text.as_bytes(), args.force)?;
+        write_new(path, text.as_bytes(), args.overwrite.force)?;
     }
     let report = DiagnoseJson::new(
         &diagnosis,
@@ -131,7 +131,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         args.before.as_deref().map(name),
         args.table.as_deref().map(name),
     );
-    if args.json {
+    if args.json_output.json {
         print_json(&report)
     } else {
         print_text(&render(&report))

@@ -5,13 +5,14 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 
 use axcomp::evaluate::evaluate;
-use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
+use axcomp::measurement::{Direction, Measurement, RunSelector};
 use axcomp::read;
 use axcomp::report::{json::EvaluationJson, terminal, verdict};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    Verbosity, name_axis, parse_format, parse_run_selector, print_json, print_text, print_warnings,
+    InputFormat, JsonOutput, MachineFile, Verbosity, name_axis, parse_run_selector, print_json,
+    print_text, print_warnings,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -25,8 +26,8 @@ pub struct EvaluateArgs {
     pub files: Vec<PathBuf>,
 
     /// Input format, instead of detecting it: rtl, ecmc, api-pos, csv.
-    #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
-    pub format: Option<SourceFormat>,
+    #[command(flatten)]
+    pub input_format: InputFormat,
 
     /// Name of the axis, instead of the one in the file.
     ///
@@ -49,15 +50,15 @@ pub struct EvaluateArgs {
     ///
     /// See README.md for the table: a fixed µm value or one per 1000 mm of
     /// measured travel with a minimum, per axis if wanted. --limit overrides it.
-    #[arg(long, value_name = "M.toml", help_heading = "Acceptance")]
-    pub machine: Option<PathBuf>,
+    #[command(flatten)]
+    pub machine_file: MachineFile,
 
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
     /// Print one JSON object (units in the keys) instead of the report.
-    #[arg(long, help_heading = "Output")]
-    pub json: bool,
+    #[command(flatten)]
+    pub json_output: JsonOutput,
 
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
@@ -69,14 +70,14 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let read::ReadResult {
         mut measurement,
         mut warnings,
-    } = read::read_paths(&args.files, args.format)?;
+    } = read::read_paths(&args.files, args.input_format.format)?;
     name_axis(&mut measurement, args.axis.as_ref());
     check_selectors(&measurement, &args.exclude_runs)?;
     let measurement = measurement
         .without_runs(&args.exclude_runs)
         .context("after excluding runs")?;
     let limits = load_limits(
-        args.machine.as_deref(),
+        args.machine_file.machine.as_deref(),
         measurement.axis(),
         &args.acceptance,
     )?;
@@ -85,7 +86,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
     report.verdict = verdict::judge(&evaluation, &limits);
     print_warnings(&warnings, args.verbosity.quiet);
-    if args.json {
+    if args.json_output.json {
         print_json(&report)
     } else {
         print_text(&terminal::evaluation_report(&report))
@@ -128,7 +129,7 @@ mod tests {
             panic!("parsed as evaluate")
         };
         assert_eq!(evaluate.files.len(), 2);
-        assert!(evaluate.json);
+        assert!(evaluate.json_output.json);
         assert_eq!(evaluate.exclude_runs.len(), 1);
     }
 }

@@ -16,8 +16,8 @@ use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::mm_to_um;
 
 use super::common::{
-    Verbosity, load, load_effects, load_machine, load_profile, name_axis, parse_position,
-    print_json, print_text, print_warnings, read_table,
+    JsonOutput, LinuxCncType, MachineFile, Verbosity, load, load_effects, load_machine,
+    load_profile, name_axis, parse_position, print_json, print_text, print_warnings, read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -25,8 +25,8 @@ use super::common::{
 pub struct PredictArgs {
     /// Machine description (TOML: [kinematics], and [controller] for reading
     /// tables); default: the bundled MCV 754 Quick.
-    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
-    pub machine: Option<PathBuf>,
+    #[command(flatten)]
+    pub machine_file: MachineFile,
 
     /// The errors the model knows besides the measured ones (TOML: EXX … EYOZ,
     /// tables or constants, µm and µrad).
@@ -82,12 +82,12 @@ pub struct PredictArgs {
     pub grid: f64,
 
     /// LinuxCNC table type, when its numbers do not tell it.
-    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Tables")]
-    pub linuxcnc_type: Option<u8>,
+    #[command(flatten)]
+    pub table_type: LinuxCncType,
 
     /// Print JSON instead of the report.
-    #[arg(long, help_heading = "Output")]
-    pub json: bool,
+    #[command(flatten)]
+    pub json_output: JsonOutput,
 
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
@@ -99,8 +99,8 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     if !(args.grid > 0.0 && args.grid.is_finite()) {
         bail!("--grid must be a step > 0 mm, found {}", args.grid);
     }
-    let machine = load_machine(args.machine.as_deref())?;
-    let profile = load_profile(args.machine.as_deref())?;
+    let machine = load_machine(args.machine_file.machine.as_deref())?;
+    let profile = load_profile(args.machine_file.machine.as_deref())?;
     let errors = match &args.errors {
         Some(path) => load_errors(path)?,
         None => GeometricErrors::default(),
@@ -137,7 +137,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     let tables = args
         .table
         .iter()
-        .map(|spec| load_table(spec, &measurements, &profile, args.linuxcnc_type))
+        .map(|spec| load_table(spec, &measurements, &profile, args.table_type.linuxcnc_type))
         .collect::<Result<Vec<CompensationTable>>>()?;
     // Each table against the test of its axis: the range it is predicted over.
     let mut doubts = Vec::new();
@@ -176,7 +176,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     let prediction = predict(&input)?;
     let mut notes = notes(&prediction, &effects);
     notes.extend(doubts.iter().map(ToString::to_string));
-    if args.machine.is_none() {
+    if args.machine_file.machine.is_none() {
         notes.push("machine: the bundled MCV 754 Quick (give --machine for another)".to_string());
     }
     let report = PredictJson::new(
@@ -187,7 +187,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         effects.iter().map(|e| e.kind().name()).collect(),
         notes,
     );
-    if args.json {
+    if args.json_output.json {
         print_json(&report)
     } else {
         print_text(&render(&report))

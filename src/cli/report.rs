@@ -20,7 +20,8 @@ use axcomp::together::{Input, Pairing, check_together};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    Verbosity, load_profile, name_axis, parse_format, print_text, print_warnings, read_active_table,
+    InputFormat, LinuxCncType, MachineFile, Overwrite, Verbosity, load_profile, name_axis,
+    print_text, print_warnings, read_active_table,
 };
 
 /// Flags of `axcomp report`.
@@ -56,8 +57,8 @@ pub struct ReportArgs {
     pub diagnose: bool,
 
     /// Input format of FILE and FILE2, instead of detecting it: rtl, ecmc, api-pos, csv.
-    #[arg(long, value_name = "FORMAT", value_parser = parse_format, help_heading = "Input")]
-    pub format: Option<SourceFormat>,
+    #[command(flatten)]
+    pub input_format: InputFormat,
 
     /// Name of the axis of FILE and FILE2, instead of the one in the files
     /// (needed with --table when FILE does not record its axis).
@@ -66,15 +67,15 @@ pub struct ReportArgs {
 
     /// Machine profile (TOML): the table's axis names (as in convert) and the
     /// [acceptance] table's permissible values for the verdict box.
-    #[arg(long, value_name = "M.toml", help_heading = "Input")]
-    pub machine: Option<PathBuf>,
+    #[command(flatten)]
+    pub machine_file: MachineFile,
 
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
     /// LinuxCNC table type, 0 or 1, when its numbers do not tell it.
-    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Input")]
-    pub linuxcnc_type: Option<u8>,
+    #[command(flatten)]
+    pub table_type: LinuxCncType,
 
     /// The HTML file to write (refused if it exists, unless --force).
     #[arg(
@@ -96,8 +97,8 @@ pub struct ReportArgs {
     pub png: Option<PathBuf>,
 
     /// Replace existing output files.
-    #[arg(long, help_heading = "Output")]
-    pub force: bool,
+    #[command(flatten)]
+    pub overwrite: Overwrite,
 
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
@@ -138,14 +139,18 @@ impl Test {
 
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
-    let mut before = Test::read(&args.file, args.format, args.axis.as_ref())?;
+    let mut before = Test::read(&args.file, args.input_format.format, args.axis.as_ref())?;
     let limits = load_limits(
-        args.machine.as_deref(),
+        args.machine_file.machine.as_deref(),
         before.measurement.axis(),
         &args.acceptance,
     )?;
     let mut after = match &args.after {
-        Some(path) => Some(Test::read(path, args.format, args.axis.as_ref())?),
+        Some(path) => Some(Test::read(
+            path,
+            args.input_format.format,
+            args.axis.as_ref(),
+        )?),
         None => None,
     };
     if let (Some(after), Some(path)) = (&mut after, &args.after) {
@@ -159,13 +164,13 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     }
     let table = match &args.table {
         Some(path) => {
-            let profile = load_profile(args.machine.as_deref())?;
+            let profile = load_profile(args.machine_file.machine.as_deref())?;
             let (controller, table, doubts) = read_active_table(
                 path,
                 &before.measurement,
                 args.file.display().to_string(),
                 &profile,
-                args.linuxcnc_type,
+                args.table_type.linuxcnc_type,
             )?;
             before.warnings.extend(doubts);
             Some((path.display().to_string(), controller, table))
@@ -222,7 +227,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         }
         _ => None,
     };
-    if let Err(error) = write_all_new(&files, args.force) {
+    if let Err(error) = write_all_new(&files, args.overwrite.force) {
         if let Some(directory) = created {
             let _ = std::fs::remove_dir(directory);
         }

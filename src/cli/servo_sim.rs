@@ -20,7 +20,7 @@ use axcomp::servo::simulate::{ForceStep, Stepping};
 use axcomp::servo::trajectory::{Circle, CircleAxis, MoveLimits};
 use axcomp::units::{mm_to_m, um_to_mm};
 
-use super::common::{Verbosity, in_file, print_json, print_text};
+use super::common::{JsonOutput, Overwrite, Verbosity, in_file, print_json, print_text};
 use super::progress;
 
 /// Which test to simulate.
@@ -196,16 +196,16 @@ pub struct ServoSimArgs {
     pub reference: bool,
 
     /// Print one JSON object (units in the keys) instead of the report.
-    #[arg(long, help_heading = "Output")]
-    pub json: bool,
+    #[command(flatten)]
+    pub json_output: JsonOutput,
 
     /// Also write a CSV: the 1 ms trace, or the ISO readings (axcomp CSV layout).
     #[arg(long, value_name = "OUT", help_heading = "Output")]
     pub csv: Option<PathBuf>,
 
     /// Replace an existing --csv file.
-    #[arg(long, help_heading = "Output")]
-    pub force: bool,
+    #[command(flatten)]
+    pub overwrite: Overwrite,
 
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
@@ -357,9 +357,9 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
         if csv.is_empty() {
             bail!("--csv: the {} test has no trace to write", args.test.name());
         }
-        write_new(path, &csv, args.force)?;
+        write_new(path, &csv, args.overwrite.force)?;
     }
-    if args.json {
+    if args.json_output.json {
         print_json(&report)
     } else {
         print_text(&text(&report))

@@ -9,7 +9,9 @@ use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
 use axcomp::synth::{self, Truth};
 
-use super::common::{Verbosity, load, load_profile, print_text, read_table};
+use super::common::{
+    LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_profile, print_text, read_table,
+};
 
 /// Flags of `axcomp synth`.
 #[derive(Debug, clap::Args)]
@@ -35,16 +37,16 @@ pub struct SynthArgs {
     pub seed: u64,
 
     /// Machine profile, to read the table's axis names (as in convert).
-    #[arg(long, value_name = "M.toml")]
-    pub machine: Option<PathBuf>,
+    #[command(flatten)]
+    pub machine_file: MachineFile,
 
     /// LinuxCNC table type, when its numbers do not tell it.
-    #[arg(long = "linuxcnc-type", value_name = "0|1", value_parser = clap::value_parser!(u8).range(0..=1))]
-    pub linuxcnc_type: Option<u8>,
+    #[command(flatten)]
+    pub table_type: LinuxCncType,
 
     /// Replace existing output files.
-    #[arg(long)]
-    pub force: bool,
+    #[command(flatten)]
+    pub overwrite: Overwrite,
 
     /// -q/--quiet (the same in every command; synth prints no warnings yet).
     #[command(flatten)]
@@ -59,9 +61,13 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     let first_text = render(&first, &args.output)?;
     let second = match (&args.table, &args.output2) {
         (Some(table_path), Some(output2)) => {
-            let profile = load_profile(args.machine.as_deref())?;
-            let (_, table) =
-                read_table(table_path, &truth.axis.name, &profile, args.linuxcnc_type)?;
+            let profile = load_profile(args.machine_file.machine.as_deref())?;
+            let (_, table) = read_table(
+                table_path,
+                &truth.axis.name,
+                &profile,
+                args.table_type.linuxcnc_type,
+            )?;
             let retest = synth::after(&truth, &table, args.seed)?;
             let text = render(&retest, output2)?;
             Some((output2, text))
@@ -73,7 +79,7 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     if let Some((path, text)) = &second {
         files.push((path.as_path(), text.as_bytes()));
     }
-    write_all_new(&files, args.force)?;
+    write_all_new(&files, args.overwrite.force)?;
     let mut summary = format!(
         "Wrote {} ({} targets, {} runs)\n",
         args.output.display(),

@@ -23,7 +23,9 @@ use axcomp::report::tolerance::{
 };
 use axcomp::units::um_per_m_to_rad;
 
-use super::common::{Verbosity, load_machine, print_json, print_text};
+use super::common::{
+    JsonOutput, MachineFile, Overwrite, Verbosity, load_machine, print_json, print_text,
+};
 use super::progress;
 
 /// Flags of `axcomp tolerance`.
@@ -34,8 +36,8 @@ pub struct ToleranceArgs {
     /// The table is documented in src/model/machine.rs and, with every
     /// assumed dimension, in fixtures/machines/mcv754-quick.toml (whose
     /// [controller] table is what `axcomp convert --machine` reads).
-    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
-    pub machine: Option<PathBuf>,
+    #[command(flatten)]
+    pub machine_file: MachineFile,
 
     /// Number of random machines (or axes with --single-axis).
     ///
@@ -131,16 +133,16 @@ pub struct ToleranceArgs {
     pub histogram: Option<PathBuf>,
 
     /// Replace an existing histogram file.
-    #[arg(long, help_heading = "Output")]
-    pub force: bool,
+    #[command(flatten)]
+    pub overwrite: Overwrite,
 
     /// Worker threads (default: one per core). The result does not depend on it.
     #[arg(long, value_name = "N", value_parser = parse_samples, help_heading = "Study")]
     pub threads: Option<usize>,
 
     /// Print one JSON object (units in the keys) instead of the report.
-    #[arg(long, help_heading = "Output")]
-    pub json: bool,
+    #[command(flatten)]
+    pub json_output: JsonOutput,
 
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
@@ -172,7 +174,7 @@ pub fn run(args: &ToleranceArgs) -> Result<()> {
         })?),
         None => None,
     };
-    let machine = load_machine(args.machine.as_deref())?;
+    let machine = load_machine(args.machine_file.machine.as_deref())?;
     let mut tolerances = Tolerances::uniform(
         args.straightness,
         args.positioning,
@@ -227,9 +229,9 @@ pub fn run(args: &ToleranceArgs) -> Result<()> {
             &title,
             format,
         )?;
-        write_new(path, &bytes, args.force)?;
+        write_new(path, &bytes, args.overwrite.force)?;
     }
-    if args.json {
+    if args.json_output.json {
         print_json(&report)
     } else {
         print_text(&tolerance_report(&report))
@@ -240,7 +242,7 @@ fn run_single_axis(args: &ToleranceArgs, shape: ProfileShape) -> Result<()> {
     for (flag, given) in [
         ("--sweep", args.sweep),
         ("--histogram", args.histogram.is_some()),
-        ("--machine", args.machine.is_some()),
+        ("--machine", args.machine_file.machine.is_some()),
         ("--surface", !args.surfaces.is_empty()),
     ] {
         if given {
@@ -264,7 +266,7 @@ fn run_single_axis(args: &ToleranceArgs, shape: ProfileShape) -> Result<()> {
     let result = single_axis_study(&options, &|done| bar.inc(done))?;
     bar.finish_and_clear();
     let report = AxisStudyJson::new(&options, &result);
-    if args.json {
+    if args.json_output.json {
         print_json(&report)
     } else {
         print_text(&axis_study_report(&report))
@@ -343,7 +345,7 @@ mod tests {
             (50.0, 100.0, 0.5, 1.0)
         );
         assert_eq!(args.sweep_values, THESIS_SWEEP_MM);
-        assert!(!args.sweep && !args.single_axis && !args.json);
+        assert!(!args.sweep && !args.single_axis && !args.json_output.json);
     }
 
     #[test]

@@ -47,6 +47,7 @@ use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 
 use crate::error::ParseError;
 use crate::evaluate::{AxisFigures, Evaluation};
+use crate::measurement::Direction;
 use crate::units::per_m_over_mm;
 use crate::units::um_to_mm;
 
@@ -111,6 +112,21 @@ impl Figure {
             Figure::RDown => "R_down",
             Figure::B => "B",
             Figure::BMean => "B_mean",
+        }
+    }
+
+    /// The figure of one direction that this bidirectional figure has (A↑ of
+    /// A), or `None` for a figure without directions (M, B, B̄) or one that
+    /// is already of a direction.
+    pub fn directed(self, direction: Direction) -> Option<Figure> {
+        match (self, direction) {
+            (Figure::A, Direction::Up) => Some(Figure::AUp),
+            (Figure::A, Direction::Down) => Some(Figure::ADown),
+            (Figure::E, Direction::Up) => Some(Figure::EUp),
+            (Figure::E, Direction::Down) => Some(Figure::EDown),
+            (Figure::R, Direction::Up) => Some(Figure::RUp),
+            (Figure::R, Direction::Down) => Some(Figure::RDown),
+            _ => None,
         }
     }
 

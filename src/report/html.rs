@@ -49,7 +49,7 @@ use crate::evaluate::AxisFigures;
 use crate::evaluate::TestConformance;
 use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexAt, IndexComparison, RefractiveIndexCheck};
-use crate::evaluate::verdict::Limit;
+use crate::evaluate::verdict::{Figure, Limit};
 use crate::measurement::{Direction, Measurement, StartEnd};
 use crate::report::acceptance::{
     NamedChart, ReportInput, TableRecord, TestRecord, charts, prediction,
@@ -639,35 +639,31 @@ fn signed_plus(value: f64, decimals: usize) -> String {
     }
 }
 
-/// (row label, JSON key, which directions have a column).
-const FIGURE_ROWS: [(&str, &str, bool); 6] = [
-    ("A &nbsp;accuracy of positioning", "A", true),
-    ("E &nbsp;systematic positional deviation", "E", true),
-    ("R &nbsp;repeatability of positioning", "R", true),
-    (
-        "M &nbsp;mean bidirectional positional deviation",
-        "M",
-        false,
-    ),
-    ("B &nbsp;reversal value", "B", false),
-    ("B̄ &nbsp;mean reversal value", "B_mean", false),
+/// (row label, figure); a figure with directions gets a column for each.
+const FIGURE_ROWS: [(&str, Figure); 6] = [
+    ("A &nbsp;accuracy of positioning", Figure::A),
+    ("E &nbsp;systematic positional deviation", Figure::E),
+    ("R &nbsp;repeatability of positioning", Figure::R),
+    ("M &nbsp;mean bidirectional positional deviation", Figure::M),
+    ("B &nbsp;reversal value", Figure::B),
+    ("B̄ &nbsp;mean reversal value", Figure::BMean),
 ];
 
-fn figure_value(figures: &FiguresJson, key: &str) -> Option<f64> {
-    match key {
-        "A" => figures.A,
-        "A_up" => figures.A_up,
-        "A_down" => figures.A_down,
-        "E" => figures.E,
-        "E_up" => figures.E_up,
-        "E_down" => figures.E_down,
-        "M" => figures.M,
-        "R" => figures.R,
-        "R_up" => figures.R_up,
-        "R_down" => figures.R_down,
-        "B" => figures.B,
-        "B_mean" => figures.B_mean,
-        _ => None,
+/// A figure's value as `figures_um` gives it, µm.
+fn figure_value(figures: &FiguresJson, figure: Figure) -> Option<f64> {
+    match figure {
+        Figure::A => figures.A,
+        Figure::AUp => figures.A_up,
+        Figure::ADown => figures.A_down,
+        Figure::E => figures.E,
+        Figure::EUp => figures.E_up,
+        Figure::EDown => figures.E_down,
+        Figure::M => figures.M,
+        Figure::R => figures.R,
+        Figure::RUp => figures.R_up,
+        Figure::RDown => figures.R_down,
+        Figure::B => figures.B,
+        Figure::BMean => figures.B_mean,
     }
 }
 
@@ -697,28 +693,26 @@ fn figures_section(out: &mut String, input: &ReportInput<'_>) {
         out.push_str("<th>bidirectional</th>");
     }
     out.push_str("</tr></thead>\n<tbody>\n");
-    for (label, key, directional) in FIGURE_ROWS {
+    for (label, figure) in FIGURE_ROWS {
         let _ = write!(out, "<tr><th>{label}</th>");
         for ((_, f), prefix) in figures.iter().zip(prefixes) {
             out.push_str(&um_cell(
-                &format!("{prefix}.figures_um.{key}"),
-                figure_value(f, key),
+                &format!("{prefix}.figures_um.{}", figure.name()),
+                figure_value(f, figure),
             ));
-            for suffix in ["_up", "_down"] {
-                if directional {
-                    let directed = format!("{key}{suffix}");
-                    out.push_str(&um_cell(
-                        &format!("{prefix}.figures_um.{directed}"),
-                        figure_value(f, &directed),
-                    ));
-                } else {
-                    out.push_str("<td></td>");
+            for direction in [Direction::Up, Direction::Down] {
+                match figure.directed(direction) {
+                    Some(directed) => out.push_str(&um_cell(
+                        &format!("{prefix}.figures_um.{}", directed.name()),
+                        figure_value(f, directed),
+                    )),
+                    None => out.push_str("<td></td>"),
                 }
             }
         }
         if let [(_, before), (_, after)] = figures.as_slice() {
-            let change = figure_value(before, key)
-                .zip(figure_value(after, key))
+            let change = figure_value(before, figure)
+                .zip(figure_value(after, figure))
                 .map(|(b, a)| a - b);
             let _ = write!(out, "<td class=\"num\">{}</td>", um(change));
         }
@@ -752,19 +746,18 @@ fn inch_figures(out: &mut String, tests: &[(&str, &TestRecord<'_>)]) {
         let f = FiguresJson::from_figures(&test.evaluation.figures);
         let parts: Vec<String> = FIGURE_ROWS
             .iter()
-            .flat_map(|(_, key, directional)| {
-                let keys = if *directional {
-                    vec![
-                        (key.to_string(), ""),
-                        (format!("{key}_up"), "↑"),
-                        (format!("{key}_down"), "↓"),
-                    ]
-                } else {
-                    vec![(key.to_string(), "")]
-                };
-                keys.into_iter().filter_map(move |(full, arrow)| {
-                    let um = figure_value(&f, &full)?;
-                    let name = if *key == "B_mean" { "B̄" } else { key };
+            .flat_map(|&(_, figure)| {
+                let directed = [(Direction::Up, "↑"), (Direction::Down, "↓")]
+                    .into_iter()
+                    .filter_map(move |(d, arrow)| Some((figure.directed(d)?, arrow)));
+                let figures = std::iter::once((figure, "")).chain(directed);
+                figures.filter_map(move |(shown, arrow)| {
+                    let um = figure_value(&f, shown)?;
+                    let name = if figure == Figure::BMean {
+                        "B̄"
+                    } else {
+                        figure.name()
+                    };
                     Some(format!(
                         "{name}{arrow} {} in",
                         inch_text(LengthUnit::Inch.from_mm(um_to_mm(um)))
@@ -1050,13 +1043,13 @@ fn diagnosis_figures(out: &mut String, diagnosis: &Diagnosis) {
         let _ = write!(out, "<th>{label}</th>");
     }
     out.push_str("</tr></thead><tbody>\n");
-    for (label, key, _) in FIGURE_ROWS {
+    for (label, figure) in FIGURE_ROWS {
         let _ = write!(out, "<tr><th>{label}</th>");
         for (set, _, figures) in &sets {
             let json = FiguresJson::from_figures(figures);
             out.push_str(&um_cell(
-                &format!("diagnosis.figures.{set}.{key}"),
-                figure_value(&json, key),
+                &format!("diagnosis.figures.{set}.{}", figure.name()),
+                figure_value(&json, figure),
             ));
         }
         out.push_str("</tr>\n");

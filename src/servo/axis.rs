@@ -21,6 +21,7 @@
 
 use serde::Deserialize;
 
+use super::ServoError;
 use crate::error::ParseError;
 use crate::servo::friction::{Classic, Friction, FrictionKind, LuGre, Power, Ramp};
 
@@ -135,27 +136,6 @@ pub struct FrictionParams {
     pub stribeck_velocity_m_per_s: f64,
 }
 
-/// Why an axis file was refused.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum AxisError {
-    /// The TOML did not parse or did not match the layout.
-    #[error("{0}")]
-    Parse(ParseError),
-    /// A value is out of its physical range.
-    #[error("{key}: expected {expected}, found {found}")]
-    Value {
-        /// The key, as `motor.resistance_ohm`.
-        key: &'static str,
-        /// What is allowed.
-        expected: &'static str,
-        /// The value found.
-        found: f64,
-    },
-    /// `--axis NAME` names no bundled axis.
-    #[error("unknown axis {0:?}; bundled: mcfv5050-x, mcfv5050-y (or give a .toml file)")]
-    UnknownBundled(String),
-}
-
 impl Axis {
     /// A bundled axis by name (`mcfv5050-x`, `mcfv5050-y`).
     ///
@@ -167,19 +147,19 @@ impl Axis {
     /// assert_eq!(x.mass_kg, 225.0); // Tab. 6.3
     /// assert!(Axis::bundled("mcfv5050-z").is_err());
     /// ```
-    pub fn bundled(name: &str) -> Result<Axis, AxisError> {
+    pub fn bundled(name: &str) -> Result<Axis, ServoError> {
         let text = match name.to_ascii_lowercase().as_str() {
             "mcfv5050-x" => MCFV5050_X_TOML,
             "mcfv5050-y" => MCFV5050_Y_TOML,
-            _ => return Err(AxisError::UnknownBundled(name.to_string())),
+            _ => return Err(ServoError::UnknownBundled(name.to_string())),
         };
         Axis::from_toml_str(text)
     }
 
     /// Parses and validates an axis file.
-    pub fn from_toml_str(text: &str) -> Result<Axis, AxisError> {
+    pub fn from_toml_str(text: &str) -> Result<Axis, ServoError> {
         let axis: Axis = toml::from_str(text)
-            .map_err(|error| AxisError::Parse(ParseError::from_toml(text, &error)))?;
+            .map_err(|error| ServoError::Parse(ParseError::from_toml(text, &error)))?;
         axis.validate()?;
         Ok(axis)
     }
@@ -217,7 +197,7 @@ impl Axis {
         }
     }
 
-    fn validate(&self) -> Result<(), AxisError> {
+    fn validate(&self) -> Result<(), ServoError> {
         let positive: [(&'static str, f64); 17] = [
             ("mass_kg", self.mass_kg),
             ("motor.resistance_ohm", self.motor.resistance_ohm),
@@ -341,8 +321,8 @@ impl Axis {
     }
 }
 
-fn value_error(key: &'static str, expected: &'static str, found: f64) -> AxisError {
-    AxisError::Value {
+fn value_error(key: &'static str, expected: &'static str, found: f64) -> ServoError {
+    ServoError::Value {
         key,
         expected,
         found,
@@ -392,7 +372,7 @@ mod tests {
     fn bad_files_are_refused_with_a_position_or_a_key() {
         let bad_toml = MCFV5050_X_TOML.replace("mass_kg = 225.0", "mass_kg = heavy");
         match Axis::from_toml_str(&bad_toml) {
-            Err(AxisError::Parse(error)) => {
+            Err(ServoError::Parse(error)) => {
                 // `mass_kg` is on line 9 of the bundled file.
                 assert_eq!(error.position.line, 9, "{error}");
             }
@@ -401,7 +381,7 @@ mod tests {
         let unknown = MCFV5050_X_TOML.replace("mass_kg", "masss_kg");
         assert!(matches!(
             Axis::from_toml_str(&unknown),
-            Err(AxisError::Parse(_))
+            Err(ServoError::Parse(_))
         ));
         let negative = MCFV5050_X_TOML.replace("resistance_ohm = 1.8", "resistance_ohm = -1.8");
         assert_eq!(

@@ -29,6 +29,7 @@
 //! The readings make a [`Measurement`] (mm, as everywhere in axcomp), so
 //! `evaluate::evaluate` gives the ISO 230-2 figures, B and B̄ among them.
 
+use super::ServoError;
 use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::{Direction, Environment, Measurement, MeasurementError, Metadata, Run};
 use crate::servo::axis::Axis;
@@ -145,17 +146,6 @@ impl IsoResult {
     }
 }
 
-/// Why a cycle cannot be simulated.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum IsoError {
-    /// A parameter out of range.
-    #[error("{0}")]
-    Invalid(&'static str),
-    /// The readings did not make a valid measurement (not expected).
-    #[error("simulated readings: {0}")]
-    Measurement(#[from] MeasurementError),
-}
-
 impl IsoCycle {
     /// `count` targets evenly spaced from `first_m` to `last_m`.
     pub fn evenly_spaced(first_m: f64, last_m: f64, count: usize) -> Vec<f64> {
@@ -166,24 +156,24 @@ impl IsoCycle {
         (0..count).map(|i| first_m + step * i as f64).collect()
     }
 
-    fn check(&self) -> Result<(), IsoError> {
+    fn check(&self) -> Result<(), ServoError> {
         let finite_increasing = self
             .targets_m
             .windows(2)
             .all(|pair| pair[0].is_finite() && pair[1].is_finite() && pair[1] > pair[0]);
         if self.targets_m.is_empty() || !finite_increasing {
-            return Err(IsoError::Invalid(
+            return Err(ServoError::Invalid(
                 "targets must be finite and strictly increasing",
             ));
         }
         if self.runs == 0 {
-            return Err(IsoError::Invalid("at least one run is needed"));
+            return Err(ServoError::Invalid("at least one run is needed"));
         }
         if !(self.dwell_s.is_finite() && self.dwell_s >= 0.0) {
-            return Err(IsoError::Invalid("dwell must be a finite number ≥ 0 s"));
+            return Err(ServoError::Invalid("dwell must be a finite number ≥ 0 s"));
         }
         if !(self.overrun_m.is_finite() && self.overrun_m > 0.0) {
-            return Err(IsoError::Invalid(
+            return Err(ServoError::Invalid(
                 "overrun must be > 0 so that each direction starts with a reversal",
             ));
         }
@@ -193,7 +183,7 @@ impl IsoCycle {
             self.limits.jerk_m_per_s3,
         ];
         if limits.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-            return Err(IsoError::Invalid(
+            return Err(ServoError::Invalid(
                 "feed, acceleration and jerk must be finite and > 0",
             ));
         }
@@ -251,12 +241,12 @@ pub fn run_iso_cycle(
     cycle: &IsoCycle,
     options: IsoOptions,
     progress: &mut dyn FnMut(f64),
-) -> Result<IsoResult, IsoError> {
+) -> Result<IsoResult, ServoError> {
     cycle.check()?;
     if let Some(k) = options.compliance_n_per_um
         && !(k.is_finite() && k > 0.0)
     {
-        return Err(IsoError::Invalid(
+        return Err(ServoError::Invalid(
             "compliance stiffness must be finite and > 0",
         ));
     }

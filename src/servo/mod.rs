@@ -42,5 +42,37 @@ pub mod reversal;
 pub mod simulate;
 pub mod trajectory;
 
+use crate::error::ParseError;
+use crate::measurement::MeasurementError;
+
+/// Why the servo stage refuses: an axis file, a bundled name, or a cycle's
+/// parameters (one error type for the stage).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ServoError {
+    /// The TOML did not parse or did not match the layout.
+    #[error("{0}")]
+    Parse(ParseError),
+    /// A value is out of its physical range.
+    #[error("{key}: expected {expected}, found {found}")]
+    Value {
+        /// The key, as `motor.resistance_ohm`.
+        key: &'static str,
+        /// What is allowed.
+        expected: &'static str,
+        /// The value found.
+        found: f64,
+    },
+    /// `--axis NAME` names no bundled axis.
+    #[error("unknown axis {0:?}; bundled: mcfv5050-x, mcfv5050-y (or give a .toml file)")]
+    UnknownBundled(String),
+
+    /// A parameter out of range.
+    #[error("{0}")]
+    Invalid(&'static str),
+    /// The readings did not make a valid measurement (not expected).
+    #[error("simulated readings: {0}")]
+    Measurement(#[from] MeasurementError),
+}
+
 #[cfg(test)]
 mod tests;
