@@ -89,32 +89,21 @@ impl From<ParseError> for FileError {
     }
 }
 
-impl From<ModelError> for FileError {
-    fn from(error: ModelError) -> FileError {
-        match error {
-            ModelError::Toml(parse) => FileError::At(parse),
-            other => FileError::Whole(other.to_string()),
+/// A stage's error whose one variant carries a position (`ParseError`).
+macro_rules! positioned {
+    ($($error:ident::$variant:ident),*) => {$(
+        impl From<$error> for FileError {
+            fn from(error: $error) -> FileError {
+                match error {
+                    $error::$variant(parse) => FileError::At(parse),
+                    other => FileError::Whole(other.to_string()),
+                }
+            }
         }
-    }
+    )*};
 }
 
-impl From<ServoError> for FileError {
-    fn from(error: ServoError) -> FileError {
-        match error {
-            ServoError::Parse(parse) => FileError::At(parse),
-            other => FileError::Whole(other.to_string()),
-        }
-    }
-}
-
-impl From<SynthError> for FileError {
-    fn from(error: SynthError) -> FileError {
-        match error {
-            SynthError::Toml(parse) => FileError::At(parse),
-            other => FileError::Whole(other.to_string()),
-        }
-    }
-}
+positioned!(ModelError::Toml, ServoError::Parse, SynthError::Toml);
 
 impl From<EmitError> for FileError {
     fn from(error: EmitError) -> FileError {
