@@ -494,8 +494,11 @@ impl RtlParser {
             }
             return Ok(());
         }
-        let fields: Vec<&str> = line.fields().collect();
-        if fields.len() != 3 {
+        let mut fields = line.fields();
+        let (Some(run), Some(target), Some(value), None) =
+            (fields.next(), fields.next(), fields.next(), fields.next())
+        else {
+            let fields: Vec<&str> = line.fields().collect();
             let at = fields.get(3).copied().unwrap_or(line.text.trim_start());
             return Err(line.error_at(
                 at,
@@ -504,8 +507,7 @@ impl RtlParser {
                     fields.len()
                 ),
             ));
-        }
-        let (run, target, value) = (fields[0], fields[1], fields[2]);
+        };
         let file_run = text::integer(line, run, "run number")?;
         let Some(run_count) = self.run_count else {
             return Err(line.error_at(run, "deviation row before RUNS:: Run-count"));
@@ -533,6 +535,15 @@ impl RtlParser {
         check_deviation_mm(um_to_mm(deviation_um), line.number, line.column_of(value))?;
         let file_run = file_run as u32;
         let target_number = target_number as usize;
+        if self.rows.is_empty() {
+            // Room for every (run, target) pair the file announces, so that
+            // a large file is not rehashed a dozen times (bounded: a
+            // Run-count of a billion must not reserve gigabytes).
+            let pairs = u64::from(run_count.value).saturating_mul(listed);
+            let capacity = usize::try_from(pairs.min(1 << 20)).unwrap_or(0);
+            self.row_lookup.reserve(capacity);
+            self.rows.reserve(capacity);
+        }
         if let Some(first_line) = self
             .row_lookup
             .insert((file_run, target_number), line.number)
