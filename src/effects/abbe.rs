@@ -54,6 +54,10 @@ impl Model for Abbe {
             Parameter::number("angle_urad", "angle", "µrad", self.angle_urad),
         ]
     }
+
+    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+        format!("Abbe, offset {} mm", number(self.offset_mm))
+    }
 }
 
 impl Fit for Abbe {

@@ -52,6 +52,10 @@ impl Model for Drift {
             self.rate_um_per_h,
         )]
     }
+
+    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+        format!("drift {} µm/h", number(self.rate_um_per_h))
+    }
 }
 
 impl Fit for Drift {

@@ -213,6 +213,10 @@ pub trait Model {
     /// The parameters, in the order they are shown and saved.
     fn parameters(&self) -> Vec<Parameter>;
 
+    /// A short legend label with the fitted parameters, each number written
+    /// by `number` (the plot's own tick format).
+    fn label(&self, number: &dyn Fn(f64) -> String) -> String;
+
     /// A check beyond the types, for an effect read from a file.
     fn check(&self) -> Result<(), String> {
         Ok(())

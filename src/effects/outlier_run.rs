@@ -80,6 +80,15 @@ impl Model for OutlierRun {
             Parameter::number("offset_um", "offset", "µm", self.offset_um),
         ]
     }
+
+    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+        format!(
+            "run {}{} offset {} µm",
+            self.run,
+            self.direction,
+            number(self.offset_um)
+        )
+    }
 }
 
 impl Fit for OutlierRun {

@@ -67,6 +67,14 @@ impl Model for Periodic {
         ]
     }
 
+    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+        format!(
+            "periodic {} µm, period {} mm",
+            number(self.amplitude_um),
+            number(self.period_mm)
+        )
+    }
+
     fn check(&self) -> Result<(), String> {
         if self.period_mm > 0.0 && self.period_mm.is_finite() {
             Ok(())

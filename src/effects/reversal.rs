@@ -53,6 +53,10 @@ impl Model for Reversal {
     fn parameters(&self) -> Vec<Parameter> {
         vec![Parameter::number("B_um", "B", "µm", self.b_um)]
     }
+
+    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+        format!("reversal B = {} µm", number(self.b_um))
+    }
 }
 
 impl Fit for Reversal {

@@ -62,6 +62,10 @@ impl Model for Scale {
             self.scale_um_per_m,
         )]
     }
+
+    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+        format!("scale {} µm/m", number(self.scale_um_per_m))
+    }
 }
 
 impl Fit for Scale {

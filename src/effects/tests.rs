@@ -211,3 +211,18 @@ fn bad_effects_are_refused_with_a_position() {
     assert!(infinite.message.contains("finite"), "{infinite}");
     assert!(read_effects("").unwrap().is_empty());
 }
+
+#[test]
+fn every_kind_labels_itself_with_the_numbers_it_is_given() {
+    let two_decimals = |v: f64| format!("{v:.2}");
+    let labels: Vec<String> = one_of_each()
+        .iter()
+        .map(|e| e.model().label(&two_decimals))
+        .collect();
+    assert_eq!(labels[0], "reversal B = -3.00 µm");
+    assert_eq!(labels[3], "periodic 1.25 µm, period 5.00 mm");
+    assert_eq!(labels[4], "run 2↓ offset 4.50 µm");
+    for (label, kind) in labels.iter().zip(Kind::ALL) {
+        assert!(label.to_lowercase().contains(&kind.name().replace("outlier-", "")), "{label}");
+    }
+}

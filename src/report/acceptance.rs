@@ -11,7 +11,7 @@
 use crate::compensate::CompensationTable;
 use crate::compensate::retest::{Applied, KnownError, predicted_deviation_mm, with_scatter};
 use crate::diagnose::{Diagnosis, ReadingResidual};
-use crate::effects::{Abbe, Drift, Effect, Line, OutlierRun, Periodic, Reversal, Scale};
+use crate::effects::{Effect, Line};
 use crate::emit::Controller;
 use crate::error::Warning;
 use crate::evaluate::{AxisFigures, DirectionStats, Evaluation, TargetStats, evaluate};
@@ -694,26 +694,5 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
 /// A short legend label with the fitted parameters, in the plot font's characters.
 pub fn effect_label(effect: &Effect) -> String {
     let signed = |v: f64| crate::report::chart::tick_label((v * 100.0).round() / 100.0);
-    match *effect {
-        Effect::Reversal(Reversal { b_um }) => format!("reversal B = {} µm", signed(b_um)),
-        Effect::Scale(Scale { scale_um_per_m }) => {
-            format!("scale {} µm/m", signed(scale_um_per_m))
-        }
-        Effect::Drift(Drift { rate_um_per_h }) => format!("drift {} µm/h", signed(rate_um_per_h)),
-        Effect::Periodic(Periodic {
-            period_mm,
-            amplitude_um,
-            ..
-        }) => format!(
-            "periodic {} µm, period {} mm",
-            signed(amplitude_um),
-            signed(period_mm)
-        ),
-        Effect::OutlierRun(OutlierRun {
-            run,
-            direction,
-            offset_um,
-        }) => format!("run {run}{direction} offset {} µm", signed(offset_um)),
-        Effect::Abbe(Abbe { offset_mm, .. }) => format!("Abbe, offset {} mm", signed(offset_mm)),
-    }
+    effect.model().label(&signed)
 }

@@ -40,7 +40,7 @@ use crate::evaluate::environment::{
 use crate::measurement::{
     Direction, Environment, Measurement, MeasurementError, Metadata, Run, StartEnd, TestDate,
 };
-use crate::units::{mm_to_m, mm_to_um, per_m_over_mm, um_to_mm, urad_times_mm_to_um};
+use crate::units::{mm_to_m, mm_to_um, per_m_over_mm, um_to_mm};
 pub use truth::{EffectSpec, TargetSpec, TestKind, Truth};
 
 /// Why a truth cannot be turned into measurements.
@@ -278,53 +278,15 @@ fn effects_um(
     at_mm: f64,
     stroke: (f64, f64),
 ) -> f64 {
-    let (first, last) = stroke;
     let mut value = 0.0;
     for effect in truth.effects.iter().filter(|e| e.acts_in(test)) {
-        value += match effect {
-            EffectSpec::Reversal { B_um, .. } => match reading.direction {
-                Direction::Up => B_um / 2.0,
-                Direction::Down => -B_um / 2.0,
-            },
-            EffectSpec::Scale { scale_um_per_m, .. } => {
-                per_m_over_mm(*scale_um_per_m, at_mm - first)
-            }
-            EffectSpec::Drift { rate_um_per_h, .. } => rate_um_per_h * reading.time_s / 3600.0,
-            EffectSpec::Periodic {
-                period_mm,
-                amplitude_um,
-                phase_rad,
-                ..
-            } => amplitude_um * (std::f64::consts::TAU * at_mm / period_mm + phase_rad).sin(),
-            EffectSpec::OutlierRun {
-                run,
-                direction,
-                offset_um,
-                ..
-            } => {
-                let matches = *run == reading.run && direction == reading.direction.as_str();
-                if matches { *offset_um } else { 0.0 }
-            }
-            EffectSpec::Abbe {
-                offset_mm,
-                angle_urad,
-                ..
-            } => urad_times_mm_to_um(offset_mm * abbe_angle_urad(*angle_urad, at_mm, stroke)),
-            EffectSpec::Quadratic { sag_um, .. } => {
-                sag_um * 4.0 * (at_mm - first) * (last - at_mm) / ((last - first) * (last - first))
-            }
-            EffectSpec::Step {
-                position_mm,
-                step_um,
-                ..
-            } => {
-                if at_mm >= *position_mm {
-                    *step_um
-                } else {
-                    0.0
-                }
-            }
-        };
+        value += effect.value_um(
+            reading.direction,
+            reading.run,
+            reading.time_s,
+            at_mm,
+            stroke,
+        );
     }
     value
 }

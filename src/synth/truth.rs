@@ -49,6 +49,7 @@ use super::SynthError;
 use crate::effects::{Abbe, Drift, Effect, OutlierRun, Periodic, Reversal, Scale};
 use crate::error::ParseError;
 use crate::measurement::Direction;
+use crate::units::{per_m_over_mm, urad_times_mm_to_um};
 
 /// The whole truth file.
 #[derive(Clone, Debug, Deserialize)]
@@ -394,6 +395,68 @@ impl EffectSpec {
             }),
             EffectSpec::Quadratic { .. } | EffectSpec::Step { .. } => return None,
         })
+    }
+
+    /// What the effect adds to a reading, µm: taken `time_s` into the test
+    /// in run `run_number` moving `direction`, with the axis at `at_mm` of
+    /// `stroke` (first, last target). Position-dependent effects act where
+    /// the axis is, run- and time-dependent ones on the reading. This is the
+    /// truth's own arithmetic, independent of `crate::effects`.
+    pub fn value_um(
+        &self,
+        direction: Direction,
+        run_number: u32,
+        time_s: f64,
+        at_mm: f64,
+        stroke: (f64, f64),
+    ) -> f64 {
+        let (first, last) = stroke;
+        match self {
+            EffectSpec::Reversal { B_um, .. } => match direction {
+                Direction::Up => B_um / 2.0,
+                Direction::Down => -B_um / 2.0,
+            },
+            EffectSpec::Scale { scale_um_per_m, .. } => {
+                per_m_over_mm(*scale_um_per_m, at_mm - first)
+            }
+            EffectSpec::Drift { rate_um_per_h, .. } => rate_um_per_h * time_s / 3600.0,
+            EffectSpec::Periodic {
+                period_mm,
+                amplitude_um,
+                phase_rad,
+                ..
+            } => amplitude_um * (std::f64::consts::TAU * at_mm / period_mm + phase_rad).sin(),
+            EffectSpec::OutlierRun {
+                run,
+                direction: of_run,
+                offset_um,
+                ..
+            } => {
+                let matches = *run == run_number && of_run == direction.as_str();
+                if matches { *offset_um } else { 0.0 }
+            }
+            EffectSpec::Abbe {
+                offset_mm,
+                angle_urad,
+                ..
+            } => {
+                urad_times_mm_to_um(offset_mm * super::abbe_angle_urad(*angle_urad, at_mm, stroke))
+            }
+            EffectSpec::Quadratic { sag_um, .. } => {
+                sag_um * 4.0 * (at_mm - first) * (last - at_mm) / ((last - first) * (last - first))
+            }
+            EffectSpec::Step {
+                position_mm,
+                step_um,
+                ..
+            } => {
+                if at_mm >= *position_mm {
+                    *step_um
+                } else {
+                    0.0
+                }
+            }
+        }
     }
 
     /// Whether the effect acts in a test.
