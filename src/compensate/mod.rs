@@ -220,6 +220,9 @@ pub enum CompensateError {
     /// No target has a mean deviation.
     #[error("no target has a mean deviation to compensate")]
     NoData,
+    /// The backlash parameter cannot be applied as said.
+    #[error("the backlash parameter {0}")]
+    Backlash(retest::BacklashRefusal),
     /// The controller needs one step and the targets have none.
     #[error(
         "the targets are unevenly spaced ({count} targets from {first_mm} to {last_mm} mm) and {controller} needs one step: give --step (and optionally --start, --count)"

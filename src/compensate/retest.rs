@@ -26,6 +26,8 @@
 //! the first test could not show) is in the difference between this and the
 //! re-test; that is what `diagnose` explains.
 
+use std::fmt;
+
 use crate::compensate::CompensationTable;
 use crate::evaluate::Evaluation;
 use crate::measurement::{Direction, Measurement, MeasurementError};
@@ -161,19 +163,28 @@ pub struct Applied<'a> {
     pub backlash_reversal_mm: f64,
 }
 
-/// Why the backlash parameter cannot be applied as said.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum BacklashError {
+/// Why the backlash parameter cannot be applied as said: the reason inside
+/// [`CompensateError::Backlash`] and predict's per-axis message, a sentence's
+/// predicate ("the backlash parameter …").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BacklashRefusal {
     /// A bidirectional table takes the reversal out already.
-    #[error(
-        "must be 0 with a bidirectional table, which already takes the reversal out (drop --backlash-set)"
-    )]
     WithBidirectionalTable,
     /// The first test does not give B̄.
-    #[error(
-        "is set as convert suggests (−B̄), but there is no bidirectional first test of the axis to give B̄"
-    )]
     NoMeasuredReversal,
+}
+
+impl fmt::Display for BacklashRefusal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            BacklashRefusal::WithBidirectionalTable => {
+                "must be 0 with a bidirectional table, which already takes the reversal out (drop --backlash-set)"
+            }
+            BacklashRefusal::NoMeasuredReversal => {
+                "is set as convert suggests (−B̄), but there is no bidirectional first test of the axis to give B̄"
+            }
+        })
+    }
 }
 
 impl<'a> Applied<'a> {
@@ -193,7 +204,7 @@ impl<'a> Applied<'a> {
         table: Option<&'a CompensationTable>,
         known: Option<&KnownError>,
         backlash_set: bool,
-    ) -> Result<Applied<'a>, BacklashError> {
+    ) -> Result<Applied<'a>, BacklashRefusal> {
         if !backlash_set {
             return Ok(Applied {
                 table,
@@ -201,11 +212,11 @@ impl<'a> Applied<'a> {
             });
         }
         if table.is_some_and(|t| t.values.mode() == crate::compensate::TableMode::Bidirectional) {
-            return Err(BacklashError::WithBidirectionalTable);
+            return Err(BacklashRefusal::WithBidirectionalTable);
         }
         let known = known
             .filter(|k| k.is_bidirectional())
-            .ok_or(BacklashError::NoMeasuredReversal)?;
+            .ok_or(BacklashRefusal::NoMeasuredReversal)?;
         Ok(Applied {
             table,
             backlash_reversal_mm: known.mean_reversal_mm(),

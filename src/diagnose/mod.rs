@@ -43,8 +43,8 @@ mod unexplained;
 
 pub use angular_profile::AngularProfile;
 
+use crate::compensate::CompensateError;
 use crate::compensate::CompensationTable;
-use crate::compensate::retest::BacklashError;
 use crate::cycle::CycleTiming;
 use crate::effects::{Effect, FileEntry, Kind, Reading, Reversal, Shape};
 use crate::evaluate::AxisFigures;
@@ -228,9 +228,9 @@ pub enum DiagnoseError {
     /// The first test has no usable means.
     #[error("the first test has no target with a mean deviation")]
     NoKnownError,
-    /// The backlash parameter cannot be applied as said.
-    #[error("the backlash parameter {0}")]
-    Backlash(#[from] BacklashError),
+    /// A table cannot be applied as said (the backlash parameter).
+    #[error(transparent)]
+    Compensate(#[from] CompensateError),
     /// The two tests (or the table) do not belong together: another axis,
     /// ranges without a common stretch, the same readings twice.
     #[error(transparent)]

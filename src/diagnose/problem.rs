@@ -5,10 +5,10 @@
 use super::fit::Design;
 use super::selection::Chosen;
 use super::{DiagnoseError, DiagnoseInput};
-use crate::compensate::interpolate_hold;
 use crate::compensate::retest::{
-    Applied, BacklashError, KnownError, predicted_deviation_mm, with_scatter,
+    Applied, BacklashRefusal, KnownError, predicted_deviation_mm, with_scatter,
 };
+use crate::compensate::{CompensateError, interpolate_hold};
 use crate::cycle::{self, CycleTiming};
 use crate::effects::{Line, Reading, Shape};
 use crate::evaluate::{Evaluation, evaluate};
@@ -112,14 +112,17 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
                 KnownError::from_evaluation(&evaluation).ok_or(DiagnoseError::NoKnownError)?;
             Some((known, mean_variances(&evaluation)))
         }
-        None if input.backlash_set => return Err(BacklashError::NoMeasuredReversal.into()),
+        None if input.backlash_set => {
+            return Err(CompensateError::Backlash(BacklashRefusal::NoMeasuredReversal).into());
+        }
         None => None,
     };
     let applied = Applied::with_backlash(
         input.table,
         first.as_ref().map(|(known, _)| known),
         input.backlash_set,
-    )?;
+    )
+    .map_err(CompensateError::Backlash)?;
     let first_test_prediction = match (input.before, &first) {
         (Some(before), Some((known, _))) => Some(
             with_scatter(before, &evaluate(before), |i, direction| {

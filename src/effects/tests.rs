@@ -223,6 +223,11 @@ fn every_kind_labels_itself_with_the_numbers_it_is_given() {
     assert_eq!(labels[3], "periodic 1.25 µm, period 5.00 mm");
     assert_eq!(labels[4], "run 2↓ offset 4.50 µm");
     for (label, kind) in labels.iter().zip(Kind::ALL) {
-        assert!(label.to_lowercase().contains(&kind.name().replace("outlier-", "")), "{label}");
+        assert!(
+            label
+                .to_lowercase()
+                .contains(&kind.name().replace("outlier-", "")),
+            "{label}"
+        );
     }
 }

@@ -61,7 +61,7 @@
 //!
 //! Pure: values in, values out.
 
-use crate::compensate::retest::{Applied, BacklashError, KnownError};
+use crate::compensate::retest::{Applied, BacklashRefusal, KnownError};
 use crate::compensate::{CompensationTable, TableMode};
 use crate::effects::Effect;
 use crate::evaluate::{AxisFigures, evaluate};
@@ -224,7 +224,7 @@ pub enum PredictError {
         /// The axis.
         axis: Axis,
         /// Why it cannot be applied.
-        why: BacklashError,
+        why: BacklashRefusal,
     },
     /// The model refused a value.
     #[error(transparent)]
