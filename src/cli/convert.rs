@@ -40,7 +40,7 @@ pub struct ConvertArgs {
     )]
     pub output: PathBuf,
 
-    /// Replace an existing output file.
+    /// `--force` (the same in every command).
     #[command(flatten)]
     pub overwrite: Overwrite,
 
@@ -119,7 +119,7 @@ pub struct ConvertArgs {
     #[arg(long = "also", value_name = "AXIS", help_heading = "Table")]
     pub also: Vec<String>,
 
-    /// Machine profile (TOML): axis names and numbers per controller, units, limits.
+    /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
 
@@ -131,7 +131,7 @@ pub struct ConvertArgs {
     #[arg(long = "linuxcnc-type", value_name = "0|1", default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Machine")]
     pub linuxcnc_type: u8,
 
-    /// Input format, instead of detecting it: rtl, ecmc, api-pos, csv.
+    /// `--format` (the same in every command).
     #[command(flatten)]
     pub input_format: InputFormat,
 
@@ -139,7 +139,7 @@ pub struct ConvertArgs {
     #[arg(long = "exclude-run", value_name = "RUN[:DIR]", value_parser = parse_run_selector, help_heading = "Input")]
     pub exclude_runs: Vec<RunSelector>,
 
-    /// Print the table as one JSON object instead of the summary.
+    /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
 

@@ -44,7 +44,7 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "NAME")]
     pub axis: Option<String>,
 
-    /// Machine profile, to read the table's axis names (as in convert).
+    /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
 
@@ -57,15 +57,15 @@ pub struct DiagnoseArgs {
     #[arg(long = "write-effects", value_name = "E.toml")]
     pub write_effects: Option<PathBuf>,
 
-    /// Replace an existing --write-effects file.
+    /// `--force` (the same in every command).
     #[command(flatten)]
     pub overwrite: Overwrite,
 
-    /// LinuxCNC table type, when its numbers do not tell it.
+    /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
 
-    /// Print JSON instead of the report.
+    /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
 

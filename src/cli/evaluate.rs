@@ -25,7 +25,7 @@ pub struct EvaluateArgs {
     #[arg(required = true, num_args = 1..=2, value_name = "FILE")]
     pub files: Vec<PathBuf>,
 
-    /// Input format, instead of detecting it: rtl, ecmc, api-pos, csv.
+    /// `--format` (the same in every command).
     #[command(flatten)]
     pub input_format: InputFormat,
 
@@ -46,17 +46,14 @@ pub struct EvaluateArgs {
     #[arg(long = "exclude-run", value_name = "RUN[:DIR]", value_parser = parse_run_selector, help_heading = "Evaluation")]
     pub exclude_runs: Vec<RunSelector>,
 
-    /// Machine profile (TOML): its [acceptance] table gives permissible values.
-    ///
-    /// See README.md for the table: a fixed µm value or one per 1000 mm of
-    /// measured travel with a minimum, per axis if wanted. --limit overrides it.
+    /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
 
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
-    /// Print one JSON object (units in the keys) instead of the report.
+    /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
 

@@ -23,8 +23,7 @@ use super::common::{
 /// Flags of `axcomp predict`.
 #[derive(Debug, clap::Args)]
 pub struct PredictArgs {
-    /// Machine description (TOML: [kinematics], and [controller] for reading
-    /// tables); default: the bundled MCV 754 Quick.
+    /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
 
@@ -81,11 +80,11 @@ pub struct PredictArgs {
     )]
     pub grid: f64,
 
-    /// LinuxCNC table type, when its numbers do not tell it.
+    /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
 
-    /// Print JSON instead of the report.
+    /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
 

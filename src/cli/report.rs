@@ -56,7 +56,7 @@ pub struct ReportArgs {
     #[arg(long, requires = "after", help_heading = "Input")]
     pub diagnose: bool,
 
-    /// Input format of FILE and FILE2, instead of detecting it: rtl, ecmc, api-pos, csv.
+    /// `--format` (the same in every command).
     #[command(flatten)]
     pub input_format: InputFormat,
 
@@ -65,15 +65,14 @@ pub struct ReportArgs {
     #[arg(long, value_name = "NAME", help_heading = "Input")]
     pub axis: Option<String>,
 
-    /// Machine profile (TOML): the table's axis names (as in convert) and the
-    /// [acceptance] table's permissible values for the verdict box.
+    /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
 
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
-    /// LinuxCNC table type, 0 or 1, when its numbers do not tell it.
+    /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
 
@@ -96,7 +95,7 @@ pub struct ReportArgs {
     #[arg(long, value_name = "DIR", help_heading = "Output")]
     pub png: Option<PathBuf>,
 
-    /// Replace existing output files.
+    /// `--force` (the same in every command).
     #[command(flatten)]
     pub overwrite: Overwrite,
 

@@ -195,7 +195,7 @@ pub struct ServoSimArgs {
     #[arg(long, help_heading = "Numerics")]
     pub reference: bool,
 
-    /// Print one JSON object (units in the keys) instead of the report.
+    /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
 
@@ -203,7 +203,7 @@ pub struct ServoSimArgs {
     #[arg(long, value_name = "OUT", help_heading = "Output")]
     pub csv: Option<PathBuf>,
 
-    /// Replace an existing --csv file.
+    /// `--force` (the same in every command).
     #[command(flatten)]
     pub overwrite: Overwrite,
 

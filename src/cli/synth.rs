@@ -36,15 +36,15 @@ pub struct SynthArgs {
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
 
-    /// Machine profile, to read the table's axis names (as in convert).
+    /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
 
-    /// LinuxCNC table type, when its numbers do not tell it.
+    /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
 
-    /// Replace existing output files.
+    /// `--force` (the same in every command).
     #[command(flatten)]
     pub overwrite: Overwrite,
 

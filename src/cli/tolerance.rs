@@ -31,11 +31,7 @@ use super::progress;
 /// Flags of `axcomp tolerance`.
 #[derive(Debug, clap::Args)]
 pub struct ToleranceArgs {
-    /// Machine profile (TOML) with a [kinematics] table; default: the bundled MCV 754 Quick.
-    ///
-    /// The table is documented in src/model/machine.rs and, with every
-    /// assumed dimension, in fixtures/machines/mcv754-quick.toml (whose
-    /// [controller] table is what `axcomp convert --machine` reads).
+    /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
 
@@ -132,7 +128,7 @@ pub struct ToleranceArgs {
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub histogram: Option<PathBuf>,
 
-    /// Replace an existing histogram file.
+    /// `--force` (the same in every command).
     #[command(flatten)]
     pub overwrite: Overwrite,
 
@@ -140,7 +136,7 @@ pub struct ToleranceArgs {
     #[arg(long, value_name = "N", value_parser = parse_samples, help_heading = "Study")]
     pub threads: Option<usize>,
 
-    /// Print one JSON object (units in the keys) instead of the report.
+    /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
 
