@@ -29,7 +29,7 @@ fn direction<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Direction, D:
         "up" => Ok(Direction::Up),
         "down" => Ok(Direction::Down),
         other => Err(serde::de::Error::custom(format!(
-            "direction must be \"up\" or \"down\", found {other:?}"
+            "outlier-run: direction must be \"up\" or \"down\", found {other:?}"
         ))),
     }
 }
