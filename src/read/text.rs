@@ -116,6 +116,19 @@ pub fn consumed<'a>(input: &'a str, rest: &str) -> &'a str {
 pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseError> {
     // Only an error needs the text (formatting it for every reading was a
     // fifth of the time a large file took to read).
+    // The common case first: a token of digits, sign, point and exponent
+    // letters that the standard parser takes is a decimal of the grammar
+    // below (which would parse the same token with the same parser); every
+    // other token goes through the grammar for its message.
+    let plain = token
+        .bytes()
+        .all(|b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E'));
+    if plain
+        && let Ok(value) = token.parse::<f64>()
+        && value.is_finite()
+    {
+        return Ok(value);
+    }
     let expected = || format!("a number ({what})");
     let Ok((rest, digits)) = decimal(token) else {
         return Err(line.expected_at(token, &expected()));

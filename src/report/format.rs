@@ -11,11 +11,49 @@ pub const NOT_EVALUATED: &str = "—";
 
 /// Formats an optional µm value with two decimals, or `—`.
 pub fn um(value: Option<f64>) -> String {
-    value.map_or_else(
-        || NOT_EVALUATED.to_string(),
+    let mut text = String::new();
+    push_um(&mut text, value);
+    text
+}
+
+/// Appends [`um`]'s text to `out`, without a `String` of its own (a large
+/// test's per-target table has a hundred thousand of these).
+pub fn push_um(out: &mut String, value: Option<f64>) {
+    match value {
+        None => out.push_str(NOT_EVALUATED),
         // −0.004 µm is 0.00, not "-0.00".
-        |v| format!("{:.2}", if v.abs() < 0.005 { 0.0 } else { v }),
-    )
+        Some(v) if v.abs() < 0.005 => out.push_str("0.00"),
+        Some(v) => push_two_decimals(out, v),
+    }
+}
+
+/// Appends `format!("{:.2}", value)` to `out`, the same text, faster.
+///
+/// The standard formatter rounds the exact binary value to two decimals,
+/// which takes arbitrary-precision arithmetic. `value × 100` rounded to an
+/// integer gives the same digits whenever the product is not within its own
+/// rounding error (under 1e-7 for |value| < 1e7) of a half: there the
+/// standard formatter decides.
+fn push_two_decimals(out: &mut String, value: f64) {
+    use std::fmt::Write;
+    let scaled = value * 100.0;
+    let rounded = scaled.round();
+    let clear_of_a_tie = 0.5 - (scaled - rounded).abs() > 1e-6;
+    if scaled.abs() < 1e9 && clear_of_a_tie && rounded != 0.0 {
+        // |rounded| < 1e9, so the cast is exact.
+        let hundredths = rounded as i64;
+        if hundredths < 0 {
+            out.push('-');
+        }
+        let hundredths = hundredths.unsigned_abs();
+        push_integer(out, hundredths / 100);
+        let cents = hundredths % 100;
+        out.push('.');
+        out.push(char::from(b'0' + (cents / 10) as u8));
+        out.push(char::from(b'0' + (cents % 10) as u8));
+        return;
+    }
+    let _ = write!(out, "{value:.2}");
 }
 
 /// A length in an inch file's own unit, ` (… in)`, beside the mm; empty for mm files.
@@ -70,4 +108,97 @@ pub fn um_cell(key: &str, value: Option<f64>) -> String {
 pub fn source(key: &str, value: Option<f64>) -> String {
     let full = value.map_or_else(|| "null".to_string(), |v| v.to_string());
     format!("data-key=\"{}\" data-um=\"{full}\"", esc(key))
+}
+
+/// Appends the decimal digits of `value` (what `{}` writes, without the
+/// formatting machinery: the large per-target table writes 120 000 numbers).
+pub fn push_integer(out: &mut String, value: u64) {
+    let mut digits = [0u8; 20];
+    let mut start = digits.len();
+    let mut rest = value;
+    loop {
+        start -= 1;
+        digits[start] = b'0' + (rest % 10) as u8;
+        rest /= 10;
+        if rest == 0 {
+            break;
+        }
+    }
+    for &digit in &digits[start..] {
+        out.push(char::from(digit));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The standard formatter is the definition `push_two_decimals` must match.
+    fn standard(value: f64) -> String {
+        format!("{value:.2}")
+    }
+
+    fn fast(value: f64) -> String {
+        let mut text = String::new();
+        push_two_decimals(&mut text, value);
+        text
+    }
+
+    #[test]
+    fn two_decimals_match_the_standard_formatter_at_ties_and_edges() {
+        // Decimal ties whose binary value lies just below or above the half,
+        // values that round to zero, and values past the fast path's range.
+        for value in [
+            0.125,
+            -0.125,
+            0.375,
+            1.005,
+            -1.005,
+            2.675,
+            0.015,
+            0.045,
+            1.115,
+            10.005,
+            0.005,
+            -0.005,
+            0.0049,
+            -0.0049,
+            0.0,
+            -0.0,
+            99.995,
+            1e7,
+            -1e7,
+            123456789.125,
+            1e300,
+            f64::MIN_POSITIVE,
+            0.994999,
+            0.995,
+            9.999,
+        ] {
+            assert_eq!(fast(value), standard(value), "{value:e}");
+        }
+        assert_eq!(um(Some(-0.004)), "0.00");
+        assert_eq!(um(Some(-1.236)), "-1.24");
+        assert_eq!(um(None), NOT_EVALUATED);
+        for value in [0, 7, 10, 99, 100, 12345, u64::MAX] {
+            let mut text = String::new();
+            push_integer(&mut text, value);
+            assert_eq!(text, value.to_string());
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn two_decimals_match_the_standard_formatter(value in -1e8f64..1e8) {
+            prop_assert_eq!(fast(value), standard(value));
+        }
+
+        #[test]
+        fn two_decimals_match_on_the_hundredths_grid(hundredths in -10_000_000i64..10_000_000, half in 0..3i64) {
+            // k/100 and (k + ½)/100: exactly the values where rounding is delicate.
+            let value = (hundredths as f64 + half as f64 * 0.5) / 100.0;
+            prop_assert_eq!(fast(value), standard(value));
+        }
+    }
 }
