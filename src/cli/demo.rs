@@ -352,7 +352,7 @@ fn summary(s: &Summary<'_>) -> String {
     );
     let _ = writeln!(
         out,
-        " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC: {} points (tables/)",
+        " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC, Fagor 8055, 8065: {} points (tables/)",
         s.table.values.mode().as_str(),
         s.table.positions_mm.len()
     );

@@ -103,9 +103,6 @@ pub fn update(existing: &str, table: &CompensationTable) -> Result<String, EmitE
         .iter()
         .rposition(|(content, _)| is_data(content))
         .unwrap_or(first_data);
-    if !segments.iter().any(|(c, _)| key_of(c) == NPOINTS) {
-        return Err(missing(NPOINTS));
-    }
     let bidirectional = table.values.mode() == crate::compensate::TableMode::Bidirectional;
     if bidirectional && !segments.iter().any(|(c, _)| key_of(c) == BIDIR) {
         return Err(missing(BIDIR));
@@ -323,15 +320,24 @@ pub fn read(input: &str, axis: &str) -> Result<CompensationTable, ParseError> {
             slots[index - 1] = Some((number_mm, line.number));
         }
     }
-    let Some((count, npoints_line, npoints_token)) = npoints else {
-        return Err(ParseError::new(
-            1,
-            1,
-            "expected a Fagor 8065 leadscrew table (/LSCRWDATA/NPOINTS and its DATA lines), found none",
-        ));
+    // Without NPOINTS (upstream's cut-down test file) the lists give the count.
+    let count = match &npoints {
+        Some((count, _, _)) => *count,
+        None if !lists[0].is_empty() => lists[0].len(),
+        None => {
+            return Err(ParseError::new(
+                1,
+                1,
+                "expected a Fagor 8065 leadscrew table (/LSCRWDATA/NPOINTS and its DATA lines), found none",
+            ));
+        }
+    };
+    let at_npoints = |message: String| match &npoints {
+        Some((_, line, token)) => line.error_at(token, message),
+        None => ParseError::new(1, 1, message),
     };
     if count < 2 {
-        return Err(npoints_line.error_at(npoints_token, "NPOINTS must be at least 2"));
+        return Err(at_npoints("NPOINTS must be at least 2".to_string()));
     }
     let mut columns: [Vec<f64>; 3] = [Vec::new(), Vec::new(), Vec::new()];
     for (which, slots) in lists.iter().enumerate() {
@@ -351,14 +357,11 @@ pub fn read(input: &str, axis: &str) -> Result<CompensationTable, ParseError> {
             match slots.get(index).copied().flatten() {
                 Some((value, _)) => columns[which].push(value),
                 None => {
-                    return Err(npoints_line.error_at(
-                        npoints_token,
-                        format!(
-                            "NPOINTS is {count}, but {} {} is missing",
-                            LISTS[which],
-                            index + 1
-                        ),
-                    ));
+                    return Err(at_npoints(format!(
+                        "NPOINTS is {count}, but {} {} is missing",
+                        LISTS[which],
+                        index + 1
+                    )));
                 }
             }
         }
