@@ -6,10 +6,10 @@
 use libfuzzer_sys::fuzz_target;
 
 use axcomp::emit::{self, EmitOptions, MachineProfile};
-use axcomp::read::decode;
+use axcomp::emit::decode_table;
 
 fuzz_target!(|bytes: &[u8]| {
-    let Ok(text) = decode(bytes) else { return };
+    let Ok((text, _)) = decode_table(bytes) else { return };
     let options = EmitOptions::for_axis(&MachineProfile::default(), "X", "X.COM").expect("X has defaults");
     let Ok((controller, table)) = emit::read_any(&text, &options, Some(0)) else { return };
     // What was read may still break a controller rule (e.g. a non-zero iTNC

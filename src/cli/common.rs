@@ -15,6 +15,7 @@ use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
+use axcomp::units::LengthUnit;
 
 /// `--format NAME`: one of the input formats.
 pub fn parse_format(name: &str) -> Result<SourceFormat, String> {
@@ -155,20 +156,31 @@ pub fn load_effects(path: &Path) -> Result<Vec<Effect>> {
 /// A compensation table for `axis` in any format `convert` writes; the
 /// machine profile names the axis's columns. A LinuxCNC table's type is told
 /// from its numbers; `linuxcnc_type` decides when they do not.
+///
+/// The file may be UTF-8, Latin-1 or UTF-16 with a byte-order mark (a Fagor
+/// 8065 `.mp`). A Fagor 8055 table is read in the profile's unit, else in
+/// `test_unit`, the unit of the test it belongs to
+/// (`MachineProfile::table_unit`).
 pub fn read_table(
     path: &Path,
     axis: &str,
     profile: &MachineProfile,
     linuxcnc_type: Option<u8>,
+    test_unit: LengthUnit,
 ) -> Result<(Controller, CompensationTable)> {
     let mut options = EmitOptions::for_axis(profile, axis, "")?;
     options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
-    load(path, |text| {
-        emit::read_any(text, &options, None).or_else(|error| match linuxcnc_type {
-            Some(kind) => emit::read_any(text, &options, Some(kind)),
+    let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
+    let (text, _) = emit::decode_table(&bytes).map_err(|error| in_file(path, error))?;
+    if emit::fagor8055::looks_like(&text) {
+        options.machine_unit = profile.table_unit(Controller::Fagor8055, test_unit);
+    }
+    emit::read_any(&text, &options, None)
+        .or_else(|error| match linuxcnc_type {
+            Some(kind) => emit::read_any(&text, &options, Some(kind)),
             None => Err(error),
         })
-    })
+        .map_err(|error| in_file(path, error))
 }
 
 /// The table that was active during `test` (named `test_label` in messages),
@@ -183,7 +195,8 @@ pub fn read_active_table(
     linuxcnc_type: Option<u8>,
 ) -> Result<(Controller, CompensationTable, Vec<Warning>)> {
     let axis = recorded_axis(test, "to say which axis the table is for")?;
-    let (controller, table) = read_table(path, axis, profile, linuxcnc_type)?;
+    let test_unit = test.metadata.length_unit;
+    let (controller, table) = read_table(path, axis, profile, linuxcnc_type, test_unit)?;
     let doubts = check_together(
         Pairing::TableOnTest,
         &Input::measurement(test, test_label),

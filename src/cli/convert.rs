@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use axcomp::compensate::plan::{Request, plan};
 use axcomp::compensate::{self, Extrapolate, TableMode};
@@ -27,7 +27,7 @@ pub struct ConvertArgs {
     #[arg(required = true, num_args = 1..=2, value_name = "FILE")]
     pub files: Vec<PathBuf>,
 
-    /// The controller: itnc530, tnc640, sinumerik840d or linuxcnc.
+    /// The controller: itnc530, tnc640, sinumerik840d, linuxcnc, fagor8055 or fagor8065.
     #[arg(long, value_name = "CONTROLLER", value_parser = parse_controller, help_heading = "Table")]
     pub controller: Controller,
 
@@ -104,7 +104,8 @@ pub struct ConvertArgs {
     /// The table that was active during the measurement (any format convert writes).
     ///
     /// The measurement then shows the residual; the new table is the old one
-    /// plus that residual, on the new grid.
+    /// plus that residual, on the new grid. A Fagor 8065 .mp file is updated
+    /// in place: only its leadscrew lines change.
     #[arg(long, value_name = "TABLE", help_heading = "Table")]
     pub existing: Option<PathBuf>,
 
@@ -195,6 +196,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     }
     options.linuxcnc_type = args.linuxcnc_type;
     options.max_points = args.max_points.or(options.max_points);
+    options.machine_unit = profile.table_unit(args.controller, measurement.metadata.length_unit);
     if let Some(existing) = &args.existing {
         // The table was active during the test: its axis, over the test's range.
         let test_name = args
@@ -238,8 +240,13 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         &plan.options,
         &effects,
     )?;
-    let text = emit::write(args.controller, &table, &options)?;
-    write_new(&args.output, text.as_bytes(), args.overwrite.force)?;
+    // A Fagor 8065 table goes back into the .mp file that was active.
+    let existing_bytes = match &args.existing {
+        Some(path) => Some(std::fs::read(path).with_context(|| path.display().to_string())?),
+        None => None,
+    };
+    let bytes = emit::write_bytes(args.controller, &table, &options, existing_bytes.as_deref())?;
+    write_new(&args.output, &bytes, args.overwrite.force)?;
     let file_name = args.output.file_name().map_or_else(
         || args.output.display().to_string(),
         |n| n.to_string_lossy().into_owned(),

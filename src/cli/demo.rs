@@ -92,13 +92,15 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let mut active = None;
     for controller in Controller::ALL {
         let emit_options = emit_options(&table.axis)?;
-        let text = emit::write(controller, &table, &emit_options)?;
+        let bytes = emit::write_bytes(controller, &table, &emit_options, None)?;
+        let (text, _) = emit::decode_table(&bytes)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", controller.name()))?;
         let (_, read_back) = emit::read_any(&text, &emit_options, Some(0))
             .map_err(|e| anyhow::anyhow!("{}: {e}", controller.name()))?;
         if controller == Controller::Tnc640 {
             active = Some(read_back);
         }
-        files.push((table_path(controller, &table.axis), text.into_bytes()));
+        files.push((table_path(controller, &table.axis), bytes));
     }
     let active = active.context("no TNC 640 table")?;
     steps.inc(1);
@@ -242,6 +244,8 @@ fn table_path(controller: Controller, axis: &str) -> String {
         Controller::Itnc530 | Controller::Tnc640 => format!("{axis}.COM"),
         Controller::Sinumerik840d => format!("{axis}.MPF"),
         Controller::LinuxCnc => format!("{}.comp", axis.to_ascii_lowercase()),
+        Controller::Fagor8055 => format!("AL{axis}"),
+        Controller::Fagor8065 => format!("{axis}.mp"),
     };
     format!("tables/{}/{file}", controller.name())
 }
@@ -348,7 +352,7 @@ fn summary(s: &Summary<'_>) -> String {
     );
     let _ = writeln!(
         out,
-        " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC: {} points (tables/)",
+        " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC, Fagor 8055, 8065: {} points (tables/)",
         s.table.values.mode().as_str(),
         s.table.positions_mm.len()
     );

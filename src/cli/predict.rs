@@ -13,7 +13,7 @@ use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
 use axcomp::report::predict::{PredictJson, render};
 use axcomp::together::{Input, Pairing, check_together};
-use axcomp::units::mm_to_um;
+use axcomp::units::{LengthUnit, mm_to_um};
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, Verbosity, load, load_effects, load_machine,
@@ -240,7 +240,14 @@ fn load_table(
             ),
         },
     };
-    Ok(read_table(Path::new(path), &axis, profile, linuxcnc_type)?.1)
+    // A Fagor 8055 table holds the machine unit: that of the test of its axis.
+    let test_unit = measurements
+        .iter()
+        .map(|(m, _)| m)
+        .find(|m| m.axis() == axis)
+        .or(measurements.first().map(|(m, _)| m))
+        .map_or(LengthUnit::Millimetre, |m| m.metadata.length_unit);
+    Ok(read_table(Path::new(path), &axis, profile, linuxcnc_type, test_unit)?.1)
 }
 
 /// What the reader should know about this prediction.

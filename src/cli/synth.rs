@@ -8,6 +8,7 @@ use axcomp::measurement::Measurement;
 use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
 use axcomp::synth::{self, Truth};
+use axcomp::units::LengthUnit;
 
 use super::common::{
     LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_profile, print_text, read_table,
@@ -67,6 +68,8 @@ pub fn run(args: &SynthArgs) -> Result<()> {
                 &truth.axis.name,
                 &profile,
                 args.table_type.linuxcnc_type,
+                // The truth file is in mm.
+                LengthUnit::Millimetre,
             )?;
             let retest = synth::after(&truth, &table, args.seed)?;
             let text = render(&retest, output2)?;

@@ -11,6 +11,9 @@
 //! the controller would reject ([`check_table`]), the number formats, and
 //! format detection for reading an existing table ([`read_any`]).
 
+mod fagor;
+pub mod fagor8055;
+pub mod fagor8065;
 mod heidenhain;
 pub mod itnc530;
 pub mod linuxcnc;
@@ -22,6 +25,7 @@ use crate::compensate::plan::Capabilities;
 use crate::compensate::{CompensationTable, TableMode};
 use crate::error::ParseError;
 use crate::units::LengthUnit;
+pub use fagor::{TextEncoding, decode as decode_table, encode as encode_table};
 pub use profile::{AxisProfile, CecValues, MachineProfile};
 
 /// The controllers axcomp writes tables for.
@@ -35,15 +39,21 @@ pub enum Controller {
     Sinumerik840d,
     /// LinuxCNC `[JOINT_n] COMP_FILE` (type 0 or 1).
     LinuxCnc,
+    /// Fagor 8055 leadscrew table `AL<axis>`.
+    Fagor8055,
+    /// Fagor 8065 axis parameter file `<axis>.mp` (its `/LSCRWDATA` table).
+    Fagor8065,
 }
 
 impl Controller {
     /// Every controller, in the order they are listed to users.
-    pub const ALL: [Controller; 4] = [
+    pub const ALL: [Controller; 6] = [
         Controller::Itnc530,
         Controller::Tnc640,
         Controller::Sinumerik840d,
         Controller::LinuxCnc,
+        Controller::Fagor8055,
+        Controller::Fagor8065,
     ];
 
     /// The `--controller` name.
@@ -53,6 +63,8 @@ impl Controller {
             Controller::Tnc640 => "tnc640",
             Controller::Sinumerik840d => "sinumerik840d",
             Controller::LinuxCnc => "linuxcnc",
+            Controller::Fagor8055 => "fagor8055",
+            Controller::Fagor8065 => "fagor8065",
         }
     }
 
@@ -65,7 +77,13 @@ impl Controller {
 
     /// Whether the format takes free (uneven) compensation points.
     pub fn accepts_free_positions(self) -> bool {
-        matches!(self, Controller::Tnc640 | Controller::LinuxCnc)
+        matches!(
+            self,
+            Controller::Tnc640
+                | Controller::LinuxCnc
+                | Controller::Fagor8055
+                | Controller::Fagor8065
+        )
     }
 
     /// Whether the format holds separate ↑ and ↓ values.
@@ -96,6 +114,8 @@ impl Controller {
             Controller::Tnc640 => tnc640::backlash_parameter(backlash_mm, options),
             Controller::Sinumerik840d => sinumerik840d::backlash_parameter(backlash_mm, options),
             Controller::LinuxCnc => linuxcnc::backlash_parameter(backlash_mm, options),
+            Controller::Fagor8055 => fagor8055::backlash_parameter(backlash_mm, options),
+            Controller::Fagor8065 => fagor8065::backlash_parameter(backlash_mm, options),
         }
     }
 
@@ -106,8 +126,10 @@ impl Controller {
             Controller::Itnc530 => Some(256),
             // LinuxCNC motion.h: EMCMOT_COMP_SIZE 256.
             Controller::LinuxCnc => Some(256),
-            // TNC 640: not documented publicly; Sinumerik: MD38000, machine-specific.
-            Controller::Tnc640 | Controller::Sinumerik840d => None,
+            Controller::Fagor8055 => Some(fagor8055::MAX_POINTS),
+            // TNC 640: not documented publicly; Sinumerik: MD38000,
+            // machine-specific; Fagor 8065: no public limit found.
+            Controller::Tnc640 | Controller::Sinumerik840d | Controller::Fagor8065 => None,
         }
     }
 }
@@ -349,6 +371,9 @@ fn format_limits_mm(
             let digits_mm = resolution_mm(controller, machine_unit) * 1e15;
             (digits_mm, ("15-digit", digits_mm))
         }
+        Controller::Fagor8055 | Controller::Fagor8065 => {
+            (fagor::LIMIT_MM, ("Fagor", fagor::LIMIT_MM))
+        }
     }
 }
 
@@ -457,8 +482,47 @@ pub fn write(
         Controller::Tnc640 => tnc640::write(table, options),
         Controller::Sinumerik840d => sinumerik840d::write(table, options),
         Controller::LinuxCnc => linuxcnc::write(table, options),
+        Controller::Fagor8055 => fagor8055::write(table, options),
+        Controller::Fagor8065 => fagor8065::write(table, options),
     }?;
-    let (_, back) = read_any(&text, options, Some(options.linuxcnc_type)).map_err(|error| {
+    check_read_back(controller, table, &text, options)?;
+    Ok(text)
+}
+
+/// The bytes of the file to hand out: [`write`]'s text, except that a Fagor
+/// 8065 table goes into `existing` (the `.mp` file that was active, when it
+/// holds a leadscrew table) with every other line, the encoding, the
+/// byte-order mark and the line ends kept, or into a new UTF-16LE file.
+/// The result is read back like [`write`]'s.
+pub fn write_bytes(
+    controller: Controller,
+    table: &CompensationTable,
+    options: &EmitOptions,
+    existing: Option<&[u8]>,
+) -> Result<Vec<u8>, EmitError> {
+    if controller != Controller::Fagor8065 {
+        return Ok(write(controller, table, options)?.into_bytes());
+    }
+    let decoded = existing.and_then(|bytes| decode_table(bytes).ok());
+    let Some((old_text, encoding)) = decoded.filter(|(text, _)| fagor8065::looks_like(text)) else {
+        let text = write(controller, table, options)?;
+        return Ok(encode_table(&text, TextEncoding::Utf16Le));
+    };
+    check_table(controller, table, options)?;
+    let text = fagor8065::update(&old_text, table)?;
+    check_read_back(controller, table, &text, options)?;
+    Ok(encode_table(&text, encoding))
+}
+
+/// Reads `text` back as [`read_any`] does and compares it with `table` to the
+/// format's resolution: a file that would not round-trip is never handed out.
+fn check_read_back(
+    controller: Controller,
+    table: &CompensationTable,
+    text: &str,
+    options: &EmitOptions,
+) -> Result<(), EmitError> {
+    let (_, back) = read_any(text, options, Some(options.linuxcnc_type)).map_err(|error| {
         EmitError::Internal(format!(
             "the written {} table does not read back: {error}",
             controller.name()
@@ -484,7 +548,7 @@ pub fn write(
             controller.name()
         )));
     }
-    Ok(text)
+    Ok(())
 }
 
 /// The smallest step a format writes, mm.
@@ -496,6 +560,10 @@ pub fn resolution_mm(controller: Controller, machine_unit: LengthUnit) -> f64 {
             LengthUnit::Millimetre => 1e-6,
             LengthUnit::Inch => crate::units::inch_to_mm(1e-7),
         },
+        Controller::Fagor8055 => {
+            machine_unit.to_mm(10f64.powi(-(fagor8055::decimals(machine_unit) as i32)))
+        }
+        Controller::Fagor8065 => 1e-4,
     }
 }
 
@@ -517,7 +585,12 @@ pub fn read_any(
         .map(str::trim)
         .find(|l| !l.is_empty())
         .unwrap_or("");
-    let (controller, mut table) = if first.starts_with("BEGIN") && first.contains("DATUM") {
+    let (controller, mut table) = if fagor8065::looks_like(text) {
+        (Controller::Fagor8065, fagor8065::read(text, &axis.axis)?)
+    } else if fagor8055::looks_like(text) {
+        let table = fagor8055::read(text, &axis.axis, options.machine_unit)?;
+        (Controller::Fagor8055, table)
+    } else if first.starts_with("BEGIN") && first.contains("DATUM") {
         (
             Controller::Itnc530,
             itnc530::read(text, axis.itnc530_column)?,
@@ -538,7 +611,7 @@ pub fn read_any(
         return Err(ParseError::new(
             1,
             1,
-            "unknown compensation table format: expected a Heidenhain .COM (BEGIN …), a Sinumerik .MPF (%_N_…) or a LinuxCNC COMP_FILE (nominal forward reverse)",
+            "unknown compensation table format: expected a Heidenhain .COM (BEGIN …), a Sinumerik .MPF (%_N_…), a LinuxCNC COMP_FILE (nominal forward reverse), a Fagor 8055 AL<axis> (P0001 X … EX … EX …) or a Fagor 8065 .mp (/LSCRWDATA/…)",
         ));
     };
     table.axis = axis.axis.clone();
@@ -557,6 +630,8 @@ pub fn activation(
         Controller::Tnc640 => tnc640::activation(file_name, options),
         Controller::Sinumerik840d => sinumerik840d::activation(table, options),
         Controller::LinuxCnc => linuxcnc::activation(file_name, options),
+        Controller::Fagor8055 => fagor8055::activation(file_name, options),
+        Controller::Fagor8065 => fagor8065::activation(file_name, options),
     }
 }
 

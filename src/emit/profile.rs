@@ -146,6 +146,19 @@ impl MachineProfile {
         self.controller.units.unwrap_or(LengthUnit::Millimetre)
     }
 
+    /// The unit of a `controller` table on this machine: the profile's
+    /// `units`; without it, for the Fagor 8055, whose file states no unit and
+    /// holds the machine's, the unit the test was measured in (an inch laser
+    /// file on an inch machine gives an inch table, as the real files in
+    /// `formats/fagor8055/README.md` show); else mm.
+    pub fn table_unit(&self, controller: super::Controller, test_unit: LengthUnit) -> LengthUnit {
+        match (self.controller.units, controller) {
+            (Some(unit), _) => unit,
+            (None, super::Controller::Fagor8055) => test_unit,
+            (None, _) => LengthUnit::Millimetre,
+        }
+    }
+
     /// The resolved names of an axis: profile entries first, defaults from the letter.
     pub fn axis(&self, axis: &str) -> Result<AxisProfile, EmitError> {
         let entry = self.controller.axes.get(axis).cloned().unwrap_or_default();

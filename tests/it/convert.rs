@@ -208,6 +208,29 @@ fn cases() -> Vec<Case> {
             ],
             "sample-existing-type0.txt",
         ),
+        // Fagor: the 8055 in the test's unit (inch here), the 8065 in mm,
+        // a UTF-16LE file (the golden holds its decoded text).
+        case(inch(), "fagor8055", &[], "api-inch-ALX"),
+        case(
+            inch(),
+            "fagor8055",
+            &[
+                "--existing",
+                "../shared/data/api-xd/example__8055__ALX",
+                "--reference",
+                "0",
+            ],
+            "api-existing-ALX",
+        ),
+        case(
+            sample(),
+            "fagor8055",
+            &["--mode", "bidirectional"],
+            "sample-bidirectional-ALX",
+        ),
+        // (An updated .mp would copy the third-party file's other lines into
+        // the repository: tests/it/fagor.rs checks the update instead.)
+        case(inch(), "fagor8065", &[], "api-inch-X.mp"),
     ]
 }
 
@@ -236,7 +259,9 @@ fn convert(
     let run = axcomp(&args);
     assert_eq!(run.code, 0, "convert {args:?}: {}", run.stderr);
     let json = serde_json::from_str(&run.stdout).unwrap();
-    (std::fs::read_to_string(&output).unwrap(), json)
+    // Fagor 8065 files are UTF-16: compare their decoded text.
+    let (text, _) = emit::decode_table(&std::fs::read(&output).unwrap()).unwrap();
+    (text, json)
 }
 
 /// The options a module needs to read the file back, from the case's profile.
@@ -255,7 +280,15 @@ fn read_options(case: &Case) -> EmitOptions {
     EmitOptions {
         axes: vec![profile.axis("X").unwrap()],
         table_name: String::new(),
-        machine_unit: profile.machine_unit(),
+        // A Fagor 8055 table is in the test's unit (the API .pos files are inch).
+        machine_unit: profile.table_unit(
+            Controller::from_name(case.controller).unwrap(),
+            if case.input.extension().is_some_and(|e| e == "pos") {
+                axcomp::units::LengthUnit::Inch
+            } else {
+                axcomp::units::LengthUnit::Millimetre
+            },
+        ),
         linuxcnc_type: if case.flags.contains(&"1") { 1 } else { 0 },
         max_points: None,
         max_value_mm: None,

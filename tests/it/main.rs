@@ -15,6 +15,7 @@ mod convert;
 mod demo;
 mod diagnose;
 mod evaluate_ecmc;
+mod fagor;
 mod flags;
 mod linuxcnc;
 mod model;
