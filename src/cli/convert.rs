@@ -262,6 +262,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         warning_texts,
     );
     report.effects = plan.notes;
+    report.file_unit = options.machine_unit.as_str();
     if let Some(backlash_mm) = table.suggested_backlash_mm {
         report.set_backlash(args.controller.backlash_parameter(backlash_mm, &options));
     }

@@ -10,7 +10,7 @@
 //!   "suggested_backlash_um": 3.2 | null,
 //!   "backlash_parameter": {"name": "MD32450 $MA_BACKLASH[0,X1]", "value": 0.0032,
 //!                          "unit": "mm" | "inch", "sign": "…", "note": "…" | null} | null,
-//!   "backlash_note": "…" | null, "activation": "…",
+//!   "backlash_note": "…" | null, "activation": "…", "file_unit": "mm" | "inch",
 //!   "effects": ["…what --effects changed…"], "warnings": [...] }
 //! ```
 //! Values are the axis error actual − target in µm, zero at the reference,
@@ -26,8 +26,8 @@ use serde::Serialize;
 
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::BacklashAdvice;
-use crate::report::format::um;
-use crate::units::mm_to_um;
+use crate::report::format::{inch_text, um};
+use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 
 /// The table's values, µm.
 #[derive(Clone, Debug, Serialize)]
@@ -68,6 +68,10 @@ pub struct BacklashParameterJson {
 /// The whole `convert --json` object.
 #[derive(Clone, Debug, Serialize)]
 pub struct ConvertJson {
+    /// The unit of the positions and values in the file written: `mm` or
+    /// `inch` (the controller's, from the machine profile; for a Fagor 8055
+    /// without one, the test's).
+    pub file_unit: &'static str,
     /// `--controller` name.
     pub controller: &'static str,
     /// The file written.
@@ -117,6 +121,7 @@ impl ConvertJson {
     ) -> ConvertJson {
         let to_um = |values: &[f64]| values.iter().copied().map(mm_to_um).collect();
         ConvertJson {
+            file_unit: LengthUnit::Millimetre.as_str(),
             controller,
             file,
             axis: table.axis.clone(),
@@ -220,6 +225,9 @@ impl ConvertJson {
             out,
             "\nCompensation table [µm] (axis error actual − target, zero at the reference)"
         );
+        if self.file_unit == LengthUnit::Inch.as_str() {
+            return self.inch_table(out);
+        }
         match &self.values_um {
             ValuesJson::Mean { mean } => {
                 let _ = writeln!(out, "{:>12}  {:>9}", "position mm", "value");
@@ -233,6 +241,45 @@ impl ConvertJson {
                     let _ = writeln!(out, "{p:>12}  {:>9}  {:>9}", um(Some(*u)), um(Some(*d)));
                 }
             }
+        }
+        let _ = writeln!(out, "\nActivation:\n{}", self.activation);
+        out
+    }
+
+    /// The table of an inch file: positions and values in inches, as the
+    /// file holds them and the controller shows them, beside the µm.
+    fn inch_table(&self, mut out: String) -> String {
+        let inch = |mm: f64| inch_text(LengthUnit::Inch.from_mm(mm));
+        let _ = writeln!(
+            out,
+            "The file is in inches (the controller's unit); µm beside them."
+        );
+        let columns: Vec<(&str, &Vec<f64>)> = match &self.values_um {
+            ValuesJson::Mean { mean } => vec![("value", mean)],
+            ValuesJson::Bidirectional { up, down } => vec![("↑", up), ("↓", down)],
+        };
+        let _ = write!(out, "{:>12}  {:>12}", "position in", "position mm");
+        for (name, _) in &columns {
+            let _ = write!(
+                out,
+                "  {:>10}  {:>9}",
+                format!("{name} in"),
+                format!("{name} µm")
+            );
+        }
+        out.push('\n');
+        for (index, p) in self.positions_mm.iter().enumerate() {
+            let _ = write!(out, "{:>12}  {p:>12}", inch(*p));
+            for (_, values) in &columns {
+                let value_um = values[index];
+                let _ = write!(
+                    out,
+                    "  {:>10}  {:>9}",
+                    inch(um_to_mm(value_um)),
+                    um(Some(value_um))
+                );
+            }
+            out.push('\n');
         }
         let _ = writeln!(out, "\nActivation:\n{}", self.activation);
         out
