@@ -4,6 +4,10 @@
 //! check the page against `--json`). Every report file uses these; this file
 //! uses none of them.
 
+use std::fmt;
+
+use askama::Template;
+
 use crate::units::LengthUnit;
 
 /// How a not-evaluated value is shown.
@@ -82,32 +86,75 @@ pub fn inch_text(value_in: f64) -> String {
 /// Escapes text for HTML content and attribute values.
 pub fn esc(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            _ => out.push(c),
-        }
-    }
+    // Writing into a String cannot fail.
+    let _ = escape_into(&mut out, text);
     out
 }
 
-/// A µm cell with its source (see the module doc).
-pub fn um_cell(key: &str, value: Option<f64>) -> String {
-    format!(
-        "<td class=\"num\" {}>{}</td>",
-        source(key, value),
-        um(value)
-    )
+/// The report templates' escaper (`askama.toml`): the same five characters
+/// as [`esc`], so text from a file is escaped alike wherever the page shows it.
+#[derive(Clone, Copy, Debug)]
+pub struct Html;
+
+impl askama::filters::Escaper for Html {
+    fn write_escaped_str<W: fmt::Write>(&self, dest: W, string: &str) -> fmt::Result {
+        escape_into(dest, string)
+    }
 }
 
-/// The `data-key` and `data-um` attributes of a µm value.
-pub fn source(key: &str, value: Option<f64>) -> String {
-    let full = value.map_or_else(|| "null".to_string(), |v| v.to_string());
-    format!("data-key=\"{}\" data-um=\"{full}\"", esc(key))
+/// A µm value with its source (see the module doc), as a template shows it:
+/// `data-key`, `data-um` and the text.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SourcedUm {
+    /// The value's path in the JSON (`before.figures_um.A`).
+    pub key: String,
+    /// The full value, `null` when not evaluated.
+    pub full: String,
+    /// As the terminal report shows it ([`um`]).
+    pub shown: String,
+}
+
+impl SourcedUm {
+    /// The value at `key`, `None` when not evaluated.
+    pub fn new(key: String, value: Option<f64>) -> SourcedUm {
+        SourcedUm {
+            key,
+            full: value.map_or_else(|| "null".to_string(), |v| v.to_string()),
+            shown: um(value),
+        }
+    }
+}
+
+/// A µm cell with its source (see the module doc); the markup is the
+/// templates' `um_cell` macro.
+pub fn um_cell(key: &str, value: Option<f64>) -> String {
+    UmCell {
+        um: &SourcedUm::new(key.to_string(), value),
+    }
+    .to_string()
+}
+
+#[derive(Template)]
+#[template(
+    source = r#"{% import "report/macros.html" as m %}{% call m::um_cell(um) %}"#,
+    ext = "html"
+)]
+struct UmCell<'a> {
+    um: &'a SourcedUm,
+}
+
+fn escape_into<W: fmt::Write>(mut dest: W, text: &str) -> fmt::Result {
+    for c in text.chars() {
+        match c {
+            '&' => dest.write_str("&amp;")?,
+            '<' => dest.write_str("&lt;")?,
+            '>' => dest.write_str("&gt;")?,
+            '"' => dest.write_str("&quot;")?,
+            '\'' => dest.write_str("&#39;")?,
+            _ => dest.write_char(c)?,
+        }
+    }
+    Ok(())
 }
 
 /// Appends the decimal digits of `value` (what `{}` writes, without the

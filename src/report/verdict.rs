@@ -1,6 +1,6 @@
 //! The acceptance verdict as users and scripts read it: its `--json` wire
 //! format ([`VerdictJson`], the `verdict` key of `evaluate --json`), its
-//! terminal lines ([`terminal`]) and the report's verdict box ([`html_box`]).
+//! terminal lines ([`terminal`]) and the report's verdict box ([`verdict_box`]).
 //!
 //! # Wire format
 //!
@@ -21,15 +21,12 @@
 //! when not evaluated (such a check fails). Checks come in the order of
 //! `figures_um`.
 
-use std::fmt::Write;
-
 use serde::Serialize;
 
 use crate::evaluate::Evaluation;
 use crate::evaluate::verdict::{Check, Limit, Outcome, Permissible, Verdict, verdict};
-use crate::report::acceptance::ReportInput;
-use crate::report::format::esc;
-use crate::report::format::um;
+use crate::report::acceptance::{ReportInput, TestRecord};
+use crate::report::format::{SourcedUm, um};
 use crate::units::mm_to_um;
 use crate::units::per_m_over_mm;
 
@@ -234,126 +231,127 @@ fn result_word(check: &CheckJson) -> &'static str {
     }
 }
 
-/// The report's verdict box, at the top: the verdict on the re-test when
-/// there is one (the state being accepted), else on the test.
-pub fn html_section(out: &mut String, input: &ReportInput<'_>) {
-    let name = |what: &str, test: &crate::report::acceptance::TestRecord<'_>| match &test
-        .measurement
-        .metadata
-        .source_file
-    {
+/// The report's verdict box (`templates/report/verdict.html`), at the top:
+/// the verdict on the re-test when there is one (the state being accepted),
+/// else on the test; `None` without limits, and the box then says so: no
+/// verdict, never an implied pass.
+pub fn verdict_box(input: &ReportInput<'_>) -> Option<Judged> {
+    let name = |what: &str, test: &TestRecord<'_>| match &test.measurement.metadata.source_file {
         Some(file) => format!("{what} {}", file.display()),
         None => what.to_string(),
     };
     let before = judge(input.before.evaluation, input.limits);
     match &input.after {
         Some(after) => {
-            let judged = judge(after.evaluation, input.limits);
-            let name = name("re-test", after);
-            html_box(
-                out,
-                judged.as_ref().map(|v| ("after", name.as_str(), v)),
+            let judged = judge(after.evaluation, input.limits)?;
+            Some(Judged::new(
+                "after",
+                name("re-test", after),
+                &judged,
                 before.as_ref(),
-            );
+            ))
         }
-        None => {
-            let name = name("test", &input.before);
-            html_box(
-                out,
-                before.as_ref().map(|v| ("before", name.as_str(), v)),
-                None,
-            );
-        }
+        None => Some(Judged::new(
+            "before",
+            name("test", &input.before),
+            &before?,
+            None,
+        )),
     }
 }
 
-/// The report's verdict box. `verdict` is the test being accepted (the
-/// re-test when there is one) with its `evaluate --json` key prefix
-/// (`before`, `after`) and a name for it; `first_test` the first test's
-/// verdict in a before/after report. Without limits the box says so: no
-/// verdict, never an implied pass.
-pub fn html_box(
-    out: &mut String,
-    verdict: Option<(&str, &str, &VerdictJson)>,
-    first_test: Option<&VerdictJson>,
-) {
-    let Some((prefix, test_name, verdict)) = verdict else {
-        out.push_str(
-            "<section id=\"verdict\" class=\"keep verdict none\" data-verdict=\"none\">\n\
-             <p class=\"verdict-line\">No acceptance limits given: no verdict.</p>\n\
-             <p class=\"note\">Give the permissible values with <code>--limit A=12</code> (µm) \
-             or in the machine profile's <code>[acceptance]</code> table (<code>--machine</code>).</p>\n\
-             </section>\n",
-        );
-        return;
-    };
-    let class = if verdict.pass { "pass" } else { "fail" };
-    let _ = write!(
-        out,
-        "<section id=\"verdict\" class=\"keep verdict {class}\" data-verdict=\"{class}\">\n\
-         <h2>Acceptance verdict: {word}</h2>\n<p class=\"verdict-line\">{line} <span class=\"note\">({test_name})</span></p>\n\
-         <table class=\"checks\"><thead><tr><th>figure</th><th>measured [µm]</th>\
-         <th>permissible [µm]</th><th>result</th><th>limit from</th></tr></thead><tbody>\n",
-        word = if verdict.pass { "PASS" } else { "FAIL" },
-        line = esc(&headline(verdict)),
-        test_name = esc(test_name),
-    );
-    for (index, c) in verdict.checks.iter().enumerate() {
-        let key = |what: &str| format!("{prefix}.verdict.checks.{index}.{what}");
-        let result_class = if c.pass { "pass" } else { "fail" };
-        let _ = writeln!(
-            out,
-            "<tr data-figure=\"{figure}\" data-figure-key=\"{prefix}.figures_um.{figure}\">\
-             <th>{label}</th>{value}{limit}<td class=\"{result_class}\">{result}</td>\
-             <td>{source}: {derivation}</td></tr>",
-            figure = c.figure,
-            label = if c.figure == "B_mean" {
-                "|B̄|".to_string()
-            } else {
-                c.figure.replace("_up", "↑").replace("_down", "↓")
-            },
-            value = crate::report::format::um_cell(&key("value_um"), c.value_um),
-            limit = crate::report::format::um_cell(&key("limit_um"), Some(c.limit_um)),
-            result = match &c.reason {
-                Some(reason) if !c.pass =>
-                    format!("{}<br><small>{}</small>", result_word(c), esc(reason)),
-                _ => result_word(c).to_string(),
-            },
-            source = esc(&c.limit_source),
-            derivation = esc(&c.limit_derivation),
-        );
-    }
-    out.push_str("</tbody></table>\n");
-    let mut notes = format!(
-        "Decision rule: {DECISION} (ISO 14253-1): a figure passes when its value is at most \
-         the limit, compared at full precision; the measurement uncertainty is not taken into \
-         account. A figure that is not evaluated cannot pass. Per-length limits use the measured \
-         travel, {} mm.",
-        short(verdict.travel_mm)
-    );
-    if let Some(first) = first_test {
-        let _ = write!(
-            notes,
-            " The first test, before compensation: {}.",
-            esc(&headline(first))
-        );
-    }
-    let _ = writeln!(out, "<p class=\"note\">{notes}</p>\n</section>");
+/// The verdict box of the test being accepted.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Judged {
+    /// `pass` or `fail`, the box's class and `data-verdict`.
+    pub class: &'static str,
+    /// `PASS` or `FAIL`.
+    pub word: &'static str,
+    /// The verdict in one line ([`headline`]).
+    pub headline: String,
+    /// `test FILE` or `re-test FILE`.
+    pub test_name: String,
+    /// One row per check, in the order of `figures_um`.
+    pub checks: Vec<CheckRow>,
+    /// The decision rule ([`DECISION`]).
+    pub decision: &'static str,
+    /// The measured travel that per-length limits use, mm.
+    pub travel_mm: String,
+    /// The first test's headline in a before/after report.
+    pub first_test: Option<String>,
 }
 
-/// The verdict box's CSS (appended to the report's).
-pub const CSS: &str =
-    "section.verdict { border: 3px solid #777; padding: 4px 14px 6px; margin: 14px 0; }
-section.verdict h2 { border: none; margin: 6px 0 4px; }
-section.verdict.pass { border-color: #1b7a30; background: #eef8f0; }
-section.verdict.pass h2 { color: #1b7a30; }
-section.verdict.fail { border-color: #c81414; background: #fdf0f0; }
-section.verdict.fail h2 { color: #c81414; }
-section.verdict.none { border-color: #999; border-style: dashed; }
-.verdict-line { font-weight: 600; }
-table.checks td.pass { color: #1b7a30; font-weight: 600; }
-table.checks td.fail { color: #c81414; font-weight: 600; }
-";
+/// A check's row: the figure, its value and limit with their sources.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckRow {
+    /// The figure's key in `figures_um` (`A`, `R_up`, `B_mean`).
+    pub figure: &'static str,
+    /// The figure's cell in the figures table (`after.figures_um.A`).
+    pub figure_key: String,
+    /// `A`, `R↑`, `|B̄|`.
+    pub label: String,
+    /// The value compared (`value_um`).
+    pub value: SourcedUm,
+    /// The permissible value (`limit_um`).
+    pub limit: SourcedUm,
+    /// `pass` or `fail`.
+    pub class: &'static str,
+    /// `pass`, `FAIL` or `FAIL (not evaluated)`.
+    pub result: &'static str,
+    /// Why it fails; `None` when it passes.
+    pub reason: Option<String>,
+    /// Where the limit comes from (`--limit`, the machine profile).
+    pub limit_source: String,
+    /// How the limit follows from the permissible value.
+    pub limit_derivation: String,
+}
+
+impl Judged {
+    /// `prefix` is the `evaluate --json` key of the test being accepted
+    /// (`before`, `after`); `first_test` the first test's verdict in a
+    /// before/after report.
+    fn new(
+        prefix: &str,
+        test_name: String,
+        verdict: &VerdictJson,
+        first_test: Option<&VerdictJson>,
+    ) -> Judged {
+        let checks = verdict
+            .checks
+            .iter()
+            .enumerate()
+            .map(|(index, c)| {
+                let key = |what: &str| format!("{prefix}.verdict.checks.{index}.{what}");
+                CheckRow {
+                    figure: c.figure,
+                    figure_key: format!("{prefix}.figures_um.{}", c.figure),
+                    label: if c.figure == "B_mean" {
+                        "|B̄|".to_string()
+                    } else {
+                        c.figure.replace("_up", "↑").replace("_down", "↓")
+                    },
+                    value: SourcedUm::new(key("value_um"), c.value_um),
+                    limit: SourcedUm::new(key("limit_um"), Some(c.limit_um)),
+                    class: if c.pass { "pass" } else { "fail" },
+                    result: result_word(c),
+                    reason: c.reason.clone().filter(|_| !c.pass),
+                    limit_source: c.limit_source.clone(),
+                    limit_derivation: c.limit_derivation.clone(),
+                }
+            })
+            .collect();
+        Judged {
+            class: if verdict.pass { "pass" } else { "fail" },
+            word: if verdict.pass { "PASS" } else { "FAIL" },
+            headline: headline(verdict),
+            test_name,
+            checks,
+            decision: DECISION,
+            travel_mm: short(verdict.travel_mm),
+            first_test: first_test.map(headline),
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {
