@@ -323,7 +323,7 @@ fn split_runs<'r>(
         None => header.count("NumofPos", "point count")?,
     };
     let size = if let Some((points, line, value)) = points {
-        if points == 0 || rows.len() % points != 0 {
+        if points == 0 || !rows.len().is_multiple_of(points) {
             return Err(line.error_at(
                 value,
                 format!("NumofPoints is {points} but the data table has {} rows, not a whole number of runs", rows.len()),
@@ -331,7 +331,7 @@ fn split_runs<'r>(
         }
         points
     } else if let Some((runs, line, value)) = header.count("RunNum", "run count")? {
-        if runs == 0 || rows.len() % runs != 0 {
+        if runs == 0 || !rows.len().is_multiple_of(runs) {
             return Err(line.error_at(
                 value,
                 format!(

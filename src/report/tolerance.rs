@@ -415,7 +415,7 @@ fn text_histogram(histogram: &HistogramJson, width: usize) -> String {
         let (low, high) = (histogram.edges_um[index], histogram.edges_um[index + 1]);
         let eighths = (*count as f64 / fullest as f64 * (width * 8) as f64).round() as usize;
         let mut bar = "█".repeat(eighths / 8);
-        if eighths % 8 > 0 {
+        if !eighths.is_multiple_of(8) {
             bar.push(['▏', '▎', '▍', '▌', '▋', '▊', '▉'][eighths % 8 - 1]);
         }
         let _ = writeln!(out, "  {low:>6.1} – {high:>6.1} │{bar:<width$} {count}");

@@ -99,7 +99,7 @@ pub fn run_circle(
         if snapshot.is_position_sample {
             trace.push(*snapshot);
         }
-        if steps % report_every == 0 {
+        if steps.is_multiple_of(report_every) {
             progress(snapshot.time_s / end_s);
         }
         for reversal in reversals.iter_mut() {

@@ -235,7 +235,7 @@ impl Constants {
         let common = gcd(dead_us, sample_us);
         let macro_us = (1..=MAX_MACRO_STEP_US.min(common))
             .rev()
-            .find(|d| common % d == 0)
+            .find(|d| common.is_multiple_of(*d))
             .unwrap_or(1);
         Constants {
             macro_us,
@@ -330,7 +330,7 @@ impl<'a> Simulator<'a> {
             current_a: self.state[I],
             friction_force_n: self.friction_force_n,
             command: self.trajectory.at(time_s),
-            is_position_sample: self.step_index % self.constants.samples_every == 0,
+            is_position_sample: self.step_index.is_multiple_of(self.constants.samples_every),
             peak_current_a: self.step_peak_current_a,
         }
     }
@@ -377,7 +377,7 @@ impl<'a> Simulator<'a> {
             return;
         }
         let t0 = self.time_s();
-        if self.step_index % c.samples_every == 0 {
+        if self.step_index.is_multiple_of(c.samples_every) {
             // Position loop: error sampled and held for T_s, the measured
             // position quantised (Fig. 3.10; notes §10 rounds x to 1 µm).
             let measured = (self.state[X] / c.increment_m).round() * c.increment_m;
