@@ -10,6 +10,7 @@ use axcomp::compensate::CompensationTable;
 use axcomp::effects::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
 use axcomp::error::{ParseError, Warning};
+use axcomp::evaluate::Standard;
 use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
@@ -245,6 +246,37 @@ pub struct JsonOutput {
     /// Print one JSON object (units in the keys) instead of the report.
     #[arg(long, help_heading = "Output")]
     pub json: bool,
+}
+
+/// `--standard`, the same in every command that evaluates a test to one.
+#[derive(Clone, Copy, clap::Args)]
+pub struct StandardArg {
+    /// The standard the figures follow (default iso230-2:2014).
+    ///
+    /// iso230-2:2014, iso230-2:2006, iso230-2:1997 (the same figures; the
+    /// edition is named), gb/t17421.2 (an identical adoption of the 1997
+    /// edition), iso230-2:1988 and jis-b6192 (±3s in A and R), vdi3441 (P,
+    /// Pa, Ps, U). Definitions the project reconstructs from public sources
+    /// (1988, JIS, VDI) are said to be so. A standard whose definitions are
+    /// not established (ASME B5.54, NMTBA) is refused.
+    #[arg(
+        long,
+        value_name = "NAME",
+        default_value = "iso230-2:2014",
+        value_parser = parse_standard,
+        help_heading = "Evaluation"
+    )]
+    pub standard: &'static dyn Standard,
+}
+
+impl std::fmt::Debug for StandardArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.standard.key())
+    }
+}
+
+fn parse_standard(name: &str) -> Result<&'static dyn Standard, String> {
+    axcomp::evaluate::by_name(name).map_err(|error| error.to_string())
 }
 
 /// `--force`, the same in every command that writes files.

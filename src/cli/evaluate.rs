@@ -4,15 +4,15 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 
-use axcomp::evaluate::evaluate;
+use axcomp::evaluate::evaluate_with;
 use axcomp::measurement::{Direction, Measurement, RunSelector};
 use axcomp::read;
 use axcomp::report::{json::EvaluationJson, terminal, verdict};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, JsonOutput, MachineFile, Verbosity, name_axis, parse_run_selector, print_json,
-    print_text, print_warnings,
+    InputFormat, JsonOutput, MachineFile, StandardArg, Verbosity, name_axis, parse_run_selector,
+    print_json, print_text, print_warnings,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -50,6 +50,10 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub machine_file: MachineFile,
 
+    /// `--standard` (the same in every command).
+    #[command(flatten)]
+    pub standard: StandardArg,
+
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
@@ -78,7 +82,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         measurement.axis(),
         &args.acceptance,
     )?;
-    let evaluation = evaluate(&measurement);
+    let evaluation = evaluate_with(&measurement, args.standard.standard);
     warnings.extend(evaluation.warnings.iter().cloned());
     let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
     report.verdict = verdict::judge(&evaluation, &limits);

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::error::Warning;
-use axcomp::evaluate::{Evaluation, evaluate};
+use axcomp::evaluate::{Evaluation, Standard, evaluate_with};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::output::write_all_new;
 use axcomp::read;
@@ -20,8 +20,8 @@ use axcomp::together::{Input, Pairing, check_together};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, LinuxCncType, MachineFile, Overwrite, Verbosity, load_profile, name_axis,
-    print_text, print_warnings, read_active_table,
+    InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load_profile,
+    name_axis, print_text, print_warnings, read_active_table,
 };
 
 /// Flags of `axcomp report`.
@@ -99,6 +99,10 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub overwrite: Overwrite,
 
+    /// `--standard` (the same in every command).
+    #[command(flatten)]
+    pub standard: StandardArg,
+
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
     pub verbosity: Verbosity,
@@ -112,13 +116,18 @@ struct Test {
 }
 
 impl Test {
-    fn read(path: &Path, format: Option<SourceFormat>, axis: Option<&String>) -> Result<Test> {
+    fn read(
+        path: &Path,
+        format: Option<SourceFormat>,
+        axis: Option<&String>,
+        standard: &dyn Standard,
+    ) -> Result<Test> {
         let read::ReadResult {
             mut measurement,
             mut warnings,
         } = read::read_paths(&[path.to_path_buf()], format)?;
         name_axis(&mut measurement, axis);
-        let evaluation = evaluate(&measurement);
+        let evaluation = evaluate_with(&measurement, standard);
         warnings.extend(evaluation.warnings.iter().cloned());
         Ok(Test {
             measurement,
@@ -138,7 +147,13 @@ impl Test {
 
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
-    let mut before = Test::read(&args.file, args.input_format.format, args.axis.as_ref())?;
+    let standard = args.standard.standard;
+    let mut before = Test::read(
+        &args.file,
+        args.input_format.format,
+        args.axis.as_ref(),
+        standard,
+    )?;
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
         before.measurement.axis(),
@@ -149,6 +164,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             path,
             args.input_format.format,
             args.axis.as_ref(),
+            standard,
         )?),
         None => None,
     };

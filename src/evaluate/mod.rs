@@ -30,7 +30,7 @@ use crate::measurement::{Direction, Measurement};
 pub use conformance::TestConformance;
 use environment::{RefractiveIndexCheck, check_refractive_index};
 pub use outliers::SuspectedOutlier;
-pub use standard::{ISO_230_2, Standard};
+pub use standard::{ISO_230_2, SUPPORTED, Standard, StandardFigure, UnknownStandard, by_name};
 use targets::per_target_stats;
 pub use targets::{DirectionStats, TargetStats};
 
@@ -63,13 +63,62 @@ pub struct AxisFigures {
     pub b_mean_mm: Option<f64>,
 }
 
+impl AxisFigures {
+    /// The figures with their keys in `figures_um` and `--limit`, in order.
+    pub fn keyed(&self) -> [(&'static str, Option<f64>); 12] {
+        [
+            ("A", self.a_mm),
+            ("A_up", self.a_up_mm),
+            ("A_down", self.a_down_mm),
+            ("E", self.e_mm),
+            ("E_up", self.e_up_mm),
+            ("E_down", self.e_down_mm),
+            ("M", self.m_mm),
+            ("R", self.r_mm),
+            ("R_up", self.r_up_mm),
+            ("R_down", self.r_down_mm),
+            ("B", self.b_mm),
+            ("B_mean", self.b_mean_mm),
+        ]
+    }
+}
+
+/// Which standard a test was evaluated to, as the reports name it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StandardUsed {
+    /// The `--standard` name (`iso230-2:2014`, `vdi3441`).
+    pub key: &'static str,
+    /// Its name and edition.
+    pub name: &'static str,
+    /// Whether its definitions are reconstructed from public sources.
+    pub reconstructed: bool,
+    /// The multiple of s in the ISO 230-2 figures' bands (2; 3 for ±3s).
+    pub k: f64,
+}
+
+impl StandardUsed {
+    /// How the reports name `standard`.
+    pub fn of(standard: &dyn Standard) -> StandardUsed {
+        StandardUsed {
+            key: standard.key(),
+            name: standard.name(),
+            reconstructed: standard.reconstructed(),
+            k: standard.k(),
+        }
+    }
+}
+
 /// The result of evaluating a measurement.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Evaluation {
     /// Per-target statistics, in target order.
     pub per_target: Vec<TargetStats>,
-    /// Axis figures.
+    /// Axis figures (ISO 230-2; of the 1988 edition's ±3s when that is the standard).
     pub figures: AxisFigures,
+    /// The standard the test was evaluated to.
+    pub standard: StandardUsed,
+    /// The figures that standard reports, with its keys, in its order.
+    pub standard_figures: Vec<StandardFigure>,
     /// Number of ↑ runs.
     pub runs_up: usize,
     /// Number of ↓ runs.
@@ -137,10 +186,13 @@ pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Eval
     let conformance = conformance::check_test(measurement);
     let mut warnings = conformance.warnings();
     warnings.extend(coverage_warnings(&per_target, runs_up, runs_down));
+    let figures = standard.axis_figures(&per_target);
     Evaluation {
         conformance,
         refractive_index: check_refractive_index(&measurement.environment),
-        figures: standard.axis_figures(&per_target),
+        standard: StandardUsed::of(standard),
+        standard_figures: standard.figures(&per_target, &figures),
+        figures,
         outliers: outliers::suspected_outliers(measurement),
         per_target,
         runs_up,

@@ -1,9 +1,12 @@
 //! A standard: what derives the axis figures from the statistics of each
 //! target. [`evaluate`](super::evaluate) applies [`ISO_230_2`] (the 2014
-//! edition, `../shared/spec/iso230-2.md`); another standard is another
-//! [`Standard`] beside it, and another edition of ISO 230-2 another value of
-//! [`Iso230_2`] (the 1988 edition is the same formulas with k = 3:
-//! `../shared/spec/standards.md` §2), not a fork of [`evaluate`](super::evaluate).
+//! edition, `../shared/spec/iso230-2.md`); `--standard` picks another from
+//! [`SUPPORTED`] by [`by_name`]. Another edition of ISO 230-2 is another value
+//! of [`Iso230_2`] (the 1988 edition is the same formulas with k = 3), VDI/DGQ
+//! 3441 is [`Vdi3441`] beside it: data, not a fork of
+//! [`evaluate`](super::evaluate). Evidence levels are those of
+//! `../shared/spec/standards.md`: a standard whose definitions are
+//! reconstructed there says so ([`Standard::reconstructed`]).
 //!
 //! ISO 230-2 (1997, 2006, 2014): per target x̄_i = (x̄_i↑ + x̄_i↓)/2, the
 //! reversal value B_i = x̄_i↑ − x̄_i↓, the repeatabilities R_i↑ = 2k·s_i↑,
@@ -12,42 +15,161 @@
 //! the signed mean reversal B̄ (seed 001 eq. (22) swaps two signs in A; the
 //! spec's form is used), with k = 2. An axis figure is evaluated only when
 //! what it needs is defined at every target.
+//!
+//! VDI/DGQ 3441 (standards.md §3, reconstructed): per target U_i = |B_i|
+//! and Ps_i = 6·(s_i↑ + s_i↓)/2; per axis U max, U mean, Ps max, Ps mean,
+//! Pa = max x̄_i − min x̄_i and P = max(x̄_i + (U_i + Ps_i)/2) −
+//! min(x̄_i − (U_i + Ps_i)/2).
 
 use super::AxisFigures;
 use super::targets::{DirectionStats, TargetStats};
 use crate::measurement::Direction;
 
 /// What derives a test's figures from the statistics of each target.
-pub trait Standard {
+pub trait Standard: Sync {
     /// Its name and edition, as a report cites it.
     fn name(&self) -> &'static str;
+
+    /// Its `--standard` name (`iso230-2:2014`), also `standard` in the JSON.
+    fn key(&self) -> &'static str;
+
+    /// Whether `../shared/spec/standards.md` reconstructs its definitions
+    /// from public traces rather than reading them in the standard: the
+    /// report then says so.
+    fn reconstructed(&self) -> bool;
+
+    /// The multiple of s in ISO 230-2's bands (A) and half the one in its
+    /// repeatabilities (R), as [`Standard::axis_figures`] uses it.
+    fn k(&self) -> f64;
 
     /// What it defines at one target from the statistics of each direction.
     fn target_stats(&self, target_mm: f64, up: DirectionStats, down: DirectionStats)
     -> TargetStats;
 
-    /// The axis figures from every target's.
+    /// The ISO 230-2 axis figures from every target's (the prediction and the
+    /// diagnosis work with these, whatever the report's standard).
     fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures;
+
+    /// The figures this standard reports, in its order, with its keys.
+    fn figures(&self, per_target: &[TargetStats], axis: &AxisFigures) -> Vec<StandardFigure>;
+}
+
+/// One figure as a standard names it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StandardFigure {
+    /// Its key in `figures_um` and in `--limit` (`A`, `Ps_max`).
+    pub key: &'static str,
+    /// The value, mm; `None` where not evaluated.
+    pub value_mm: Option<f64>,
+}
+
+/// A `--standard` name that is not one of [`SUPPORTED`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "standard {name:?} is not supported: its definitions are not established from public sources; supported: {}",
+    supported_names()
+)]
+pub struct UnknownStandard {
+    /// What was asked for.
+    pub name: String,
+}
+
+fn supported_names() -> String {
+    SUPPORTED
+        .iter()
+        .map(|s| s.key())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// ISO 230-2, one edition: the figures with the band x̄ ± k·s.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Iso230_2 {
-    /// The name and edition.
+    /// The `--standard` name.
+    pub key: &'static str,
+    /// The name and edition, as the report cites it.
     pub name: &'static str,
     /// The multiple of s in a band (A) and half the one in a repeatability (R).
     pub k: f64,
+    /// Whether the spec reconstructs this edition's forms (the ±3s ones).
+    pub reconstructed: bool,
 }
 
 /// ISO 230-2:2014 (the same figures as 1997 and 2006): k = 2.
 pub const ISO_230_2: Iso230_2 = Iso230_2 {
+    key: "iso230-2:2014",
     name: "ISO 230-2:2014",
     k: 2.0,
+    reconstructed: false,
 };
+
+/// VDI/DGQ 3441 (1977): P, Pa, Ps, U (standards.md §3, reconstructed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vdi3441;
+
+/// Every standard `--standard` takes, in the order `--help` lists them.
+///
+/// The 1997, 2006 and 2014 editions and GB/T 17421.2-2000 (an identical
+/// adoption of the 1997 edition) define the same figures (standards.md §1);
+/// the 1988 edition and JIS B 6192 use ±3s (§2).
+pub static SUPPORTED: [&dyn Standard; 7] = [
+    &ISO_230_2,
+    &Iso230_2 {
+        key: "iso230-2:2006",
+        name: "ISO 230-2:2006",
+        ..ISO_230_2
+    },
+    &Iso230_2 {
+        key: "iso230-2:1997",
+        name: "ISO 230-2:1997",
+        ..ISO_230_2
+    },
+    &Iso230_2 {
+        key: "gb/t17421.2",
+        name: "GB/T 17421.2-2000 (identical adoption of ISO 230-2:1997)",
+        ..ISO_230_2
+    },
+    &Iso230_2 {
+        key: "iso230-2:1988",
+        name: "ISO 230-2:1988 (±3s)",
+        k: 3.0,
+        reconstructed: true,
+    },
+    &Iso230_2 {
+        key: "jis-b6192",
+        name: "JIS B 6192 (±3s)",
+        k: 3.0,
+        reconstructed: true,
+    },
+    &Vdi3441,
+];
+
+/// The standard of a `--standard` name (case-insensitive), or why not.
+pub fn by_name(name: &str) -> Result<&'static dyn Standard, UnknownStandard> {
+    SUPPORTED
+        .iter()
+        .copied()
+        .find(|s| s.key().eq_ignore_ascii_case(name.trim()))
+        .ok_or_else(|| UnknownStandard {
+            name: name.to_string(),
+        })
+}
 
 impl Standard for Iso230_2 {
     fn name(&self) -> &'static str {
         self.name
+    }
+
+    fn key(&self) -> &'static str {
+        self.key
+    }
+
+    fn reconstructed(&self) -> bool {
+        self.reconstructed
+    }
+
+    fn k(&self) -> f64 {
+        self.k
     }
 
     fn target_stats(
@@ -62,6 +184,98 @@ impl Standard for Iso230_2 {
     fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures {
         axis_figures(self.k, per_target)
     }
+
+    fn figures(&self, _: &[TargetStats], axis: &AxisFigures) -> Vec<StandardFigure> {
+        axis.keyed()
+            .into_iter()
+            .map(|(key, value_mm)| StandardFigure { key, value_mm })
+            .collect()
+    }
+}
+
+impl Standard for Vdi3441 {
+    fn name(&self) -> &'static str {
+        "VDI/DGQ 3441 (1977)"
+    }
+
+    fn key(&self) -> &'static str {
+        "vdi3441"
+    }
+
+    fn reconstructed(&self) -> bool {
+        true
+    }
+
+    fn k(&self) -> f64 {
+        ISO_230_2.k
+    }
+
+    /// The per-target table stays ISO 230-2:2014's (x̄, s, B_i: what VDI's
+    /// figures are made of).
+    fn target_stats(
+        &self,
+        target_mm: f64,
+        up: DirectionStats,
+        down: DirectionStats,
+    ) -> TargetStats {
+        ISO_230_2.target_stats(target_mm, up, down)
+    }
+
+    fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures {
+        ISO_230_2.axis_figures(per_target)
+    }
+
+    fn figures(&self, per_target: &[TargetStats], _: &AxisFigures) -> Vec<StandardFigure> {
+        let figures = vdi_figures(per_target);
+        let keyed = [
+            ("P", figures.map(|f| f.p)),
+            ("Pa", figures.map(|f| f.pa)),
+            ("Ps_max", figures.map(|f| f.ps_max)),
+            ("Ps_mean", figures.map(|f| f.ps_mean)),
+            ("U_max", figures.map(|f| f.u_max)),
+            ("U_mean", figures.map(|f| f.u_mean)),
+        ];
+        keyed
+            .into_iter()
+            .map(|(key, value_mm)| StandardFigure { key, value_mm })
+            .collect()
+    }
+}
+
+/// VDI 3441's axis figures, mm.
+#[derive(Clone, Copy, Debug)]
+struct VdiFigures {
+    p: f64,
+    pa: f64,
+    ps_max: f64,
+    ps_mean: f64,
+    u_max: f64,
+    u_mean: f64,
+}
+
+/// VDI 3441's figures, or `None` unless every target has x̄, B_i and s both
+/// ways (VDI defines no unidirectional or single-run form).
+fn vdi_figures(per_target: &[TargetStats]) -> Option<VdiFigures> {
+    // (x̄_i, U_i, Ps_i) per target.
+    let cells = every_target(per_target, |t| {
+        Some((
+            t.mean_mm?,
+            t.reversal_mm?.abs(),
+            6.0 * (t.up.s_mm? + t.down.s_mm?) / 2.0,
+        ))
+    })?;
+    let count = cells.len() as f64;
+    let max = |values: &mut dyn Iterator<Item = f64>| values.fold(f64::NEG_INFINITY, f64::max);
+    let min = |values: &mut dyn Iterator<Item = f64>| values.fold(f64::INFINITY, f64::min);
+    Some(VdiFigures {
+        p: max(&mut cells.iter().map(|(x, u, ps)| x + (u + ps) / 2.0))
+            - min(&mut cells.iter().map(|(x, u, ps)| x - (u + ps) / 2.0)),
+        pa: span(cells.iter().map(|(x, _, _)| (*x, *x)))?,
+        ps_max: max(&mut cells.iter().map(|(_, _, ps)| *ps)),
+        ps_mean: cells.iter().map(|(_, _, ps)| ps).sum::<f64>() / count,
+        u_max: max(&mut cells.iter().map(|(_, u, _)| *u)),
+        u_mean: cells.iter().map(|(_, u, _)| u).sum::<f64>() / count,
+    })
 }
 
 fn target_stats(k: f64, target_mm: f64, up: DirectionStats, down: DirectionStats) -> TargetStats {
@@ -174,8 +388,10 @@ mod tests {
         // s = √2 µm in every cell (two readings 2 µm apart); B_i = 2 µm.
         let s = 2f64.sqrt();
         let edition_1988 = Iso230_2 {
+            key: "iso230-2:1988",
             name: "ISO 230-2:1988",
             k: 3.0,
+            reconstructed: true,
         };
         for (standard, k) in [(ISO_230_2, 2.0), (edition_1988, 3.0)] {
             let f = evaluate_with(&two_by_two(), &standard).figures;

@@ -698,6 +698,12 @@ mod tests {
         };
         Evaluation {
             per_target: vec![target(first_mm), target(last_mm)],
+            standard: crate::evaluate::StandardUsed::of(&crate::evaluate::ISO_230_2),
+            standard_figures: crate::evaluate::Standard::figures(
+                &crate::evaluate::ISO_230_2,
+                &[],
+                &figures,
+            ),
             figures,
             runs_up: 5,
             runs_down: 5,

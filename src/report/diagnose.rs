@@ -131,7 +131,7 @@ pub struct RejectedJson {
 }
 
 /// The figures of the re-test three ways, µm.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize)]
 pub struct FigureSetJson {
     /// As measured.
     pub measured: FiguresJson,
@@ -310,11 +310,36 @@ pub fn render(report: &DiagnoseJson) -> String {
     );
     let f = &report.figures_um;
     for (name, m, p, e) in [
-        ("A", f.measured.A, f.predicted.A, f.predicted_with_effects.A),
-        ("E", f.measured.E, f.predicted.E, f.predicted_with_effects.E),
-        ("M", f.measured.M, f.predicted.M, f.predicted_with_effects.M),
-        ("R", f.measured.R, f.predicted.R, f.predicted_with_effects.R),
-        ("B", f.measured.B, f.predicted.B, f.predicted_with_effects.B),
+        (
+            "A",
+            f.measured.get("A"),
+            f.predicted.get("A"),
+            f.predicted_with_effects.get("A"),
+        ),
+        (
+            "E",
+            f.measured.get("E"),
+            f.predicted.get("E"),
+            f.predicted_with_effects.get("E"),
+        ),
+        (
+            "M",
+            f.measured.get("M"),
+            f.predicted.get("M"),
+            f.predicted_with_effects.get("M"),
+        ),
+        (
+            "R",
+            f.measured.get("R"),
+            f.predicted.get("R"),
+            f.predicted_with_effects.get("R"),
+        ),
+        (
+            "B",
+            f.measured.get("B"),
+            f.predicted.get("B"),
+            f.predicted_with_effects.get("B"),
+        ),
     ] {
         let _ = writeln!(
             out,

@@ -53,11 +53,12 @@ use serde::Serialize;
 use crate::compensate::TableMode;
 use crate::diagnose::{Diagnosis, ResidualStats};
 use crate::effects::{Parameter, ParameterValue};
-use crate::evaluate::AxisFigures;
 use crate::evaluate::TestConformance;
 use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
+use crate::evaluate::standard::Vdi3441;
 use crate::evaluate::verdict::{Figure, Limit};
+use crate::evaluate::{AxisFigures, Standard, StandardUsed};
 use crate::measurement::{Direction, Measurement, StartEnd};
 use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts, prediction};
 use crate::report::chart::chart;
@@ -196,6 +197,10 @@ struct Header {
     /// ("Measurement" or "Re-test", its file).
     sources: Vec<(&'static str, SourceLine)>,
     table: Option<TableFile>,
+    /// The standard, as the header names it.
+    standard: String,
+    /// Whether its definitions are reconstructed from public sources.
+    reconstructed: bool,
 }
 
 /// A test's file, its format and size.
@@ -280,6 +285,13 @@ struct Figures {
     /// (test name, its figures in inches) for an inch file.
     inch: Vec<(&'static str, String)>,
     source_notes: Vec<&'static str>,
+    /// The ISO 230-2 figures' k (2; 3 for the ±3s editions) and 2k, for the note.
+    k: f64,
+    two_k: f64,
+    /// A standard other than ISO 230-2 (VDI 3441): its name and its figures,
+    /// one row each (symbol and name, a cell per test); empty for ISO 230-2.
+    standard_name: &'static str,
+    standard_rows: Vec<(String, Vec<Option<SourcedUm>>)>,
 }
 
 /// A figure's row: per test bidirectional, ↑ and ↓ (`None`: the figure has
@@ -475,7 +487,25 @@ fn header(input: &ReportInput<'_>) -> Header {
             file: table.file.to_string(),
             controller: table.controller.name(),
         }),
+        standard: standard_line(&input.before.evaluation.standard),
+        reconstructed: input.before.evaluation.standard.reconstructed,
     }
+}
+
+/// The header's line on the standard: its name, and what A and R mean in it.
+fn standard_line(standard: &StandardUsed) -> String {
+    let iso = format!(
+        "test of accuracy and repeatability of positioning of numerically controlled axes; A and R with the coverage of that edition (x̄ ± {k}s, R = {r}s)",
+        k = standard.k,
+        r = 2.0 * standard.k
+    );
+    if standard.key == Vdi3441.key() {
+        return format!(
+            "{}: P, Pa, Ps and U of each direction's statistics; the ISO 230-2:2014 figures beside them ({iso})",
+            standard.name
+        );
+    }
+    format!("{}, {iso}", standard.name)
 }
 
 fn source_line(measurement: &Measurement) -> SourceLine {
@@ -815,22 +845,22 @@ const FIGURE_ROWS: [(&str, &str, Figure); 6] = [
     ("B̄", "mean reversal value", Figure::BMean),
 ];
 
+/// What a VDI/DGQ 3441 figure is (`../shared/spec/standards.md` §3).
+fn vdi_figure_name(key: &str) -> &'static str {
+    match key {
+        "P" => "positional uncertainty",
+        "Pa" => "positional deviation (span of x̄ᵢ)",
+        "Ps_max" => "largest positional scatter 6·(s↑ + s↓)/2",
+        "Ps_mean" => "mean positional scatter",
+        "U_max" => "largest reversal span |x̄↑ − x̄↓|",
+        "U_mean" => "mean reversal span",
+        _ => "",
+    }
+}
+
 /// A figure's value as `figures_um` gives it, µm.
 fn figure_value(figures: &FiguresJson, figure: Figure) -> Option<f64> {
-    match figure {
-        Figure::A => figures.A,
-        Figure::AUp => figures.A_up,
-        Figure::ADown => figures.A_down,
-        Figure::E => figures.E,
-        Figure::EUp => figures.E_up,
-        Figure::EDown => figures.E_down,
-        Figure::M => figures.M,
-        Figure::R => figures.R,
-        Figure::RUp => figures.R_up,
-        Figure::RDown => figures.R_down,
-        Figure::B => figures.B,
-        Figure::BMean => figures.B_mean,
-    }
+    figures.get(figure.name())
 }
 
 fn figures(input: &ReportInput<'_>) -> Figures {
@@ -871,7 +901,44 @@ fn figures(input: &ReportInput<'_>) -> Figures {
             }
         })
         .collect();
+    let standard = input.before.evaluation.standard;
+    let standard_rows = if standard.key == Vdi3441.key() {
+        input
+            .before
+            .evaluation
+            .standard_figures
+            .iter()
+            .map(|figure| {
+                let cells = tests
+                    .iter()
+                    .zip(["before", "after"])
+                    .map(|((_, test), prefix)| {
+                        let value = test
+                            .evaluation
+                            .standard_figures
+                            .iter()
+                            .find(|f| f.key == figure.key)
+                            .and_then(|f| f.value_mm);
+                        Some(SourcedUm::new(
+                            format!("{prefix}.figures_um.{}", figure.key),
+                            value.map(mm_to_um),
+                        ))
+                    })
+                    .collect();
+                (
+                    format!("{}  {}", figure.key, vdi_figure_name(figure.key)),
+                    cells,
+                )
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     Figures {
+        k: standard.k,
+        two_k: 2.0 * standard.k,
+        standard_name: standard.name,
+        standard_rows,
         compared: figures.len() > 1,
         test_names: tests.iter().map(|(name, _)| *name).collect(),
         rows,
@@ -887,7 +954,7 @@ fn inch_figures(tests: &[(&'static str, &TestRecord<'_>)]) -> Vec<(&'static str,
         if test.measurement.metadata.length_unit != LengthUnit::Inch {
             continue;
         }
-        let f = FiguresJson::from_figures(&test.evaluation.figures);
+        let f = &FiguresJson::from_figures(&test.evaluation.figures);
         let parts: Vec<String> = FIGURE_ROWS
             .iter()
             .flat_map(|&(symbol, _, figure)| {
@@ -896,7 +963,7 @@ fn inch_figures(tests: &[(&'static str, &TestRecord<'_>)]) -> Vec<(&'static str,
                     .filter_map(move |(d, arrow)| Some((figure.directed(d)?, arrow)));
                 let figures = std::iter::once((figure, "")).chain(directed);
                 figures.filter_map(move |(shown, arrow)| {
-                    let um = figure_value(&f, shown)?;
+                    let um = figure_value(f, shown)?;
                     Some(format!(
                         "{symbol}{arrow} {} in",
                         inch_text(LengthUnit::Inch.from_mm(um_to_mm(um)))

@@ -10,8 +10,11 @@
 //!   "source_file": "…", "length_unit": "mm",
 //!   "targets_mm": [15.0, …],
 //!   "runs": {"up": 5, "down": 5}, "excluded_runs": ["1:down"],
+//!   "standard": "iso230-2:2014", "standard_name": "ISO 230-2:2014",
+//!   "definitions_reconstructed": false,
 //!   "figures_um": {"A": …, "A_up": …, "A_down": …, "E": …, "E_up": …, "E_down": …,
-//!                  "M": …, "R": …, "R_up": …, "R_down": …, "B": …, "B_mean": …},
+//!                  "M": …, "R": …, "R_up": …, "R_down": …, "B": …, "B_mean": …}
+//!               | {"P": …, "Pa": …, "Ps_max": …, "Ps_mean": …, "U_max": …, "U_mean": …} (vdi3441),
 //!   "per_target": [{"target_mm": …, "n_up": 5, "n_down": 5,
 //!                   "mean_up_um": …, "mean_down_um": …, "mean_um": …,
 //!                   "s_up_um": …, "s_down_um": …, "B_um": …,
@@ -50,7 +53,9 @@
 use serde::Serialize;
 
 use crate::error::Warning;
-use crate::evaluate::{AxisFigures, Evaluation, SuspectedOutlier, TargetStats, TestConformance};
+use crate::evaluate::{
+    AxisFigures, Evaluation, StandardFigure, SuspectedOutlier, TargetStats, TestConformance,
+};
 use crate::measurement::{
     AxisSource, Environment, Measurement, RunSelector, SourceFormat, StartEnd, TestSetup,
 };
@@ -75,7 +80,14 @@ pub struct EvaluationJson {
     pub runs: RunCountsJson,
     /// Runs left out by `--exclude-run`, as `3`, `3:up` or `3:down`.
     pub excluded_runs: Vec<String>,
-    /// Axis figures, µm.
+    /// The standard evaluated to (`--standard`: `iso230-2:2014`, `vdi3441`, …).
+    pub standard: &'static str,
+    /// Its name and edition.
+    pub standard_name: &'static str,
+    /// Whether its definitions are reconstructed from public sources
+    /// (`../shared/spec/standards.md`), not read in the standard.
+    pub definitions_reconstructed: bool,
+    /// That standard's axis figures, µm, under its keys.
     pub figures_um: FiguresJson,
     /// Per-target statistics.
     pub per_target: Vec<PerTargetJson>,
@@ -247,41 +259,54 @@ pub struct RunCountsJson {
     pub down: usize,
 }
 
-/// ISO 230-2 axis figures, µm.
-#[allow(non_snake_case, missing_docs)]
-#[derive(Clone, Copy, Debug, Serialize)]
+/// A standard's axis figures, µm, under its own keys and in its order
+/// (ISO 230-2: `A`, `A_up`, …, `B_mean`; VDI 3441: `P`, `Pa`, `Ps_max`,
+/// `Ps_mean`, `U_max`, `U_mean`); serialised as one JSON object.
+#[derive(Clone, Debug, PartialEq)]
 pub struct FiguresJson {
-    pub A: Option<f64>,
-    pub A_up: Option<f64>,
-    pub A_down: Option<f64>,
-    pub E: Option<f64>,
-    pub E_up: Option<f64>,
-    pub E_down: Option<f64>,
-    pub M: Option<f64>,
-    pub R: Option<f64>,
-    pub R_up: Option<f64>,
-    pub R_down: Option<f64>,
-    pub B: Option<f64>,
-    pub B_mean: Option<f64>,
+    /// (key, value µm), in the standard's order.
+    pub values: Vec<(&'static str, Option<f64>)>,
 }
 
 impl FiguresJson {
-    /// Converts axis figures (mm) to µm.
+    /// Converts ISO 230-2 axis figures (mm) to µm.
     pub fn from_figures(f: &AxisFigures) -> FiguresJson {
         FiguresJson {
-            A: opt_mm_to_um(f.a_mm),
-            A_up: opt_mm_to_um(f.a_up_mm),
-            A_down: opt_mm_to_um(f.a_down_mm),
-            E: opt_mm_to_um(f.e_mm),
-            E_up: opt_mm_to_um(f.e_up_mm),
-            E_down: opt_mm_to_um(f.e_down_mm),
-            M: opt_mm_to_um(f.m_mm),
-            R: opt_mm_to_um(f.r_mm),
-            R_up: opt_mm_to_um(f.r_up_mm),
-            R_down: opt_mm_to_um(f.r_down_mm),
-            B: opt_mm_to_um(f.b_mm),
-            B_mean: opt_mm_to_um(f.b_mean_mm),
+            values: f
+                .keyed()
+                .into_iter()
+                .map(|(key, value_mm)| (key, opt_mm_to_um(value_mm)))
+                .collect(),
         }
+    }
+
+    /// Converts a standard's figures (mm) to µm.
+    pub fn from_standard(figures: &[StandardFigure]) -> FiguresJson {
+        FiguresJson {
+            values: figures
+                .iter()
+                .map(|f| (f.key, opt_mm_to_um(f.value_mm)))
+                .collect(),
+        }
+    }
+
+    /// The value under `key`, µm (`None` when not evaluated or not this standard's).
+    pub fn get(&self, key: &str) -> Option<f64> {
+        self.values
+            .iter()
+            .find(|(k, _)| *k == key)
+            .and_then(|(_, value)| *value)
+    }
+}
+
+impl Serialize for FiguresJson {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(self.values.len()))?;
+        for (key, value) in &self.values {
+            map.serialize_entry(key, value)?;
+        }
+        map.end()
     }
 }
 
@@ -462,7 +487,10 @@ impl EvaluationJson {
                 down: evaluation.runs_down,
             },
             excluded_runs: excluded.iter().map(ToString::to_string).collect(),
-            figures_um: FiguresJson::from_figures(&evaluation.figures),
+            standard: evaluation.standard.key,
+            standard_name: evaluation.standard.name,
+            definitions_reconstructed: evaluation.standard.reconstructed,
+            figures_um: FiguresJson::from_standard(&evaluation.standard_figures),
             per_target: evaluation
                 .per_target
                 .iter()

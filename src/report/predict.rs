@@ -229,12 +229,12 @@ fn render_retest(out: &mut String, retest: &RetestJson) {
     let _ = writeln!(out, "-------------+----------+---------------");
     let (b, p) = (&retest.figures_before_um, &retest.predicted_figures_um);
     for (name, before, predicted) in [
-        ("A", b.A, p.A),
-        ("E", b.E, p.E),
-        ("M", b.M, p.M),
-        ("R", b.R, p.R),
-        ("B", b.B, p.B),
-        ("B̄", b.B_mean, p.B_mean),
+        ("A", b.get("A"), p.get("A")),
+        ("E", b.get("E"), p.get("E")),
+        ("M", b.get("M"), p.get("M")),
+        ("R", b.get("R"), p.get("R")),
+        ("B", b.get("B"), p.get("B")),
+        ("B̄", b.get("B_mean"), p.get("B_mean")),
     ] {
         let _ = writeln!(
             out,

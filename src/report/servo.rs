@@ -402,12 +402,12 @@ fn iso_text(out: &mut String, iso: &IsoJson) {
     let _ = writeln!(
         out,
         "\nISO 230-2 figures [µm]: A {}  E {}  M {}  R {}  B {}  B̄ {}",
-        show(f.A),
-        show(f.E),
-        show(f.M),
-        show(f.R),
-        show(f.B),
-        show(f.B_mean)
+        show(f.get("A")),
+        show(f.get("E")),
+        show(f.get("M")),
+        show(f.get("R")),
+        show(f.get("B")),
+        show(f.get("B_mean"))
     );
     let _ = writeln!(
         out,

@@ -20,8 +20,21 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     out.push('\n');
     out.push_str("Per target [µm]\n");
     out.push_str(&per_target_table(report));
-    out.push_str("\n\nAxis figures [µm] (ISO 230-2)\n");
-    out.push_str(&figures_table(report));
+    let _ = writeln!(out, "\n\nAxis figures [µm] ({})", report.standard_name);
+    // The ISO 230-2 family's figures in their table (↑, ↓ beside each);
+    // another standard's one per row.
+    let iso_family = report.figures_um.values.iter().any(|(key, _)| *key == "A");
+    if iso_family {
+        out.push_str(&figures_table(report));
+    } else {
+        out.push_str(&keyed_figures_table(report));
+    }
+    if report.definitions_reconstructed {
+        let _ = write!(
+            out,
+            "\nDefinitions reconstructed from public sources, not read in the standard (README, Standards)."
+        );
+    }
     out.push('\n');
     if !report.outliers.is_empty() {
         out.push_str("\nSuspected outlier runs (included; exclude with --exclude-run RUN:DIRECTION only if you know why)\n");
@@ -229,38 +242,70 @@ fn psql_right_aligned<'a, const N: usize>(
     out
 }
 
+/// A standard's figures one per row, as its keys name them (VDI 3441).
+fn keyed_figures_table(r: &EvaluationJson) -> String {
+    let mut builder = Builder::default();
+    builder.push_record(["figure", "value"]);
+    for (key, value) in &r.figures_um.values {
+        builder.push_record([format!("{key}  {}", figure_name(key)), um(*value)]);
+    }
+    let mut table = builder.build();
+    table
+        .with(Style::psql())
+        .modify(Columns::new(1..), Alignment::right());
+    table.to_string()
+}
+
+/// What a non-ISO figure is (VDI/DGQ 3441, `../shared/spec/standards.md` §3).
+fn figure_name(key: &str) -> &'static str {
+    match key {
+        "P" => "positional uncertainty",
+        "Pa" => "positional deviation (span of x̄_i)",
+        "Ps_max" => "largest positional scatter 6·(s↑ + s↓)/2",
+        "Ps_mean" => "mean positional scatter",
+        "U_max" => "largest reversal span |x̄↑ − x̄↓|",
+        "U_mean" => "mean reversal span",
+        _ => "",
+    }
+}
+
 fn figures_table(r: &EvaluationJson) -> String {
     let f = &r.figures_um;
     let mut builder = Builder::default();
     builder.push_record(["figure", "bidirectional", "↑", "↓"]);
-    builder.push_record(["A  accuracy".to_string(), um(f.A), um(f.A_up), um(f.A_down)]);
+    builder.push_record([
+        "A  accuracy".to_string(),
+        um(f.get("A")),
+        um(f.get("A_up")),
+        um(f.get("A_down")),
+    ]);
     builder.push_record([
         "E  systematic deviation".to_string(),
-        um(f.E),
-        um(f.E_up),
-        um(f.E_down),
+        um(f.get("E")),
+        um(f.get("E_up")),
+        um(f.get("E_down")),
     ]);
     builder.push_record([
         "R  repeatability".to_string(),
-        um(f.R),
-        um(f.R_up),
-        um(f.R_down),
+        um(f.get("R")),
+        um(f.get("R_up")),
+        um(f.get("R_down")),
     ]);
     builder.push_record([
         "M  mean bidirectional deviation".to_string(),
-        um(f.M),
+        um(f.get("M")),
         String::new(),
         String::new(),
     ]);
     builder.push_record([
         "B  reversal value".to_string(),
-        um(f.B),
+        um(f.get("B")),
         String::new(),
         String::new(),
     ]);
     builder.push_record([
         "B̄  mean reversal value".to_string(),
-        um(f.B_mean),
+        um(f.get("B_mean")),
         String::new(),
         String::new(),
     ]);

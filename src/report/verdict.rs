@@ -394,6 +394,12 @@ mod tests {
         };
         let evaluation = crate::evaluate::Evaluation {
             per_target: Vec::new(),
+            standard: crate::evaluate::StandardUsed::of(&crate::evaluate::ISO_230_2),
+            standard_figures: crate::evaluate::Standard::figures(
+                &crate::evaluate::ISO_230_2,
+                &[],
+                &figures,
+            ),
             figures,
             runs_up: 1,
             runs_down: 1,

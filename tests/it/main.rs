@@ -24,6 +24,7 @@ mod predict;
 mod read_api_pos;
 mod report;
 mod servo;
+mod standards;
 mod together;
 mod util;
 mod verdict;

@@ -1,0 +1,154 @@
+//! `--standard` (issue 13): VDI/DGQ 3441 and the ±3s forms of ISO 230-2:1988
+//! and JIS B 6192 against an independent computation, written here from the
+//! formulas of `../shared/spec/standards.md` §2–3, on the ecmc test-report
+//! data (5 targets × 5 cycles each way). The readings come from the reader;
+//! everything after that is computed in this file.
+
+use serde_json::Value;
+
+use axcomp::measurement::Direction;
+use axcomp::read;
+
+use crate::util::axcomp;
+
+const ECMC: &str =
+    "../shared/data/ecmc/ecmccfg/examples__ESS__mcu1025_fat_sat__report.md_ISO230.dat";
+const TOLERANCE_UM: f64 = 0.005;
+
+/// Per target: (x̄↑, x̄↓, s↑, s↓) in µm, with the n − 1 divisor.
+fn cells() -> Vec<(f64, f64, f64, f64)> {
+    let measurement = read::read_path(std::path::Path::new(ECMC), None)
+        .unwrap()
+        .measurement;
+    let stats = |direction: Direction, index: usize| {
+        let values: Vec<f64> = measurement
+            .runs_in(direction)
+            .filter_map(|run| run.deviations_mm[index])
+            .map(|mm| mm * 1000.0)
+            .collect();
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let s = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        (mean, s)
+    };
+    (0..measurement.targets_mm().len())
+        .map(|i| {
+            let (up, s_up) = stats(Direction::Up, i);
+            let (down, s_down) = stats(Direction::Down, i);
+            (up, down, s_up, s_down)
+        })
+        .collect()
+}
+
+fn figures(standard: &str) -> Value {
+    let run = axcomp(["evaluate", ECMC, "--json", "--standard", standard]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(json["standard"], standard);
+    json
+}
+
+fn close(json: &Value, key: &str, expected: f64) {
+    let found = json["figures_um"][key].as_f64().unwrap_or(f64::NAN);
+    assert!(
+        (found - expected).abs() <= TOLERANCE_UM,
+        "{key}: axcomp {found} µm, independent {expected} µm"
+    );
+}
+
+fn max(values: impl Iterator<Item = f64>) -> f64 {
+    values.fold(f64::NEG_INFINITY, f64::max)
+}
+
+fn min(values: impl Iterator<Item = f64>) -> f64 {
+    values.fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn vdi_3441_matches_the_spec_formulas() {
+    let cells = cells();
+    let json = figures("vdi3441");
+    assert_eq!(json["definitions_reconstructed"], true);
+    let keys: Vec<&str> = json["figures_um"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(keys, ["P", "Pa", "Ps_max", "Ps_mean", "U_max", "U_mean"]);
+    // U_i = |x̄↑ − x̄↓|, Ps_i = 6·(s↑ + s↓)/2, x̄_i = (x̄↑ + x̄↓)/2.
+    let u = |c: &(f64, f64, f64, f64)| (c.0 - c.1).abs();
+    let ps = |c: &(f64, f64, f64, f64)| 6.0 * (c.2 + c.3) / 2.0;
+    let mean = |c: &(f64, f64, f64, f64)| (c.0 + c.1) / 2.0;
+    let m = cells.len() as f64;
+    close(&json, "U_max", max(cells.iter().map(u)));
+    close(&json, "U_mean", cells.iter().map(u).sum::<f64>() / m);
+    close(&json, "Ps_max", max(cells.iter().map(ps)));
+    close(&json, "Ps_mean", cells.iter().map(ps).sum::<f64>() / m);
+    close(
+        &json,
+        "Pa",
+        max(cells.iter().map(mean)) - min(cells.iter().map(mean)),
+    );
+    let p = max(cells.iter().map(|c| mean(c) + (u(c) + ps(c)) / 2.0))
+        - min(cells.iter().map(|c| mean(c) - (u(c) + ps(c)) / 2.0));
+    close(&json, "P", p);
+}
+
+#[test]
+fn the_plus_minus_3s_forms_match_the_spec_formulas() {
+    let cells = cells();
+    for standard in ["iso230-2:1988", "jis-b6192"] {
+        let json = figures(standard);
+        assert_eq!(json["definitions_reconstructed"], true, "{standard}");
+        // R_i↑ = 6s↑; R_i = max(3s↑ + 3s↓ + |B_i|, 6s↑, 6s↓); A from x̄ ± 3s.
+        let r_i = |c: &(f64, f64, f64, f64)| {
+            (3.0 * c.2 + 3.0 * c.3 + (c.0 - c.1).abs())
+                .max(6.0 * c.2)
+                .max(6.0 * c.3)
+        };
+        close(&json, "R", max(cells.iter().map(r_i)));
+        close(&json, "R_up", max(cells.iter().map(|c| 6.0 * c.2)));
+        close(&json, "R_down", max(cells.iter().map(|c| 6.0 * c.3)));
+        let high = max(cells
+            .iter()
+            .flat_map(|c| [c.0 + 3.0 * c.2, c.1 + 3.0 * c.3]));
+        let low = min(cells
+            .iter()
+            .flat_map(|c| [c.0 - 3.0 * c.2, c.1 - 3.0 * c.3]));
+        close(&json, "A", high - low);
+        // E, M and B do not change with k.
+        let e =
+            max(cells.iter().flat_map(|c| [c.0, c.1])) - min(cells.iter().flat_map(|c| [c.0, c.1]));
+        close(&json, "E", e);
+        close(&json, "B", max(cells.iter().map(|c| (c.0 - c.1).abs())));
+    }
+}
+
+#[test]
+fn the_iso_editions_give_the_same_figures_and_name_themselves() {
+    let reference = figures("iso230-2:2014");
+    assert_eq!(reference["definitions_reconstructed"], false);
+    for standard in ["iso230-2:2006", "iso230-2:1997", "gb/t17421.2"] {
+        let json = figures(standard);
+        assert_eq!(json["figures_um"], reference["figures_um"], "{standard}");
+        assert_eq!(json["definitions_reconstructed"], false);
+    }
+    assert!(
+        figures("gb/t17421.2")["standard_name"]
+            .as_str()
+            .unwrap()
+            .contains("identical adoption of ISO 230-2:1997")
+    );
+}
+
+#[test]
+fn a_standard_without_established_definitions_is_refused() {
+    for name in ["asme-b5.54", "nmtba"] {
+        let run = axcomp(["evaluate", ECMC, "--standard", name]);
+        assert_eq!(run.code, 2, "{name}");
+        assert!(run.stderr.contains("is not supported"), "{}", run.stderr);
+        assert!(run.stderr.contains("vdi3441, ") || run.stderr.contains("vdi3441"));
+        assert!(run.stderr.contains("iso230-2:1988"));
+    }
+}
