@@ -66,127 +66,21 @@ pub struct ServoSimArgs {
     #[arg(long, value_enum, value_name = "TEST", help_heading = "Model")]
     pub test: TestKind,
 
-    /// Circle radius, mm.
-    #[arg(
-        long = "radius-mm",
-        value_name = "MM",
-        default_value_t = 90.0,
-        help_heading = "Circle"
-    )]
-    pub radius_mm: f64,
+    /// `--radius-mm`, `--circle-axis`.
+    #[command(flatten, next_help_heading = "Circle")]
+    pub circle: CircleFlags,
 
-    /// Which circle coordinate the axis follows: x (R cos φ) or y (R sin φ).
-    ///
-    /// Defaults from the axis name in the file (X or Y).
-    #[arg(long = "circle-axis", value_name = "x|y", value_parser = parse_circle_axis, help_heading = "Circle")]
-    pub circle_axis: Option<CircleAxis>,
+    /// `--feed-m-min`, `--acceleration-m-s2`, `--jerk-m-s3`.
+    #[command(flatten, next_help_heading = "Motion")]
+    pub motion: MotionFlags,
 
-    /// Feed, m/min [circle 16, constant-velocity 5, iso230-2 2].
-    ///
-    /// The path feed of the circle (the thesis ran 3.2, 8, 16, 24 and
-    /// 48 m/min), the cruise feed of the constant-velocity run, or the feed of
-    /// every move of the ISO cycle.
-    #[arg(long = "feed-m-min", value_name = "M_PER_MIN", help_heading = "Motion")]
-    pub feed_m_min: Option<f64>,
+    /// `--force-n`, `--duration-s`.
+    #[command(flatten, next_help_heading = "Step")]
+    pub step: StepFlags,
 
-    /// Acceleration of the moves, m/s² (constant-velocity and iso230-2).
-    #[arg(
-        long = "acceleration-m-s2",
-        value_name = "M_PER_S2",
-        default_value_t = 1.0,
-        help_heading = "Motion"
-    )]
-    pub acceleration_m_s2: f64,
-
-    /// Jerk of the moves, m/s³ (constant-velocity and iso230-2).
-    #[arg(
-        long = "jerk-m-s3",
-        value_name = "M_PER_S3",
-        default_value_t = 20.0,
-        help_heading = "Motion"
-    )]
-    pub jerk_m_s3: f64,
-
-    /// Force of the step test, N [1500: half the continuous force, §6.2].
-    #[arg(
-        long = "force-n",
-        value_name = "N",
-        default_value_t = 1500.0,
-        help_heading = "Step"
-    )]
-    pub force_n: f64,
-
-    /// Simulated time of the step test, s (the step comes at 0.01 s).
-    #[arg(
-        long = "duration-s",
-        value_name = "S",
-        default_value_t = 0.3,
-        help_heading = "Step"
-    )]
-    pub duration_s: f64,
-
-    /// Number of ISO targets, evenly spaced from --first-mm to --last-mm.
-    #[arg(
-        long,
-        value_name = "N",
-        default_value_t = 21,
-        help_heading = "ISO 230-2"
-    )]
-    pub targets: usize,
-
-    /// First ISO target, mm.
-    #[arg(
-        long = "first-mm",
-        value_name = "MM",
-        default_value_t = 0.0,
-        help_heading = "ISO 230-2"
-    )]
-    pub first_mm: f64,
-
-    /// Last ISO target, mm [400: fits both bundled axes].
-    #[arg(
-        long = "last-mm",
-        value_name = "MM",
-        default_value_t = 400.0,
-        help_heading = "ISO 230-2"
-    )]
-    pub last_mm: f64,
-
-    /// Bidirectional runs (ISO 230-2 asks for 5).
-    #[arg(
-        long,
-        value_name = "N",
-        default_value_t = 5,
-        help_heading = "ISO 230-2"
-    )]
-    pub runs: u32,
-
-    /// Dwell at each target before the reading, s.
-    #[arg(
-        long = "dwell-s",
-        value_name = "S",
-        default_value_t = 1.0,
-        help_heading = "ISO 230-2"
-    )]
-    pub dwell_s: f64,
-
-    /// Overrun past the first and last target, mm.
-    #[arg(
-        long = "overrun-mm",
-        value_name = "MM",
-        default_value_t = 5.0,
-        help_heading = "ISO 230-2"
-    )]
-    pub overrun_mm: f64,
-
-    /// Structural stiffness between the drive's force line and the laser, N/µm.
-    ///
-    /// The drive holds its residual friction force through this stiffness,
-    /// so the measured point lags the scale by F/k_c. The default (100 N/µm)
-    /// is illustrative, not from the thesis. 0 means rigid: the laser reads
-    /// the scale.
-    #[arg(long = "compliance-n-um", value_name = "N_PER_UM", default_value_t = DEFAULT_COMPLIANCE_N_PER_UM, help_heading = "ISO 230-2")]
-    pub compliance_n_um: f64,
+    /// The ISO cycle's targets, runs, dwell, overrun and compliance.
+    #[command(flatten, next_help_heading = "ISO 230-2")]
+    pub iso: IsoFlags,
 
     /// Step uniformly at 1 µs (the reference) instead of adaptively.
     ///
@@ -210,6 +104,94 @@ pub struct ServoSimArgs {
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
     pub verbosity: Verbosity,
+}
+
+/// The circle test's flags (heading "Circle").
+#[derive(Debug, clap::Args)]
+pub struct CircleFlags {
+    /// Circle radius, mm.
+    #[arg(long = "radius-mm", value_name = "MM", default_value_t = 90.0)]
+    pub radius_mm: f64,
+
+    /// Which circle coordinate the axis follows: x (R cos φ) or y (R sin φ).
+    ///
+    /// Defaults from the axis name in the file (X or Y).
+    #[arg(long = "circle-axis", value_name = "x|y", value_parser = parse_circle_axis)]
+    pub circle_axis: Option<CircleAxis>,
+}
+
+/// The moves' feed, acceleration and jerk (heading "Motion").
+#[derive(Debug, clap::Args)]
+pub struct MotionFlags {
+    /// Feed, m/min [circle 16, constant-velocity 5, iso230-2 2].
+    ///
+    /// The path feed of the circle (the thesis ran 3.2, 8, 16, 24 and
+    /// 48 m/min), the cruise feed of the constant-velocity run, or the feed of
+    /// every move of the ISO cycle.
+    #[arg(long = "feed-m-min", value_name = "M_PER_MIN")]
+    pub feed_m_min: Option<f64>,
+
+    /// Acceleration of the moves, m/s² (constant-velocity and iso230-2).
+    #[arg(
+        long = "acceleration-m-s2",
+        value_name = "M_PER_S2",
+        default_value_t = 1.0
+    )]
+    pub acceleration_m_s2: f64,
+
+    /// Jerk of the moves, m/s³ (constant-velocity and iso230-2).
+    #[arg(long = "jerk-m-s3", value_name = "M_PER_S3", default_value_t = 20.0)]
+    pub jerk_m_s3: f64,
+}
+
+/// The force step test's flags (heading "Step").
+#[derive(Debug, clap::Args)]
+pub struct StepFlags {
+    /// Force of the step test, N [1500: half the continuous force, §6.2].
+    #[arg(long = "force-n", value_name = "N", default_value_t = 1500.0)]
+    pub force_n: f64,
+
+    /// Simulated time of the step test, s (the step comes at 0.01 s).
+    #[arg(long = "duration-s", value_name = "S", default_value_t = 0.3)]
+    pub duration_s: f64,
+}
+
+/// The ISO 230-2 cycle's flags (heading "ISO 230-2"); `--first-mm` and
+/// `--last-mm` also set the constant-velocity run's length.
+#[derive(Debug, clap::Args)]
+pub struct IsoFlags {
+    /// Number of ISO targets, evenly spaced from --first-mm to --last-mm.
+    #[arg(long, value_name = "N", default_value_t = 21)]
+    pub targets: usize,
+
+    /// First ISO target, mm.
+    #[arg(long = "first-mm", value_name = "MM", default_value_t = 0.0)]
+    pub first_mm: f64,
+
+    /// Last ISO target, mm [400: fits both bundled axes].
+    #[arg(long = "last-mm", value_name = "MM", default_value_t = 400.0)]
+    pub last_mm: f64,
+
+    /// Bidirectional runs (ISO 230-2 asks for 5).
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    pub runs: u32,
+
+    /// Dwell at each target before the reading, s.
+    #[arg(long = "dwell-s", value_name = "S", default_value_t = 1.0)]
+    pub dwell_s: f64,
+
+    /// Overrun past the first and last target, mm.
+    #[arg(long = "overrun-mm", value_name = "MM", default_value_t = 5.0)]
+    pub overrun_mm: f64,
+
+    /// Structural stiffness between the drive's force line and the laser, N/µm.
+    ///
+    /// The drive holds its residual friction force through this stiffness,
+    /// so the measured point lags the scale by F/k_c. The default (100 N/µm)
+    /// is illustrative, not from the thesis. 0 means rigid: the laser reads
+    /// the scale.
+    #[arg(long = "compliance-n-um", value_name = "N_PER_UM", default_value_t = DEFAULT_COMPLIANCE_N_PER_UM)]
+    pub compliance_n_um: f64,
 }
 
 fn parse_friction(name: &str) -> Result<FrictionKind, String> {
@@ -278,8 +260,11 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
     };
     let csv: Vec<u8> = match args.test {
         TestKind::Circle => {
-            let feed = positive("--feed-m-min", args.feed_m_min.unwrap_or(16.0))?;
-            let circle_axis = match (args.circle_axis, axis.name.to_ascii_uppercase().as_str()) {
+            let feed = positive("--feed-m-min", args.motion.feed_m_min.unwrap_or(16.0))?;
+            let circle_axis = match (
+                args.circle.circle_axis,
+                axis.name.to_ascii_uppercase().as_str(),
+            ) {
                 (Some(chosen), _) => chosen,
                 (None, "X") => CircleAxis::X,
                 (None, "Y") => CircleAxis::Y,
@@ -288,7 +273,7 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
                 ),
             };
             let circle = Circle {
-                radius_m: mm_to_m(positive("--radius-mm", args.radius_mm)?),
+                radius_m: mm_to_m(positive("--radius-mm", args.circle.radius_mm)?),
                 ..Circle::thesis(feed, circle_axis)
             };
             let result = run_circle(&axis, friction, &circle, stepping, &mut report_progress);
@@ -304,9 +289,9 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
         TestKind::Step => {
             let step = ForceStep {
                 at_s: 0.01,
-                force_n: args.force_n,
+                force_n: args.step.force_n,
             };
-            let duration = positive("--duration-s", args.duration_s)?;
+            let duration = positive("--duration-s", args.step.duration_s)?;
             let result = run_force_step(&axis, friction, step, duration + step.at_s, stepping);
             report.simulated_s = result.simulated_s;
             report.macro_steps = MacroStepsJson::new(result.counts);
@@ -314,8 +299,8 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
             trace_csv(&result.trace)
         }
         TestKind::ConstantVelocity => {
-            let limits = move_limits(args, 5.0)?;
-            let distance_m = mm_to_m(args.last_mm - args.first_mm)
+            let limits = move_limits(&args.motion, 5.0)?;
+            let distance_m = mm_to_m(args.iso.last_mm - args.iso.first_mm)
                 .abs()
                 .max(um_to_mm(1.0));
             let result = run_constant_velocity(&axis, friction, distance_m, limits, stepping);
@@ -328,16 +313,16 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
         TestKind::Iso230_2 => {
             let cycle = IsoCycle {
                 targets_m: IsoCycle::evenly_spaced(
-                    mm_to_m(args.first_mm),
-                    mm_to_m(args.last_mm),
-                    args.targets,
+                    mm_to_m(args.iso.first_mm),
+                    mm_to_m(args.iso.last_mm),
+                    args.iso.targets,
                 ),
-                runs: args.runs,
-                dwell_s: args.dwell_s,
-                overrun_m: mm_to_m(args.overrun_mm),
-                limits: move_limits(args, 2.0)?,
+                runs: args.iso.runs,
+                dwell_s: args.iso.dwell_s,
+                overrun_m: mm_to_m(args.iso.overrun_mm),
+                limits: move_limits(&args.motion, 2.0)?,
             };
-            let compliance = (args.compliance_n_um != 0.0).then_some(args.compliance_n_um);
+            let compliance = (args.iso.compliance_n_um != 0.0).then_some(args.iso.compliance_n_um);
             let options = IsoOptions {
                 compliance_n_per_um: compliance,
                 stepping,
@@ -366,14 +351,14 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
     }
 }
 
-fn move_limits(args: &ServoSimArgs, default_feed_m_min: f64) -> Result<MoveLimits> {
+fn move_limits(motion: &MotionFlags, default_feed_m_min: f64) -> Result<MoveLimits> {
     Ok(MoveLimits {
         feed_m_per_s: positive(
             "--feed-m-min",
-            args.feed_m_min.unwrap_or(default_feed_m_min),
+            motion.feed_m_min.unwrap_or(default_feed_m_min),
         )? / 60.0,
-        acceleration_m_per_s2: positive("--acceleration-m-s2", args.acceleration_m_s2)?,
-        jerk_m_per_s3: positive("--jerk-m-s3", args.jerk_m_s3)?,
+        acceleration_m_per_s2: positive("--acceleration-m-s2", motion.acceleration_m_s2)?,
+        jerk_m_per_s3: positive("--jerk-m-s3", motion.jerk_m_s3)?,
     })
 }
 
@@ -430,10 +415,13 @@ mod tests {
             "circle",
         ])
         .unwrap();
-        assert_eq!(args.radius_mm, 90.0);
-        assert_eq!(args.feed_m_min, None);
-        assert_eq!((args.targets, args.runs, args.dwell_s), (21, 5, 1.0));
-        assert_eq!(args.compliance_n_um, 100.0);
+        assert_eq!(args.circle.radius_mm, 90.0);
+        assert_eq!(args.motion.feed_m_min, None);
+        assert_eq!(
+            (args.iso.targets, args.iso.runs, args.iso.dwell_s),
+            (21, 5, 1.0)
+        );
+        assert_eq!(args.iso.compliance_n_um, 100.0);
         assert!(!args.reference);
     }
 
@@ -454,8 +442,11 @@ mod tests {
             "8",
         ])
         .unwrap();
-        assert_eq!(args.circle_axis, Some(CircleAxis::Y));
-        assert_eq!((args.radius_mm, args.feed_m_min), (50.0, Some(8.0)));
+        assert_eq!(args.circle.circle_axis, Some(CircleAxis::Y));
+        assert_eq!(
+            (args.circle.radius_mm, args.motion.feed_m_min),
+            (50.0, Some(8.0))
+        );
         assert!(
             parse(&[
                 "--axis",

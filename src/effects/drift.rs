@@ -2,7 +2,7 @@
 
 use serde::Deserialize;
 
-use super::{Context, Fit, Line, Model, Parameter, Reading, Shape, TableRole, column};
+use super::{Context, Fit, Line, Model, OneNumber, Parameter, Reading, Shape, TableRole, column};
 use crate::measurement::Direction;
 
 /// Drift, µm/h.
@@ -12,6 +12,13 @@ pub struct Drift {
     /// µm per hour from the start of the test.
     pub rate_um_per_h: f64,
 }
+
+/// The one parameter, as it is shown and saved.
+const RATE: OneNumber = OneNumber {
+    key: "rate_um_per_h",
+    name: "rate",
+    unit: "µm/h",
+};
 
 impl Model for Drift {
     fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
@@ -45,16 +52,11 @@ impl Model for Drift {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        vec![Parameter::number(
-            "rate_um_per_h",
-            "rate",
-            "µm/h",
-            self.rate_um_per_h,
-        )]
+        RATE.parameters(self.rate_um_per_h)
     }
 
     fn label(&self, number: &dyn Fn(f64) -> String) -> String {
-        format!("drift {} µm/h", number(self.rate_um_per_h))
+        RATE.label(Self::NAME, self.rate_um_per_h, number)
     }
 }
 

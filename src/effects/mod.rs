@@ -163,6 +163,28 @@ impl Parameter {
     }
 }
 
+/// The one parameter of a kind that has a single number (scale, drift): its
+/// key, name and unit, from which the kind's [`Model::parameters`] and
+/// [`Model::label`] follow.
+struct OneNumber {
+    key: &'static str,
+    name: &'static str,
+    unit: &'static str,
+}
+
+impl OneNumber {
+    /// [`Model::parameters`]: this parameter with its value.
+    fn parameters(&self, value: f64) -> Vec<Parameter> {
+        vec![Parameter::number(self.key, self.name, self.unit, value)]
+    }
+
+    /// [`Model::label`]: the kind's name, the number and its unit
+    /// (`drift 2.00 µm/h`).
+    fn label(&self, kind: &str, value: f64, number: &dyn Fn(f64) -> String) -> String {
+        format!("{kind} {} {}", number(value), self.unit)
+    }
+}
+
 /// The standard uncertainty of one parameter, by its key.
 pub type Uncertainty = (&'static str, f64);
 

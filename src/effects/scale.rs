@@ -2,7 +2,7 @@
 
 use serde::Deserialize;
 
-use super::{Context, Fit, Line, Model, Parameter, Reading, Shape, TableRole, column};
+use super::{Context, Fit, Line, Model, OneNumber, Parameter, Reading, Shape, TableRole, column};
 use crate::measurement::Direction;
 use crate::units::{mm_to_m, per_m_over_mm};
 
@@ -13,6 +13,13 @@ pub struct Scale {
     /// µm per m of travel from the first target.
     pub scale_um_per_m: f64,
 }
+
+/// The one parameter, as it is shown and saved.
+const SCALE: OneNumber = OneNumber {
+    key: "scale_um_per_m",
+    name: "scale",
+    unit: "µm/m",
+};
 
 impl Model for Scale {
     fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
@@ -55,16 +62,11 @@ impl Model for Scale {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        vec![Parameter::number(
-            "scale_um_per_m",
-            "scale",
-            "µm/m",
-            self.scale_um_per_m,
-        )]
+        SCALE.parameters(self.scale_um_per_m)
     }
 
     fn label(&self, number: &dyn Fn(f64) -> String) -> String {
-        format!("scale {} µm/m", number(self.scale_um_per_m))
+        SCALE.label(Self::NAME, self.scale_um_per_m, number)
     }
 }
 

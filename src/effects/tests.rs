@@ -231,3 +231,22 @@ fn every_kind_labels_itself_with_the_numbers_it_is_given() {
         );
     }
 }
+
+#[test]
+fn one_number_kinds_show_their_parameter_and_label() {
+    let two_decimals = |v: f64| format!("{v:.2}");
+    let scale = Effect::Scale(Scale {
+        scale_um_per_m: 11.5,
+    });
+    let drift = Effect::Drift(Drift { rate_um_per_h: 2.0 });
+    assert_eq!(
+        scale.parameters(),
+        vec![Parameter::number("scale_um_per_m", "scale", "µm/m", 11.5)]
+    );
+    assert_eq!(
+        drift.parameters(),
+        vec![Parameter::number("rate_um_per_h", "rate", "µm/h", 2.0)]
+    );
+    assert_eq!(scale.model().label(&two_decimals), "scale 11.50 µm/m");
+    assert_eq!(drift.model().label(&two_decimals), "drift 2.00 µm/h");
+}

@@ -450,24 +450,25 @@ mod tests {
         #[rustfmt::skip]
         let cases = [
             ("x,y\n", (1, 1), "expected the header"),
-            ("target_mm,run,direction,deviation_um\n0,1,up,1,5\n", (2, 1), "decimal comma"),
             ("target_mm,run,direction,deviation_um\n0,1,sideways,1\n", (2, 5), "direction up or down"),
             ("target_mm,run,direction,deviation_um\n0,0,up,1\n", (2, 3), "from 1"),
             ("target_mm,run,direction,deviation_um\n0,1,up,1\n0,1,up,2\n", (3, 1), "listed twice"),
             ("target_mm,run,direction,deviation_um\n", (2, 1), "at least one data row"),
             ("target_mm,run,direction,deviation_um\n0,1,up,inf\n", (2, 8), "expected a number"),
+        ];
+        text::assert_errors_at(parse, &cases);
+    }
+
+    /// A decimal comma where the layout has none, or a mixture of separators.
+    #[test]
+    fn decimal_separator_errors_are_positioned() {
+        #[rustfmt::skip]
+        let cases = [
+            ("target_mm,run,direction,deviation_um\n0,1,up,1,5\n", (2, 1), "decimal comma"),
             ("target_mm;run;direction;deviation_um\n0;1;up;0,5\n10;1;up;1.5\n", (3, 9), "expected a decimal comma as on line 2, found a decimal point in \"1.5\""),
             ("target_mm;run;direction;deviation_um\n1.000,5;1;up;0\n", (2, 1), "found both '.' and ','"),
             ("target_mm;run;direction;deviation_um\n0;1;up;1,2,3\n", (2, 8), "expected a number (deviation in µm), found \"1,2,3\""),
         ];
-        for (text, (line, column), needle) in cases {
-            let error = parse(text).unwrap_err();
-            assert_eq!(
-                (error.position.line, error.position.column),
-                (line, column),
-                "{text:?}: {error}"
-            );
-            assert!(error.message.contains(needle), "{text:?}: {error}");
-        }
+        text::assert_errors_at(parse, &cases);
     }
 }

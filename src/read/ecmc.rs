@@ -708,14 +708,6 @@ mod tests {
             ("TGT_DATA[1]=nan\n", (1, 13), "expected a number"),
             ("CYCLES=1\nTGT_DATA[1]=1\nREF_DATA_BWD[1,2]=1\n", (3, 14), "beyond CYCLES=1"),
         ];
-        for (text, (line, column), needle) in cases {
-            let error = parse(text).unwrap_err();
-            assert_eq!(
-                (error.position.line, error.position.column),
-                (line, column),
-                "{text:?}: {error}"
-            );
-            assert!(error.message.contains(needle), "{text:?}: {error}");
-        }
+        text::assert_errors_at(parse, &cases);
     }
 }

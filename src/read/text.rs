@@ -236,6 +236,25 @@ pub fn split_key(text: &str, sep: char) -> Option<(&str, &str)> {
     Some((text[..at].trim(), text[at + sep.len_utf8()..].trim()))
 }
 
+/// Test helper for the readers' tables of bad inputs: parses each case's
+/// text and asserts that it fails at (line, column) with a message that
+/// contains the needle.
+#[cfg(test)]
+pub(crate) fn assert_errors_at<T: std::fmt::Debug>(
+    parse: impl Fn(&str) -> Result<T, ParseError>,
+    cases: &[(&str, (usize, usize), &str)],
+) {
+    for &(text, (line, column), needle) in cases {
+        let error = parse(text).unwrap_err();
+        assert_eq!(
+            (error.position.line, error.position.column),
+            (line, column),
+            "{text:?}: {error}"
+        );
+        assert!(error.message.contains(needle), "{text:?}: {error}");
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
