@@ -242,6 +242,20 @@ impl Standard for Vdi3441 {
     }
 }
 
+/// What a VDI/DGQ 3441 figure is, by its key (standards.md §3), for the
+/// terminal and the report; empty for a key that is not VDI's.
+pub fn vdi_figure_name(key: &str) -> &'static str {
+    match key {
+        "P" => "positional uncertainty",
+        "Pa" => "positional deviation (span of x̄_i)",
+        "Ps_max" => "largest positional scatter 6·(s↑ + s↓)/2",
+        "Ps_mean" => "mean positional scatter",
+        "U_max" => "largest reversal span |x̄↑ − x̄↓|",
+        "U_mean" => "mean reversal span",
+        _ => "",
+    }
+}
+
 /// VDI 3441's axis figures, mm.
 #[derive(Clone, Copy, Debug)]
 struct VdiFigures {

@@ -56,7 +56,7 @@ use crate::effects::{Parameter, ParameterValue};
 use crate::evaluate::TestConformance;
 use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
-use crate::evaluate::standard::Vdi3441;
+use crate::evaluate::standard::{Vdi3441, vdi_figure_name};
 use crate::evaluate::verdict::{Figure, Limit};
 use crate::evaluate::{AxisFigures, Standard, StandardUsed};
 use crate::measurement::{Direction, Measurement, StartEnd};
@@ -844,19 +844,6 @@ const FIGURE_ROWS: [(&str, &str, Figure); 6] = [
     ("B", "reversal value", Figure::B),
     ("B̄", "mean reversal value", Figure::BMean),
 ];
-
-/// What a VDI/DGQ 3441 figure is (`../shared/spec/standards.md` §3).
-fn vdi_figure_name(key: &str) -> &'static str {
-    match key {
-        "P" => "positional uncertainty",
-        "Pa" => "positional deviation (span of x̄ᵢ)",
-        "Ps_max" => "largest positional scatter 6·(s↑ + s↓)/2",
-        "Ps_mean" => "mean positional scatter",
-        "U_max" => "largest reversal span |x̄↑ − x̄↓|",
-        "U_mean" => "mean reversal span",
-        _ => "",
-    }
-}
 
 /// A figure's value as `figures_um` gives it, µm.
 fn figure_value(figures: &FiguresJson, figure: Figure) -> Option<f64> {

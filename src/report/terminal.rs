@@ -10,6 +10,7 @@ use tabled::settings::object::Columns;
 use tabled::settings::{Alignment, Style};
 use unicode_width::UnicodeWidthStr;
 
+use crate::evaluate::standard::vdi_figure_name;
 use crate::report::format::{NOT_EVALUATED, inch_beside, push_integer, push_um, um};
 use crate::report::json::{EvaluationJson, StartEndJson};
 
@@ -247,26 +248,13 @@ fn keyed_figures_table(r: &EvaluationJson) -> String {
     let mut builder = Builder::default();
     builder.push_record(["figure", "value"]);
     for (key, value) in &r.figures_um.values {
-        builder.push_record([format!("{key}  {}", figure_name(key)), um(*value)]);
+        builder.push_record([format!("{key}  {}", vdi_figure_name(key)), um(*value)]);
     }
     let mut table = builder.build();
     table
         .with(Style::psql())
         .modify(Columns::new(1..), Alignment::right());
     table.to_string()
-}
-
-/// What a non-ISO figure is (VDI/DGQ 3441, `../shared/spec/standards.md` §3).
-fn figure_name(key: &str) -> &'static str {
-    match key {
-        "P" => "positional uncertainty",
-        "Pa" => "positional deviation (span of x̄_i)",
-        "Ps_max" => "largest positional scatter 6·(s↑ + s↓)/2",
-        "Ps_mean" => "mean positional scatter",
-        "U_max" => "largest reversal span |x̄↑ − x̄↓|",
-        "U_mean" => "mean reversal span",
-        _ => "",
-    }
 }
 
 fn figures_table(r: &EvaluationJson) -> String {
