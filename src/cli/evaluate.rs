@@ -7,12 +7,13 @@ use anyhow::{Context, Result, bail};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::{Direction, Measurement, RunSelector};
 use axcomp::read;
+use axcomp::report::uncertainty::UncertaintyJson;
 use axcomp::report::{json::EvaluationJson, terminal, verdict};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, JsonOutput, MachineFile, Verbosity, name_axis, parse_run_selector, print_json,
-    print_text, print_warnings,
+    InputFormat, JsonOutput, MachineFile, UncertaintyArgs, Verbosity, load_equipment, name_axis,
+    parse_run_selector, print_json, print_text, print_warnings, uncertainty_budget,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -53,6 +54,10 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
+    /// `--equipment`, `--decision` (the same in `report`).
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
+
     /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
@@ -78,10 +83,18 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         measurement.axis(),
         &args.acceptance,
     )?;
+    let equipment = load_equipment(&args.uncertainty)?;
+    let budget = uncertainty_budget(&measurement, &equipment)?;
     let evaluation = evaluate(&measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
     let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
-    report.verdict = verdict::judge(&evaluation, &limits);
+    report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));
+    report.verdict = verdict::judge(
+        &evaluation,
+        &limits,
+        args.uncertainty.decision,
+        Some(&budget),
+    );
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

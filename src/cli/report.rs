@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::error::Warning;
+use axcomp::evaluate::uncertainty::{Budget, Equipment};
 use axcomp::evaluate::{Evaluation, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::output::write_all_new;
@@ -20,8 +21,8 @@ use axcomp::together::{Input, Pairing, check_together};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, LinuxCncType, MachineFile, Overwrite, Verbosity, load_profile, name_axis,
-    print_text, print_warnings, read_active_table,
+    InputFormat, LinuxCncType, MachineFile, Overwrite, UncertaintyArgs, Verbosity, load_equipment,
+    load_profile, name_axis, print_text, print_warnings, read_active_table, uncertainty_budget,
 };
 
 /// Flags of `axcomp report`.
@@ -72,6 +73,10 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
+    /// `--equipment`, `--decision` (the same in `evaluate`).
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
+
     /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
@@ -109,10 +114,16 @@ struct Test {
     measurement: Measurement,
     evaluation: Evaluation,
     warnings: Vec<Warning>,
+    budget: Budget,
 }
 
 impl Test {
-    fn read(path: &Path, format: Option<SourceFormat>, axis: Option<&String>) -> Result<Test> {
+    fn read(
+        path: &Path,
+        format: Option<SourceFormat>,
+        axis: Option<&String>,
+        equipment: &Equipment,
+    ) -> Result<Test> {
         let read::ReadResult {
             mut measurement,
             mut warnings,
@@ -120,10 +131,12 @@ impl Test {
         name_axis(&mut measurement, axis);
         let evaluation = evaluate(&measurement);
         warnings.extend(evaluation.warnings.iter().cloned());
+        let budget = uncertainty_budget(&measurement, equipment)?;
         Ok(Test {
             measurement,
             evaluation,
             warnings,
+            budget,
         })
     }
 
@@ -132,13 +145,20 @@ impl Test {
             measurement: &self.measurement,
             evaluation: &self.evaluation,
             warnings: &self.warnings,
+            budget: Some(&self.budget),
         }
     }
 }
 
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
-    let mut before = Test::read(&args.file, args.input_format.format, args.axis.as_ref())?;
+    let equipment = load_equipment(&args.uncertainty)?;
+    let mut before = Test::read(
+        &args.file,
+        args.input_format.format,
+        args.axis.as_ref(),
+        &equipment,
+    )?;
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
         before.measurement.axis(),
@@ -149,6 +169,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             path,
             args.input_format.format,
             args.axis.as_ref(),
+            &equipment,
         )?),
         None => None,
     };
@@ -205,6 +226,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         }),
         diagnosis: diagnosis.as_ref(),
         limits: &limits,
+        decision: args.uncertainty.decision,
         generator: &generator,
     };
     // Render everything before writing anything: a failure leaves no half report.

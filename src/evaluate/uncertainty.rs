@@ -302,11 +302,9 @@ pub fn budget(
             name: "u_AIR",
             u_mm: um_to_mm(over_length(per_m)),
             source: format!(
-                "air sensors u = {} °C, {} hPa, {} %RH through Edlén's sensitivities \
+                "air sensors u = {} °C, {:.2} hPa, {} %RH through Edlén's sensitivities \
                  0.93, 0.27, 0.0085 µm/m per unit · {length}",
-                equipment.air_temperature_u_c,
-                format!("{pressure_u_hpa:.2}"),
-                equipment.air_humidity_u_pct
+                equipment.air_temperature_u_c, pressure_u_hpa, equipment.air_humidity_u_pct
             ),
         });
     }
@@ -364,8 +362,8 @@ pub fn budget(
         name: "u_E,MACHINE",
         u_mm: um_to_mm(over_length(difference_c * alpha_u)),
         source: format!(
-            "T_mat = {} °C ({material_from}): |T_mat − 20 °C| · u_α ({} µm/(m·°C) / √3) · {length}",
-            format!("{material_c:.2}"),
+            "T_mat = {:.2} °C ({material_from}): |T_mat − 20 °C| · u_α ({} µm/(m·°C) / √3) · {length}",
+            material_c,
             equipment.expansion_coefficient_limit_ppm_per_k
         ),
     });
@@ -382,10 +380,7 @@ pub fn budget(
     contributors.push(Contributor {
         name: "u_EVE",
         u_mm: eve_mm / (2.0 * 3f64.sqrt()),
-        source: format!(
-            "E_VE = {} µm ({eve_from}) / (2√3)",
-            format!("{:.2}", mm_to_um(eve_mm))
-        ),
+        source: format!("E_VE = {:.2} µm ({eve_from}) / (2√3)", mm_to_um(eve_mm)),
     });
 
     contributors.sort_by(|a, b| b.u_mm.total_cmp(&a.u_mm));
@@ -501,9 +496,9 @@ impl fmt::Display for Contributor {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} = {} µm ({})",
+            "{} = {:.3} µm ({})",
             self.name,
-            format!("{:.3}", mm_to_um(self.u_mm)),
+            mm_to_um(self.u_mm),
             self.source
         )
     }

@@ -23,6 +23,9 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     out.push_str("\n\nAxis figures [µm] (ISO 230-2)\n");
     out.push_str(&figures_table(report));
     out.push('\n');
+    if let Some(uncertainty) = &report.uncertainty_um {
+        out.push_str(&crate::report::uncertainty::terminal(uncertainty));
+    }
     if !report.outliers.is_empty() {
         out.push_str("\nSuspected outlier runs (included; exclude with --exclude-run RUN:DIRECTION only if you know why)\n");
         for o in &report.outliers {
@@ -231,12 +234,23 @@ fn psql_right_aligned<'a, const N: usize>(
 
 fn figures_table(r: &EvaluationJson) -> String {
     let f = &r.figures_um;
+    // `11.96 ± 3.49` where U of the figure is evaluated (E, M, A).
+    let u = r.uncertainty_um.as_ref();
+    let with_u = |value: Option<f64>, expanded: Option<f64>| match (value, expanded) {
+        (Some(_), Some(expanded)) => format!("{} ± {}", um(value), um(Some(expanded))),
+        _ => um(value),
+    };
     let mut builder = Builder::default();
     builder.push_record(["figure", "bidirectional", "↑", "↓"]);
-    builder.push_record(["A  accuracy".to_string(), um(f.A), um(f.A_up), um(f.A_down)]);
+    builder.push_record([
+        "A  accuracy".to_string(),
+        with_u(f.A, u.map(|u| u.A)),
+        um(f.A_up),
+        um(f.A_down),
+    ]);
     builder.push_record([
         "E  systematic deviation".to_string(),
-        um(f.E),
+        with_u(f.E, u.map(|u| u.E)),
         um(f.E_up),
         um(f.E_down),
     ]);
@@ -248,7 +262,7 @@ fn figures_table(r: &EvaluationJson) -> String {
     ]);
     builder.push_record([
         "M  mean bidirectional deviation".to_string(),
-        um(f.M),
+        with_u(f.M, u.map(|u| u.M)),
         String::new(),
         String::new(),
     ]);
