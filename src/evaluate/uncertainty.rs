@@ -183,7 +183,7 @@ impl Equipment {
     /// use axcomp::evaluate::uncertainty::{DEFAULT_EQUIPMENT_TOML, Equipment};
     /// let equipment = Equipment::from_toml_str(DEFAULT_EQUIPMENT_TOML, "default").unwrap();
     /// assert_eq!(equipment.laser_expanded_um_per_m, 0.5);
-    /// let bad = DEFAULT_EQUIPMENT_TOML.replace("k = 2", "k = 2\nq = 1");
+    /// let bad = DEFAULT_EQUIPMENT_TOML.replacen("\nk = 2", "\nk = 2\nq = 1", 1);
     /// let error = Equipment::from_toml_str(&bad, "bad").unwrap_err();
     /// assert!(error.message.contains("unknown field `q`"), "{error}");
     /// ```
