@@ -166,6 +166,16 @@ pub fn inch_to_mm(value_inch: f64) -> Mm {
     value_inch * MM_PER_INCH
 }
 
+/// Milliradians to radians.
+pub fn mrad_to_rad(value_mrad: f64) -> f64 {
+    value_mrad / 1000.0
+}
+
+/// Kilopascal to hectopascal (hPa, the unit of Edlén's sensitivities).
+pub fn kpa_to_hpa(value_kpa: f64) -> f64 {
+    value_kpa * 10.0
+}
+
 /// Degrees Fahrenheit to degrees Celsius.
 pub fn fahrenheit_to_celsius(value_f: f64) -> f64 {
     (value_f - 32.0) * 5.0 / 9.0
@@ -217,6 +227,9 @@ mod tests {
         assert!((inhg_to_kpa(29.92) - 101.320_759).abs() < 1e-6);
         // 6.7 ppm/°F (API file, steel) is 12.06 ppm/°C.
         assert!((per_fahrenheit_to_per_celsius(6.7) - 12.06).abs() < 1e-12);
+        // 0.1 kPa is 1 hPa; 0.1 mrad is 1e-4 rad.
+        assert!((kpa_to_hpa(0.1) - 1.0).abs() < 1e-15);
+        assert_eq!(mrad_to_rad(0.1), 1e-4);
     }
 
     #[test]

@@ -19,8 +19,8 @@ pub struct LimitArgs {
     /// FIGURE is a key of figures_um in evaluate --json: A, A_up, A_down, E,
     /// E_up, E_down, M, R, R_up, R_down, B, B_mean (B_mean compares |B̄|).
     /// Replaces the machine profile's [acceptance] limit for that figure. With
-    /// limits the output gets a PASS/FAIL verdict (simple acceptance: value ≤
-    /// limit); a figure that is not evaluated fails. The exit status stays 0:
+    /// limits the output gets a verdict under --decision (default simple:
+    /// value ≤ limit); a figure that is not evaluated fails. The exit status stays 0:
     /// a FAIL is a result, not an error.
     #[arg(long = "limit", value_name = "FIGURE=UM", value_parser = parse_limit, help_heading = "Acceptance")]
     pub limits: Vec<(Figure, f64)>,

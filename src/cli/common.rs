@@ -11,6 +11,8 @@ use axcomp::effects::{Effect, read_effects};
 use axcomp::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
 use axcomp::error::{ParseError, Warning};
 use axcomp::evaluate::Standard;
+use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
+use axcomp::evaluate::verdict::Decision;
 use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
@@ -303,6 +305,62 @@ pub struct MachineFile {
     /// [acceptance] the permissible values (README.md).
     #[arg(long, value_name = "M.toml", help_heading = "Machine")]
     pub machine: Option<PathBuf>,
+}
+
+/// `--equipment` and `--decision`: the measurement uncertainty and the rule
+/// that decides the verdict with it, the same in `evaluate` and `report`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct UncertaintyArgs {
+    /// Equipment profile (TOML) for the measurement uncertainty (default: a typical HeNe laser).
+    ///
+    /// The laser's expanded uncertainty and k, whether it includes the air
+    /// compensation, the air and material sensors' standard uncertainties,
+    /// the expansion coefficient's ± limit, the misalignment (mrad) and the
+    /// environmental variation E_VE (eve_um, or drift_test = "FILE", a
+    /// measurement file relative to the profile; E_VE is its range). The
+    /// bundled default is fixtures/equipment/hene-default.toml (README.md).
+    #[arg(long, value_name = "E.toml", help_heading = "Uncertainty")]
+    pub equipment: Option<PathBuf>,
+
+    /// Decision rule of the verdict: simple or iso14253-1.
+    ///
+    /// simple: a figure passes when value ≤ limit (the uncertainty is not
+    /// considered). iso14253-1: conformance is proven when value + U ≤ limit,
+    /// non-conformance when value − U > limit, and otherwise the check is
+    /// "not proven"; figures without an evaluated U (R, B, ↑, ↓) are compared
+    /// by their value.
+    #[arg(long, value_name = "RULE", default_value = "simple", value_parser = parse_decision, help_heading = "Acceptance")]
+    pub decision: Decision,
+}
+
+/// `simple` or `iso14253-1`.
+pub fn parse_decision(name: &str) -> Result<Decision, String> {
+    Decision::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Decision::ALL.map(Decision::name).to_vec();
+        format!("expected one of {}, found {name:?}", names.join(", "))
+    })
+}
+
+/// The equipment of `--equipment` (or the bundled profile), with its drift
+/// test read (relative to the profile) when it names one.
+pub fn load_equipment(args: &UncertaintyArgs) -> Result<Equipment> {
+    let Some(path) = &args.equipment else {
+        return Ok(Equipment::bundled());
+    };
+    let name = path.display().to_string();
+    let equipment = load(path, |text| Equipment::from_toml_str(text, &name))?;
+    let Some(drift) = equipment.drift_test_path() else {
+        return Ok(equipment);
+    };
+    let drift_path = path.parent().unwrap_or(Path::new("")).join(drift);
+    let read = axcomp::read::read_paths(std::slice::from_ref(&drift_path), None)
+        .with_context(|| format!("{name}: the drift test"))?;
+    Ok(equipment.with_drift_test(&read.measurement, &drift_path.display().to_string()))
+}
+
+/// The uncertainty budget of `measurement` with `equipment`.
+pub fn uncertainty_budget(measurement: &Measurement, equipment: &Equipment) -> Result<Budget> {
+    Ok(budget(measurement, equipment)?)
 }
 
 /// `--linuxcnc-type` for reading a LinuxCNC table (`convert` has its own: the

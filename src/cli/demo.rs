@@ -184,11 +184,13 @@ pub fn run(args: &DemoArgs) -> Result<()> {
             measurement: &before,
             evaluation: &evaluation,
             warnings: &evaluation.warnings,
+            budget: None,
         },
         after: Some(TestRecord {
             measurement: &after,
             evaluation: &after_evaluation,
             warnings: &after_evaluation.warnings,
+            budget: None,
         }),
         table: Some(TableRecord {
             table: &active,
@@ -197,6 +199,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         }),
         diagnosis: Some(&diagnosis),
         limits: &[],
+        decision: Default::default(),
         generator: &generator,
     };
     files.push(("report.html".into(), html::render(&input)?.into_bytes()));

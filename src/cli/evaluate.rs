@@ -7,12 +7,13 @@ use anyhow::{Context, Result, bail};
 use axcomp::evaluate::evaluate_with;
 use axcomp::measurement::{Direction, Measurement, RunSelector};
 use axcomp::read;
+use axcomp::report::uncertainty::UncertaintyJson;
 use axcomp::report::{json::EvaluationJson, terminal, verdict};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, JsonOutput, MachineFile, StandardArg, Verbosity, name_axis, parse_run_selector,
-    print_json, print_text, print_warnings,
+    InputFormat, JsonOutput, MachineFile, StandardArg, UncertaintyArgs, Verbosity, load_equipment,
+    name_axis, parse_run_selector, print_json, print_text, print_warnings, uncertainty_budget,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -57,6 +58,10 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
+    /// `--equipment`, `--decision` (the same in `report`).
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
+
     /// `--json` (the same in every command).
     #[command(flatten)]
     pub json_output: JsonOutput,
@@ -82,10 +87,18 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         measurement.axis(),
         &args.acceptance,
     )?;
+    let equipment = load_equipment(&args.uncertainty)?;
+    let budget = uncertainty_budget(&measurement, &equipment)?;
     let evaluation = evaluate_with(&measurement, args.standard.standard);
     warnings.extend(evaluation.warnings.iter().cloned());
     let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
-    report.verdict = verdict::judge(&evaluation, &limits);
+    report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));
+    report.verdict = verdict::judge(
+        &evaluation,
+        &limits,
+        args.uncertainty.decision,
+        Some(&budget),
+    );
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

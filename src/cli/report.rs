@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::error::Warning;
+use axcomp::evaluate::uncertainty::{Budget, Equipment};
 use axcomp::evaluate::{Evaluation, Standard, evaluate_with};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::output::write_all_new;
@@ -20,8 +21,9 @@ use axcomp::together::{Input, Pairing, check_together};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load_profile,
-    name_axis, print_text, print_warnings, read_active_table,
+    InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
+    load_equipment, load_profile, name_axis, print_text, print_warnings, read_active_table,
+    uncertainty_budget,
 };
 
 /// Flags of `axcomp report`.
@@ -72,6 +74,10 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub acceptance: LimitArgs,
 
+    /// `--equipment`, `--decision` (the same in `evaluate`).
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
+
     /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
@@ -113,6 +119,7 @@ struct Test {
     measurement: Measurement,
     evaluation: Evaluation,
     warnings: Vec<Warning>,
+    budget: Budget,
 }
 
 impl Test {
@@ -121,6 +128,7 @@ impl Test {
         format: Option<SourceFormat>,
         axis: Option<&String>,
         standard: &dyn Standard,
+        equipment: &Equipment,
     ) -> Result<Test> {
         let read::ReadResult {
             mut measurement,
@@ -129,10 +137,12 @@ impl Test {
         name_axis(&mut measurement, axis);
         let evaluation = evaluate_with(&measurement, standard);
         warnings.extend(evaluation.warnings.iter().cloned());
+        let budget = uncertainty_budget(&measurement, equipment)?;
         Ok(Test {
             measurement,
             evaluation,
             warnings,
+            budget,
         })
     }
 
@@ -141,6 +151,7 @@ impl Test {
             measurement: &self.measurement,
             evaluation: &self.evaluation,
             warnings: &self.warnings,
+            budget: Some(&self.budget),
         }
     }
 }
@@ -148,11 +159,13 @@ impl Test {
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
     let standard = args.standard.standard;
+    let equipment = load_equipment(&args.uncertainty)?;
     let mut before = Test::read(
         &args.file,
         args.input_format.format,
         args.axis.as_ref(),
         standard,
+        &equipment,
     )?;
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
@@ -165,6 +178,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             args.input_format.format,
             args.axis.as_ref(),
             standard,
+            &equipment,
         )?),
         None => None,
     };
@@ -221,6 +235,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         }),
         diagnosis: diagnosis.as_ref(),
         limits: &limits,
+        decision: args.uncertainty.decision,
         generator: &generator,
     };
     // Render everything before writing anything: a failure leaves no half report.

@@ -196,8 +196,9 @@ fn compare(
     })
 }
 
-/// The mean of the fitted material sensors, °C (the laser software averages them).
-fn material_temperature_c(
+/// The mean of the fitted material sensors, °C (the laser software averages
+/// them), at the start or the end of the test as `pick` says.
+pub fn material_temperature_c(
     environment: &Environment,
     pick: fn(&StartEnd) -> Option<f64>,
 ) -> Option<f64> {

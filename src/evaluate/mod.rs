@@ -23,6 +23,7 @@ pub mod environment;
 pub mod outliers;
 pub mod standard;
 pub mod targets;
+pub mod uncertainty;
 pub mod verdict;
 
 use crate::error::Warning;

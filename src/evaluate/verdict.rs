@@ -9,9 +9,16 @@
 //! standards state tolerances for a measuring length); the length is the
 //! measured travel, last target − first target.
 //!
-//! The decision is simple acceptance (ISO 14253-1, `../shared/spec/standards.md`
-//! §5): a figure passes when its value is at most the limit, compared at full
-//! precision; the measurement uncertainty is not taken into account. A figure
+//! The decision rule ([`Decision`], `../shared/spec/standards.md` §5) is
+//! simple acceptance by default: a figure passes when its value is at most
+//! the limit, compared at full precision, the measurement uncertainty not
+//! taken into account. Under ISO 14253-1 the expanded uncertainty U of the
+//! figure ([`Figure::expanded_uncertainty_mm`], from the budget of
+//! [`crate::evaluate::uncertainty`]) decides: conformance is proven when
+//! value + U ≤ limit, non-conformance when value − U > limit, and neither
+//! between ([`Conformance::NotProven`]). A figure without an evaluated U
+//! (R, B, the unidirectional figures: standards.md §4 gives no form) is
+//! compared by its value alone, and its check says so. A figure
 //! that is not evaluated (`None`, e.g. R of a one-run test) cannot pass: its
 //! check fails with [`Outcome::NotEvaluated`], never an implied pass. Without
 //! limits there is no verdict at all ([`verdict`] returns `None`).
@@ -46,6 +53,7 @@ use serde::Deserialize;
 use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 
 use crate::error::ParseError;
+use crate::evaluate::uncertainty::Budget;
 use crate::evaluate::{AxisFigures, Evaluation};
 use crate::measurement::Direction;
 use crate::units::per_m_over_mm;
@@ -157,6 +165,90 @@ impl Figure {
             Figure::RDown => figures.r_down_mm,
             Figure::B => figures.b_mm,
             Figure::BMean => figures.b_mean_mm.map(f64::abs),
+        }
+    }
+
+    /// The expanded uncertainty of the figure, mm: U(E) = U(M) = U(A) = the
+    /// budget's U (standards.md §4); `None` for the figures whose U is not
+    /// evaluated (R and B: no public form; the unidirectional figures: the
+    /// spec names only E, M and A).
+    pub fn expanded_uncertainty_mm(self, budget: &Budget) -> Option<f64> {
+        match self {
+            Figure::A | Figure::E | Figure::M => Some(budget.expanded_mm),
+            _ => None,
+        }
+    }
+}
+
+/// The decision rule of a verdict (standards.md §5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Decision {
+    /// Value ≤ limit; the measurement uncertainty is not considered.
+    #[default]
+    Simple,
+    /// ISO 14253-1: value + U ≤ limit proves conformance, value − U > limit
+    /// non-conformance, neither is proven between.
+    Iso14253_1,
+}
+
+impl Decision {
+    /// Both rules, in the order they are listed to users.
+    pub const ALL: [Decision; 2] = [Decision::Simple, Decision::Iso14253_1];
+
+    /// The name, as `--decision` and the JSON `rule` write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Decision::Simple => "simple",
+            Decision::Iso14253_1 => "iso14253-1",
+        }
+    }
+
+    /// The rule of a name (exactly as [`Decision::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Decision> {
+        Decision::ALL.into_iter().find(|d| d.name() == name)
+    }
+
+    /// The rule's short label: `simple acceptance` or `ISO 14253-1`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Decision::Simple => "simple acceptance",
+            Decision::Iso14253_1 => "ISO 14253-1",
+        }
+    }
+
+    /// The rule in words, as the report states it.
+    pub fn description(self) -> &'static str {
+        match self {
+            Decision::Simple => {
+                "simple acceptance: value ≤ limit, measurement uncertainty not considered"
+            }
+            Decision::Iso14253_1 => {
+                "ISO 14253-1: conformance proven when value + U ≤ limit, \
+                 non-conformance when value − U > limit, otherwise not proven"
+            }
+        }
+    }
+}
+
+/// What a check proves under its decision rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Conformance {
+    /// Conformance is proven (simple: value ≤ limit).
+    Pass,
+    /// Non-conformance is proven (simple: value > limit), or the figure is
+    /// not evaluated.
+    Fail,
+    /// ISO 14253-1: the limit lies within value ± U.
+    NotProven,
+}
+
+impl Conformance {
+    /// `pass`, `fail` or `not-proven`, as in the JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Conformance::Pass => "pass",
+            Conformance::Fail => "fail",
+            Conformance::NotProven => "not-proven",
         }
     }
 }
@@ -320,8 +412,13 @@ pub struct Check {
     pub value_mm: Option<f64>,
     /// The limit for this test's travel, mm.
     pub limit_mm: f64,
-    /// The outcome.
+    /// The value against the limit alone.
     pub outcome: Outcome,
+    /// The figure's expanded uncertainty U, mm, when the verdict has a
+    /// budget and U of this figure is evaluated.
+    pub uncertainty_mm: Option<f64>,
+    /// What the check proves under the verdict's decision rule.
+    pub conformance: Conformance,
 }
 
 impl Check {
@@ -330,9 +427,9 @@ impl Check {
         self.limit.figure
     }
 
-    /// Whether the figure passed.
+    /// Whether conformance is proven.
     pub fn pass(&self) -> bool {
-        self.outcome == Outcome::Pass
+        self.conformance == Conformance::Pass
     }
 }
 
@@ -343,12 +440,27 @@ pub struct Verdict {
     pub checks: Vec<Check>,
     /// The measured travel per-length limits use: last − first target, mm.
     pub travel_mm: f64,
+    /// The decision rule.
+    pub decision: Decision,
 }
 
 impl Verdict {
     /// Pass: every check passed (and there is at least one).
     pub fn pass(&self) -> bool {
         !self.checks.is_empty() && self.checks.iter().all(Check::pass)
+    }
+
+    /// The verdict's conformance: fail when a check fails, else not proven
+    /// when a check is not proven, else pass.
+    pub fn conformance(&self) -> Conformance {
+        let any = |c: Conformance| self.checks.iter().any(|check| check.conformance == c);
+        if any(Conformance::Fail) || self.checks.is_empty() {
+            Conformance::Fail
+        } else if any(Conformance::NotProven) {
+            Conformance::NotProven
+        } else {
+            Conformance::Pass
+        }
     }
 
     /// The checks that did not pass.
@@ -380,6 +492,39 @@ impl Verdict {
 /// assert!(verdict(&evaluate(&m), &[]).is_none());
 /// ```
 pub fn verdict(evaluation: &Evaluation, limits: &[Limit]) -> Option<Verdict> {
+    verdict_with(evaluation, limits, Decision::Simple, None)
+}
+
+/// Compares the figures with the limits under `decision`, with the
+/// uncertainty of `budget` (none: no figure has a U, and ISO 14253-1 then
+/// compares values alone); `None` without limits.
+///
+/// # Example
+/// ```
+/// use axcomp::evaluate::evaluate;
+/// use axcomp::evaluate::uncertainty::{Equipment, budget};
+/// use axcomp::evaluate::verdict::{Conformance, Decision, Figure, command_line_limits, verdict_with};
+/// use axcomp::measurement::{Direction, Measurement, Run};
+/// let run = |direction, number, values: [f64; 2]| Run {
+///     direction, number, start_time_s: None,
+///     deviations_mm: values.iter().map(|v| Some(*v)).collect() };
+/// let m = Measurement::new("X", vec![0.0, 1000.0], vec![
+///     run(Direction::Up, 1, [0.000, 0.004]), run(Direction::Down, 1, [-0.002, 0.002]),
+///     run(Direction::Up, 2, [0.002, 0.006]), run(Direction::Down, 2, [0.000, 0.004]),
+/// ], Default::default(), Default::default()).unwrap();
+/// // E = 6 µm against 6.5 µm: a pass by value, but U(E) of the bundled
+/// // equipment over 1 m (about 3.3 µm) reaches over the limit.
+/// let limits = command_line_limits(&[(Figure::E, 6.5)]).unwrap();
+/// let budget = budget(&m, &Equipment::bundled()).unwrap();
+/// let v = verdict_with(&evaluate(&m), &limits, Decision::Iso14253_1, Some(&budget)).unwrap();
+/// assert_eq!(v.checks[0].conformance, Conformance::NotProven);
+/// ```
+pub fn verdict_with(
+    evaluation: &Evaluation,
+    limits: &[Limit],
+    decision: Decision,
+    budget: Option<&Budget>,
+) -> Option<Verdict> {
     if limits.is_empty() {
         return None;
     }
@@ -399,15 +544,36 @@ pub fn verdict(evaluation: &Evaluation, limits: &[Limit]) -> Option<Verdict> {
                 Some(value) if value <= limit_mm => Outcome::Pass,
                 Some(_) => Outcome::Exceeds,
             };
+            let uncertainty_mm = budget.and_then(|b| limit.figure.expanded_uncertainty_mm(b));
+            let conformance = match (outcome, decision, value_mm, uncertainty_mm) {
+                (Outcome::NotEvaluated, ..) => Conformance::Fail,
+                (_, Decision::Iso14253_1, Some(value), Some(u)) => {
+                    if value + u <= limit_mm {
+                        Conformance::Pass
+                    } else if value - u > limit_mm {
+                        Conformance::Fail
+                    } else {
+                        Conformance::NotProven
+                    }
+                }
+                (Outcome::Pass, ..) => Conformance::Pass,
+                _ => Conformance::Fail,
+            };
             Check {
                 limit: limit.clone(),
                 value_mm,
                 limit_mm,
                 outcome,
+                uncertainty_mm,
+                conformance,
             }
         })
         .collect();
-    Some(Verdict { checks, travel_mm })
+    Some(Verdict {
+        checks,
+        travel_mm,
+        decision,
+    })
 }
 
 /// The `[acceptance]` table of a machine profile (see the module doc).
@@ -798,6 +964,66 @@ mod tests {
         assert!(!verdict(&evaluation, &below).unwrap().pass());
         // No limits, no verdict.
         assert_eq!(verdict(&evaluation, &[]), None);
+    }
+
+    #[test]
+    fn iso_14253_1_proves_conformance_non_conformance_or_neither() {
+        // E = 11.96 µm, R = 3 µm over 1000 mm; a budget with U = 3.49 µm
+        // (standards.md §4's U(E) to two decimals), applying to E, M, A only.
+        let figures = AxisFigures {
+            e_mm: Some(0.011_96),
+            r_mm: Some(0.003),
+            ..Default::default()
+        };
+        let evaluation = evaluation(0.0, 1000.0, figures);
+        let budget = Budget {
+            equipment: "test".into(),
+            length_mm: 1000.0,
+            contributors: Vec::new(),
+            combined_mm: 0.001_745,
+            coverage_factor: 2.0,
+            expanded_mm: 0.003_49,
+        };
+        let check = |e_limit_um: f64, decision| {
+            let limits = command_line_limits(&[(Figure::E, e_limit_um), (Figure::R, 3.5)]).unwrap();
+            verdict_with(&evaluation, &limits, decision, Some(&budget)).unwrap()
+        };
+        // Just under the limit 12: simple passes; 11.96 + 3.49 = 15.45 > 12
+        // and 11.96 − 3.49 = 8.47 ≤ 12: not proven.
+        let simple = check(12.0, Decision::Simple);
+        assert_eq!(simple.checks[0].conformance, Conformance::Pass);
+        assert_eq!(simple.conformance(), Conformance::Pass);
+        let iso = check(12.0, Decision::Iso14253_1);
+        assert_eq!(iso.checks[0].conformance, Conformance::NotProven);
+        assert_eq!(iso.checks[0].outcome, Outcome::Pass);
+        assert_eq!(iso.checks[0].uncertainty_mm, Some(0.003_49));
+        assert_eq!(iso.conformance(), Conformance::NotProven);
+        assert!(!iso.pass());
+        // 15.45 ≤ 16: conformance proven.
+        let proven = check(16.0, Decision::Iso14253_1);
+        assert_eq!(proven.checks[0].conformance, Conformance::Pass);
+        assert!(proven.pass());
+        // 8.47 > 8: non-conformance proven; at 8.47 exactly it would not be.
+        let failed = check(8.0, Decision::Iso14253_1);
+        assert_eq!(failed.checks[0].conformance, Conformance::Fail);
+        assert_eq!(failed.conformance(), Conformance::Fail);
+        // R has no U: decided by its value (3 ≤ 3.5), with no U.
+        assert_eq!(iso.checks[1].figure(), Figure::R);
+        assert_eq!(iso.checks[1].uncertainty_mm, None);
+        assert_eq!(iso.checks[1].conformance, Conformance::Pass);
+        // Without a budget ISO 14253-1 has no U anywhere: values alone.
+        let limits = command_line_limits(&[(Figure::E, 12.0)]).unwrap();
+        let no_budget = verdict_with(&evaluation, &limits, Decision::Iso14253_1, None).unwrap();
+        assert_eq!(no_budget.checks[0].conformance, Conformance::Pass);
+        // A figure not evaluated fails under either rule.
+        let limits = command_line_limits(&[(Figure::A, 12.0)]).unwrap();
+        let missing = verdict_with(&evaluation, &limits, Decision::Iso14253_1, Some(&budget));
+        assert_eq!(missing.unwrap().checks[0].conformance, Conformance::Fail);
+        // The rule's names.
+        for decision in Decision::ALL {
+            assert_eq!(Decision::from_name(decision.name()), Some(decision));
+        }
+        assert_eq!(Decision::default(), Decision::Simple);
     }
 
     #[test]

@@ -28,6 +28,8 @@ pub struct TestRecord<'a> {
     pub evaluation: &'a Evaluation,
     /// Reader and evaluator warnings.
     pub warnings: &'a [Warning],
+    /// Its measurement uncertainty (`evaluate::uncertainty::budget`); `None`: not evaluated.
+    pub budget: Option<&'a crate::evaluate::uncertainty::Budget>,
 }
 
 /// The compensation table active in the re-test, as read from its file.
@@ -55,6 +57,8 @@ pub struct ReportInput<'a> {
     /// The acceptance limits for the verdict box (`report::verdict`);
     /// empty: no limits, no verdict.
     pub limits: &'a [crate::evaluate::verdict::Limit],
+    /// The decision rule of the verdict (`--decision`).
+    pub decision: crate::evaluate::verdict::Decision,
     /// What made the report, e.g. `axcomp 0.1.0 on 2026-11-22 15:04`
     /// (the library reads no clock: the caller says when).
     pub generator: &'a str,

@@ -57,7 +57,7 @@ use crate::evaluate::TestConformance;
 use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
 use crate::evaluate::standard::{Vdi3441, vdi_figure_name};
-use crate::evaluate::verdict::{Figure, Limit};
+use crate::evaluate::verdict::{Decision, Figure, Limit};
 use crate::evaluate::{AxisFigures, Standard, StandardUsed};
 use crate::measurement::{Direction, Measurement, StartEnd};
 use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts, prediction};
@@ -66,6 +66,7 @@ use crate::report::format::{SourcedUm, inch_beside, inch_text, um};
 use crate::report::json::source_notes;
 use crate::report::json::{EvaluationJson, FiguresJson, PerTargetJson};
 use crate::report::plot::{FONT, PlotError, PlotFormat};
+use crate::report::uncertainty::{NOT_EVALUATED_NOTE, UncertaintyJson};
 use crate::report::verdict::{Judged, verdict_box};
 use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 
@@ -80,8 +81,9 @@ use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 ///            0,2,up,2\n100,2,up,6\n0,2,down,0\n100,2,down,4\n";
 /// let (measurement, warnings) = read::parse_str(csv, SourceFormat::Csv).unwrap();
 /// let evaluation = evaluate(&measurement);
-/// let before = TestRecord { measurement: &measurement, evaluation: &evaluation, warnings: &warnings };
-/// let input = ReportInput { before, after: None, table: None, diagnosis: None, limits: &[], generator: "axcomp" };
+/// let before = TestRecord { measurement: &measurement, evaluation: &evaluation, warnings: &warnings, budget: None };
+/// let input = ReportInput { before, after: None, table: None, diagnosis: None, limits: &[],
+///     decision: Default::default(), generator: "axcomp" };
 /// let html = axcomp::report::html::render(&input).unwrap();
 /// // E = max(x̄↑; x̄↓) − min(x̄↑; x̄↓) = 5 − (−1) = 6 µm, shown as the terminal shows it.
 /// assert!(html.contains(r#"data-key="before.figures_um.E" data-um="6">6.00</td>"#));
@@ -106,11 +108,11 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
     let plot = |name: &str| plots.iter().find(|plot| plot.name == name).cloned();
     let data = ReportDataJson {
         generator: input.generator,
-        before: evaluation_json(&input.before, input.limits),
+        before: evaluation_json(&input.before, input.limits, input.decision),
         after: input
             .after
             .as_ref()
-            .map(|a| evaluation_json(a, input.limits)),
+            .map(|a| evaluation_json(a, input.limits, input.decision)),
     };
     let json = serde_json::to_string(&data).unwrap_or_else(|_| "null".into());
     let page = Page {
@@ -131,6 +133,7 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
         verdict: verdict_box(input),
         conditions: conditions(input),
         figures: figures(input),
+        uncertainty: uncertainty_view(input),
         deviation: if input.after.is_none() {
             Deviation::One(plot("deviation"))
         } else {
@@ -164,6 +167,7 @@ struct Page<'a> {
     verdict: Option<Judged>,
     conditions: Conditions,
     figures: Figures,
+    uncertainty: Option<UncertaintyView>,
     deviation: Deviation,
     per_target: Vec<PerTargetTable>,
     table: Option<TableView>,
@@ -171,6 +175,56 @@ struct Page<'a> {
     notes: Vec<Note>,
     /// The `axcomp-data` JSON, safe inside `<script>` ([`json_in_script`]).
     json: String,
+}
+
+/// `uncertainty.html`: the budget of the test being accepted, largest
+/// contributor first, and U of the figures.
+struct UncertaintyView {
+    /// "test FILE" or "re-test FILE".
+    test_name: String,
+    /// U(E) = U(M) = U(A).
+    expanded: SourcedUm,
+    /// u_c, µm, three decimals.
+    combined_um: String,
+    /// k.
+    k: String,
+    /// The equipment profile.
+    equipment: String,
+    /// (name, u, source), largest first.
+    rows: Vec<(&'static str, SourcedUm, String)>,
+    /// U(R), U(B) not evaluated.
+    note: &'static str,
+}
+
+/// The budget of the test being accepted (the re-test when there is one, as
+/// the verdict box); `None` when no budget was made.
+fn uncertainty_view(input: &ReportInput<'_>) -> Option<UncertaintyView> {
+    let (prefix, what, test) = match &input.after {
+        Some(after) => ("after", "re-test", after),
+        None => ("before", "test", &input.before),
+    };
+    let json = UncertaintyJson::from_budget(test.budget?);
+    let test_name = match &test.measurement.metadata.source_file {
+        Some(file) => format!("{what} {}", file.display()),
+        None => what.to_string(),
+    };
+    Some(UncertaintyView {
+        test_name,
+        expanded: SourcedUm::new(format!("{prefix}.uncertainty_um.E"), Some(json.E)),
+        combined_um: format!("{:.3}", json.u_c),
+        k: json.k.to_string(),
+        equipment: json.equipment.clone(),
+        rows: json
+            .budget
+            .iter()
+            .enumerate()
+            .map(|(index, c)| {
+                let key = format!("{prefix}.uncertainty_um.budget.{index}.u_um");
+                (c.name, SourcedUm::new(key, Some(c.u_um)), c.source.clone())
+            })
+            .collect(),
+        note: NOT_EVALUATED_NOTE,
+    })
 }
 
 /// A plot as report::chart draws it, split at its opening `<svg ` tag
@@ -437,10 +491,11 @@ fn json_in_script(json: &str) -> String {
     json.replace('<', "\\u003c")
 }
 
-/// As `evaluate --json` prints it, with the same limits.
-fn evaluation_json(test: &TestRecord<'_>, limits: &[Limit]) -> EvaluationJson {
+/// As `evaluate --json` prints it, with the same limits, rule and budget.
+fn evaluation_json(test: &TestRecord<'_>, limits: &[Limit], decision: Decision) -> EvaluationJson {
     let mut json = EvaluationJson::new(test.measurement, test.evaluation, &[], test.warnings);
-    json.verdict = crate::report::verdict::judge(test.evaluation, limits);
+    json.uncertainty_um = test.budget.map(UncertaintyJson::from_budget);
+    json.verdict = crate::report::verdict::judge(test.evaluation, limits, decision, test.budget);
     json
 }
 

@@ -30,6 +30,7 @@
 //!                  "feed_mm_per_min": null, "dwell_s": 3.0,
 //!                  "other_axes_mm": [{"axis": "Y", "position_mm": 0.0}, …]},
 //!   "notes": ["…"],
+//!   "uncertainty_um": {"E": 3.49, "M": 3.49, "A": 3.49, "R": null, "B": null, "budget": […], …},
 //!   "verdict": {"pass": …, "checks": […], …} }
 //! ```
 //!
@@ -39,6 +40,9 @@
 //! spacing the constant step in mm (`null` when irregular). `test_setup`
 //! holds what the file records, `null` or `[]` where it does not. `notes`
 //! says where another program's report of the same file will differ.
+//!
+//! `uncertainty_um` is the expanded measurement uncertainty of the figures
+//! and its budget (`report::uncertainty`); absent where none was evaluated.
 //!
 //! `verdict` is there only when acceptance limits are given (`--limit`, a
 //! profile's `[acceptance]`): no limits, no verdict. Its format is in
@@ -105,6 +109,9 @@ pub struct EvaluationJson {
     pub test_setup: TestSetupJson,
     /// Where another program's report of the same file differs, and why.
     pub notes: Vec<&'static str>,
+    /// The measurement uncertainty and its budget (see `report::uncertainty`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uncertainty_um: Option<crate::report::uncertainty::UncertaintyJson>,
     /// The acceptance verdict; absent without limits (see `report::verdict`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub verdict: Option<crate::report::verdict::VerdictJson>,
@@ -516,6 +523,7 @@ impl EvaluationJson {
                 description: metadata.description.clone(),
             },
             warnings: warnings.iter().map(ToString::to_string).collect(),
+            uncertainty_um: None,
             verdict: None,
             test_conformance: ConformanceJson::from_conformance(&evaluation.conformance),
             test_setup: TestSetupJson::from_setup(&metadata.setup),

@@ -12,7 +12,8 @@
 //! what it is made from and its charts, [`chart`] x–y charts as data drawn
 //! as SVG or PNG, [`html`] the self-contained page. All convert mm to µm
 //! through `crate::units`; [`verdict`] the acceptance verdict (JSON,
-//! terminal lines, the report's box); nothing else in the crate depends on this module;
+//! terminal lines, the report's box); [`uncertainty`] the measurement
+//! uncertainty's budget (JSON, terminal table); nothing else in the crate depends on this module;
 //! files are written by `crate::output`.
 pub mod acceptance;
 pub mod chart;
@@ -26,4 +27,5 @@ pub mod predict;
 pub mod servo;
 pub mod terminal;
 pub mod tolerance;
+pub mod uncertainty;
 pub mod verdict;

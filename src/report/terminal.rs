@@ -37,6 +37,9 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
         );
     }
     out.push('\n');
+    if let Some(uncertainty) = &report.uncertainty_um {
+        out.push_str(&crate::report::uncertainty::terminal(uncertainty));
+    }
     if !report.outliers.is_empty() {
         out.push_str("\nSuspected outlier runs (included; exclude with --exclude-run RUN:DIRECTION only if you know why)\n");
         for o in &report.outliers {
@@ -259,17 +262,23 @@ fn keyed_figures_table(r: &EvaluationJson) -> String {
 
 fn figures_table(r: &EvaluationJson) -> String {
     let f = &r.figures_um;
+    // `11.96 ± 3.49` where U of the figure is evaluated (E, M, A).
+    let u = r.uncertainty_um.as_ref();
+    let with_u = |value: Option<f64>, expanded: Option<f64>| match (value, expanded) {
+        (Some(_), Some(expanded)) => format!("{} ± {}", um(value), um(Some(expanded))),
+        _ => um(value),
+    };
     let mut builder = Builder::default();
     builder.push_record(["figure", "bidirectional", "↑", "↓"]);
     builder.push_record([
         "A  accuracy".to_string(),
-        um(f.get("A")),
+        with_u(f.get("A"), u.map(|u| u.A)),
         um(f.get("A_up")),
         um(f.get("A_down")),
     ]);
     builder.push_record([
         "E  systematic deviation".to_string(),
-        um(f.get("E")),
+        with_u(f.get("E"), u.map(|u| u.E)),
         um(f.get("E_up")),
         um(f.get("E_down")),
     ]);
@@ -281,7 +290,7 @@ fn figures_table(r: &EvaluationJson) -> String {
     ]);
     builder.push_record([
         "M  mean bidirectional deviation".to_string(),
-        um(f.get("M")),
+        with_u(f.get("M"), u.map(|u| u.M)),
         String::new(),
         String::new(),
     ]);

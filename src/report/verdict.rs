@@ -8,10 +8,15 @@
 //! no `verdict` key); keys may be added, never renamed:
 //!
 //! ```text
-//! "verdict": { "pass": false, "decision": "simple acceptance", "travel_mm": 750.0,
-//!   "failed": ["A"],
+//! "verdict": { "pass": false, "rule": "simple",      // or "iso14253-1" (--decision)
+//!   "decision": "simple acceptance",               // or "ISO 14253-1"
+//!   "decision_rule": "simple acceptance: value ≤ limit, measurement uncertainty not considered",
+//!   "conformance": "fail",                         // or "pass", "not-proven"
+//!   "travel_mm": 750.0, "failed": ["A"],
 //!   "checks": [{ "figure": "A", "value_um": 13.19, "limit_um": 12.0, "pass": false,
-//!                "outcome": "exceeds",            // or "pass", "not evaluated"
+//!                "U_um": 3.49,                    // null where U is not evaluated (R, B, ↑, ↓)
+//!                "conformance": "fail",           // or "pass", "not-proven" (under the rule)
+//!                "outcome": "exceeds",            // value against limit alone: or "pass", "not evaluated"
 //!                "reason": "13.19 µm is above the limit 12 µm",   // null when it passes
 //!                "limit_source": "--limit",       // or "M.toml [acceptance]", "M.toml [acceptance.axes.X]"
 //!                "limit_derivation": "12 µm" }, …] }
@@ -19,32 +24,45 @@
 //!
 //! `value_um` is the value compared: the figure, |B̄| for `B_mean`, `null`
 //! when not evaluated (such a check fails). Checks come in the order of
-//! `figures_um`.
+//! `figures_um`. `pass` is `conformance == "pass"`: under ISO 14253-1 a
+//! check passes only when value + U ≤ limit, and `not-proven` is no pass.
 
 use serde::Serialize;
 
 use crate::evaluate::Evaluation;
-use crate::evaluate::verdict::{Check, Limit, Outcome, Permissible, Verdict, verdict};
+use crate::evaluate::uncertainty::Budget;
+use crate::evaluate::verdict::{
+    Check, Conformance, Decision, Limit, Outcome, Permissible, Verdict, verdict_with,
+};
 use crate::report::acceptance::{ReportInput, TestRecord};
 use crate::report::format::{SourcedUm, um};
 use crate::units::mm_to_um;
 use crate::units::per_m_over_mm;
 
-/// The decision rule (ISO 14253-1 "simple acceptance", `../shared/spec/standards.md` §5).
-pub const DECISION: &str = "simple acceptance";
-
-/// The verdict on an evaluation as JSON; `None` without limits.
-pub fn judge(evaluation: &Evaluation, limits: &[Limit]) -> Option<VerdictJson> {
-    verdict(evaluation, limits).map(|v| VerdictJson::from_verdict(&v))
+/// The verdict on an evaluation as JSON under `decision`, with the
+/// uncertainty of `budget`; `None` without limits.
+pub fn judge(
+    evaluation: &Evaluation,
+    limits: &[Limit],
+    decision: Decision,
+    budget: Option<&Budget>,
+) -> Option<VerdictJson> {
+    verdict_with(evaluation, limits, decision, budget).map(|v| VerdictJson::from_verdict(&v))
 }
 
 /// The verdict on one test.
 #[derive(Clone, Debug, Serialize)]
 pub struct VerdictJson {
-    /// Every check passed.
+    /// Every check passed (conformance proven for every check).
     pub pass: bool,
-    /// The decision rule: `simple acceptance` (value ≤ limit, uncertainty not considered).
+    /// The decision rule: `simple` or `iso14253-1`.
+    pub rule: &'static str,
+    /// The decision rule's label: `simple acceptance` or `ISO 14253-1`.
     pub decision: &'static str,
+    /// The decision rule in words.
+    pub decision_rule: &'static str,
+    /// `pass`, `fail` or `not-proven`.
+    pub conformance: &'static str,
     /// The measured travel per-length limits use, last − first target, mm.
     pub travel_mm: f64,
     /// The figures that did not pass, in check order.
@@ -54,6 +72,7 @@ pub struct VerdictJson {
 }
 
 /// One figure against its limit.
+#[allow(non_snake_case)]
 #[derive(Clone, Debug, Serialize)]
 pub struct CheckJson {
     /// The figure, as in `figures_um`.
@@ -62,9 +81,13 @@ pub struct CheckJson {
     pub value_um: Option<f64>,
     /// The limit for this test, µm.
     pub limit_um: f64,
-    /// Whether it passed.
+    /// Whether it passed (conformance proven).
     pub pass: bool,
-    /// `pass`, `exceeds` or `not evaluated`.
+    /// The figure's expanded uncertainty, µm; `null` where not evaluated.
+    pub U_um: Option<f64>,
+    /// `pass`, `fail` or `not-proven`, under the rule.
+    pub conformance: &'static str,
+    /// The value against the limit alone: `pass`, `exceeds` or `not evaluated`.
     pub outcome: &'static str,
     /// Why it did not pass; `null` when it passed.
     pub reason: Option<String>,
@@ -79,26 +102,45 @@ impl VerdictJson {
     pub fn from_verdict(verdict: &Verdict) -> VerdictJson {
         VerdictJson {
             pass: verdict.pass(),
-            decision: DECISION,
+            rule: verdict.decision.name(),
+            decision: verdict.decision.label(),
+            decision_rule: verdict.decision.description(),
+            conformance: verdict.conformance().name(),
             travel_mm: verdict.travel_mm,
             failed: verdict.failed().map(|c| c.figure().name()).collect(),
             checks: verdict
                 .checks
                 .iter()
-                .map(|c| CheckJson::from_check(c, verdict.travel_mm))
+                .map(|c| CheckJson::from_check(c, verdict.travel_mm, verdict.decision))
                 .collect(),
         }
     }
 }
 
 impl CheckJson {
-    fn from_check(check: &Check, travel_mm: f64) -> CheckJson {
+    fn from_check(check: &Check, travel_mm: f64, decision: Decision) -> CheckJson {
         let figure = check.figure();
         let limit_um = mm_to_um(check.limit_mm);
         let value_um = check.value_mm.map(mm_to_um);
-        let reason = match (check.outcome, value_um) {
-            (Outcome::Pass, _) => None,
-            (Outcome::Exceeds, Some(value)) => Some(format!(
+        let u_um = check.uncertainty_mm.map(mm_to_um);
+        // U enters the reason only where the rule used it.
+        let u_used = u_um.filter(|_| decision == Decision::Iso14253_1);
+        let reason = match (check.conformance, check.outcome, value_um, u_used) {
+            (Conformance::Pass, ..) => None,
+            (Conformance::NotProven, _, Some(value), Some(u)) => Some(format!(
+                "{} ± {} µm straddles the limit {} µm: neither conformance nor \
+                 non-conformance is proven (ISO 14253-1)",
+                um(Some(value)),
+                um(Some(u)),
+                short(limit_um)
+            )),
+            (_, Outcome::Exceeds, Some(value), Some(u)) => Some(format!(
+                "{} − {} µm is above the limit {} µm (ISO 14253-1: non-conformance proven)",
+                um(Some(value)),
+                um(Some(u)),
+                short(limit_um)
+            )),
+            (_, Outcome::Exceeds, Some(value), None) => Some(format!(
                 "{} µm is above the limit {} µm",
                 um(Some(value)),
                 short(limit_um)
@@ -113,6 +155,8 @@ impl CheckJson {
             value_um,
             limit_um,
             pass: check.pass(),
+            U_um: u_um,
+            conformance: check.conformance.name(),
             outcome: match check.outcome {
                 Outcome::Pass => "pass",
                 Outcome::Exceeds => "exceeds",
@@ -162,8 +206,9 @@ fn derivation(permissible: &Permissible, travel_mm: f64) -> String {
     }
 }
 
-/// The one-line verdict: `PASS: A, R within their limits` or
-/// `FAIL: A above its limit; R not evaluated`.
+/// The one-line verdict: `PASS: A, R within the limits`,
+/// `FAIL: A above the limit; R not evaluated (cannot pass)` or
+/// `NOT PROVEN: E within U of the limit (ISO 14253-1)`.
 pub fn headline(verdict: &VerdictJson) -> String {
     let figures = |checks: &[&CheckJson]| {
         checks
@@ -184,7 +229,8 @@ pub fn headline(verdict: &VerdictJson) -> String {
             .collect()
     };
     let mut parts = Vec::new();
-    let exceeds = of("exceeds");
+    let failed = |c: &&CheckJson| c.conformance == "fail";
+    let exceeds: Vec<&CheckJson> = of("exceeds").into_iter().filter(failed).collect();
     if !exceeds.is_empty() {
         parts.push(format!("{} above the limit", figures(&exceeds)));
     }
@@ -192,7 +238,27 @@ pub fn headline(verdict: &VerdictJson) -> String {
     if !missing.is_empty() {
         parts.push(format!("{} not evaluated (cannot pass)", figures(&missing)));
     }
-    format!("FAIL: {}", parts.join("; "))
+    let straddle: Vec<&CheckJson> = verdict
+        .checks
+        .iter()
+        .filter(|c| c.conformance == "not-proven")
+        .collect();
+    if !straddle.is_empty() {
+        parts.push(format!(
+            "{} within U of the limit (ISO 14253-1: not proven)",
+            figures(&straddle)
+        ));
+    }
+    format!("{}: {}", verdict_word(verdict), parts.join("; "))
+}
+
+/// `PASS`, `FAIL` or `NOT PROVEN`.
+fn verdict_word(verdict: &VerdictJson) -> &'static str {
+    match verdict.conformance {
+        "pass" => "PASS",
+        "not-proven" => "NOT PROVEN",
+        _ => "FAIL",
+    }
 }
 
 /// The terminal lines of `evaluate`: the checks and the verdict line.
@@ -202,11 +268,12 @@ pub fn terminal(verdict: &VerdictJson) -> String {
     use tabled::settings::{Alignment, Style};
 
     let mut builder = Builder::default();
-    builder.push_record(["figure", "value", "limit", "result", "limit from"]);
+    builder.push_record(["figure", "value", "U", "limit", "result", "limit from"]);
     for c in &verdict.checks {
         builder.push_record([
             c.figure.to_string(),
             um(c.value_um),
+            um(c.U_um),
             um(Some(c.limit_um)),
             result_word(c).to_string(),
             format!("{}: {}", c.limit_source, c.limit_derivation),
@@ -215,19 +282,21 @@ pub fn terminal(verdict: &VerdictJson) -> String {
     let mut table = builder.build();
     table
         .with(Style::psql())
-        .modify(Columns::new(1..3), Alignment::right());
+        .modify(Columns::new(1..4), Alignment::right());
     format!(
-        "\nAcceptance [µm] ({DECISION}: value ≤ limit, measurement uncertainty not considered)\n\
-         {table}\n{}\n",
+        "\nAcceptance [µm] (rule {}: {})\n{table}\n{}\n",
+        verdict.rule,
+        verdict.decision_rule,
         headline(verdict)
     )
 }
 
 fn result_word(check: &CheckJson) -> &'static str {
-    match check.outcome {
-        "pass" => "pass",
-        "exceeds" => "FAIL",
-        _ => "FAIL (not evaluated)",
+    match (check.conformance, check.outcome) {
+        ("pass", _) => "pass",
+        ("not-proven", _) => "NOT PROVEN",
+        (_, "not evaluated") => "FAIL (not evaluated)",
+        _ => "FAIL",
     }
 }
 
@@ -240,10 +309,12 @@ pub fn verdict_box(input: &ReportInput<'_>) -> Option<Judged> {
         Some(file) => format!("{what} {}", file.display()),
         None => what.to_string(),
     };
-    let before = judge(input.before.evaluation, input.limits);
+    let judge_test =
+        |test: &TestRecord<'_>| judge(test.evaluation, input.limits, input.decision, test.budget);
+    let before = judge_test(&input.before);
     match &input.after {
         Some(after) => {
-            let judged = judge(after.evaluation, input.limits)?;
+            let judged = judge_test(after)?;
             Some(Judged::new(
                 "after",
                 name("re-test", after),
@@ -263,9 +334,9 @@ pub fn verdict_box(input: &ReportInput<'_>) -> Option<Judged> {
 /// The verdict box of the test being accepted.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Judged {
-    /// `pass` or `fail`, the box's class and `data-verdict`.
+    /// `pass`, `fail` or `not-proven`, the box's class and `data-verdict`.
     pub class: &'static str,
-    /// `PASS` or `FAIL`.
+    /// `PASS`, `FAIL` or `NOT PROVEN`.
     pub word: &'static str,
     /// The verdict in one line ([`headline`]).
     pub headline: String,
@@ -273,7 +344,9 @@ pub struct Judged {
     pub test_name: String,
     /// One row per check, in the order of `figures_um`.
     pub checks: Vec<CheckRow>,
-    /// The decision rule ([`DECISION`]).
+    /// The decision rule's name (`simple`, `iso14253-1`).
+    pub rule: &'static str,
+    /// The decision rule in words.
     pub decision: &'static str,
     /// The measured travel that per-length limits use, mm.
     pub travel_mm: String,
@@ -294,9 +367,11 @@ pub struct CheckRow {
     pub value: SourcedUm,
     /// The permissible value (`limit_um`).
     pub limit: SourcedUm,
-    /// `pass` or `fail`.
+    /// The figure's expanded uncertainty (`U_um`), `—` where not evaluated.
+    pub uncertainty: SourcedUm,
+    /// `pass`, `fail` or `not-proven`.
     pub class: &'static str,
-    /// `pass`, `FAIL` or `FAIL (not evaluated)`.
+    /// `pass`, `FAIL`, `NOT PROVEN` or `FAIL (not evaluated)`.
     pub result: &'static str,
     /// Why it fails; `None` when it passes.
     pub reason: Option<String>,
@@ -332,7 +407,8 @@ impl Judged {
                     },
                     value: SourcedUm::new(key("value_um"), c.value_um),
                     limit: SourcedUm::new(key("limit_um"), Some(c.limit_um)),
-                    class: if c.pass { "pass" } else { "fail" },
+                    uncertainty: SourcedUm::new(key("U_um"), c.U_um),
+                    class: c.conformance,
                     result: result_word(c),
                     reason: c.reason.clone().filter(|_| !c.pass),
                     limit_source: c.limit_source.clone(),
@@ -341,12 +417,13 @@ impl Judged {
             })
             .collect();
         Judged {
-            class: if verdict.pass { "pass" } else { "fail" },
-            word: if verdict.pass { "PASS" } else { "FAIL" },
+            class: verdict.conformance,
+            word: verdict_word(verdict),
             headline: headline(verdict),
             test_name,
             checks,
-            decision: DECISION,
+            rule: verdict.rule,
+            decision: verdict.decision_rule,
             travel_mm: short(verdict.travel_mm),
             first_test: first_test.map(headline),
         }

@@ -81,10 +81,11 @@ fn the_sample_report_shows_the_figures_of_evaluate_json() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     let html = std::fs::read_to_string(&output).unwrap();
     let evaluation = evaluate_json(&[Path::new(SAMPLE)]);
-    // 12 axis figures and 9 values at each of the 16 targets, each equal to evaluate's.
+    // 12 axis figures, 9 values at each of the 16 targets, U and the 5
+    // contributors of the budget, each equal to evaluate's.
     assert_eq!(
         check_against_json(&html, "before", &evaluation),
-        12 + 16 * 9
+        12 + 16 * 9 + 1 + 5
     );
     assert_eq!(embedded_data(&html)["before"], evaluation);
     // The figures of the README (computed by evaluate, checked there by hand).
@@ -287,7 +288,11 @@ fn the_retest_report_shows_evaluate_and_diagnose_numbers_and_writes_pngs() {
     let before = evaluate_json(&[&case.before]);
     let after = evaluate_json(&[&case.after]);
     assert_eq!(check_against_json(&html, "before", &before), 12 + 16 * 9);
-    assert_eq!(check_against_json(&html, "after", &after), 12 + 16 * 9);
+    // The re-test, being accepted, also has its U and 5 budget rows.
+    assert_eq!(
+        check_against_json(&html, "after", &after),
+        12 + 16 * 9 + 1 + 5
+    );
     let data = embedded_data(&html);
     assert_eq!((&data["before"], &data["after"]), (&before, &after));
 
@@ -372,11 +377,13 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
             measurement: &before,
             evaluation: &evaluation_before,
             warnings: &[],
+            budget: None,
         },
         after: Some(TestRecord {
             measurement: &after,
             evaluation: &evaluation_after,
             warnings: &[],
+            budget: None,
         }),
         table: Some(TableRecord {
             table: &table,
@@ -385,6 +392,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
         }),
         diagnosis: Some(&diagnosis),
         limits: &[],
+        decision: Default::default(),
         generator: "test",
     };
     let charts = charts(&input);
@@ -515,13 +523,67 @@ fn the_sample_report_opens_in_chromium_without_errors_and_is_not_blank() {
     assert_eq!(embedded_data(&browser.dom)["before"], evaluation);
 }
 
+/// Issue 13: the budget table (largest contributor first) and the decision
+/// rule are on the page; E = 11.21 ± 1.82 µm against 12 µm under ISO 14253-1
+/// is "not proven", an amber box (#b06a00) in the screenshot.
+#[test]
+fn the_report_shows_the_uncertainty_budget_and_the_decision_rule() {
+    let directory = tempfile::tempdir().unwrap();
+    let page = directory.path().join("report.html");
+    let run = axcomp([
+        "report",
+        SAMPLE,
+        "-o",
+        page.to_str().unwrap(),
+        "--limit",
+        "E=12",
+        "--decision",
+        "iso14253-1",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let screenshot = artefacts().join("sample-x-uncertainty.png");
+    let browser = open_in_browser(&page, (1280, 2400), BrowserOutput::Screenshot(&screenshot));
+    assert!(browser.console.is_empty(), "console: {:?}", browser.console);
+    let dom = &browser.dom;
+    assert!(dom.contains("data-verdict=\"not-proven\""));
+    assert!(dom.contains("Acceptance verdict: NOT PROVEN"));
+    assert!(dom.contains("data-rule=\"iso14253-1\""), "no rule");
+    assert!(dom.contains(
+        "Decision rule (iso14253-1): ISO 14253-1: conformance proven when value + U ≤ limit"
+    ));
+    let at = |needle: &str| dom.find(needle).unwrap_or_else(|| panic!("{needle}"));
+    // The budget table, largest first: u_M,MACHINE (0.8775 µm) leads.
+    assert!(at("id=\"figures\"") < at("id=\"uncertainty\""));
+    assert!(at("id=\"uncertainty\"") < at("id=\"deviation\""));
+    let rows: Vec<&str> = dom
+        .split("data-contributor=\"")
+        .skip(1)
+        .map(|s| s.split('"').next().unwrap())
+        .collect();
+    assert_eq!(rows.len(), 5, "{rows:?}");
+    assert_eq!(rows[0], "u_M,MACHINE");
+    // Every number on the page is the embedded JSON's (U included).
+    let data = embedded_data(dom);
+    assert!(check_against_json(dom, "before", &data["before"]) > 0);
+    assert!(dom.contains("data-key=\"before.uncertainty_um.E\""));
+    assert!(dom.contains("data-key=\"before.verdict.checks.0.U_um\""));
+    let shot = Pixels::read(&screenshot);
+    let amber = shot.fraction(|r, g, b| r > 150 && (80..140).contains(&g) && b < 40);
+    assert!(
+        amber > 0.0003,
+        "no amber NOT PROVEN box in {}: {amber}",
+        screenshot.display()
+    );
+}
+
 #[test]
 fn the_retest_report_opens_in_chromium_and_prints_on_a4() {
     let case = RetestCase::new();
     let (page, run) = case.report(&[]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     let screenshot = artefacts().join("retest.png");
-    let browser = open_in_browser(&page, (1280, 3000), BrowserOutput::Screenshot(&screenshot));
+    // 3400 px: down to the plots, below the uncertainty budget.
+    let browser = open_in_browser(&page, (1280, 3400), BrowserOutput::Screenshot(&screenshot));
     assert!(browser.console.is_empty(), "console: {:?}", browser.console);
     let shot = Pixels::read(&screenshot);
     let (inked, blue) = (shot.inked(), shot.blue());

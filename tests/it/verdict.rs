@@ -67,7 +67,7 @@ fn a_limit_below_the_sample_fails_and_limits_above_pass() {
         run.stdout
     );
     assert!(
-        run.stdout.contains(" A      | 13.19 | 12.00 | FAIL"),
+        run.stdout.contains(" A      | 13.19 | 1.82 | 12.00 | FAIL"),
         "{}",
         run.stdout
     );
@@ -299,13 +299,14 @@ fn the_report_has_a_verdict_box_at_the_top() {
         at("</header>") < at("id=\"verdict\"") && at("id=\"verdict\"") < at("id=\"conditions\"")
     );
     // Its cells are those of evaluate --json with the same limits: 12 figures,
-    // 16 × 9 per-target values and 2 × (value, limit) of the checks.
+    // 16 × 9 per-target values, 2 × (value, U, limit) of the checks, and
+    // U with the 5 contributors of the uncertainty budget.
     let mut evaluate_args = vec![SAMPLE];
     evaluate_args.extend(limits);
     let evaluation = evaluate_json_with(&evaluate_args);
     assert_eq!(
         check_against_json(&html, "before", &evaluation),
-        12 + 16 * 9 + 4
+        12 + 16 * 9 + 2 * 3 + 1 + 5
     );
     assert_eq!(embedded_data(&html)["before"], evaluation);
     // Each check row names the figure cell it checks, which shows the same value.
@@ -376,4 +377,139 @@ fn a_before_after_report_judges_the_retest() {
     );
     assert_eq!(data["before"]["verdict"]["pass"], json!(false));
     assert_eq!(data["after"]["verdict"]["pass"], json!(true));
+}
+
+// --- Measurement uncertainty and ISO 14253-1 (issue 13) ----------------------
+
+/// The sample's E is 11.21 µm (README). Its U with the bundled equipment,
+/// by hand: L = 750 mm, α = 11.7 (the file), u_Tmat = 0.1 °C:
+/// u_M,MACHINE = 0.75 · 11.7 · 0.1 = 0.8775 µm; u_DEVICE = 0.5/2 · 0.75 =
+/// 0.1875 µm; the others (u_E,MACHINE from the file's ~20.3 °C, θ, E_VE = 0)
+/// are small; U = 2 √Σu² ≈ 1.82 µm. So against E = 12 µm: simple passes,
+/// ISO 14253-1 proves nothing (11.21 + 1.82 > 12 ≥ 11.21 − 1.82); against
+/// 14 µm conformance and against 9 µm non-conformance are proven.
+#[test]
+fn iso_14253_1_pass_fail_and_not_proven_with_the_json_keys() {
+    let json = evaluate_json_with(&[SAMPLE]);
+    let u = &json["uncertainty_um"];
+    let budget = u["budget"].as_array().unwrap();
+    let named = |name: &str| {
+        budget.iter().find(|c| c["name"] == name).unwrap()["u_um"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((named("u_M,MACHINE") - 0.8775).abs() < 1e-9);
+    assert!((named("u_DEVICE") - 0.1875).abs() < 1e-9);
+    // Largest first, and U = 2 √Σu² from the rows themselves.
+    let sizes: Vec<f64> = budget.iter().map(|c| c["u_um"].as_f64().unwrap()).collect();
+    assert!(sizes.windows(2).all(|w| w[0] >= w[1]), "{sizes:?}");
+    let expanded = 2.0 * sizes.iter().map(|s| s * s).sum::<f64>().sqrt();
+    for figure in ["E", "M", "A"] {
+        assert!((u[figure].as_f64().unwrap() - expanded).abs() < 1e-9);
+    }
+    assert!((expanded - 1.82).abs() < 0.01, "{expanded}");
+    assert_eq!(u["R"], Value::Null);
+    assert_eq!(u["B"], Value::Null);
+    for contributor in budget {
+        assert!(
+            contributor["source"]
+                .as_str()
+                .is_some_and(|s| !s.is_empty())
+        );
+    }
+
+    let verdict = |limit: &str, rule: &str| {
+        let limit = format!("E={limit}");
+        evaluate_json_with(&[SAMPLE, "--limit", &limit, "--decision", rule])["verdict"].clone()
+    };
+    let simple = verdict("12", "simple");
+    assert_eq!(simple["rule"], "simple");
+    assert_eq!(simple["checks"][0]["conformance"], "pass");
+    assert_eq!(simple["pass"], true);
+    let straddles = verdict("12", "iso14253-1");
+    assert_eq!(straddles["rule"], "iso14253-1");
+    assert_eq!(straddles["conformance"], "not-proven");
+    assert_eq!(straddles["pass"], false);
+    let check = &straddles["checks"][0];
+    assert_eq!(check["conformance"], "not-proven");
+    assert_eq!(check["outcome"], "pass");
+    assert!((check["U_um"].as_f64().unwrap() - expanded).abs() < 1e-9);
+    assert!(
+        check["reason"].as_str().unwrap().contains("not proven")
+            || check["reason"].as_str().unwrap().contains("neither")
+    );
+    assert_eq!(
+        verdict("14", "iso14253-1")["checks"][0]["conformance"],
+        "pass"
+    );
+    assert_eq!(verdict("14", "iso14253-1")["conformance"], "pass");
+    assert_eq!(
+        verdict("9", "iso14253-1")["checks"][0]["conformance"],
+        "fail"
+    );
+    // R has no U: `null`, decided by its value (6.26 ≤ 7).
+    let r = evaluate_json_with(&[SAMPLE, "--limit", "R=7", "--decision", "iso14253-1"]);
+    assert_eq!(r["verdict"]["checks"][0]["U_um"], Value::Null);
+    assert_eq!(r["verdict"]["checks"][0]["conformance"], "pass");
+
+    // The terminal: U beside E, M, A and the rule named.
+    let run = axcomp([
+        "evaluate",
+        SAMPLE,
+        "--limit",
+        "E=12",
+        "--decision",
+        "iso14253-1",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains("11.21 ± 1.82"), "{}", run.stdout);
+    assert!(run.stdout.contains("rule iso14253-1"));
+    assert!(run.stdout.contains("NOT PROVEN"));
+    let bad = axcomp(["evaluate", SAMPLE, "--decision", "iso"]);
+    assert_eq!(bad.code, 2);
+    assert!(bad.stderr.contains("simple, iso14253-1"), "{}", bad.stderr);
+}
+
+/// An equipment file: its values used, a bad value refused at its line and
+/// column with exit 2, a drift test read relative to the profile.
+#[test]
+fn an_equipment_file_and_its_errors() {
+    let directory = tempfile::tempdir().unwrap();
+    let bundled = std::fs::read_to_string("fixtures/equipment/hene-default.toml").unwrap();
+    // E_VE = 6 µm: u_EVE = 6/(2√3) = 1.7321 µm.
+    let given = write(
+        directory.path(),
+        "e.toml",
+        &bundled.replace("eve_um = 0", "eve_um = 6"),
+    );
+    let json = evaluate_json_with(&[SAMPLE, "--equipment", given.to_str().unwrap()]);
+    let budget = json["uncertainty_um"]["budget"].as_array().unwrap();
+    assert_eq!(budget[0]["name"], "u_EVE");
+    assert!((budget[0]["u_um"].as_f64().unwrap() - 1.732_051).abs() < 1e-6);
+    // A drift test: BEFORE's deviations span 0–12 µm, E_VE = 12, u_EVE = 3.4641 µm.
+    write(directory.path(), "drift.csv", BEFORE);
+    let drift = write(
+        directory.path(),
+        "d.toml",
+        &bundled.replace("eve_um = 0", "drift_test = \"drift.csv\""),
+    );
+    let json = evaluate_json_with(&[SAMPLE, "--equipment", drift.to_str().unwrap()]);
+    let first = &json["uncertainty_um"]["budget"][0];
+    assert!((first["u_um"].as_f64().unwrap() - 3.464_102).abs() < 1e-6);
+    assert!(first["source"].as_str().unwrap().contains("drift.csv"));
+    // A negative value: PATH:LINE:COL, exit 2.
+    let bad = write(
+        directory.path(),
+        "bad.toml",
+        &bundled.replace("k = 2", "k = -2"),
+    );
+    let run = axcomp(["evaluate", SAMPLE, "--equipment", bad.to_str().unwrap()]);
+    assert_eq!(run.code, 2);
+    let line = bundled.lines().position(|l| l == "k = 2").unwrap() + 1;
+    assert!(
+        run.stderr
+            .contains(&format!("bad.toml:{line}:5: expected a number above 0")),
+        "{}",
+        run.stderr
+    );
 }
