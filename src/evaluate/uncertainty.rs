@@ -369,6 +369,11 @@ pub fn budget(
     });
 
     let (eve_mm, eve_from) = match &equipment.environmental_variation {
+        // A zero E_VE is not a measured stability: say that U leaves it out.
+        EnvironmentalVariation::Given { eve_mm } if *eve_mm == 0.0 => (
+            *eve_mm,
+            "equipment profile: not measured, so U leaves the environment's drift out; give eve_um or drift_test".to_string(),
+        ),
         EnvironmentalVariation::Given { eve_mm } => (*eve_mm, "equipment profile".to_string()),
         EnvironmentalVariation::Measured { eve_mm, file } => {
             (*eve_mm, format!("range of the drift test {file}"))

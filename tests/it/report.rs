@@ -489,8 +489,9 @@ fn the_sample_report_opens_in_chromium_without_errors_and_is_not_blank() {
     let run = axcomp(args);
     assert_eq!(run.code, 0, "{}", run.stderr);
     let screenshot = artefacts().join("sample-x.png");
-    // 2400 px: the page down to the plot's caption, verdict box included.
-    let browser = open_in_browser(&page, (1280, 2400), BrowserOutput::Screenshot(&screenshot));
+    // 2800 px: the page down to the plot's caption, verdict box and the
+    // uncertainty budget included.
+    let browser = open_in_browser(&page, (1280, 2800), BrowserOutput::Screenshot(&screenshot));
     assert!(browser.console.is_empty(), "console: {:?}", browser.console);
     let shot = Pixels::read(&screenshot);
     let (inked, blue) = (shot.inked(), shot.blue());
