@@ -21,7 +21,7 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
 use axcomp::effects::{Effect, Parameter, ParameterValue};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
-use axcomp::evaluate::{Evaluation, evaluate};
+use axcomp::evaluate::{Evaluation, ISO_230_2, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::model::{GeometricErrors, Machine};
 use axcomp::output::write_all_new;
@@ -121,6 +121,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         grid_step_mm: 50.0,
         effects: &[],
         backlash_set: false,
+        standard: &ISO_230_2,
     })?;
     let predict_json = PredictJson::new(
         machine.name(),
@@ -144,6 +145,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         backlash_set: false,
         angular: None,
         timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
     })?;
     let diagnose_json = DiagnoseJson::new(
         &diagnosis,
@@ -200,6 +202,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         diagnosis: Some(&diagnosis),
         limits: &[],
         decision: Default::default(),
+        standard: &ISO_230_2,
         generator: &generator,
     };
     files.push(("report.html".into(), html::render(&input)?.into_bytes()));

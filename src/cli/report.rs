@@ -215,6 +215,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
                 backlash_set: false,
                 angular: None,
                 timing: CycleTiming::ASSUMED,
+                standard,
             };
             Some(diagnose(&input).context("cannot diagnose the re-test")?)
         }
@@ -236,6 +237,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         diagnosis: diagnosis.as_ref(),
         limits: &limits,
         decision: args.uncertainty.decision,
+        standard,
         generator: &generator,
     };
     // Render everything before writing anything: a failure leaves no half report.

@@ -20,6 +20,16 @@ pub fn um(value: Option<f64>) -> String {
     text
 }
 
+/// `name` padded with spaces to `width` columns as a terminal shows it
+/// (B̄'s bar is a combining character and takes no column).
+pub fn pad_name(name: &str, width: usize) -> String {
+    let shown = name
+        .chars()
+        .filter(|c| !('\u{300}'..='\u{36f}').contains(c))
+        .count();
+    format!("{name}{}", " ".repeat(width.saturating_sub(shown)))
+}
+
 /// Appends [`um`]'s text to `out`, without a `String` of its own (a large
 /// test's per-target table has a hundred thousand of these).
 pub fn push_um(out: &mut String, value: Option<f64>) {

@@ -13,7 +13,7 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
 use axcomp::effects::ParameterValue;
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
-use axcomp::evaluate::evaluate;
+use axcomp::evaluate::{ISO_230_2, evaluate};
 use axcomp::read::{read_path, rtl};
 use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
 use axcomp::synth::{self, Truth};
@@ -235,6 +235,7 @@ impl RetestCase {
             backlash_set: false,
             angular: None,
             timing: CycleTiming::ASSUMED,
+            standard: &ISO_230_2,
         })
         .unwrap()
     }
@@ -393,6 +394,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
         diagnosis: Some(&diagnosis),
         limits: &[],
         decision: Default::default(),
+        standard: &ISO_230_2,
         generator: "test",
     };
     let charts = charts(&input);
