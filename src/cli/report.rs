@@ -170,6 +170,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
         before.measurement.axis(),
+        &before.evaluation,
         &args.acceptance,
     )?;
     let mut after = match &args.after {
