@@ -346,6 +346,8 @@ struct Figures {
     /// one row each (symbol and name, a cell per test); empty for ISO 230-2.
     standard_name: &'static str,
     standard_rows: Vec<(String, Vec<Option<SourcedUm>>)>,
+    /// Whether E, M and A show their U (a test has a budget).
+    with_u: bool,
 }
 
 /// A figure's row: per test bidirectional, ↑ and ↓ (`None`: the figure has
@@ -916,12 +918,19 @@ fn figures(input: &ReportInput<'_>) -> Figures {
         .map(|(symbol, name, figure)| {
             let cells = figures
                 .iter()
+                .zip(&tests)
                 .zip(["before", "after"])
-                .flat_map(|(f, prefix)| {
+                .flat_map(|((f, (_, test)), prefix)| {
+                    // U beside the figures it is evaluated for (E, M, A).
                     let cell = |shown: Figure| {
                         SourcedUm::new(
                             format!("{prefix}.figures_um.{}", shown.name()),
                             figure_value(f, shown),
+                        )
+                        .with_u(
+                            test.budget
+                                .and_then(|b| shown.expanded_uncertainty_mm(b))
+                                .map(mm_to_um),
                         )
                     };
                     let directed = [Direction::Up, Direction::Down]
@@ -981,6 +990,7 @@ fn figures(input: &ReportInput<'_>) -> Figures {
         two_k: 2.0 * standard.k,
         standard_name: standard.name,
         standard_rows,
+        with_u: tests.iter().any(|(_, test)| test.budget.is_some()),
         compared: figures.len() > 1,
         test_names: tests.iter().map(|(name, _)| *name).collect(),
         rows,
