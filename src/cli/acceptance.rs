@@ -7,17 +7,20 @@ use std::path::Path;
 use super::common::load;
 use anyhow::Result;
 
+use axcomp::evaluate::Evaluation;
 use axcomp::evaluate::verdict::{
-    AcceptanceProfile, Figure, Limit, command_line_limits, with_overrides,
+    AcceptanceProfile, Figure, Limit, check_standard, command_line_limits, with_overrides,
 };
 
 /// The acceptance flags.
 #[derive(Debug, Clone, clap::Args)]
 pub struct LimitArgs {
-    /// Permissible value of an ISO 230-2 figure, µm: FIGURE=UM, e.g. A=12 (repeat for several).
+    /// Permissible value of a figure, µm: FIGURE=UM, e.g. A=12 (repeat for several).
     ///
-    /// FIGURE is a key of figures_um in evaluate --json: A, A_up, A_down, E,
-    /// E_up, E_down, M, R, R_up, R_down, B, B_mean (B_mean compares |B̄|).
+    /// FIGURE is a key of figures_um in evaluate --json under the --standard:
+    /// A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B, B_mean
+    /// (B_mean compares |B̄|) for ISO 230-2 and its ±3s forms; P, Pa,
+    /// Ps_max, Ps_mean, U_max, U_mean for vdi3441.
     /// Replaces the machine profile's [acceptance] limit for that figure. With
     /// limits the output gets a verdict under --decision (default simple:
     /// value ≤ limit); a figure that is not evaluated fails. The exit status stays 0:
@@ -48,15 +51,23 @@ pub fn parse_limit(text: &str) -> Result<(Figure, f64), String> {
 }
 
 /// The limits for `axis`: the profile's `[acceptance]` (if a profile is
-/// given), with the command line's on top. Empty: no verdict.
-pub fn load_limits(profile: Option<&Path>, axis: &str, args: &LimitArgs) -> Result<Vec<Limit>> {
+/// given), with the command line's on top, each on a figure of the
+/// evaluation's standard. Empty: no verdict.
+pub fn load_limits(
+    profile: Option<&Path>,
+    axis: &str,
+    evaluation: &Evaluation,
+    args: &LimitArgs,
+) -> Result<Vec<Limit>> {
     let from_profile = match profile {
         Some(path) => load(path, AcceptanceProfile::from_toml_str)?
             .limits_for(axis, &path.display().to_string()),
         None => Vec::new(),
     };
     let from_command_line = command_line_limits(&args.limits)?;
-    Ok(with_overrides(from_profile, from_command_line))
+    let limits = with_overrides(from_profile, from_command_line);
+    check_standard(&limits, evaluation)?;
+    Ok(limits)
 }
 
 #[cfg(test)]

@@ -21,7 +21,8 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
 use axcomp::effects::{Effect, Parameter, ParameterValue};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
-use axcomp::evaluate::{Evaluation, evaluate};
+use axcomp::evaluate::uncertainty::Equipment;
+use axcomp::evaluate::{Evaluation, ISO_230_2, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::model::{GeometricErrors, Machine};
 use axcomp::output::write_all_new;
@@ -37,7 +38,7 @@ use axcomp::report::predict::PredictJson;
 use axcomp::synth::{EffectSpec, Truth};
 use axcomp::units::{LengthUnit, mm_to_um};
 
-use super::common::{Verbosity, print_text};
+use super::common::{Verbosity, print_text, uncertainty_budget};
 use super::progress;
 
 const TRUTH: &str = include_str!("../../fixtures/demo/truth.toml");
@@ -121,6 +122,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         grid_step_mm: 50.0,
         effects: &[],
         backlash_set: false,
+        standard: &ISO_230_2,
     })?;
     let predict_json = PredictJson::new(
         machine.name(),
@@ -144,6 +146,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         backlash_set: false,
         angular: None,
         timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
     })?;
     let diagnose_json = DiagnoseJson::new(
         &diagnosis,
@@ -175,8 +178,13 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     ));
     steps.inc(1);
 
-    // 6. The acceptance report with its plots.
+    // 6. The acceptance report with its plots, and the measurement
+    // uncertainty of each test with the bundled equipment, as `axcomp report`
+    // computes it without --equipment.
     let after_evaluation = evaluate(&after);
+    let equipment = Equipment::bundled();
+    let before_budget = uncertainty_budget(&before, &equipment)?;
+    let after_budget = uncertainty_budget(&after, &equipment)?;
     let tnc640_file = table_path(Controller::Tnc640, &table.axis);
     let generator = format!("axcomp {} demo", env!("CARGO_PKG_VERSION"));
     let input = ReportInput {
@@ -184,13 +192,13 @@ pub fn run(args: &DemoArgs) -> Result<()> {
             measurement: &before,
             evaluation: &evaluation,
             warnings: &evaluation.warnings,
-            budget: None,
+            budget: Some(&before_budget),
         },
         after: Some(TestRecord {
             measurement: &after,
             evaluation: &after_evaluation,
             warnings: &after_evaluation.warnings,
-            budget: None,
+            budget: Some(&after_budget),
         }),
         table: Some(TableRecord {
             table: &active,
@@ -200,6 +208,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         diagnosis: Some(&diagnosis),
         limits: &[],
         decision: Default::default(),
+        standard: &ISO_230_2,
         generator: &generator,
     };
     files.push(("report.html".into(), html::render(&input)?.into_bytes()));

@@ -13,8 +13,8 @@ use axcomp::report::diagnose::{DiagnoseJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 
 use super::common::{
-    JsonOutput, LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_profile, name_axis,
-    print_json, print_text, print_warnings, read_active_table,
+    JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load, load_profile,
+    name_axis, print_json, print_text, print_warnings, read_active_table,
 };
 
 /// Flags of `axcomp diagnose`.
@@ -64,6 +64,10 @@ pub struct DiagnoseArgs {
     /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
+
+    /// `--standard` (the same in every command).
+    #[command(flatten)]
+    pub standard: StandardArg,
 
     /// `--json` (the same in every command).
     #[command(flatten)]
@@ -118,6 +122,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         backlash_set: args.backlash_set,
         angular: angular.as_ref(),
         timing: CycleTiming::ASSUMED,
+        standard: args.standard.standard,
     };
     let diagnosis = diagnose(&input)?;
     let name = |p: &Path| p.display().to_string();

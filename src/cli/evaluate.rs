@@ -82,14 +82,15 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let measurement = measurement
         .without_runs(&args.exclude_runs)
         .context("after excluding runs")?;
+    let evaluation = evaluate_with(&measurement, args.standard.standard);
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
         measurement.axis(),
+        &evaluation,
         &args.acceptance,
     )?;
     let equipment = load_equipment(&args.uncertainty)?;
     let budget = uncertainty_budget(&measurement, &equipment)?;
-    let evaluation = evaluate_with(&measurement, args.standard.standard);
     warnings.extend(evaluation.warnings.iter().cloned());
     let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
     report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));

@@ -16,8 +16,9 @@ use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::{LengthUnit, mm_to_um};
 
 use super::common::{
-    JsonOutput, LinuxCncType, MachineFile, Verbosity, load, load_effects, load_machine,
-    load_profile, name_axis, parse_position, print_json, print_text, print_warnings, read_table,
+    JsonOutput, LinuxCncType, MachineFile, StandardArg, Verbosity, load, load_effects,
+    load_machine, load_profile, name_axis, parse_position, print_json, print_text, print_warnings,
+    read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -83,6 +84,10 @@ pub struct PredictArgs {
     /// `--linuxcnc-type` for reading a table (the same in every command).
     #[command(flatten)]
     pub table_type: LinuxCncType,
+
+    /// `--standard` (the same in every command).
+    #[command(flatten)]
+    pub standard: StandardArg,
 
     /// `--json` (the same in every command).
     #[command(flatten)]
@@ -171,6 +176,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         grid_step_mm: args.grid,
         effects: &effects,
         backlash_set: args.backlash_set,
+        standard: args.standard.standard,
     };
     let prediction = predict(&input)?;
     let mut notes = notes(&prediction, &effects);

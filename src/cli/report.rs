@@ -170,6 +170,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
         before.measurement.axis(),
+        &before.evaluation,
         &args.acceptance,
     )?;
     let mut after = match &args.after {
@@ -215,6 +216,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
                 backlash_set: false,
                 angular: None,
                 timing: CycleTiming::ASSUMED,
+                standard,
             };
             Some(diagnose(&input).context("cannot diagnose the re-test")?)
         }
@@ -236,6 +238,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         diagnosis: diagnosis.as_ref(),
         limits: &limits,
         decision: args.uncertainty.decision,
+        standard,
         generator: &generator,
     };
     // Render everything before writing anything: a failure leaves no half report.

@@ -8,7 +8,7 @@ use super::{AcceptedEffect, DiagnoseError, DiagnoseInput, FigureSet, ResidualSta
 use crate::compensate::CompensationTable;
 use crate::compensate::retest::KnownError;
 use crate::effects::{Context, Effect, FitSummary, Kind, Shape};
-use crate::evaluate::evaluate;
+use crate::evaluate::{AxisFigures, StandardFigure, evaluate, evaluate_with};
 use crate::measurement::{Measurement, Run};
 use crate::units::um_to_mm;
 
@@ -79,14 +79,16 @@ pub(super) fn stats(values: &[f64]) -> ResidualStats {
     }
 }
 
-/// ISO figures of the re-test as measured, as predicted and as predicted with
-/// the effects; `value(i, with_effects)` gives reading i of the model (µm,
-/// with the measured scatter, so A and R stay comparable).
+/// Figures of the re-test as measured, as predicted and as predicted with
+/// the effects, ISO 230-2:2014's and `input.standard`'s of the same three
+/// tests; `value(i, with_effects)` gives reading i of the model (µm, with
+/// the measured scatter, so A and R stay comparable).
 pub(super) fn figures(
-    after: &Measurement,
+    input: &DiagnoseInput<'_>,
     problem: &Problem,
     value: impl Fn(usize, bool) -> f64,
-) -> Result<FigureSet, DiagnoseError> {
+) -> Result<(FigureSet, FigureSet<Vec<StandardFigure>>), DiagnoseError> {
+    let after = input.after;
     let build = |with_effects: bool| -> Result<Measurement, DiagnoseError> {
         let mut runs: Vec<Run> = after
             .runs()
@@ -109,13 +111,32 @@ pub(super) fn figures(
         )
         .map_err(|e| DiagnoseError::Internal(e.to_string()))
     };
+    let built;
     let predicted = match &problem.first_test_prediction {
-        Some(prediction) => evaluate(prediction).figures,
-        None => evaluate(&build(false)?).figures,
+        Some(prediction) => prediction,
+        None => {
+            built = build(false)?;
+            &built
+        }
     };
-    Ok(FigureSet {
-        measured: evaluate(after).figures,
-        predicted,
-        predicted_with_effects: evaluate(&build(true)?).figures,
-    })
+    let with_effects = build(true)?;
+    let both = |test: &Measurement| -> (AxisFigures, Vec<StandardFigure>) {
+        (
+            evaluate(test).figures,
+            evaluate_with(test, input.standard).standard_figures,
+        )
+    };
+    let (measured, predicted, with_effects) = (both(after), both(predicted), both(&with_effects));
+    Ok((
+        FigureSet {
+            measured: measured.0,
+            predicted: predicted.0,
+            predicted_with_effects: with_effects.0,
+        },
+        FigureSet {
+            measured: measured.1,
+            predicted: predicted.1,
+            predicted_with_effects: with_effects.1,
+        },
+    ))
 }

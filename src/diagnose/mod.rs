@@ -47,7 +47,7 @@ use crate::compensate::CompensateError;
 use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
 use crate::effects::{Effect, FileEntry, Kind, Reading, Reversal, Shape};
-use crate::evaluate::AxisFigures;
+use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
 use crate::measurement::{Direction, Measurement};
 use crate::together::NotTogether;
 use along_axis::{Background, select_along_axis};
@@ -86,6 +86,9 @@ pub struct DiagnoseInput<'a> {
     pub angular: Option<&'a AngularProfile>,
     /// Cycle timing to assume when the file records no duration.
     pub timing: CycleTiming,
+    /// The standard whose figures the diagnosis reports
+    /// ([`Diagnosis::standard_figures`]); the statistics do not depend on it.
+    pub standard: &'a dyn Standard,
 }
 
 /// RMS and largest |value| of a residual, µm.
@@ -149,19 +152,21 @@ pub struct Unexplained {
     pub rms_um: f64,
 }
 
-/// The ISO 230-2 figures of the re-test as measured and as the model predicts it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FigureSet {
+/// The figures of the re-test as measured and as the model predicts it:
+/// ISO 230-2:2014's ([`AxisFigures`]) or a standard's, keyed
+/// (`Vec<StandardFigure>`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FigureSet<F = AxisFigures> {
     /// As measured.
-    pub measured: AxisFigures,
+    pub measured: F,
     /// Predicted by the model, as `predict` gives them: the first test's
     /// readings with the predicted systematic error (so the first test's
     /// scatter and R). Without a first test: the re-test's own systematic
     /// curve with its scatter.
-    pub predicted: AxisFigures,
+    pub predicted: F,
     /// What the prediction with the accepted effects explains of this
     /// re-test: its systematic part with this re-test's scatter.
-    pub predicted_with_effects: AxisFigures,
+    pub predicted_with_effects: F,
 }
 
 /// The diagnosis.
@@ -177,8 +182,12 @@ pub struct Diagnosis {
     pub rejected: Vec<RejectedEffect>,
     /// The model's error with the effects.
     pub residual_after: ResidualStats,
-    /// Figures.
+    /// ISO 230-2:2014 figures.
     pub figures: FigureSet,
+    /// The same re-tests' figures as [`DiagnoseInput::standard`] reports them.
+    pub standard_figures: FigureSet<Vec<StandardFigure>>,
+    /// That standard.
+    pub standard: StandardUsed,
     /// What none of the effects explains.
     pub unexplained: Unexplained,
     /// Scatter of one reading left at the end, µm.
@@ -383,7 +392,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         reversal_p,
         with_prediction,
     );
-    let figures = figures(input.after, &problem, |i, with_effects| {
+    let (figures, standard_figures) = figures(input, &problem, |i, with_effects| {
         let r = &problem.readings[i];
         // Without effects this is only asked without a first test (see `figures`).
         let systematic = if with_effects {
@@ -403,6 +412,8 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         rejected,
         residual_after: stats(&residual_after),
         figures,
+        standard_figures,
+        standard: StandardUsed::of(input.standard),
         unexplained,
         noise_um,
         time_assumed,

@@ -26,7 +26,7 @@ use super::targets::{DirectionStats, TargetStats};
 use crate::measurement::Direction;
 
 /// What derives a test's figures from the statistics of each target.
-pub trait Standard: Sync {
+pub trait Standard: Sync + std::fmt::Debug {
     /// Its name and edition, as a report cites it.
     fn name(&self) -> &'static str;
 
@@ -46,8 +46,8 @@ pub trait Standard: Sync {
     fn target_stats(&self, target_mm: f64, up: DirectionStats, down: DirectionStats)
     -> TargetStats;
 
-    /// The ISO 230-2 axis figures from every target's (the prediction and the
-    /// diagnosis work with these, whatever the report's standard).
+    /// The ISO 230-2 axis figures from every target's (±k·s; VDI 3441 gives
+    /// ISO 230-2:2014's beside its own).
     fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures;
 
     /// The figures this standard reports, in its order, with its keys.

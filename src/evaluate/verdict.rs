@@ -1,4 +1,7 @@
-//! The acceptance verdict: ISO 230-2 axis figures against permissible values.
+//! The acceptance verdict: a standard's axis figures (ISO 230-2's, or VDI
+//! 3441's keys under `--standard vdi3441`) against permissible values; a
+//! limit on a figure the standard does not report is refused
+//! ([`check_standard`]).
 //!
 //! ISO 230-2 defines the figures but sets no limits: the permissible values
 //! come from the contract or a machine standard. They are given on the
@@ -17,7 +20,7 @@
 //! [`crate::evaluate::uncertainty`]) decides: conformance is proven when
 //! value + U ≤ limit, non-conformance when value − U > limit, and neither
 //! between ([`Conformance::NotProven`]). A figure without an evaluated U
-//! (R, B, the unidirectional figures: standards.md §4 gives no form) is
+//! (R, B, the unidirectional figures, VDI 3441's: standards.md §4 gives no form) is
 //! compared by its value alone, and its check says so. A figure
 //! that is not evaluated (`None`, e.g. R of a one-run test) cannot pass: its
 //! check fails with [`Outcome::NotEvaluated`], never an implied pass. Without
@@ -54,7 +57,7 @@ use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 
 use crate::error::ParseError;
 use crate::evaluate::uncertainty::Budget;
-use crate::evaluate::{AxisFigures, Evaluation};
+use crate::evaluate::{Evaluation, StandardFigure};
 use crate::measurement::Direction;
 use crate::units::per_m_over_mm;
 use crate::units::um_to_mm;
@@ -86,11 +89,23 @@ pub enum Figure {
     B,
     /// Mean reversal value B̄, compared as |B̄|.
     BMean,
+    /// VDI/DGQ 3441 positional uncertainty P.
+    P,
+    /// VDI/DGQ 3441 positional deviation Pa.
+    Pa,
+    /// VDI/DGQ 3441 largest positional scatter Ps max.
+    PsMax,
+    /// VDI/DGQ 3441 mean positional scatter Ps mean.
+    PsMean,
+    /// VDI/DGQ 3441 largest reversal span U max.
+    UMax,
+    /// VDI/DGQ 3441 mean reversal span U mean.
+    UMean,
 }
 
 impl Figure {
-    /// Every figure, in the order of `figures_um`.
-    pub const ALL: [Figure; 12] = [
+    /// Every figure, in the order of `figures_um`: ISO 230-2's, then VDI 3441's.
+    pub const ALL: [Figure; 18] = [
         Figure::A,
         Figure::AUp,
         Figure::ADown,
@@ -103,6 +118,12 @@ impl Figure {
         Figure::RDown,
         Figure::B,
         Figure::BMean,
+        Figure::P,
+        Figure::Pa,
+        Figure::PsMax,
+        Figure::PsMean,
+        Figure::UMax,
+        Figure::UMean,
     ];
 
     /// The name, as the key in `figures_um` of `evaluate --json`.
@@ -120,6 +141,12 @@ impl Figure {
             Figure::RDown => "R_down",
             Figure::B => "B",
             Figure::BMean => "B_mean",
+            Figure::P => "P",
+            Figure::Pa => "Pa",
+            Figure::PsMax => "Ps_max",
+            Figure::PsMean => "Ps_mean",
+            Figure::UMax => "U_max",
+            Figure::UMean => "U_mean",
         }
     }
 
@@ -148,30 +175,23 @@ impl Figure {
         Figure::ALL.map(Figure::name).join(", ")
     }
 
-    /// The value a limit is compared with, mm: the figure, except |B̄| for
+    /// The value a limit is compared with, mm, from a standard's figures
+    /// ([`Evaluation::standard_figures`]): the figure, except |B̄| for
     /// B_mean (the signed mean reversal is a direction, its size is the
-    /// error). `None` when the figure is not evaluated.
-    pub fn value_mm(self, figures: &AxisFigures) -> Option<f64> {
-        match self {
-            Figure::A => figures.a_mm,
-            Figure::AUp => figures.a_up_mm,
-            Figure::ADown => figures.a_down_mm,
-            Figure::E => figures.e_mm,
-            Figure::EUp => figures.e_up_mm,
-            Figure::EDown => figures.e_down_mm,
-            Figure::M => figures.m_mm,
-            Figure::R => figures.r_mm,
-            Figure::RUp => figures.r_up_mm,
-            Figure::RDown => figures.r_down_mm,
-            Figure::B => figures.b_mm,
-            Figure::BMean => figures.b_mean_mm.map(f64::abs),
-        }
+    /// error). `None` when the figure is not evaluated or not the standard's
+    /// ([`check_standard`] refuses such a limit first).
+    pub fn value_mm(self, figures: &[StandardFigure]) -> Option<f64> {
+        let value = figures.iter().find(|f| f.key == self.name())?.value_mm?;
+        Some(match self {
+            Figure::BMean => value.abs(),
+            _ => value,
+        })
     }
 
     /// The expanded uncertainty of the figure, mm: U(E) = U(M) = U(A) = the
     /// budget's U (standards.md §4); `None` for the figures whose U is not
     /// evaluated (R and B: no public form; the unidirectional figures: the
-    /// spec names only E, M and A).
+    /// spec names only E, M and A; VDI 3441's: standards.md gives no form).
     pub fn expanded_uncertainty_mm(self, budget: &Budget) -> Option<f64> {
         match self {
             Figure::A | Figure::E | Figure::M => Some(budget.expanded_mm),
@@ -346,6 +366,20 @@ pub struct Limit {
 /// Why a limit is refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LimitError {
+    /// A figure the chosen standard does not report.
+    #[error(
+        "{given}: a limit on {figure}, which {standard} does not report; its figures are {keys} (--standard picks another)"
+    )]
+    NotOfStandard {
+        /// The figure.
+        figure: Figure,
+        /// Where the limit was given.
+        given: LimitSource,
+        /// The standard's name.
+        standard: &'static str,
+        /// Its keys, comma-separated.
+        keys: String,
+    },
     /// The same figure twice on the command line.
     #[error("--limit {0} is given twice")]
     Twice(Figure),
@@ -379,6 +413,24 @@ pub fn command_line_limits(limits: &[(Figure, f64)]) -> Result<Vec<Limit>, Limit
         });
     }
     Ok(out)
+}
+
+/// Refuses a limit on a figure the evaluation's standard does not report
+/// (a VDI 3441 figure under ISO 230-2, A under VDI 3441).
+pub fn check_standard(limits: &[Limit], evaluation: &Evaluation) -> Result<(), LimitError> {
+    let keys = &evaluation.standard_figures;
+    match limits
+        .iter()
+        .find(|l| !keys.iter().any(|f| f.key == l.figure.name()))
+    {
+        None => Ok(()),
+        Some(limit) => Err(LimitError::NotOfStandard {
+            figure: limit.figure,
+            given: limit.source.clone(),
+            standard: evaluation.standard.name,
+            keys: keys.iter().map(|f| f.key).collect::<Vec<_>>().join(", "),
+        }),
+    }
 }
 
 /// `base` with every figure of `overrides` replaced (or added): how
@@ -537,7 +589,7 @@ pub fn verdict_with(
     let checks = ordered
         .into_iter()
         .map(|limit| {
-            let value_mm = limit.figure.value_mm(&evaluation.figures);
+            let value_mm = limit.figure.value_mm(&evaluation.standard_figures);
             let limit_mm = limit.permissible.limit_mm(travel_mm);
             let outcome = match value_mm {
                 None => Outcome::NotEvaluated,
@@ -848,7 +900,7 @@ fn positive_um<E: de::Error>(value: f64) -> Result<f64, E> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evaluate::TargetStats;
+    use crate::evaluate::{AxisFigures, TargetStats};
     use crate::units::mm_to_um;
 
     fn evaluation(first_mm: f64, last_mm: f64, figures: AxisFigures) -> Evaluation {

@@ -64,7 +64,9 @@
 use crate::compensate::retest::{Applied, BacklashRefusal, KnownError};
 use crate::compensate::{CompensationTable, TableMode};
 use crate::effects::Effect;
-use crate::evaluate::{AxisFigures, evaluate};
+use crate::evaluate::{
+    AxisFigures, Standard, StandardFigure, StandardUsed, evaluate, evaluate_with,
+};
 use crate::measurement::{Direction, Measurement, Run};
 use crate::model::{
     Axis, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid, Interpolation, Machine,
@@ -108,6 +110,10 @@ pub struct PredictInput<'a> {
     /// The controller's backlash parameter is set as `convert` suggests: it
     /// takes out the mean reversal B̄ of each measured axis with a mean table.
     pub backlash_set: bool,
+    /// The standard whose figures the re-tests report
+    /// ([`PredictedRetest::standard_figures`]); the prediction itself does
+    /// not depend on it.
+    pub standard: &'a dyn Standard,
 }
 
 /// The predicted re-test of one compensated axis.
@@ -122,10 +128,15 @@ pub struct PredictedRetest {
     /// The predicted re-test as readings (with the measured scatter when the
     /// axis was measured).
     pub retest: Measurement,
-    /// Its ISO 230-2 figures.
+    /// Its ISO 230-2:2014 figures.
     pub figures: AxisFigures,
-    /// The figures of the same line without the table.
+    /// The ISO 230-2:2014 figures of the same line without the table.
     pub figures_before: AxisFigures,
+    /// Its figures as [`PredictInput::standard`] reports them (its keys):
+    /// `evaluate_with` of [`PredictedRetest::retest`].
+    pub standard_figures: Vec<StandardFigure>,
+    /// The same line without the table, as that standard reports it.
+    pub standard_figures_before: Vec<StandardFigure>,
     /// Whether the readings carry a measured test's scatter (else one run per
     /// direction, no repeatability).
     pub with_measured_scatter: bool,
@@ -183,6 +194,8 @@ pub struct VolumetricMaximum {
 /// The prediction.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Prediction {
+    /// The standard of the re-tests' `standard_figures`.
+    pub standard: StandardUsed,
     /// The 21 errors the model used (with the measured positioning errors).
     pub errors: GeometricErrors,
     /// One predicted re-test per table.
@@ -268,8 +281,7 @@ pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
             },
             table,
             measured.map(|m| m.measurement),
-            input.effects,
-            input.backlash_set,
+            input,
         )?);
     }
     let grid = Grid::over_strokes(&retest_machine, input.grid_step_mm)?;
@@ -289,6 +301,7 @@ pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
     }
     let (max_mm, at_mm) = before.max_translation();
     Ok(Prediction {
+        standard: StandardUsed::of(input.standard),
         errors,
         retests,
         volumetric_before: VolumetricMaximum { max_mm, at_mm },
@@ -416,10 +429,10 @@ fn predicted_retest(
     line: Line,
     table: &CompensationTable,
     measured: Option<&Measurement>,
-    effects: &[Effect],
-    backlash_set: bool,
+    input: &PredictInput<'_>,
 ) -> Result<PredictedRetest, PredictError> {
     let Line { axis, line_mm } = line;
+    let (effects, backlash_set, standard) = (input.effects, input.backlash_set, input.standard);
     let sign = positioning_sign(machine, axis)?;
     let targets: Vec<f64> = match measured {
         Some(m) => m.targets_mm().to_vec(),
@@ -474,6 +487,8 @@ fn predicted_retest(
         line_mm,
         figures: evaluate(&retest).figures,
         figures_before: evaluate(&before).figures,
+        standard_figures: evaluate_with(&retest, standard).standard_figures,
+        standard_figures_before: evaluate_with(&before, standard).standard_figures,
         per_target,
         retest,
         with_measured_scatter: measured.is_some(),

@@ -6,6 +6,7 @@ use super::*;
 use crate::compensate::retest::{Applied, predicted_deviation_mm};
 use crate::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use crate::effects::Reversal;
+use crate::evaluate::ISO_230_2;
 use crate::synth::{self, Truth};
 
 /// A synthetic X test on the bundled machine (0 … 750 mm, 16 irregular targets).
@@ -45,6 +46,7 @@ fn input<'a>(
         grid_step_mm: 50.0,
         effects: &[],
         backlash_set: false,
+        standard: &ISO_230_2,
     }
 }
 

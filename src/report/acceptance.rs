@@ -14,7 +14,9 @@ use crate::diagnose::{Diagnosis, ReadingResidual};
 use crate::effects::{Effect, Line};
 use crate::emit::Controller;
 use crate::error::Warning;
-use crate::evaluate::{AxisFigures, DirectionStats, Evaluation, TargetStats, evaluate};
+use crate::evaluate::{
+    DirectionStats, Evaluation, Standard, StandardFigure, TargetStats, evaluate_with,
+};
 use crate::measurement::{Direction, Measurement};
 use crate::report::chart::{Chart, Mark, Rgb, Series};
 use crate::units::mm_to_um;
@@ -59,6 +61,9 @@ pub struct ReportInput<'a> {
     pub limits: &'a [crate::evaluate::verdict::Limit],
     /// The decision rule of the verdict (`--decision`).
     pub decision: crate::evaluate::verdict::Decision,
+    /// The standard the tests were evaluated to (`--standard`), whose
+    /// figures the predicted re-test reports too.
+    pub standard: &'a dyn Standard,
     /// What made the report, e.g. `axcomp 0.1.0 on 2026-11-22 15:04`
     /// (the library reads no clock: the caller says when).
     pub generator: &'a str,
@@ -84,9 +89,10 @@ pub struct Prediction {
     pub down_um: Vec<f64>,
     /// The first test's mean deviation there (what the axis does without the table), µm.
     pub uncompensated_um: Vec<f64>,
-    /// The predicted re-test's ISO 230-2 figures, as `predict` gives them on
-    /// the measured line (the first test's scatter about the predicted means).
-    pub figures: AxisFigures,
+    /// The predicted re-test's figures under the report's standard, as
+    /// `predict` gives them on the measured line (the first test's scatter
+    /// about the predicted means).
+    pub figures: Vec<StandardFigure>,
 }
 
 impl Prediction {
@@ -113,8 +119,13 @@ const PREDICTION_SAMPLES: usize = 600;
 
 /// The predicted re-test of the first test with the table applied
 /// (`compensate::retest`, with the reversal the first test measured), over
-/// the measured span; `None` if the first test has no mean deviation anywhere.
-pub fn prediction(before: &TestRecord<'_>, table: &CompensationTable) -> Option<Prediction> {
+/// the measured span, its figures per `standard`; `None` if the first test
+/// has no mean deviation anywhere.
+pub fn prediction(
+    before: &TestRecord<'_>,
+    table: &CompensationTable,
+    standard: &dyn Standard,
+) -> Option<Prediction> {
     let known = KnownError::from_evaluation(before.evaluation)?;
     let targets_mm = before.measurement.targets_mm();
     let retest = with_scatter(before.measurement, before.evaluation, |i, direction| {
@@ -147,7 +158,7 @@ pub fn prediction(before: &TestRecord<'_>, table: &CompensationTable) -> Option<
             .map(|&x| mm_to_um(known.mean_at(x)))
             .collect(),
         positions_mm,
-        figures: evaluate(&retest).figures,
+        figures: evaluate_with(&retest, standard).standard_figures,
     })
 }
 
@@ -211,7 +222,7 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
             name: "table",
             chart: table_chart(table.table, input.before.evaluation),
         });
-        if let Some(prediction) = prediction(&input.before, table.table) {
+        if let Some(prediction) = prediction(&input.before, table.table, input.standard) {
             charts.push(NamedChart {
                 name: "predicted",
                 chart: prediction_chart(

@@ -7,6 +7,8 @@
 //!
 //! ```text
 //! { "after": "after.rtl", "before": "before.rtl" | null, "table": "X.COM" | null,
+//!   "standard": "iso230-2:2014", "standard_name": "ISO 230-2:2014",
+//!   "definitions_reconstructed": false,      (as in evaluate: --standard)
 //!   "predicted_from_first_test": true,
 //!   "residual_before_um": {"rms": …, "max_abs": …},
 //!   "effects": [{"kind": "periodic", "params": {"period_mm": …, "amplitude_um": …, "phase_rad": …},
@@ -17,6 +19,7 @@
 //!   "rejected": [{"kind": "scale", "why": "…"}],
 //!   "residual_after_um": {"rms": …, "max_abs": …},
 //!   "figures_um": {"measured": {"A": …, …}, "predicted": {…}, "predicted_with_effects": {…}},
+//!                                            (each under the standard's keys, as in evaluate)
 //!   "unexplained": {"significant": false, "where_mm": [], "rms_um": …, "p_value": …},
 //!   "noise_um": …, "time_assumed": false }
 //! ```
@@ -32,7 +35,7 @@ use serde_json::{Map, Value};
 
 use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
 use crate::effects::{Effect, ParameterValue};
-use crate::report::format::um;
+use crate::report::format::{pad_name, um};
 use crate::report::json::FiguresJson;
 
 /// RMS and largest |value|, µm.
@@ -163,6 +166,12 @@ pub struct DiagnoseJson {
     pub before: Option<String>,
     /// The table file, if given.
     pub table: Option<String>,
+    /// The `--standard` the figures follow (`iso230-2:2014`, `vdi3441`).
+    pub standard: &'static str,
+    /// Its name and edition.
+    pub standard_name: &'static str,
+    /// Whether its definitions are reconstructed from public sources.
+    pub definitions_reconstructed: bool,
     /// Whether the prediction came from a first test.
     pub predicted_from_first_test: bool,
     /// The model's error before adding effects, µm.
@@ -195,6 +204,9 @@ impl DiagnoseJson {
             after,
             before,
             table,
+            standard: diagnosis.standard.key,
+            standard_name: diagnosis.standard.name,
+            definitions_reconstructed: diagnosis.standard.reconstructed,
             predicted_from_first_test: diagnosis.predicted_from_first_test,
             residual_before_um: diagnosis.residual_before.into(),
             effects: diagnosis.accepted.iter().map(EffectJson::new).collect(),
@@ -208,10 +220,10 @@ impl DiagnoseJson {
                 .collect(),
             residual_after_um: diagnosis.residual_after.into(),
             figures_um: FigureSetJson {
-                measured: FiguresJson::from_figures(&diagnosis.figures.measured),
-                predicted: FiguresJson::from_figures(&diagnosis.figures.predicted),
-                predicted_with_effects: FiguresJson::from_figures(
-                    &diagnosis.figures.predicted_with_effects,
+                measured: FiguresJson::from_standard(&diagnosis.standard_figures.measured),
+                predicted: FiguresJson::from_standard(&diagnosis.standard_figures.predicted),
+                predicted_with_effects: FiguresJson::from_standard(
+                    &diagnosis.standard_figures.predicted_with_effects,
                 ),
             },
             unexplained: UnexplainedJson {
@@ -302,51 +314,27 @@ pub fn render(report: &DiagnoseJson) -> String {
     }
     let _ = writeln!(
         out,
-        "\nFigures [µm] |  measured | predicted | predicted with effects"
+        "\nFigures [µm] |  measured | predicted | predicted with effects   ({}{})",
+        report.standard_name,
+        if report.definitions_reconstructed {
+            "; definitions reconstructed from public sources (README, Standards)"
+        } else {
+            ""
+        }
     );
     let _ = writeln!(
         out,
         "-------------+-----------+-----------+-----------------------"
     );
     let f = &report.figures_um;
-    for (name, m, p, e) in [
-        (
-            "A",
-            f.measured.get("A"),
-            f.predicted.get("A"),
-            f.predicted_with_effects.get("A"),
-        ),
-        (
-            "E",
-            f.measured.get("E"),
-            f.predicted.get("E"),
-            f.predicted_with_effects.get("E"),
-        ),
-        (
-            "M",
-            f.measured.get("M"),
-            f.predicted.get("M"),
-            f.predicted_with_effects.get("M"),
-        ),
-        (
-            "R",
-            f.measured.get("R"),
-            f.predicted.get("R"),
-            f.predicted_with_effects.get("R"),
-        ),
-        (
-            "B",
-            f.measured.get("B"),
-            f.predicted.get("B"),
-            f.predicted_with_effects.get("B"),
-        ),
-    ] {
+    for (name, key) in f.measured.terminal_rows() {
         let _ = writeln!(
             out,
-            " {name:<11} | {:>9} | {:>9} | {:>22}",
-            um(m),
-            um(p),
-            um(e)
+            " {} | {:>9} | {:>9} | {:>22}",
+            pad_name(name, 11),
+            um(f.measured.get(key)),
+            um(f.predicted.get(key)),
+            um(f.predicted_with_effects.get(key))
         );
     }
     out

@@ -20,6 +20,16 @@ pub fn um(value: Option<f64>) -> String {
     text
 }
 
+/// `name` padded with spaces to `width` columns as a terminal shows it
+/// (B̄'s bar is a combining character and takes no column).
+pub fn pad_name(name: &str, width: usize) -> String {
+    let shown = name
+        .chars()
+        .filter(|c| !('\u{300}'..='\u{36f}').contains(c))
+        .count();
+    format!("{name}{}", " ".repeat(width.saturating_sub(shown)))
+}
+
 /// Appends [`um`]'s text to `out`, without a `String` of its own (a large
 /// test's per-target table has a hundred thousand of these).
 pub fn push_um(out: &mut String, value: Option<f64>) {
@@ -112,6 +122,9 @@ pub struct SourcedUm {
     pub full: String,
     /// As the terminal report shows it ([`um`]).
     pub shown: String,
+    /// The expanded uncertainty U shown after it (`± 1.82`), as the
+    /// terminal shows it; `None` where U is not evaluated.
+    pub u: Option<String>,
 }
 
 impl SourcedUm {
@@ -121,7 +134,16 @@ impl SourcedUm {
             key,
             full: value.map_or_else(|| "null".to_string(), |v| v.to_string()),
             shown: um(value),
+            u: None,
         }
+    }
+
+    /// With U shown after the value (`13.19 ± 1.82`), where both are evaluated.
+    pub fn with_u(self, expanded_um: Option<f64>) -> SourcedUm {
+        let u = expanded_um
+            .filter(|_| self.full != "null")
+            .map(|u| um(Some(u)));
+        SourcedUm { u, ..self }
     }
 }
 

@@ -58,7 +58,7 @@ use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
 use crate::evaluate::standard::{Vdi3441, vdi_figure_name};
 use crate::evaluate::verdict::{Decision, Figure, Limit};
-use crate::evaluate::{AxisFigures, Standard, StandardUsed};
+use crate::evaluate::{Standard, StandardUsed};
 use crate::measurement::{Direction, Measurement, StartEnd};
 use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts, prediction};
 use crate::report::chart::chart;
@@ -74,7 +74,7 @@ use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 ///
 /// # Example
 /// ```
-/// use axcomp::{evaluate::evaluate, measurement::SourceFormat, read};
+/// use axcomp::{evaluate::{ISO_230_2, evaluate}, measurement::SourceFormat, read};
 /// use axcomp::report::acceptance::{ReportInput, TestRecord};
 /// let csv = "target_mm,run,direction,deviation_um\n\
 ///            0,1,up,0\n100,1,up,4\n0,1,down,-2\n100,1,down,2\n\
@@ -83,7 +83,7 @@ use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 /// let evaluation = evaluate(&measurement);
 /// let before = TestRecord { measurement: &measurement, evaluation: &evaluation, warnings: &warnings, budget: None };
 /// let input = ReportInput { before, after: None, table: None, diagnosis: None, limits: &[],
-///     decision: Default::default(), generator: "axcomp" };
+///     decision: Default::default(), standard: &ISO_230_2, generator: "axcomp" };
 /// let html = axcomp::report::html::render(&input).unwrap();
 /// // E = max(x̄↑; x̄↓) − min(x̄↑; x̄↓) = 5 − (−1) = 6 µm, shown as the terminal shows it.
 /// assert!(html.contains(r#"data-key="before.figures_um.E" data-um="6">6.00</td>"#));
@@ -346,6 +346,8 @@ struct Figures {
     /// one row each (symbol and name, a cell per test); empty for ISO 230-2.
     standard_name: &'static str,
     standard_rows: Vec<(String, Vec<Option<SourcedUm>>)>,
+    /// Whether E, M and A show their U (a test has a budget).
+    with_u: bool,
 }
 
 /// A figure's row: per test bidirectional, ↑ and ↓ (`None`: the figure has
@@ -395,9 +397,9 @@ struct TableView {
 struct PredictionView {
     range_um: String,
     uncompensated_range_um: String,
-    a: SourcedUm,
-    e: SourcedUm,
-    b: SourcedUm,
+    /// (key, cell) of the figures the paragraph names: A, E, B, or every
+    /// figure of another standard.
+    figures: Vec<(&'static str, SourcedUm)>,
     plot: Option<Plot>,
 }
 
@@ -916,12 +918,19 @@ fn figures(input: &ReportInput<'_>) -> Figures {
         .map(|(symbol, name, figure)| {
             let cells = figures
                 .iter()
+                .zip(&tests)
                 .zip(["before", "after"])
-                .flat_map(|(f, prefix)| {
+                .flat_map(|((f, (_, test)), prefix)| {
+                    // U beside the figures it is evaluated for (E, M, A).
                     let cell = |shown: Figure| {
                         SourcedUm::new(
                             format!("{prefix}.figures_um.{}", shown.name()),
                             figure_value(f, shown),
+                        )
+                        .with_u(
+                            test.budget
+                                .and_then(|b| shown.expanded_uncertainty_mm(b))
+                                .map(mm_to_um),
                         )
                     };
                     let directed = [Direction::Up, Direction::Down]
@@ -981,6 +990,7 @@ fn figures(input: &ReportInput<'_>) -> Figures {
         two_k: 2.0 * standard.k,
         standard_name: standard.name,
         standard_rows,
+        with_u: tests.iter().any(|(_, test)| test.budget.is_some()),
         compared: figures.len() > 1,
         test_names: tests.iter().map(|(name, _)| *name).collect(),
         rows,
@@ -1068,17 +1078,20 @@ fn table_view(
     plot: &dyn Fn(&str) -> Option<Plot>,
 ) -> TableView {
     let table = record.table;
-    let prediction = prediction(&input.before, table).map(|predicted| {
-        let figures = &predicted.figures;
-        let um_of = |key: &str, value_mm: Option<f64>| {
-            SourcedUm::new(key.to_string(), value_mm.map(mm_to_um))
-        };
+    let prediction = prediction(&input.before, table, input.standard).map(|predicted| {
+        let iso_family = predicted.figures.iter().any(|f| f.key == "A");
         PredictionView {
             range_um: um(Some(predicted.range_um())),
             uncompensated_range_um: um(Some(predicted.uncompensated_range_um())),
-            a: um_of("prediction.figures_um.A", figures.a_mm),
-            e: um_of("prediction.figures_um.E", figures.e_mm),
-            b: um_of("prediction.figures_um.B", figures.b_mm),
+            figures: predicted
+                .figures
+                .iter()
+                .filter(|f| !iso_family || ["A", "E", "B"].contains(&f.key))
+                .map(|f| {
+                    let key = format!("prediction.figures_um.{}", f.key);
+                    (f.key, SourcedUm::new(key, f.value_mm.map(mm_to_um)))
+                })
+                .collect(),
             plot: plot("predicted"),
         }
     });
@@ -1140,26 +1153,38 @@ fn residual_cells(name: &str, stats: &ResidualStats) -> ResidualCells {
 }
 
 fn diagnosis_figures(diagnosis: &Diagnosis) -> Vec<FigureRow> {
-    let sets: [(&str, &AxisFigures); 3] = [
-        ("measured", &diagnosis.figures.measured),
-        ("predicted", &diagnosis.figures.predicted),
-        (
-            "predicted_with_effects",
-            &diagnosis.figures.predicted_with_effects,
-        ),
-    ];
-    let sets = sets.map(|(set, figures)| (set, FiguresJson::from_figures(figures)));
-    FIGURE_ROWS
-        .into_iter()
-        .map(|(symbol, name, figure)| FigureRow {
+    let figures = &diagnosis.standard_figures;
+    let sets = [
+        ("measured", &figures.measured),
+        ("predicted", &figures.predicted),
+        ("predicted_with_effects", &figures.predicted_with_effects),
+    ]
+    .map(|(set, figures)| (set, FiguresJson::from_standard(figures)));
+    // The ISO 230-2 family's bidirectional figures, or every figure of another standard.
+    let rows: Vec<(&'static str, &'static str, &'static str)> =
+        if sets[0].1.values.iter().any(|(key, _)| *key == "A") {
+            FIGURE_ROWS
+                .iter()
+                .map(|&(symbol, name, figure)| (symbol, name, figure.name()))
+                .collect()
+        } else {
+            sets[0]
+                .1
+                .values
+                .iter()
+                .map(|&(key, _)| (key, vdi_figure_name(key), key))
+                .collect()
+        };
+    rows.into_iter()
+        .map(|(symbol, name, key)| FigureRow {
             symbol,
             name,
             cells: sets
                 .iter()
                 .map(|(set, json)| {
                     Some(SourcedUm::new(
-                        format!("diagnosis.figures.{set}.{}", figure.name()),
-                        figure_value(json, figure),
+                        format!("diagnosis.figures.{set}.{key}"),
+                        json.get(key),
                     ))
                 })
                 .collect(),

@@ -297,6 +297,23 @@ impl FiguresJson {
         }
     }
 
+    /// The rows a terminal table shows, (name, key): the ISO 230-2 family's
+    /// bidirectional figures, or every figure of another standard (VDI 3441).
+    pub fn terminal_rows(&self) -> Vec<(&'static str, &'static str)> {
+        if self.values.iter().any(|(key, _)| *key == "A") {
+            vec![
+                ("A", "A"),
+                ("E", "E"),
+                ("M", "M"),
+                ("R", "R"),
+                ("B", "B"),
+                ("B̄", "B_mean"),
+            ]
+        } else {
+            self.values.iter().map(|(key, _)| (*key, *key)).collect()
+        }
+    }
+
     /// The value under `key`, µm (`None` when not evaluated or not this standard's).
     pub fn get(&self, key: &str) -> Option<f64> {
         self.values

@@ -8,11 +8,13 @@
 //!
 //! ```text
 //! { "machine": "MCV 754 Quick", "chain": "ZFYX",
+//!   "standard": "iso230-2:2014", "standard_name": "ISO 230-2:2014",
+//!   "definitions_reconstructed": false,      (as in evaluate: --standard)
 //!   "axis": "X", "line_mm": {"x": 0.0, "y": 250.0, "z": -275.0},
 //!   "with_measured_scatter": true, "table_mode": "mean",
 //!   "measured_B_mean_um": -3.18,              (the first test's B̄, which the prediction carries; null if unknown)
 //!   "backlash_set": false,                    (--backlash-set: the backlash parameter takes B̄ out)
-//!   "predicted_figures_um": {"A": …, … as in evaluate},
+//!   "predicted_figures_um": {"A": …, … as in evaluate: the standard's keys},
 //!   "figures_before_um": {…},                 (the same line without the table)
 //!   "per_target": [{"target_mm": …, "predicted_up_um": …, "predicted_down_um": …,
 //!                   "before_up_um": …, "before_down_um": …}, …],
@@ -30,7 +32,7 @@ use std::fmt::Write;
 use serde::Serialize;
 
 use crate::predict::{PredictedRetest, Prediction};
-use crate::report::format::um;
+use crate::report::format::{pad_name, um};
 use crate::report::json::FiguresJson;
 use crate::units::mm_to_um;
 
@@ -87,9 +89,9 @@ pub struct RetestJson {
     pub measured_b_mean_um: Option<f64>,
     /// Whether the controller's backlash parameter takes B̄ out (`--backlash-set`).
     pub backlash_set: bool,
-    /// ISO 230-2 figures of the predicted re-test, µm.
+    /// Figures of the predicted re-test under the standard's keys, µm.
     pub predicted_figures_um: FiguresJson,
-    /// The same line without the table, µm.
+    /// The same line without the table, under the standard's keys, µm.
     pub figures_before_um: FiguresJson,
     /// Per target.
     pub per_target: Vec<PredictedTargetJson>,
@@ -105,8 +107,8 @@ impl RetestJson {
             table_mode: retest.table_mode.as_str(),
             measured_b_mean_um: retest.measured_mean_reversal_mm.map(mm_to_um),
             backlash_set: retest.backlash_reversal_mm != 0.0,
-            predicted_figures_um: FiguresJson::from_figures(&retest.figures),
-            figures_before_um: FiguresJson::from_figures(&retest.figures_before),
+            predicted_figures_um: FiguresJson::from_standard(&retest.standard_figures),
+            figures_before_um: FiguresJson::from_standard(&retest.standard_figures_before),
             per_target: retest
                 .per_target
                 .iter()
@@ -129,6 +131,12 @@ pub struct PredictJson {
     pub machine: String,
     /// Chain code.
     pub chain: String,
+    /// The `--standard` the figures follow (`iso230-2:2014`, `vdi3441`).
+    pub standard: &'static str,
+    /// Its name and edition.
+    pub standard_name: &'static str,
+    /// Whether its definitions are reconstructed from public sources.
+    pub definitions_reconstructed: bool,
     /// The first table's re-test.
     #[serde(flatten)]
     pub retest: RetestJson,
@@ -169,6 +177,9 @@ impl PredictJson {
         PredictJson {
             machine: machine.to_string(),
             chain: chain.to_string(),
+            standard: prediction.standard.key,
+            standard_name: prediction.standard.name,
+            definitions_reconstructed: prediction.standard.reconstructed,
             retest: first,
             also: retests.collect(),
             volumetric_max_um: mm_to_um(prediction.volumetric_after.max_mm),
@@ -187,6 +198,13 @@ impl PredictJson {
 pub fn render(report: &PredictJson) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "Machine      {} ({})", report.machine, report.chain);
+    let _ = writeln!(out, "Figures      {}", report.standard_name);
+    if report.definitions_reconstructed {
+        let _ = writeln!(
+            out,
+            "             definitions reconstructed from public sources, not read in the standard (README, Standards)"
+        );
+    }
     for retest in std::iter::once(&report.retest).chain(&report.also) {
         render_retest(&mut out, retest);
     }
@@ -228,26 +246,13 @@ fn render_retest(out: &mut String, retest: &RetestJson) {
     let _ = writeln!(out, " figure [µm] | no table | with the table");
     let _ = writeln!(out, "-------------+----------+---------------");
     let (b, p) = (&retest.figures_before_um, &retest.predicted_figures_um);
-    for (name, before, predicted) in [
-        ("A", b.get("A"), p.get("A")),
-        ("E", b.get("E"), p.get("E")),
-        ("M", b.get("M"), p.get("M")),
-        ("R", b.get("R"), p.get("R")),
-        ("B", b.get("B"), p.get("B")),
-        ("B̄", b.get("B_mean"), p.get("B_mean")),
-    ] {
+    for (name, key) in p.terminal_rows() {
         let _ = writeln!(
             out,
-            " {name}{} | {:>8} | {:>14}",
-            // Pad by what the terminal shows: B̄'s bar is a combining character.
-            " ".repeat(
-                11 - name
-                    .chars()
-                    .filter(|c| !('\u{300}'..='\u{36f}').contains(c))
-                    .count()
-            ),
-            um(before),
-            um(predicted)
+            " {} | {:>8} | {:>14}",
+            pad_name(name, 11),
+            um(b.get(key)),
+            um(p.get(key))
         );
     }
 }

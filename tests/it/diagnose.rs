@@ -15,7 +15,7 @@ use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_t
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, Diagnosis, diagnose};
 use axcomp::effects::{Abbe, Drift, Effect, OutlierRun, Periodic, Reversal, Scale};
-use axcomp::evaluate::evaluate;
+use axcomp::evaluate::{ISO_230_2, evaluate};
 use axcomp::measurement::Direction;
 use axcomp::read::read_path;
 use axcomp::synth::{self, EffectSpec, Truth};
@@ -72,6 +72,7 @@ fn run(truth_text: &str, seed: u64, angular: bool) -> Diagnosis {
         backlash_set: false,
         angular: profile.as_ref(),
         timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
     };
     let diagnosis = diagnose(&input).unwrap();
     assert_found_or_not(&diagnosis);
@@ -111,6 +112,7 @@ fn run_alone(truth_text: &str, seed: u64) -> Diagnosis {
         backlash_set: false,
         angular: None,
         timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
     };
     let diagnosis = diagnose(&input).unwrap();
     assert_found_or_not(&diagnosis);
@@ -547,6 +549,7 @@ fn real_ess_files_get_a_stated_diagnosis() {
             backlash_set: false,
             angular: None,
             timing: CycleTiming::ASSUMED,
+            standard: &ISO_230_2,
         };
         let d = diagnose(&input).unwrap();
         assert_found_or_not(&d);
@@ -604,6 +607,7 @@ fn tests_of_different_axes_are_refused() {
         backlash_set: false,
         angular: None,
         timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
     };
     let error = diagnose(&input).unwrap_err();
     assert_eq!(

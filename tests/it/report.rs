@@ -13,7 +13,7 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
 use axcomp::effects::ParameterValue;
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
-use axcomp::evaluate::evaluate;
+use axcomp::evaluate::{ISO_230_2, evaluate};
 use axcomp::read::{read_path, rtl};
 use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
 use axcomp::synth::{self, Truth};
@@ -106,7 +106,20 @@ fn the_sample_report_shows_the_figures_of_evaluate_json() {
                 .ends_with(&format!(">{text}")),
             "{key}"
         );
+        // U beside E, M and A as the terminal writes it (`13.19 ± 1.82`),
+        // evaluate's uncertainty_um; nothing beside R and B.
+        let cell_text = &html[at..at + html[at..].find("</td>").unwrap()];
+        match evaluation["uncertainty_um"][key].as_f64() {
+            Some(u) if ["A", "E", "M"].contains(&key) => assert!(
+                cell_text.ends_with(&format!(" ± {u:.2}</span>")),
+                "{key}: {cell_text}"
+            ),
+            _ => assert!(!cell_text.contains('±'), "{key}: {cell_text}"),
+        }
     }
+    assert!(html.contains(
+        ">13.19<span class=\"u\" title=\"expanded uncertainty U (k = 2)\"> ± 1.82</span>"
+    ));
     // The refractive index check, recomputed in Python from seed 001 eq. 36:
     // at the start 20.412 °C, 987.12 mbar, 41.3 %RH give n − 1 = 264.0751 ppm;
     // the factor 0.31641106 µm with λ 0.632991 µm and the material correction
@@ -235,6 +248,7 @@ impl RetestCase {
             backlash_set: false,
             angular: None,
             timing: CycleTiming::ASSUMED,
+            standard: &ISO_230_2,
         })
         .unwrap()
     }
@@ -393,6 +407,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
         diagnosis: Some(&diagnosis),
         limits: &[],
         decision: Default::default(),
+        standard: &ISO_230_2,
         generator: "test",
     };
     let charts = charts(&input);

@@ -9,7 +9,7 @@ use serde_json::Value;
 use axcomp::measurement::Direction;
 use axcomp::read;
 
-use crate::util::axcomp;
+use crate::util::{axcomp, root};
 
 const ECMC: &str =
     "../shared/data/ecmc/ecmccfg/examples__ESS__mcu1025_fat_sat__report.md_ISO230.dat";
@@ -17,9 +17,12 @@ const TOLERANCE_UM: f64 = 0.005;
 
 /// Per target: (x̄↑, x̄↓, s↑, s↓) in µm, with the n − 1 divisor.
 fn cells() -> Vec<(f64, f64, f64, f64)> {
-    let measurement = read::read_path(std::path::Path::new(ECMC), None)
-        .unwrap()
-        .measurement;
+    cells_of(std::path::Path::new(ECMC))
+}
+
+/// The same of any file.
+fn cells_of(path: &std::path::Path) -> Vec<(f64, f64, f64, f64)> {
+    let measurement = read::read_path(path, None).unwrap().measurement;
     let stats = |direction: Direction, index: usize| {
         let values: Vec<f64> = measurement
             .runs_in(direction)
@@ -150,5 +153,154 @@ fn a_standard_without_established_definitions_is_refused() {
         assert!(run.stderr.contains("is not supported"), "{}", run.stderr);
         assert!(run.stderr.contains("vdi3441, ") || run.stderr.contains("vdi3441"));
         assert!(run.stderr.contains("iso230-2:1988"));
+    }
+}
+
+/// `axcomp ARGS… --json`, exit 0, parsed.
+fn json_of(args: &[&str]) -> Value {
+    let run = axcomp(args);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    serde_json::from_str(&run.stdout).unwrap()
+}
+
+/// The value of `data-key="KEY"`'s `data-um` in a report, µm.
+fn data_um(html: &str, key: &str) -> Option<f64> {
+    let (_, rest) = html.split_once(&format!("data-key=\"{key}\" data-um=\""))?;
+    rest.split('"').next()?.parse().ok()
+}
+
+/// `predict`, `diagnose` and `report` with `--standard`: the predicted
+/// re-test's figures under the standard's keys, computed here from
+/// predict's per-target predicted means and the first test's s (the
+/// predicted re-test keeps the first test's scatter), and the same numbers
+/// in the three outputs.
+#[test]
+fn predict_diagnose_and_report_give_the_standards_figures_of_one_prediction() {
+    let sample = root().join("fixtures/demo/before.rtl");
+    let sample = sample.to_str().unwrap();
+    let retest = root().join("fixtures/demo/after.rtl");
+    let retest = retest.to_str().unwrap();
+    let directory = tempfile::tempdir().unwrap();
+    let table = directory.path().join("X.COM");
+    let table = table.to_str().unwrap();
+    let run = axcomp([
+        "convert",
+        sample,
+        "--controller",
+        "tnc640",
+        "-o",
+        table,
+        "-q",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let cells = cells_of(std::path::Path::new(sample));
+    for standard in ["vdi3441", "iso230-2:1988", "iso230-2:2014"] {
+        let with = ["--table", table, "--standard", standard];
+        let predict = json_of(&[&["predict", "--measured", sample, "--json"], &with[..]].concat());
+        assert_eq!(predict["standard"], standard);
+        // (x̄↑, x̄↓, s↑, s↓) of the predicted re-test, µm.
+        let predicted: Vec<(f64, f64, f64, f64)> = predict["per_target"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(&cells)
+            .map(|(t, c)| {
+                let up = t["predicted_up_um"].as_f64().unwrap();
+                let down = t["predicted_down_um"].as_f64().unwrap();
+                (up, down, c.2, c.3)
+            })
+            .collect();
+        let figures = &predict["predicted_figures_um"];
+        let check = |key: &str, expected: f64| {
+            let found = figures[key].as_f64().unwrap_or(f64::NAN);
+            assert!(
+                (found - expected).abs() <= TOLERANCE_UM,
+                "{standard} {key}: axcomp {found} µm, independent {expected} µm"
+            );
+        };
+        let mean = |c: &(f64, f64, f64, f64)| (c.0 + c.1) / 2.0;
+        if standard == "vdi3441" {
+            let keys: Vec<&String> = figures.as_object().unwrap().keys().collect();
+            assert_eq!(keys, ["P", "Pa", "Ps_max", "Ps_mean", "U_max", "U_mean"]);
+            let u = |c: &(f64, f64, f64, f64)| (c.0 - c.1).abs();
+            let ps = |c: &(f64, f64, f64, f64)| 6.0 * (c.2 + c.3) / 2.0;
+            check("U_max", max(predicted.iter().map(u)));
+            check("Ps_max", max(predicted.iter().map(ps)));
+            check(
+                "Pa",
+                max(predicted.iter().map(mean)) - min(predicted.iter().map(mean)),
+            );
+            check(
+                "P",
+                max(predicted.iter().map(|c| mean(c) + (u(c) + ps(c)) / 2.0))
+                    - min(predicted.iter().map(|c| mean(c) - (u(c) + ps(c)) / 2.0)),
+            );
+        } else {
+            let k = if standard == "iso230-2:1988" {
+                3.0
+            } else {
+                2.0
+            };
+            let high = max(predicted
+                .iter()
+                .flat_map(|c| [c.0 + k * c.2, c.1 + k * c.3]));
+            let low = min(predicted
+                .iter()
+                .flat_map(|c| [c.0 - k * c.2, c.1 - k * c.3]));
+            check("A", high - low);
+            check("R_up", max(predicted.iter().map(|c| 2.0 * k * c.2)));
+        }
+        // Without the table the prediction on the measured line is the
+        // measurement: evaluate's figures under the same standard.
+        let evaluated = json_of(&["evaluate", sample, "--standard", standard, "--json"]);
+        for (key, value) in evaluated["figures_um"].as_object().unwrap() {
+            let before = predict["figures_before_um"][key].as_f64().unwrap();
+            assert!(
+                (before - value.as_f64().unwrap()).abs() < 1e-6,
+                "{standard} {key}"
+            );
+        }
+        // diagnose's predicted figures and the report's are predict's.
+        let diagnose = json_of(
+            &[
+                &[
+                    "diagnose", "--after", retest, "--before", sample, "--json", "-q",
+                ],
+                &with[..],
+            ]
+            .concat(),
+        );
+        assert_eq!(diagnose["standard"], standard);
+        let output = directory
+            .path()
+            .join(format!("{}.html", standard.replace(':', "-")));
+        let run = axcomp(
+            [
+                &["report", sample, "-o", output.to_str().unwrap(), "-q"],
+                &with[..],
+            ]
+            .concat(),
+        );
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let html = std::fs::read_to_string(&output).unwrap();
+        for (key, value) in figures.as_object().unwrap() {
+            let value = value.as_f64().unwrap();
+            let diagnosed = diagnose["figures_um"]["predicted"][key].as_f64().unwrap();
+            assert!(
+                (diagnosed - value).abs() < 1e-6,
+                "{standard} {key}: diagnose {diagnosed}, predict {value}"
+            );
+            // The report names A, E and B of ISO 230-2, every figure of another standard.
+            if standard == "vdi3441" || ["A", "E", "B"].contains(&key.as_str()) {
+                let shown =
+                    data_um(&html, &format!("prediction.figures_um.{key}")).unwrap_or_else(|| {
+                        panic!("{standard}: no prediction.figures_um.{key} in the report")
+                    });
+                assert!(
+                    (shown - value).abs() < 1e-6,
+                    "{standard} {key}: report {shown}, predict {value}"
+                );
+            }
+        }
     }
 }

@@ -513,3 +513,83 @@ fn an_equipment_file_and_its_errors() {
         run.stderr
     );
 }
+
+/// Limits on VDI/DGQ 3441's own keys (`--standard vdi3441`), judged on its
+/// figures. BEFORE by hand (standards.md §3): U_i = |x̄↑ − x̄↓| = 2 at every
+/// target, Ps_i = 6·(√2 + √2)/2 = 6√2 = 8.485, x̄_i = 2, 6, 10, so Pa = 8
+/// and P = (10 + (2 + 6√2)/2) − (2 − (2 + 6√2)/2) = 10 + 6√2 = 18.485 µm.
+/// U of a VDI figure is not evaluated (standards.md gives no form): null,
+/// and ISO 14253-1 then compares the value alone.
+#[test]
+fn limits_on_a_standards_own_keys_and_keys_it_does_not_have() {
+    let directory = tempfile::tempdir().unwrap();
+    let before = write(directory.path(), "before.csv", BEFORE);
+    let before = before.to_str().unwrap();
+    let p = 10.0 + 6.0 * 2f64.sqrt();
+    let json = evaluate_json_with(&[
+        before,
+        "--standard",
+        "vdi3441",
+        "--limit",
+        "U_max=1.5",
+        "--limit",
+        "P=20",
+        "--decision",
+        "iso14253-1",
+    ]);
+    assert!(close(&json["figures_um"]["P"], p));
+    let checks = json["verdict"]["checks"].as_array().unwrap();
+    assert_eq!(checks.len(), 2);
+    assert_eq!(checks[0]["figure"], "P");
+    assert!(close(&checks[0]["value_um"], p));
+    assert_eq!(checks[0]["U_um"], Value::Null);
+    assert_eq!(checks[0]["conformance"], "pass");
+    assert_eq!(checks[1]["figure"], "U_max");
+    assert!(close(&checks[1]["value_um"], 2.0));
+    assert_eq!(checks[1]["conformance"], "fail");
+    assert_eq!(json["verdict"]["failed"], json!(["U_max"]));
+    // The profile's [acceptance] the same way: Pa = 8 against 7.5.
+    let vdi_profile = write(directory.path(), "vdi.toml", "[acceptance]\nPa = 7.5\n");
+    let vdi_profile = vdi_profile.to_str().unwrap();
+    let json = evaluate_json_with(&[before, "--standard", "vdi3441", "--machine", vdi_profile]);
+    assert!(close(&json["verdict"]["checks"][0]["value_um"], 8.0));
+    assert_eq!(json["verdict"]["pass"], false);
+    // A key the standard does not have: refused, naming its keys.
+    let iso_keys = "A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B, B_mean";
+    let vdi_keys = "P, Pa, Ps_max, Ps_mean, U_max, U_mean";
+    for (args, message) in [
+        (
+            vec![
+                "evaluate",
+                before,
+                "--standard",
+                "vdi3441",
+                "--limit",
+                "A=12",
+            ],
+            format!(
+                "--limit: a limit on A, which VDI/DGQ 3441 (1977) does not report; its figures are {vdi_keys}"
+            ),
+        ),
+        (
+            vec!["evaluate", before, "--limit", "P=20"],
+            format!(
+                "a limit on P, which ISO 230-2:2014 does not report; its figures are {iso_keys}"
+            ),
+        ),
+        (
+            vec!["evaluate", before, "--machine", vdi_profile],
+            format!("{vdi_profile} [acceptance]: a limit on Pa"),
+        ),
+        (
+            vec!["report", before, "--limit", "Ps_max=9", "-o", "never.html"],
+            "a limit on Ps_max, which ISO 230-2:2014 does not report".to_string(),
+        ),
+    ] {
+        let run = axcomp(&args);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(run.stderr.contains(&message), "{args:?}: {}", run.stderr);
+        assert!(run.stdout.is_empty());
+    }
+    assert!(!Path::new("never.html").exists());
+}
