@@ -64,7 +64,7 @@ use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts, pr
 use crate::report::chart::chart;
 use crate::report::format::{SourcedUm, inch_beside, inch_text, um};
 use crate::report::json::source_notes;
-use crate::report::json::{EvaluationJson, FiguresJson, PerTargetJson};
+use crate::report::json::{EvaluationJson, FiguresJson, PerTargetJson, iso_keys};
 use crate::report::plot::{FONT, PlotError, PlotFormat};
 use crate::report::uncertainty::{NOT_EVALUATED_NOTE, UncertaintyJson};
 use crate::report::verdict::{Judged, verdict_box};
@@ -921,10 +921,17 @@ fn figures(input: &ReportInput<'_>) -> Figures {
                 .zip(&tests)
                 .zip(["before", "after"])
                 .flat_map(|((f, (_, test)), prefix)| {
+                    // Where these figures are in the test's JSON: its
+                    // `figures_um`, or beside another standard's.
+                    let object = if iso_keys(&test.evaluation.standard_figures) {
+                        "figures_um"
+                    } else {
+                        "figures_iso230_2_um"
+                    };
                     // U beside the figures it is evaluated for (E, M, A).
                     let cell = |shown: Figure| {
                         SourcedUm::new(
-                            format!("{prefix}.figures_um.{}", shown.name()),
+                            format!("{prefix}.{object}.{}", shown.name()),
                             figure_value(f, shown),
                         )
                         .with_u(

@@ -15,6 +15,7 @@
 //!   "figures_um": {"A": …, "A_up": …, "A_down": …, "E": …, "E_up": …, "E_down": …,
 //!                  "M": …, "R": …, "R_up": …, "R_down": …, "B": …, "B_mean": …}
 //!               | {"P": …, "Pa": …, "Ps_max": …, "Ps_mean": …, "U_max": …, "U_mean": …} (vdi3441),
+//!   "figures_iso230_2_um": {"A": …, …} (only with vdi3441: the ISO 230-2:2014 figures beside),
 //!   "per_target": [{"target_mm": …, "n_up": 5, "n_down": 5,
 //!                   "mean_up_um": …, "mean_down_um": …, "mean_um": …,
 //!                   "s_up_um": …, "s_down_um": …, "B_um": …,
@@ -93,6 +94,10 @@ pub struct EvaluationJson {
     pub definitions_reconstructed: bool,
     /// That standard's axis figures, µm, under its keys.
     pub figures_um: FiguresJson,
+    /// The ISO 230-2:2014 figures too, µm, when the standard's keys are
+    /// others (VDI 3441): the report shows both; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub figures_iso230_2_um: Option<FiguresJson>,
     /// Per-target statistics.
     pub per_target: Vec<PerTargetJson>,
     /// Suspected outlier runs (included in the figures).
@@ -323,6 +328,11 @@ impl FiguresJson {
     }
 }
 
+/// Whether a standard's figures are ISO 230-2's (any edition): keyed `A`, `E`, ….
+pub fn iso_keys(figures: &[StandardFigure]) -> bool {
+    figures.iter().any(|f| f.key == "A")
+}
+
 impl Serialize for FiguresJson {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
@@ -515,6 +525,8 @@ impl EvaluationJson {
             standard_name: evaluation.standard.name,
             definitions_reconstructed: evaluation.standard.reconstructed,
             figures_um: FiguresJson::from_standard(&evaluation.standard_figures),
+            figures_iso230_2_um: (!iso_keys(&evaluation.standard_figures))
+                .then(|| FiguresJson::from_figures(&evaluation.figures)),
             per_target: evaluation
                 .per_target
                 .iter()

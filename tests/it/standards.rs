@@ -304,3 +304,74 @@ fn predict_diagnose_and_report_give_the_standards_figures_of_one_prediction() {
         }
     }
 }
+
+/// The report names the chosen standard with its coverage, shows VDI's own
+/// table and says the definitions are reconstructed; every number it shows
+/// is the one in its embedded JSON (the ISO table of a VDI report under
+/// `figures_iso230_2_um`), and the page renders in Chromium.
+#[test]
+fn the_report_names_the_chosen_standard() {
+    use crate::browser::{BrowserOutput, Pixels, artefacts, open_in_browser};
+    use crate::report::{check_against_json, embedded_data};
+
+    let directory = tempfile::tempdir().unwrap();
+    for (standard, names, vdi_table) in [
+        (
+            "iso230-2:1988",
+            "ISO 230-2:1988 (±3s), test of accuracy and repeatability of positioning of numerically controlled axes; A and R with the coverage of that edition (x̄ ± 3s, R = 6s)",
+            false,
+        ),
+        (
+            "vdi3441",
+            "VDI/DGQ 3441 (1977): P, Pa, Ps and U of each direction",
+            true,
+        ),
+    ] {
+        let page = directory
+            .path()
+            .join(format!("{}.html", standard.replace([':', '/'], "-")));
+        let run = axcomp([
+            "report",
+            "fixtures/demo/before.rtl",
+            "--after",
+            "fixtures/demo/after.rtl",
+            "--standard",
+            standard,
+            "-o",
+            page.to_str().unwrap(),
+        ]);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let html = std::fs::read_to_string(&page).unwrap();
+        assert!(
+            html.contains(names),
+            "{standard}: the header does not say {names:?}"
+        );
+        assert!(
+            html.contains("Definitions reconstructed from public sources"),
+            "{standard}: no reconstructed note"
+        );
+        assert_eq!(
+            html.contains("VDI/DGQ 3441 (1977) figures [µm]"),
+            vdi_table,
+            "{standard}"
+        );
+        let data = embedded_data(&html);
+        assert_eq!(data["before"]["standard"], standard);
+        let checked = check_against_json(&html, "before", &data["before"])
+            + check_against_json(&html, "after", &data["after"]);
+        assert!(checked > 20, "{standard}: only {checked} values checked");
+        if vdi_table {
+            // P of both tests, under VDI's key, and the ISO table beside it.
+            assert!(html.contains("data-key=\"before.figures_um.P\""));
+            assert!(html.contains("data-key=\"after.figures_iso230_2_um.A\""));
+        }
+        let screenshot = artefacts().join(format!(
+            "standard-{}.png",
+            standard.replace([':', '/'], "-")
+        ));
+        let browser = open_in_browser(&page, (1280, 2400), BrowserOutput::Screenshot(&screenshot));
+        assert!(browser.console.is_empty(), "console: {:?}", browser.console);
+        let shot = Pixels::read(&screenshot);
+        assert!(shot.inked() > 0.05, "{}: blank", screenshot.display());
+    }
+}
