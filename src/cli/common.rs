@@ -13,7 +13,7 @@ use axcomp::error::{ParseError, Warning};
 use axcomp::evaluate::Standard;
 use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
 use axcomp::evaluate::verdict::Decision;
-use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
+use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
@@ -356,6 +356,20 @@ pub fn load_equipment(args: &UncertaintyArgs) -> Result<Equipment> {
     let read = axcomp::read::read_paths(std::slice::from_ref(&drift_path), None)
         .with_context(|| format!("{name}: the drift test"))?;
     Ok(equipment.with_drift_test(&read.measurement, &drift_path.display().to_string()))
+}
+
+/// Refuses a rotary axis where a command handles linear axes only (the
+/// acceptance report, prediction and diagnosis are µm and mm throughout;
+/// rotary axes there are issue 14's later part).
+pub fn linear_only(measurement: &Measurement, command: &str) -> Result<()> {
+    if measurement.kind() == AxisKind::Rotary {
+        anyhow::bail!(
+            "axis {} is a rotary axis: {command} handles linear axes only so far; \
+             `axcomp evaluate` and `axcomp convert` take rotary axes",
+            measurement.axis()
+        );
+    }
+    Ok(())
 }
 
 /// The uncertainty budget of `measurement` with `equipment`.

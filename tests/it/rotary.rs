@@ -1,0 +1,232 @@
+//! Rotary axes end to end (issue 14): the readers, `evaluate` in arc-seconds
+//! with the rotary rules of ISO 230-2 (`../shared/spec/standards.md` §6),
+//! and the commands that refuse a rotary axis so far.
+//! See: issue 14.
+
+use std::path::{Path, PathBuf};
+
+use crate::util::{axcomp, test_data};
+
+/// Writes `rows` (target°, run, direction, deviation″) as a rotary CSV.
+fn rotary_csv(directory: &Path, name: &str, rows: &[(f64, u32, &str, f64)]) -> PathBuf {
+    let mut text = String::from("# axis: C\ntarget_deg,run,direction,deviation_arcsec\n");
+    for (target, run, direction, deviation) in rows {
+        text.push_str(&format!("{target},{run},{direction},{deviation}\n"));
+    }
+    let path = directory.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Two runs each way at `targets`, the deviations per run in the order
+/// up 1, up 2, down 1, down 2 (one value per target each).
+fn two_runs(targets: &[f64], runs: [&[f64]; 4]) -> Vec<(f64, u32, &'static str, f64)> {
+    let labels = [(1, "up"), (2, "up"), (1, "down"), (2, "down")];
+    let mut rows = Vec::new();
+    for ((run, direction), values) in labels.into_iter().zip(runs) {
+        for (target, value) in targets.iter().zip(values) {
+            rows.push((*target, run, direction, *value));
+        }
+    }
+    rows
+}
+
+fn json_of(path: &Path) -> (serde_json::Value, String) {
+    let run = axcomp(["evaluate".as_ref(), "--json".as_ref(), path.as_os_str()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    (serde_json::from_str(&run.stdout).unwrap(), run.stderr)
+}
+
+const FULL_TURN: [f64; 5] = [0.0, 90.0, 180.0, 270.0, 360.0];
+
+#[test]
+fn a_rotary_csv_is_evaluated_in_arc_seconds() {
+    let directory = tempfile::tempdir().unwrap();
+    let path = rotary_csv(
+        directory.path(),
+        "c.csv",
+        &two_runs(
+            &FULL_TURN,
+            [
+                &[1.0, 2.0, 3.0, 2.0, 1.0],
+                &[3.0, 2.0, 1.0, 2.0, 3.0],
+                &[-1.0, 0.0, 1.0, 0.0, -1.0],
+                &[-1.0, 0.0, -1.0, 0.0, -1.0],
+            ],
+        ),
+    );
+    let (json, stderr) = json_of(&path);
+    // By hand: x̄↑ = 2 everywhere, x̄↓ = −1, 0, 0, 0, −1; x̄ = 0.5, 1, 1, 1, 0.5;
+    // B_i = 3, 2, 2, 2, 3. s↑ = √2 at 0°, 180°, 360°, else 0; s↓ = √2 at 180° only.
+    // E = 2 − (−1) = 3, E↑ = 0, E↓ = 1, M = 1 − 0.5 = 0.5, B = 3, B̄ = 12/5.
+    // A = (2 + 2√2) − (0 − 2√2) = 2 + 4√2; R = R_180° = 2√2 + 2√2 + 2.
+    let root2 = 2f64.sqrt();
+    let figures = &json["figures_arcsec"];
+    for (key, expected) in [
+        ("E", 3.0),
+        ("E_up", 0.0),
+        ("E_down", 1.0),
+        ("M", 0.5),
+        ("B", 3.0),
+        ("B_mean", 2.4),
+        ("A", 2.0 + 4.0 * root2),
+        ("R", 2.0 + 4.0 * root2),
+        ("R_up", 4.0 * root2),
+    ] {
+        let value = figures[key].as_f64().unwrap_or_else(|| panic!("{key}"));
+        assert!(
+            (value - expected).abs() < 1e-9,
+            "{key}: {value} ≠ {expected}"
+        );
+    }
+    assert_eq!(json["axis_kind"], "rotary");
+    assert_eq!(json["length_unit"], "deg");
+    assert_eq!(json["targets_deg"][4], 360.0);
+    assert_eq!(json["test_conformance"]["length_deg"], 360.0);
+    for absent in ["targets_mm", "figures_um", "uncertainty_um"] {
+        assert!(json.get(absent).is_none(), "{absent} on a rotary axis");
+    }
+    let target = &json["per_target"][0];
+    assert_eq!(target["target_deg"], 0.0);
+    assert!((target["mean_arcsec"].as_f64().unwrap() - 0.5).abs() < 1e-12);
+    assert!((target["s_up_arcsec"].as_f64().unwrap() - root2).abs() < 1e-12);
+    for key in [
+        "mean_up_arcsec",
+        "mean_down_arcsec",
+        "B_arcsec",
+        "R_up_arcsec",
+        "R_down_arcsec",
+        "R_arcsec",
+    ] {
+        assert!(target.get(key).is_some(), "missing {key}");
+    }
+    assert!(target.get("target_mm").is_none() && target.get("mean_um").is_none());
+    // All four principal angles are there, and 0° and 360° agree: the one
+    // warning is the runs'.
+    assert_eq!(json["warnings"].as_array().unwrap().len(), 1, "{stderr}");
+    assert!(
+        stderr.contains("(fewer only on rotary axes over 360°)"),
+        "{stderr}"
+    );
+    let run = axcomp(["evaluate".as_ref(), path.as_os_str()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    for text in [
+        "Per target [″]",
+        "Axis figures [″]",
+        "target [°]",
+        "5 from 0 to 360°",
+        "rotary axis, bidirectional test, 2 runs, 5 targets over 360°",
+    ] {
+        assert!(run.stdout.contains(text), "{text} in\n{}", run.stdout);
+    }
+    assert!(!run.stdout.contains("µm"), "{}", run.stdout);
+}
+
+#[test]
+fn over_a_full_turn_repeatability_and_a_are_not_evaluated() {
+    let directory = tempfile::tempdir().unwrap();
+    let targets: Vec<f64> = (0..=8).map(|k| 90.0 * k as f64).collect();
+    let values: Vec<f64> = (0..=8).map(|k| k as f64 * 0.5).collect();
+    let shifted: Vec<f64> = values.iter().map(|v| v + 1.0).collect();
+    let path = rotary_csv(
+        directory.path(),
+        "two-turns.csv",
+        &two_runs(&targets, [&values, &shifted, &values, &shifted]),
+    );
+    let (json, _) = json_of(&path);
+    let figures = &json["figures_arcsec"];
+    for key in ["A", "A_up", "A_down", "R", "R_up", "R_down"] {
+        assert!(figures[key].is_null(), "{key} = {}", figures[key]);
+    }
+    // x̄ = 0.5 + 0.5 k at both directions: E = 4, B = 0.
+    assert!((figures["E"].as_f64().unwrap() - 4.0).abs() < 1e-12);
+    assert_eq!(figures["B"], 0.0);
+    let warnings = json["warnings"].to_string();
+    assert!(
+        warnings.contains("rotary axis over 360° (720°): ISO 230-2 takes one approach per direction and target there (n = 1), so the repeatabilities and A are not evaluated"),
+        "{warnings}"
+    );
+    // One run each way is what the standard asks there.
+    let runs = &json["test_conformance"]["checks"][0];
+    assert_eq!(
+        (runs["check"].as_str(), runs["required"].as_f64()),
+        (Some("runs"), Some(1.0))
+    );
+}
+
+#[test]
+fn missing_principal_angles_and_disagreeing_ends_are_said() {
+    let directory = tempfile::tempdir().unwrap();
+    let targets = [10.0, 100.0, 190.0, 280.0, 350.0];
+    let flat = [0.0; 5];
+    let path = rotary_csv(
+        directory.path(),
+        "off.csv",
+        &two_runs(&targets, [&flat, &flat, &flat, &flat]),
+    );
+    let (json, _) = json_of(&path);
+    let warnings = json["warnings"].to_string();
+    assert!(
+        warnings.contains(
+            "principal angle(s) 90°, 180°, 270° within the range are not among the targets"
+        ),
+        "{warnings}"
+    );
+
+    // 0° and 360° one turn apart: x̄ = 0.5″ at 0° and 11″ at 360°, 10.5″
+    // apart, more than R_i = max(2√2 + 3, 2) = 5.83″ (by hand).
+    let path = rotary_csv(
+        directory.path(),
+        "ends.csv",
+        &two_runs(
+            &FULL_TURN,
+            [
+                &[1.0, 2.0, 3.0, 2.0, 12.0],
+                &[3.0, 2.0, 1.0, 2.0, 12.0],
+                &[-1.0, 0.0, 1.0, 0.0, 10.0],
+                &[-1.0, 0.0, -1.0, 0.0, 10.0],
+            ],
+        ),
+    );
+    let (json, _) = json_of(&path);
+    let warnings = json["warnings"].to_string();
+    assert!(
+        warnings.contains("0° and 360° are one physical position, but their mean deviations differ by 10.50″ (+0.50″ and +11.00″), more than the repeatability there (5.83″)"),
+        "{warnings}"
+    );
+}
+
+#[test]
+fn an_ecmc_file_in_degrees_is_a_rotary_axis() {
+    let (json, _) = json_of(&test_data("rotary/ecmc-deg.dat"));
+    assert_eq!(json["axis_kind"], "rotary");
+    assert_eq!(json["targets_deg"][0], 15.0);
+    // REF_DATA_FWD[1,1] = 15.004748…° at 15°: 0.004748…° = 17.09″.
+    let first = json["per_target"][0]["mean_up_arcsec"].as_f64().unwrap();
+    assert!(first > 10.0 && first < 30.0, "{first}");
+}
+
+#[test]
+fn commands_for_linear_axes_only_refuse_a_rotary_one() {
+    let path = test_data("rotary/ecmc-deg.dat");
+    for args in [
+        vec![
+            "report".as_ref(),
+            path.as_os_str(),
+            "--axis".as_ref(),
+            "C".as_ref(),
+            "-o".as_ref(),
+            "/nonexistent/r.html".as_ref(),
+        ],
+        vec![
+            "evaluate".as_ref(),
+            path.as_os_str(),
+            "--limit".as_ref(),
+            "E=5".as_ref(),
+        ],
+    ] {
+        let run = axcomp(&args);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stdout);
+        assert!(run.stderr.contains("is a rotary axis"), "{}", run.stderr);
+    }
+}
