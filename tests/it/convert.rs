@@ -295,6 +295,7 @@ fn read_options(case: &Case) -> EmitOptions {
         cec_first_table: 0,
         cec_values_are_corrections: true,
         tnc640_columns: Vec::new(),
+        kind: Default::default(),
     }
 }
 

@@ -230,3 +230,125 @@ fn commands_for_linear_axes_only_refuse_a_rotary_one() {
         assert!(run.stderr.contains("is a rotary axis"), "{}", run.stderr);
     }
 }
+
+/// A rotary C axis' options for `controller` tables (the default profile).
+fn rotary_options() -> axcomp::emit::EmitOptions {
+    let profile = axcomp::emit::MachineProfile::default();
+    let mut options = axcomp::emit::EmitOptions::for_axis(&profile, "C", "C.COM").unwrap();
+    options.kind = axcomp::measurement::AxisKind::Rotary;
+    options
+}
+
+fn rotary_table(
+    positions_deg: &[f64],
+    values_deg: &[f64],
+) -> axcomp::compensate::CompensationTable {
+    axcomp::compensate::CompensationTable {
+        axis: "C".to_string(),
+        positions_mm: positions_deg.to_vec(),
+        values: axcomp::compensate::TableValues::Mean(values_deg.to_vec()),
+        reference_mm: positions_deg[0],
+        suggested_backlash_mm: None,
+    }
+}
+
+#[test]
+fn rotary_tables_are_written_in_degrees_and_read_back() {
+    use axcomp::emit::{self, Controller, EmitError};
+    let options = rotary_options();
+    // 0.0001° = 0.36″ steps, what a 4-decimal Heidenhain value holds exactly.
+    let full = rotary_table(&FULL_TURN, &[0.0, 0.0012, -0.0007, 0.0003, 0.0]);
+    for controller in [
+        Controller::Itnc530,
+        Controller::Tnc640,
+        Controller::Sinumerik840d,
+        Controller::LinuxCnc,
+    ] {
+        // `write` reads every text back and compares it with the table.
+        let text = emit::write(controller, &full, &options)
+            .unwrap_or_else(|e| panic!("{}: {e}", controller.name()));
+        let (_, back) = emit::read_any(&text, &options, Some(0)).unwrap();
+        assert_eq!(back.positions_mm, FULL_TURN, "{}", controller.name());
+    }
+    let sinumerik = emit::write(Controller::Sinumerik840d, &full, &options).unwrap();
+    for line in [
+        "$AA_ENC_COMP[0,1,C1]=0.0012",
+        "$AA_ENC_COMP_MIN[0,C1]=0.0",
+        "$AA_ENC_COMP_MAX[0,C1]=360.0",
+        "$AA_ENC_COMP_IS_MODULO[0,C1]=1",
+    ] {
+        assert!(sinumerik.contains(line), "{line} in\n{sinumerik}");
+    }
+    // AXISPOS and values in degrees, as they are.
+    let tnc640 = emit::write(Controller::Tnc640, &full, &options).unwrap();
+    assert!(
+        tnc640.contains("1    +90   ") && tnc640.contains("+0.0012"),
+        "{tnc640}"
+    );
+    // LinuxCNC type 0: nominal + error, degrees.
+    let linuxcnc = emit::write(Controller::LinuxCnc, &full, &options).unwrap();
+    assert!(
+        linuxcnc.starts_with("0 0 0\n90 90.0012 90.0012\n"),
+        "{linuxcnc}"
+    );
+    let activation = emit::activation(Controller::LinuxCnc, &full, "C.comp", &options);
+    assert!(activation.contains("WRAPPED_ROTARY = 1"), "{activation}");
+
+    // A part of a turn is no modulo table.
+    let part = rotary_table(&[0.0, 90.0, 180.0], &[0.0, 0.001, 0.002]);
+    let text = emit::write(Controller::Sinumerik840d, &part, &options).unwrap();
+    assert!(text.contains("$AA_ENC_COMP_IS_MODULO[0,C1]=0"), "{text}");
+
+    // Refusals, naming what is wrong.
+    let ends = rotary_table(&FULL_TURN, &[0.0, 0.001, 0.0, 0.0, 0.0005]);
+    let error = emit::write(Controller::Sinumerik840d, &ends, &options).unwrap_err();
+    assert_eq!(
+        error,
+        EmitError::ModuloEndsDiffer {
+            first_deg: 0.0,
+            last_deg: 0.0005
+        }
+    );
+    assert!(
+        error.to_string().contains("0° at 0° and 0.0005° at 360°"),
+        "{error}"
+    );
+    let shifted = rotary_table(&[-180.0, -90.0, 0.0, 90.0, 180.0], &[0.0; 5]);
+    let error = emit::write(Controller::Sinumerik840d, &shifted, &options).unwrap_err();
+    assert!(error.to_string().contains("from -180° to 180°"), "{error}");
+    for controller in [Controller::Fagor8055, Controller::Fagor8065] {
+        let error = emit::write(controller, &full, &options).unwrap_err();
+        assert_eq!(
+            error,
+            EmitError::RotaryNotSupported {
+                controller: controller.name()
+            }
+        );
+    }
+}
+
+#[test]
+fn a_full_turn_table_joins_its_ends() {
+    use axcomp::compensate::{
+        Extrapolate, GridSpec, TableMode, TableOptions, TableValues, build_table,
+    };
+    use axcomp::measurement::SourceFormat;
+    // x̄ = 1″ at 0° and 3″ at 360° (one position): both ends get their mean,
+    // 2″, and the table is zero there (reference 0°); 90° stays 5″ − 2″.
+    let csv = "target_deg,run,direction,deviation_arcsec\n0,1,up,1\n90,1,up,5\n360,1,up,3\n";
+    let (c, _) = axcomp::read::parse_str(csv, SourceFormat::Csv).unwrap();
+    let options = TableOptions {
+        mode: TableMode::Mean,
+        grid: GridSpec::Targets,
+        reference_mm: None,
+        extrapolate: Extrapolate::Refuse,
+    };
+    let table = build_table(&c, &axcomp::evaluate::evaluate(&c), &options).unwrap();
+    let TableValues::Mean(values) = table.values else {
+        panic!("a mean table")
+    };
+    let arcsec: Vec<f64> = values.iter().map(|v| v * 3600.0).collect();
+    for (value, expected) in arcsec.iter().zip([0.0, 3.0, 0.0]) {
+        assert!((value - expected).abs() < 1e-9, "{arcsec:?}");
+    }
+}
