@@ -352,3 +352,172 @@ fn a_full_turn_table_joins_its_ends() {
         assert!((value - expected).abs() < 1e-9, "{arcsec:?}");
     }
 }
+
+/// ISO 230-2's figures computed here from the CSV text, independently of
+/// `read` and `evaluate` (`../shared/spec/iso230-2.md`): per target and
+/// direction x̄ and s (n − 1), then A, E, M, R, B and B̄, in ″.
+fn independent_figures(csv: &str) -> Vec<(&'static str, f64)> {
+    use std::collections::BTreeMap;
+    // (target in thousandths of a degree, up?) → readings ″
+    let mut readings: BTreeMap<(i64, bool), Vec<f64>> = BTreeMap::new();
+    for line in csv.lines().filter(|l| !l.starts_with('#')).skip(1) {
+        let fields: Vec<&str> = line.split(',').collect();
+        let target = (fields[0].parse::<f64>().unwrap() * 1000.0).round() as i64;
+        readings
+            .entry((target, fields[2] == "up"))
+            .or_default()
+            .push(fields[3].parse().unwrap());
+    }
+    let stats = |values: &Vec<f64>| {
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let s = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        (mean, s)
+    };
+    let targets: Vec<i64> = readings
+        .keys()
+        .map(|(t, _)| *t)
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let (mut up, mut down) = (Vec::new(), Vec::new());
+    for t in &targets {
+        up.push(stats(&readings[&(*t, true)]));
+        down.push(stats(&readings[&(*t, false)]));
+    }
+    let max = |v: Vec<f64>| v.into_iter().fold(f64::MIN, f64::max);
+    let min = |v: Vec<f64>| v.into_iter().fold(f64::MAX, f64::min);
+    let span = |v: Vec<f64>| max(v.clone()) - min(v);
+    let means = |d: &Vec<(f64, f64)>| d.iter().map(|(m, _)| *m).collect::<Vec<f64>>();
+    let both: Vec<f64> = means(&up).into_iter().chain(means(&down)).collect();
+    let reversal: Vec<f64> = up.iter().zip(&down).map(|(u, d)| u.0 - d.0).collect();
+    let r_i: Vec<f64> = up
+        .iter()
+        .zip(&down)
+        .map(|(u, d)| {
+            (2.0 * u.1 + 2.0 * d.1 + (u.0 - d.0).abs())
+                .max(4.0 * u.1)
+                .max(4.0 * d.1)
+        })
+        .collect();
+    let high = |d: &Vec<(f64, f64)>| d.iter().map(|(m, s)| m + 2.0 * s).collect::<Vec<f64>>();
+    let low = |d: &Vec<(f64, f64)>| d.iter().map(|(m, s)| m - 2.0 * s).collect::<Vec<f64>>();
+    vec![
+        (
+            "A",
+            max(high(&up).into_iter().chain(high(&down)).collect())
+                - min(low(&up).into_iter().chain(low(&down)).collect()),
+        ),
+        ("A_up", max(high(&up)) - min(low(&up))),
+        ("A_down", max(high(&down)) - min(low(&down))),
+        ("E", span(both)),
+        ("E_up", span(means(&up))),
+        ("E_down", span(means(&down))),
+        (
+            "M",
+            span(
+                up.iter()
+                    .zip(&down)
+                    .map(|(u, d)| (u.0 + d.0) / 2.0)
+                    .collect(),
+            ),
+        ),
+        ("R", max(r_i)),
+        ("R_up", max(up.iter().map(|(_, s)| 4.0 * s).collect())),
+        ("R_down", max(down.iter().map(|(_, s)| 4.0 * s).collect())),
+        ("B", max(reversal.iter().map(|b| b.abs()).collect())),
+        (
+            "B_mean",
+            reversal.iter().sum::<f64>() / reversal.len() as f64,
+        ),
+    ]
+}
+
+/// Issue 14's synthetic rotary test: 0–360° every 15°, 5 runs each way, a
+/// known truth (fixtures/rotary/truth.toml). The bundled file is exactly what
+/// the truth gives; its figures equal an independent computation to 0.01″;
+/// its tables for the iTNC 530, TNC 640, Sinumerik and LinuxCNC are golden
+/// files (`convert::golden_files_per_controller`, cases `rotary-c-*`).
+#[test]
+fn the_synthetic_rotary_test_evaluates_to_an_independent_computation() {
+    let truth_text =
+        std::fs::read_to_string(crate::util::root().join("fixtures/rotary/truth.toml")).unwrap();
+    let truth = axcomp::synth::RotaryTruth::from_toml_str(&truth_text).unwrap();
+    let measurement = axcomp::synth::rotary_test(&truth, 14).unwrap();
+    let csv_path = crate::util::root().join("fixtures/rotary/c.csv");
+    let bundled = std::fs::read_to_string(&csv_path).unwrap();
+    assert_eq!(
+        axcomp::read::csv::write(&measurement),
+        bundled,
+        "regenerate as truth.toml says"
+    );
+    assert_eq!(measurement.targets_mm().len(), 25);
+    assert_eq!(measurement.runs().len(), 10);
+
+    let (json, _) = json_of(&csv_path);
+    let figures = &json["figures_arcsec"];
+    for (key, expected) in independent_figures(&bundled) {
+        let value = figures[key].as_f64().unwrap_or_else(|| panic!("{key}"));
+        assert!(
+            (value - expected).abs() < 0.01,
+            "{key}: {value}″ against {expected}″"
+        );
+    }
+    // The truth shows through the noise (σ = 0.3″, 5 runs): B̄ near the
+    // planted 2.4″, and M (the span of x̄_i, where the reversal cancels) near
+    // the span of 4 sin(θ + 0.5) + 1.5 sin(2θ − 1.1) at the targets.
+    let b_mean = figures["B_mean"].as_f64().unwrap();
+    assert!((b_mean - 2.4).abs() < 0.2, "{b_mean}");
+    let curve: Vec<f64> = (0..25)
+        .map(|k| {
+            let theta = (15.0 * k as f64).to_radians();
+            4.0 * (theta + 0.5).sin() + 1.5 * (2.0 * theta - 1.1).sin()
+        })
+        .collect();
+    let span = curve.iter().cloned().fold(f64::MIN, f64::max)
+        - curve.iter().cloned().fold(f64::MAX, f64::min);
+    let m = figures["M"].as_f64().unwrap();
+    assert!((m - span).abs() < 0.5, "M {m}″ against the truth's {span}″");
+    // A full turn with every principal angle and agreeing ends, 5 runs:
+    // no warning (the linear even-spacing note does not apply).
+    let warnings = json["warnings"].as_array().unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+}
+
+#[test]
+fn a_bad_rotary_truth_is_refused_with_its_position() {
+    let directory = tempfile::tempdir().unwrap();
+    let truth = directory.path().join("t.toml");
+    std::fs::write(
+        &truth,
+        "[rotary]\nstart_deg = 0.0\nend_deg = 360.0\ncount = 5\nruns = 1\nsigma_arcsec = 0.1\nwobble = 2\n",
+    )
+    .unwrap();
+    let output = directory.path().join("c.csv");
+    let run = axcomp([
+        "synth".as_ref(),
+        "--truth".as_ref(),
+        truth.as_os_str(),
+        "-o".as_ref(),
+        output.as_os_str(),
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stdout);
+    assert!(run.stderr.contains("t.toml:7:1"), "{}", run.stderr);
+    assert!(!output.exists(), "nothing half-written");
+    let rtl = directory.path().join("c.rtl");
+    let good = crate::util::root().join("fixtures/rotary/truth.toml");
+    let run = axcomp([
+        "synth".as_ref(),
+        "--truth".as_ref(),
+        good.as_os_str(),
+        "-o".as_ref(),
+        rtl.as_os_str(),
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stdout);
+    assert!(
+        run.stderr.contains("write a rotary test as .csv"),
+        "{}",
+        run.stderr
+    );
+    assert!(!rtl.exists());
+}
