@@ -42,7 +42,7 @@ use crate::read::text::{
     self, Line, check_deviation_deg, check_deviation_mm, check_target_mm, end_of_file_line,
     split_key,
 };
-use crate::read::{missing_readings_warning, parse_date};
+use crate::read::{missing_readings_warning_of, parse_date};
 use crate::units::{LengthUnit, arcsec_text, arcsec_to_deg, um_text, um_to_mm};
 
 /// The header line, lowercase, without spaces, as axcomp writes it.
@@ -217,7 +217,7 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
     targets_mm.sort_by(f64::total_cmp);
     targets_mm.dedup();
     let runs = assemble_runs(&readings, &targets_mm, &mut warnings);
-    if let Some(warning) = missing_readings_warning(&runs, &targets_mm) {
+    if let Some(warning) = missing_readings_warning_of(&runs, &targets_mm, layout.kind) {
         warnings.push(warning);
     }
     metadata.source_format = Some(SourceFormat::Csv);
@@ -476,8 +476,12 @@ mod tests {
     #[test]
     fn the_rotary_header_reads_degrees_and_arc_seconds() {
         let text = "# axis: C\ntarget_deg;run;direction;deviation_arcsec\n0;1;up;1,8\n90;1;up;-3,6\n0;1;down;0\n90;1;down;\n";
-        let (c, _) = parse(text).unwrap();
+        let (c, warnings) = parse(text).unwrap();
         assert_eq!(c.kind(), AxisKind::Rotary);
+        assert!(
+            warnings[0].to_string().contains("run 1↓ at 90°"),
+            "{warnings:?}"
+        );
         assert_eq!(c.targets_mm(), &[0.0, 90.0]);
         // 1.8″ = 0.0005°, −3.6″ = −0.001° (1° = 3600″, by hand).
         let up = &c.runs()[0].deviations_mm;

@@ -45,7 +45,7 @@ use crate::measurement::{
     AXIS_PLACEHOLDER, AxisKind, AxisSource, Direction, Environment, Measurement, Metadata, Run,
     SourceFormat,
 };
-use crate::read::missing_readings_warning;
+use crate::read::missing_readings_warning_of;
 use crate::read::text::{
     self, Line, check_deviation_deg, check_deviation_mm, check_target_mm, end_of_file_line,
     split_key,
@@ -361,19 +361,16 @@ impl EcmcFile {
                 "expected REF_DATA_FWD[i,j]= or REF_DATA_BWD[i,j]= lines, found none",
             ));
         }
-        if let Some(warning) = missing_readings_warning(&runs, &targets_mm) {
+        if let Some(warning) = missing_readings_warning_of(&runs, &targets_mm, unit.kind()) {
             self.warnings.push(warning);
         }
         self.metadata.source_format = Some(SourceFormat::Ecmc);
         // The reference measuring system is known only by the signal it was read from.
         self.metadata.setup.instrument = reference_instrument(&self.metadata.extra);
-        let kind = match unit {
-            Unit::Length(length_unit) => {
-                self.metadata.length_unit = length_unit;
-                AxisKind::Linear
-            }
-            Unit::Degree => AxisKind::Rotary,
-        };
+        if let Unit::Length(length_unit) = unit {
+            self.metadata.length_unit = length_unit;
+        }
+        let kind = unit.kind();
         let axis = self.axis();
         let measurement = Measurement::new(
             axis,
@@ -621,6 +618,14 @@ enum Unit {
 }
 
 impl Unit {
+    /// The kind of axis a file in this unit measured.
+    fn kind(self) -> AxisKind {
+        match self {
+            Unit::Length(_) => AxisKind::Linear,
+            Unit::Degree => AxisKind::Rotary,
+        }
+    }
+
     /// A value of the file in axcomp's inner unit: mm, or degrees as they are.
     fn to_inner(self, value: f64) -> f64 {
         match self {
