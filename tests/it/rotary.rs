@@ -198,12 +198,21 @@ fn missing_principal_angles_and_disagreeing_ends_are_said() {
 
 #[test]
 fn an_ecmc_file_in_degrees_is_a_rotary_axis() {
+    // tests/data/rotary/ecmc-deg.dat is hand-made: REF − TGT at 0° is 1.8″
+    // and 5.4″ forward (x̄↑ = 3.6″), −1.8″ and 0″ backward (x̄↓ = −0.9″).
     let (json, _) = json_of(&test_data("rotary/ecmc-deg.dat"));
     assert_eq!(json["axis_kind"], "rotary");
-    assert_eq!(json["targets_deg"][0], 15.0);
-    // REF_DATA_FWD[1,1] = 15.004748…° at 15°: 0.004748…° = 17.09″.
-    let first = json["per_target"][0]["mean_up_arcsec"].as_f64().unwrap();
-    assert!(first > 10.0 && first < 30.0, "{first}");
+    assert_eq!(json["axis"], "C");
+    assert_eq!(json["targets_deg"][4], 360.0);
+    let first = &json["per_target"][0];
+    for (key, expected) in [
+        ("mean_up_arcsec", 3.6),
+        ("mean_down_arcsec", -0.9),
+        ("B_arcsec", 4.5),
+    ] {
+        let value = first[key].as_f64().unwrap();
+        assert!((value - expected).abs() < 1e-6, "{key}: {value}");
+    }
 }
 
 #[test]
@@ -520,4 +529,17 @@ fn a_bad_rotary_truth_is_refused_with_its_position() {
         run.stderr
     );
     assert!(!rtl.exists());
+}
+
+/// The rotary report, whole: the terminal in ° and ″, the JSON with the
+/// unit in its keys (golden files; the linear ones are unchanged).
+#[test]
+fn evaluate_reports_of_the_rotary_fixture() {
+    let file = "fixtures/rotary/c.csv";
+    let run = axcomp(["evaluate", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    crate::util::assert_golden(&run.stdout, &test_data("golden/evaluate-rotary-c.txt"));
+    let run = axcomp(["evaluate", "--json", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    crate::util::assert_golden(&run.stdout, &test_data("golden/evaluate-rotary-c.json"));
 }
