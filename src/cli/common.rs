@@ -171,8 +171,29 @@ pub fn read_table(
     linuxcnc_type: Option<u8>,
     test_unit: LengthUnit,
 ) -> Result<(Controller, CompensationTable)> {
+    read_table_of(
+        path,
+        axis,
+        profile,
+        linuxcnc_type,
+        test_unit,
+        AxisKind::Linear,
+    )
+}
+
+/// [`read_table`] for an axis of `kind`: a rotary axis' table is in degrees,
+/// whatever the machine's length unit.
+pub fn read_table_of(
+    path: &Path,
+    axis: &str,
+    profile: &MachineProfile,
+    linuxcnc_type: Option<u8>,
+    test_unit: LengthUnit,
+    kind: AxisKind,
+) -> Result<(Controller, CompensationTable)> {
     let mut options = EmitOptions::for_axis(profile, axis, "")?;
     options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
+    options.kind = kind;
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
     let (text, _) = emit::decode_table(&bytes).map_err(|error| in_file(path, error))?;
     if emit::fagor8055::looks_like(&text) {
@@ -199,7 +220,8 @@ pub fn read_active_table(
 ) -> Result<(Controller, CompensationTable, Vec<Warning>)> {
     let axis = recorded_axis(test, "to say which axis the table is for")?;
     let test_unit = test.metadata.length_unit;
-    let (controller, table) = read_table(path, axis, profile, linuxcnc_type, test_unit)?;
+    let (controller, table) =
+        read_table_of(path, axis, profile, linuxcnc_type, test_unit, test.kind())?;
     let doubts = check_together(
         Pairing::TableOnTest,
         &Input::measurement(test, test_label),

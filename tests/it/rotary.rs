@@ -543,3 +543,41 @@ fn evaluate_reports_of_the_rotary_fixture() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     crate::util::assert_golden(&run.stdout, &test_data("golden/evaluate-rotary-c.json"));
 }
+
+/// A LinuxCNC table that was active on a rotary joint reads back in degrees
+/// on an inch machine too: the machine's length unit does not apply.
+#[test]
+fn an_active_rotary_table_is_read_in_degrees_on_an_inch_machine() {
+    let directory = tempfile::tempdir().unwrap();
+    let profile = directory.path().join("m.toml");
+    std::fs::write(&profile, "[controller]\nunits = \"inch\"\n").unwrap();
+    let output = directory.path().join("c.comp");
+    let run = axcomp([
+        "convert".as_ref(),
+        "fixtures/rotary/c.csv".as_ref(),
+        "--controller".as_ref(),
+        "linuxcnc".as_ref(),
+        "--machine".as_ref(),
+        profile.as_os_str(),
+        "--existing".as_ref(),
+        "formats/linuxcnc/golden/rotary-c-mean-type0.txt".as_ref(),
+        "-o".as_ref(),
+        output.as_os_str(),
+        "--json".as_ref(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(json["file_unit"], "deg");
+    // The measurement plus the active table it was taken with: the new
+    // table is about twice the first (the test saw the uncompensated axis,
+    // so the residual adds to the table), in degrees, not 25.4 times it.
+    let written = std::fs::read_to_string(&output).unwrap();
+    let golden =
+        std::fs::read_to_string("formats/linuxcnc/golden/rotary-c-mean-type0.txt").unwrap();
+    let at_90 = |text: &str| -> f64 {
+        let row = text.lines().find(|l| l.starts_with("90 ")).unwrap();
+        row.split(' ').nth(1).unwrap().parse::<f64>().unwrap() - 90.0
+    };
+    let ratio = at_90(&written) / at_90(&golden);
+    assert!((ratio - 2.0).abs() < 0.01, "{ratio}");
+}
