@@ -10,9 +10,9 @@
 
 use std::fmt;
 
-use crate::measurement::Direction;
+use crate::measurement::{AxisKind, Direction};
 use crate::units::LengthUnit;
-use crate::units::{mm_to_um, um_to_mm};
+use crate::units::{deg_to_arcsec, mm_to_um, um_to_mm};
 
 /// A position in a text file. Both fields start at 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -139,6 +139,8 @@ pub enum Warning {
     },
     /// Fewer runs per direction than ISO 230-2's standard test (a long axis needs one).
     TooFewRuns {
+        /// Linear or rotary: which axes need fewer.
+        kind: AxisKind,
         /// Runs ↑.
         runs_up: usize,
         /// Runs ↓.
@@ -148,9 +150,11 @@ pub enum Warning {
     },
     /// Fewer targets than ISO 230-2 asks: 5 in all and 5 per metre of travel.
     TooFewTargets {
+        /// Linear or rotary.
+        kind: AxisKind,
         /// Targets measured.
         targets: usize,
-        /// Travel, mm.
+        /// Travel, mm (° on a rotary axis).
         length_mm: f64,
         /// Targets the standard asks for this travel.
         required: usize,
@@ -169,10 +173,38 @@ pub enum Warning {
     },
     /// A target lacks what a figure needs, so that figure is not evaluated.
     TargetNotEvaluated {
-        /// The target.
+        /// Linear or rotary.
+        kind: AxisKind,
+        /// The target, mm (° on a rotary axis).
         target_mm: f64,
         /// Which quantity is missing there.
         missing: String,
+    },
+    /// A rotary axis over 360°: ISO 230-2 takes one approach per direction
+    /// and target there, so the repeatabilities and A are not evaluated.
+    RotaryOverFullTurn {
+        /// The span of the targets, °.
+        range_deg: f64,
+    },
+    /// Principal angles (multiples of 90°) within a rotary axis' range that
+    /// are not among its targets.
+    PrincipalAnglesMissing {
+        /// The angles missing, °.
+        missing_deg: Vec<f64>,
+    },
+    /// A full-turn test with both ends of one turn (0° and 360°), whose mean
+    /// deviations differ by more than the repeatability there.
+    FullTurnEndsDisagree {
+        /// The first end, °.
+        first_deg: f64,
+        /// The end one turn later, °.
+        last_deg: f64,
+        /// Mean bidirectional deviation x̄_i at the first, °.
+        mean_first_deg: f64,
+        /// At the last, °.
+        mean_last_deg: f64,
+        /// The larger bidirectional repeatability R_i of the two, °.
+        repeatability_deg: f64,
     },
     /// Two inputs joined or compared may not belong together
     /// (`together`).
@@ -290,10 +322,15 @@ impl fmt::Display for Warning {
                  ISO 230-2's test approaches every target from both directions: measure both to get them"
             ),
             Warning::TooFewRuns {
+                kind,
                 runs_up,
                 runs_down,
                 required,
             } => {
+                let fewer = match kind {
+                    AxisKind::Linear => "axes over 2000 mm",
+                    AxisKind::Rotary => "rotary axes over 360°",
+                };
                 let runs = match (runs_up, runs_down) {
                     (n, 0) | (0, n) => format!("{n}"),
                     (up, down) if up == down => format!("{up}"),
@@ -301,11 +338,23 @@ impl fmt::Display for Warning {
                 };
                 write!(
                     f,
-                    "{runs} run(s) per direction: ISO 230-2's test has {required} each way (fewer only on axes over 2000 mm), \
+                    "{runs} run(s) per direction: ISO 230-2's test has {required} each way (fewer only on {fewer}), \
                      and A and R from fewer runs are rough estimates; measure {required} runs each way"
                 )
             }
             Warning::TooFewTargets {
+                kind: AxisKind::Rotary,
+                targets,
+                length_mm,
+                required,
+            } => write!(
+                f,
+                "{targets} target(s) over {}°: ISO 230-2 asks for at least {required}; measure at least {required}, \
+                 with 0°, 90°, 180° and 270° among them where in range",
+                mm_text(*length_mm)
+            ),
+            Warning::TooFewTargets {
+                kind: AxisKind::Linear,
                 targets,
                 length_mm,
                 required,
@@ -328,9 +377,50 @@ impl fmt::Display for Warning {
                  ISO 230-2 recommends irregular spacing: give each target a different random offset",
                 mm_text(*step_mm)
             ),
-            Warning::TargetNotEvaluated { target_mm, missing } => write!(
+            Warning::TargetNotEvaluated {
+                kind,
+                target_mm,
+                missing,
+            } => write!(
                 f,
-                "target {target_mm} mm has no {missing}; the axis figures that need it are not evaluated"
+                "target {target_mm} {} has no {missing}; the axis figures that need it are not evaluated",
+                kind.position_unit()
+            ),
+            Warning::RotaryOverFullTurn { range_deg } => write!(
+                f,
+                "rotary axis over 360° ({}°): ISO 230-2 takes one approach per direction and target there (n = 1), \
+                 so the repeatabilities and A are not evaluated",
+                mm_text(*range_deg)
+            ),
+            Warning::PrincipalAnglesMissing { missing_deg } => {
+                let angles: Vec<String> = missing_deg
+                    .iter()
+                    .map(|angle| format!("{}°", mm_text(*angle)))
+                    .collect();
+                write!(
+                    f,
+                    "principal angle(s) {} within the range are not among the targets: ISO 230-2 asks a rotary test \
+                     to include 0°, 90°, 180° and 270° where in range; add them",
+                    angles.join(", ")
+                )
+            }
+            Warning::FullTurnEndsDisagree {
+                first_deg,
+                last_deg,
+                mean_first_deg,
+                mean_last_deg,
+                repeatability_deg,
+            } => write!(
+                f,
+                "{}° and {}° are one physical position, but their mean deviations differ by {:.2}″ \
+                 ({:+.2}″ and {:+.2}″), more than the repeatability there ({:.2}″): \
+                 check for drift or a reference that moved during the turn",
+                mm_text(*first_deg),
+                mm_text(*last_deg),
+                deg_to_arcsec((mean_last_deg - mean_first_deg).abs()),
+                deg_to_arcsec(*mean_first_deg),
+                deg_to_arcsec(*mean_last_deg),
+                deg_to_arcsec(*repeatability_deg),
             ),
             Warning::Doubtful(doubt) => write!(f, "{doubt}"),
         }

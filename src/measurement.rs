@@ -1,4 +1,10 @@
-//! The measurement of one linear axis: the plain, validated data every stage meets on.
+//! The measurement of one axis: the plain, validated data every stage meets on.
+//!
+//! An axis is linear or rotary ([`AxisKind`]). A rotary axis keeps its
+//! targets and deviations in degrees in the same fields a linear one keeps
+//! mm in (`targets_mm`, `deviations_mm`): the kind says the unit, and every
+//! stage that prints or serialises a value asks it (`../shared/spec/
+//! standards.md` §6: targets in degrees, deviations reported in ″).
 //!
 //! A [`Measurement`] holds the targets (mm, strictly increasing), the runs
 //! (each with its direction and one deviation per target, `None` where a
@@ -67,6 +73,34 @@ impl fmt::Display for Direction {
     }
 }
 
+/// Whether an axis moves along a line or turns: the unit of its values.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum AxisKind {
+    /// A linear axis: targets and deviations in mm.
+    #[default]
+    Linear,
+    /// A rotary axis: targets and deviations in degrees (reported in ″).
+    Rotary,
+}
+
+impl AxisKind {
+    /// `linear` or `rotary`, as in JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AxisKind::Linear => "linear",
+            AxisKind::Rotary => "rotary",
+        }
+    }
+
+    /// The unit of a target position in sentences: `mm` or `°`.
+    pub fn position_unit(self) -> &'static str {
+        match self {
+            AxisKind::Linear => "mm",
+            AxisKind::Rotary => "°",
+        }
+    }
+}
+
 /// One pass over the targets in one direction.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Run {
@@ -78,7 +112,8 @@ pub struct Run {
     pub number: u32,
     /// When the run started, in seconds after the test started, if known.
     pub start_time_s: Option<f64>,
-    /// One deviation per target (same order as the targets), mm; `None` is a missing reading.
+    /// One deviation per target (same order as the targets), mm (° on a
+    /// rotary axis); `None` is a missing reading.
     pub deviations_mm: Vec<Option<Mm>>,
 }
 
@@ -331,6 +366,14 @@ pub enum MeasurementError {
         /// Its last target, mm.
         other_last_mm: f64,
     },
+    /// A linear and a rotary measurement cannot be joined.
+    #[error("cannot join the files: one is a {} axis, the other {}", first.as_str(), second.as_str())]
+    KindsDiffer {
+        /// The first file's kind.
+        first: AxisKind,
+        /// The second's.
+        second: AxisKind,
+    },
     /// No targets.
     #[error("no targets")]
     NoTargets,
@@ -422,10 +465,11 @@ impl fmt::Display for RunSelector {
     }
 }
 
-/// A validated measurement of one linear axis (see the module doc for the invariants).
+/// A validated measurement of one axis (see the module doc for the invariants).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Measurement {
     axis: String,
+    kind: AxisKind,
     targets_mm: Vec<Mm>,
     runs: Vec<Run>,
     /// The test conditions.
@@ -463,6 +507,7 @@ impl Measurement {
         check_runs(&runs, targets_mm.len())?;
         Ok(Measurement {
             axis: axis.into(),
+            kind: AxisKind::Linear,
             targets_mm,
             runs,
             environment,
@@ -487,7 +532,30 @@ impl Measurement {
         self.metadata.axis_source.is_recorded()
     }
 
-    /// The targets P_i, mm, strictly increasing.
+    /// Linear or rotary: whether the values are mm or degrees.
+    pub fn kind(&self) -> AxisKind {
+        self.kind
+    }
+
+    /// The same measurement of an axis of `kind` ([`Measurement::new`]
+    /// builds a linear one): the values are then read in its unit.
+    ///
+    /// # Example
+    /// ```
+    /// use axcomp::measurement::{AxisKind, Direction, Measurement, Run};
+    /// let run = Run { direction: Direction::Up, number: 1, start_time_s: None,
+    ///                 deviations_mm: vec![Some(0.0), Some(0.001)] };
+    /// let c = Measurement::new("C", vec![0.0, 90.0], vec![run],
+    ///                          Default::default(), Default::default()).unwrap()
+    ///     .with_kind(AxisKind::Rotary);
+    /// assert_eq!(c.kind(), AxisKind::Rotary);
+    /// ```
+    pub fn with_kind(mut self, kind: AxisKind) -> Measurement {
+        self.kind = kind;
+        self
+    }
+
+    /// The targets P_i, mm (° on a rotary axis), strictly increasing.
     pub fn targets_mm(&self) -> &[Mm] {
         &self.targets_mm
     }
@@ -563,6 +631,7 @@ impl Measurement {
         // Field by field: `..self.clone()` would copy every run once more.
         Ok(Measurement {
             axis: self.axis.clone(),
+            kind: self.kind,
             targets_mm: self.targets_mm.clone(),
             runs,
             environment: self.environment.clone(),
@@ -575,6 +644,12 @@ impl Measurement {
     /// `self` and are renumbered after them, per direction.
     pub fn merge(&self, other: &Measurement) -> Result<Measurement, MeasurementError> {
         const SAME_TARGET_MM: f64 = 1e-6;
+        if self.kind != other.kind {
+            return Err(MeasurementError::KindsDiffer {
+                first: self.kind,
+                second: other.kind,
+            });
+        }
         if self.targets_mm.len() != other.targets_mm.len()
             || self
                 .targets_mm
@@ -599,13 +674,14 @@ impl Measurement {
                 ..run.clone()
             });
         }
-        Measurement::new(
+        Ok(Measurement::new(
             self.axis.clone(),
             self.targets_mm.clone(),
             runs,
             self.environment.clone(),
             self.metadata.clone(),
-        )
+        )?
+        .with_kind(self.kind))
     }
 }
 

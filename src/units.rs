@@ -1,8 +1,10 @@
 //! Units: every conversion factor axcomp uses, in one tested place.
 //!
 //! Inside axcomp every length is a millimetre `f64` (`target_mm`,
-//! `deviation_mm`); file units are converted in `read` and display units in
-//! `report`, and both go through the functions here. The aliases below
+//! `deviation_mm`) and every rotary axis' angle a degree `f64` (a rotary
+//! `Measurement` keeps degrees in the same fields: its `AxisKind` says the
+//! unit); file units are converted in `read` and display units in `report`
+//! (µm, arc-seconds ″, µrad), and both go through the functions here. The aliases below
 //! document a unit; they do not check it, which is why each name also carries
 //! the unit (see `../shared/spec/style.md` §5).
 //!
@@ -12,6 +14,10 @@
 pub type Mm = f64;
 /// A length in micrometres.
 pub type Um = f64;
+/// An angle in degrees (a rotary axis' targets and, inside, its deviations).
+pub type Deg = f64;
+/// An angle in arc-seconds (″, how rotary deviations are reported).
+pub type Arcsec = f64;
 
 /// Micrometres in one millimetre.
 pub const UM_PER_MM: f64 = 1000.0;
@@ -19,6 +25,10 @@ pub const UM_PER_MM: f64 = 1000.0;
 pub const MM_PER_INCH: f64 = 25.4;
 /// Millimetres in one metre (the servo model works in SI units).
 pub const MM_PER_M: f64 = 1000.0;
+/// Arc-seconds in one degree (60 minutes of 60 seconds).
+pub const ARCSEC_PER_DEG: f64 = 3600.0;
+/// Microradians in one degree: 10⁶·π/180.
+pub const URAD_PER_DEG: f64 = 1e6 * std::f64::consts::PI / 180.0;
 /// Kilopascal in one inch of mercury at 0 °C (NIST SP 811, B.8: 3.386 389 kPa).
 pub const KPA_PER_INHG: f64 = 3.386_389;
 
@@ -88,7 +98,19 @@ pub fn mm2_to_um2(value_mm2: f64) -> f64 {
 /// `value_mm · 1000` are tried too; writers use this so that a file reads back
 /// to the very measurement that was written.
 pub fn um_text(value_mm: Mm) -> String {
-    let um = mm_to_um(value_mm);
+    shortest_text(value_mm, mm_to_um, um_to_mm)
+}
+
+/// The shortest decimal text, in arc-seconds, that reads back (″ → ° with
+/// [`arcsec_to_deg`]) to exactly `value_deg`: [`um_text`] for angles.
+pub fn arcsec_text(value_deg: Deg) -> String {
+    shortest_text(value_deg, deg_to_arcsec, arcsec_to_deg)
+}
+
+/// The shortest text of `to(value)` that `back` turns into exactly `value`,
+/// trying the nearest neighbours of `to(value)` too.
+fn shortest_text(value: f64, to: fn(f64) -> f64, back: fn(f64) -> f64) -> String {
+    let scaled = to(value);
     let step = |x: f64, up: bool| {
         // The adjacent f64 (f64::next_up/next_down, written out for rust-version 1.85).
         if x == 0.0 {
@@ -102,8 +124,8 @@ pub fn um_text(value_mm: Mm) -> String {
         let larger_magnitude = (x > 0.0) == up;
         f64::from_bits(if larger_magnitude { bits + 1 } else { bits - 1 })
     };
-    let mut candidates = vec![um];
-    let (mut above, mut below) = (um, um);
+    let mut candidates = vec![scaled];
+    let (mut above, mut below) = (scaled, scaled);
     for _ in 0..4 {
         above = step(above, true);
         below = step(below, false);
@@ -112,10 +134,35 @@ pub fn um_text(value_mm: Mm) -> String {
     }
     candidates
         .into_iter()
-        .filter(|candidate| um_to_mm(*candidate) == value_mm)
+        .filter(|candidate| back(*candidate) == value)
         .map(|candidate| candidate.to_string())
         .min_by_key(String::len)
-        .unwrap_or_else(|| um.to_string())
+        .unwrap_or_else(|| scaled.to_string())
+}
+
+/// Degrees to arc-seconds.
+pub fn deg_to_arcsec(value_deg: Deg) -> Arcsec {
+    value_deg * ARCSEC_PER_DEG
+}
+
+/// Arc-seconds to degrees.
+pub fn arcsec_to_deg(value_arcsec: Arcsec) -> Deg {
+    value_arcsec / ARCSEC_PER_DEG
+}
+
+/// An optional angle in degrees to arc-seconds; `None` stays `None`.
+pub fn opt_deg_to_arcsec(value_deg: Option<Deg>) -> Option<Arcsec> {
+    value_deg.map(deg_to_arcsec)
+}
+
+/// Degrees to microradians.
+pub fn deg_to_urad(value_deg: Deg) -> f64 {
+    value_deg * URAD_PER_DEG
+}
+
+/// Arc-seconds to microradians (1″ ≈ 4.848 µrad).
+pub fn arcsec_to_urad(value_arcsec: Arcsec) -> f64 {
+    deg_to_urad(arcsec_to_deg(value_arcsec))
 }
 
 /// Metres to millimetres.
@@ -237,5 +284,25 @@ mod tests {
         // 30 µm/m (seed 000 Tab. 3.3) is 30 µrad.
         assert_eq!(um_per_m_to_rad(30.0), 30e-6);
         assert_eq!(rad_to_um_per_m(um_per_m_to_rad(30.0)), 30.0);
+    }
+
+    #[test]
+    fn rotary_conversions_by_hand() {
+        // 1° = 3600″; 1″ = π/648000 rad = 4.848 136 811 µrad.
+        assert_eq!(deg_to_arcsec(0.5), 1800.0);
+        assert_eq!(arcsec_to_deg(36.0), 0.01);
+        assert_eq!(opt_deg_to_arcsec(None), None);
+        assert!((arcsec_to_urad(1.0) - 4.848_136_811).abs() < 1e-9);
+        assert!((deg_to_urad(180.0) - std::f64::consts::PI * 1e6).abs() < 1e-6);
+        for arcsec in [1.3, -0.7, 12.25, 0.0, 3.1] {
+            let deg = arcsec_to_deg(arcsec);
+            let text = arcsec_text(deg);
+            assert_eq!(
+                arcsec_to_deg(text.parse().unwrap()),
+                deg,
+                "{arcsec}: {text}"
+            );
+        }
+        assert_eq!(arcsec_text(arcsec_to_deg(1.3)), "1.3");
     }
 }

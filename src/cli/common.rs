@@ -13,7 +13,7 @@ use axcomp::error::{ParseError, Warning};
 use axcomp::evaluate::Standard;
 use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
 use axcomp::evaluate::verdict::Decision;
-use axcomp::measurement::{Direction, Measurement, RunSelector, SourceFormat};
+use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
@@ -171,8 +171,29 @@ pub fn read_table(
     linuxcnc_type: Option<u8>,
     test_unit: LengthUnit,
 ) -> Result<(Controller, CompensationTable)> {
+    read_table_of(
+        path,
+        axis,
+        profile,
+        linuxcnc_type,
+        test_unit,
+        AxisKind::Linear,
+    )
+}
+
+/// [`read_table`] for an axis of `kind`: a rotary axis' table is in degrees,
+/// whatever the machine's length unit.
+pub fn read_table_of(
+    path: &Path,
+    axis: &str,
+    profile: &MachineProfile,
+    linuxcnc_type: Option<u8>,
+    test_unit: LengthUnit,
+    kind: AxisKind,
+) -> Result<(Controller, CompensationTable)> {
     let mut options = EmitOptions::for_axis(profile, axis, "")?;
     options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
+    options.kind = kind;
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
     let (text, _) = emit::decode_table(&bytes).map_err(|error| in_file(path, error))?;
     if emit::fagor8055::looks_like(&text) {
@@ -199,7 +220,8 @@ pub fn read_active_table(
 ) -> Result<(Controller, CompensationTable, Vec<Warning>)> {
     let axis = recorded_axis(test, "to say which axis the table is for")?;
     let test_unit = test.metadata.length_unit;
-    let (controller, table) = read_table(path, axis, profile, linuxcnc_type, test_unit)?;
+    let (controller, table) =
+        read_table_of(path, axis, profile, linuxcnc_type, test_unit, test.kind())?;
     let doubts = check_together(
         Pairing::TableOnTest,
         &Input::measurement(test, test_label),
@@ -356,6 +378,20 @@ pub fn load_equipment(args: &UncertaintyArgs) -> Result<Equipment> {
     let read = axcomp::read::read_paths(std::slice::from_ref(&drift_path), None)
         .with_context(|| format!("{name}: the drift test"))?;
     Ok(equipment.with_drift_test(&read.measurement, &drift_path.display().to_string()))
+}
+
+/// Refuses a rotary axis where a command handles linear axes only (the
+/// acceptance report, prediction and diagnosis are µm and mm throughout;
+/// rotary axes there are issue 14's later part).
+pub fn linear_only(measurement: &Measurement, command: &str) -> Result<()> {
+    if measurement.kind() == AxisKind::Rotary {
+        anyhow::bail!(
+            "axis {} is a rotary axis: {command} handles linear axes only so far; \
+             `axcomp evaluate` and `axcomp convert` take rotary axes",
+            measurement.axis()
+        );
+    }
+    Ok(())
 }
 
 /// The uncertainty budget of `measurement` with `equipment`.

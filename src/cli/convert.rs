@@ -8,7 +8,7 @@ use axcomp::compensate::plan::{Request, plan};
 use axcomp::compensate::{self, Extrapolate, TableMode};
 use axcomp::emit::{self, Controller, EmitOptions};
 use axcomp::evaluate::evaluate;
-use axcomp::measurement::RunSelector;
+use axcomp::measurement::{AxisKind, RunSelector};
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::convert::ConvertJson;
@@ -197,6 +197,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     options.linuxcnc_type = args.linuxcnc_type;
     options.max_points = args.max_points.or(options.max_points);
     options.machine_unit = profile.table_unit(args.controller, measurement.metadata.length_unit);
+    options.kind = measurement.kind();
     if let Some(existing) = &args.existing {
         // The table was active during the test: its axis, over the test's range.
         let test_name = args
@@ -254,6 +255,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     let activation = emit::activation(args.controller, &table, &file_name, &options);
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
     let mut report = ConvertJson::new(
+        measurement.kind(),
         args.controller.name(),
         args.output.display().to_string(),
         &table,
@@ -262,7 +264,9 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         warning_texts,
     );
     report.effects = plan.notes;
-    report.file_unit = options.machine_unit.as_str();
+    if measurement.kind() == AxisKind::Linear {
+        report.file_unit = options.machine_unit.as_str();
+    }
     if let Some(backlash_mm) = table.suggested_backlash_mm {
         report.set_backlash(args.controller.backlash_parameter(backlash_mm, &options));
     }

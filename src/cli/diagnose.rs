@@ -83,6 +83,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let mut after = read::read_path(&args.after, None)?;
     print_warnings(&after.warnings, args.verbosity.quiet);
     name_axis(&mut after.measurement, args.axis.as_ref());
+    super::common::linear_only(&after.measurement, "diagnose")?;
     let before = match &args.before {
         Some(path) => {
             let mut result = read::read_path(path, None)?;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 
 use axcomp::evaluate::evaluate_with;
-use axcomp::measurement::{Direction, Measurement, RunSelector};
+use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector};
 use axcomp::read;
 use axcomp::report::uncertainty::UncertaintyJson;
 use axcomp::report::{json::EvaluationJson, terminal, verdict};
@@ -90,16 +90,27 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         &args.acceptance,
     )?;
     let equipment = load_equipment(&args.uncertainty)?;
-    let budget = uncertainty_budget(&measurement, &equipment)?;
     warnings.extend(evaluation.warnings.iter().cloned());
     let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
-    report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));
-    report.verdict = verdict::judge(
-        &evaluation,
-        &limits,
-        args.uncertainty.decision,
-        Some(&budget),
-    );
+    if measurement.kind() == AxisKind::Rotary {
+        // The budget is the laser's, for lengths, and limits are µm: a
+        // rotary axis has neither yet (issue 14's later part).
+        if !limits.is_empty() {
+            bail!(
+                "axis {} is a rotary axis: acceptance limits (--limit, a profile's [acceptance]) are µm, for linear axes only so far",
+                measurement.axis()
+            );
+        }
+    } else {
+        let budget = uncertainty_budget(&measurement, &equipment)?;
+        report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));
+        report.verdict = verdict::judge(
+            &evaluation,
+            &limits,
+            args.uncertainty.decision,
+            Some(&budget),
+        );
+    }
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

@@ -122,6 +122,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         let mut result = read::read_path(&path, None)?;
         print_warnings(&result.warnings, args.verbosity.quiet);
         name_axis(&mut result.measurement, axis.as_ref());
+        super::common::linear_only(&result.measurement, "predict")?;
         if !result.measurement.axis_recorded() {
             bail!(
                 "{}: the file does not record which axis was measured; name it as --measured X={spec}",

@@ -22,8 +22,8 @@ use axcomp::together::{Input, Pairing, check_together};
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
-    load_equipment, load_profile, name_axis, print_text, print_warnings, read_active_table,
-    uncertainty_budget,
+    linear_only, load_equipment, load_profile, name_axis, print_text, print_warnings,
+    read_active_table, uncertainty_budget,
 };
 
 /// Flags of `axcomp report`.
@@ -135,6 +135,7 @@ impl Test {
             mut warnings,
         } = read::read_paths(&[path.to_path_buf()], format)?;
         name_axis(&mut measurement, axis);
+        linear_only(&measurement, "report")?;
         let evaluation = evaluate_with(&measurement, standard);
         warnings.extend(evaluation.warnings.iter().cloned());
         let budget = uncertainty_budget(&measurement, equipment)?;

@@ -4,10 +4,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use axcomp::measurement::Measurement;
+use axcomp::measurement::{AxisKind, Measurement};
 use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
-use axcomp::synth::{self, Truth};
+use axcomp::synth::{self, RotaryTruth, Truth};
 use axcomp::units::LengthUnit;
 
 use super::common::{
@@ -56,6 +56,11 @@ pub struct SynthArgs {
 
 /// Runs `axcomp synth`.
 pub fn run(args: &SynthArgs) -> Result<()> {
+    if load(&args.truth, |text| {
+        Ok::<bool, axcomp::synth::SynthError>(RotaryTruth::is_rotary(text))
+    })? {
+        return run_rotary(args);
+    }
     let truth = load(&args.truth, Truth::from_toml_str)?;
     // Render everything before writing anything, so a bad table leaves no half result.
     let first = synth::before(&truth, args.seed)?;
@@ -98,6 +103,29 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     print_text(&summary)
 }
 
+/// A rotary truth's test (`synth::rotary`): one file, no re-test yet.
+fn run_rotary(args: &SynthArgs) -> Result<()> {
+    if args.table.is_some() {
+        bail!(
+            "{}: a rotary truth has no re-test with a table yet (issue 14); leave out --table and --o2",
+            args.truth.display()
+        );
+    }
+    let truth = load(&args.truth, RotaryTruth::from_toml_str)?;
+    let test = synth::rotary_test(&truth, args.seed)?;
+    let text = render(&test, &args.output)?;
+    write_all_new(
+        &[(args.output.as_path(), text.as_bytes())],
+        args.overwrite.force,
+    )?;
+    print_text(&format!(
+        "Wrote {} (rotary axis, {} targets, {} runs)\n",
+        args.output.display(),
+        test.targets_mm().len(),
+        test.runs().len()
+    ))
+}
+
 /// The file text for an output path, by its extension.
 fn render(measurement: &Measurement, path: &Path) -> Result<String> {
     let extension = path
@@ -106,6 +134,10 @@ fn render(measurement: &Measurement, path: &Path) -> Result<String> {
         .unwrap_or("")
         .to_ascii_lowercase();
     match extension.as_str() {
+        "rtl" if measurement.kind() == AxisKind::Rotary => bail!(
+            "{}: Renishaw's rotary .rtl layout is not public; write a rotary test as .csv",
+            path.display()
+        ),
         "rtl" => Ok(rtl::write(measurement)),
         "csv" => Ok(csv::write(measurement)),
         _ => bail!(

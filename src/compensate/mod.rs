@@ -22,6 +22,13 @@
 //!    tool does);
 //! 4. in `mean` mode the suggested backlash parameter is −B̄ = mean(x̄↓ − x̄↑).
 //!
+//! A rotary axis' table is built the same way in degrees. On a full turn
+//! (targets from θ to θ + 360°) the two ends are one physical position
+//! (`../shared/spec/standards.md` §6): the source curve takes the mean of
+//! their two x̄ at both ends, so the table's end values are equal, as a
+//! modulo table needs (`evaluate` warns when the two disagree beyond the
+//! repeatability).
+//!
 //! A measurement taken with a table already active measures the residual;
 //! [`add_existing_table`] turns it back into the uncompensated deviations
 //! (residual + the active table, applied as the controller applies it) before
@@ -34,7 +41,8 @@ pub mod plan;
 pub mod retest;
 
 use crate::evaluate::Evaluation;
-use crate::measurement::{Direction, Measurement, MeasurementError};
+use crate::evaluate::conformance::FULL_TURN_DEG;
+use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError};
 
 /// How many standard errors B̄ must be from zero to count as a measured
 /// reversal: at 3σ a reversal-free axis passes for one in 0.3 % of tests.
@@ -311,6 +319,22 @@ fn source_curve(
         .unzip()
 }
 
+/// A rotary curve over a full turn with one value at both ends, the mean of
+/// the two: they are one physical position (module doc). Any other curve as it is.
+fn join_full_turn(curve: (Vec<f64>, Vec<f64>), kind: AxisKind) -> (Vec<f64>, Vec<f64>) {
+    let (positions, mut values) = curve;
+    let (Some(first), Some(last)) = (positions.first(), positions.last()) else {
+        return (positions, values);
+    };
+    if kind == AxisKind::Rotary && (last - first - FULL_TURN_DEG).abs() < 1e-6 {
+        let last_index = values.len() - 1;
+        let joined = (values[0] + values[last_index]) / 2.0;
+        values[0] = joined;
+        values[last_index] = joined;
+    }
+    (positions, values)
+}
+
 /// Builds a compensation table from a measurement and its evaluation.
 ///
 /// # Example
@@ -336,12 +360,16 @@ pub fn build_table(
 ) -> Result<CompensationTable, CompensateError> {
     let positions_mm = grid_positions(measurement.targets_mm(), options.grid)?;
     let has = |d: Direction| measurement.run_count(d) > 0;
+    let kind = measurement.kind();
+    let source_curve = |pick: fn(&crate::evaluate::TargetStats) -> Option<f64>| {
+        join_full_turn(source_curve(evaluation, pick), kind)
+    };
     let (raw, suggested_backlash_mm) = match options.mode {
         TableMode::Mean => {
             let curve = match (has(Direction::Up), has(Direction::Down)) {
-                (true, true) => source_curve(evaluation, |t| t.mean_mm),
-                (true, false) => source_curve(evaluation, |t| t.up.mean_mm),
-                _ => source_curve(evaluation, |t| t.down.mean_mm),
+                (true, true) => source_curve(|t| t.mean_mm),
+                (true, false) => source_curve(|t| t.up.mean_mm),
+                _ => source_curve(|t| t.down.mean_mm),
             };
             let column = resample(&curve, &positions_mm, options.extrapolate)?;
             let backlash = evaluation.figures.b_mean_mm.map(|b| -b);
@@ -354,12 +382,12 @@ pub fn build_table(
                 }
             }
             let up = resample(
-                &source_curve(evaluation, |t| t.up.mean_mm),
+                &source_curve(|t| t.up.mean_mm),
                 &positions_mm,
                 options.extrapolate,
             )?;
             let down = resample(
-                &source_curve(evaluation, |t| t.down.mean_mm),
+                &source_curve(|t| t.down.mean_mm),
                 &positions_mm,
                 options.extrapolate,
             )?;

@@ -33,7 +33,7 @@ fn decimals(unit: LengthUnit) -> usize {
 
 /// Writes the `COMP_FILE` for the table (type from `options.linuxcnc_type`).
 pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String, EmitError> {
-    let unit = options.machine_unit;
+    let unit = options.file_unit();
     let places = decimals(unit);
     if options.linuxcnc_type > 1 {
         return Err(EmitError::Profile(format!(
@@ -84,9 +84,12 @@ pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAd
     ))
 }
 
-/// The INI lines that activate the file on a joint.
+/// The INI lines that activate the file on a joint; for a rotary joint,
+/// what LinuxCNC does beyond the table (\[seen\] `ini-config.adoc`: no
+/// modulo wrap, the end values held; `WRAPPED_ROTARY = 1` keeps the joint
+/// within 0…359.999°).
 pub fn activation(file_name: &str, options: &EmitOptions) -> String {
-    options
+    let lines = options
         .axes
         .iter()
         .map(|axis| {
@@ -96,7 +99,15 @@ pub fn activation(file_name: &str, options: &EmitOptions) -> String {
             )
         })
         .collect::<Vec<_>>()
-        .join("\n\n")
+        .join("\n\n");
+    if options.kind == crate::measurement::AxisKind::Rotary {
+        return format!(
+            "{lines}\n\nA rotary joint: the table is in degrees ([TRAJ]ANGULAR_UNITS = degree) and LinuxCNC does not wrap it: \
+             beyond its first and last points it holds the end values. With [JOINT_n]WRAPPED_ROTARY = 1 the joint runs 0…359.999°, \
+             which a 0…360° table covers; otherwise make the table cover every angle the joint turns to"
+        );
+    }
+    lines
 }
 
 /// Reads a `COMP_FILE`. `file_type` may be `None` when the numbers tell it
@@ -237,6 +248,7 @@ mod tests {
             cec_first_table: 0,
             cec_values_are_corrections: true,
             tnc640_columns: Vec::new(),
+            kind: Default::default(),
         }
     }
 

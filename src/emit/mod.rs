@@ -10,6 +10,13 @@
 //! every writer takes ([`EmitOptions`]), the refusal rules that stop a table
 //! the controller would reject ([`check_table`]), the number formats, and
 //! format detection for reading an existing table ([`read_any`]).
+//!
+//! A rotary axis' table ([`EmitOptions::kind`]) holds degrees, written as
+//! they are (no length unit applies): Heidenhain `.COM` with AXISPOS and
+//! values in °, Sinumerik LEC with `$AA_ENC_COMP_IS_MODULO = 1` over a full
+//! turn from 0° to 360° (equal values at both ends, refused otherwise),
+//! LinuxCNC over the table's range with the ends held. The Fagor files show
+//! no rotary form, so a rotary table is refused for them.
 
 mod fagor;
 pub mod fagor8055;
@@ -24,6 +31,8 @@ pub mod tnc640;
 use crate::compensate::plan::Capabilities;
 use crate::compensate::{CompensationTable, TableMode};
 use crate::error::ParseError;
+use crate::evaluate::conformance::FULL_TURN_DEG;
+use crate::measurement::AxisKind;
 use crate::units::LengthUnit;
 pub use fagor::{TextEncoding, decode as decode_table, encode as encode_table};
 pub use profile::{AxisProfile, CecValues, MachineProfile};
@@ -215,6 +224,8 @@ pub struct EmitOptions {
     /// TNC 640: the machine's axis columns (CfgAxes/axisList); empty for just
     /// the written axes.
     pub tnc640_columns: Vec<String>,
+    /// Linear (positions and values mm) or rotary (degrees).
+    pub kind: AxisKind,
 }
 
 impl EmitOptions {
@@ -240,7 +251,28 @@ impl EmitOptions {
                 .tnc640_columns
                 .clone()
                 .unwrap_or_default(),
+            kind: AxisKind::Linear,
         })
+    }
+
+    /// The unit of the numbers in a file that converts them (LinuxCNC): the
+    /// machine's length unit, or for a rotary axis degrees as they are,
+    /// which is `Millimetre`'s identity conversion of the inner value.
+    pub fn file_unit(&self) -> LengthUnit {
+        match self.kind {
+            AxisKind::Linear => self.machine_unit,
+            AxisKind::Rotary => LengthUnit::Millimetre,
+        }
+    }
+
+    /// Whether the table is a rotary axis' full turn from 0° to 360°, which
+    /// a Sinumerik writes as a modulo table.
+    pub fn is_full_turn(&self, table: &CompensationTable) -> bool {
+        let (Some(first), Some(last)) = (table.positions_mm.first(), table.positions_mm.last())
+        else {
+            return false;
+        };
+        self.kind == AxisKind::Rotary && (last - first - FULL_TURN_DEG).abs() < 1e-9
     }
 }
 
@@ -341,6 +373,34 @@ pub enum EmitError {
         /// The value at the first point.
         value_mm: f64,
     },
+    /// A rotary axis for a format that shows no rotary form.
+    #[error(
+        "{controller} tables are written for linear axes only: the format's documents show no rotary table (formats/{controller}/README.md)"
+    )]
+    RotaryNotSupported {
+        /// The controller.
+        controller: &'static str,
+    },
+    /// A full-turn modulo table must go from 0° to 360°.
+    #[error(
+        "a Sinumerik modulo table of a rotary axis goes from 0° to 360° ($AA_ENC_COMP_MIN 0, MAX 360); this one goes from {first_deg}° to {last_deg}°: build it on a 0…360° grid (--start 0 --step …)"
+    )]
+    ModuloRange {
+        /// The first point, °.
+        first_deg: f64,
+        /// The last point, °.
+        last_deg: f64,
+    },
+    /// A modulo table whose ends, one physical position, differ.
+    #[error(
+        "a Sinumerik modulo table repeats every turn, so its values at 0° and 360° must be equal; this one has {first_deg}° at 0° and {last_deg}° at 360°"
+    )]
+    ModuloEndsDiffer {
+        /// The value at 0°, °.
+        first_deg: f64,
+        /// The value at 360°, °.
+        last_deg: f64,
+    },
     /// A profile value the format cannot use.
     #[error("{0}")]
     Profile(String),
@@ -384,6 +444,7 @@ pub fn check_table(
     options: &EmitOptions,
 ) -> Result<(), EmitError> {
     let name = controller.name();
+    check_rotary(controller, table, options)?;
     let count = table.positions_mm.len();
     let limit = match (controller.max_points(), options.max_points) {
         (Some(a), Some(b)) => Some(a.min(b)),
@@ -412,7 +473,7 @@ pub fn check_table(
         };
         // One step for the whole table, written to the format's resolution:
         // a rounded step would shift point k by k times the rounding.
-        let resolution = resolution_mm(controller, options.machine_unit);
+        let resolution = resolution_mm(controller, options.file_unit());
         if ((step / resolution).round() * resolution - step).abs() > 1e-9 {
             return Err(EmitError::StepNotRepresentable {
                 controller: name,
@@ -434,7 +495,7 @@ pub fn check_table(
             value_mm: first_value,
         });
     }
-    let (position_limit_mm, value_limit) = format_limits_mm(controller, options.machine_unit);
+    let (position_limit_mm, value_limit) = format_limits_mm(controller, options.file_unit());
     if let Some(position_mm) = table
         .positions_mm
         .iter()
@@ -462,6 +523,51 @@ pub fn check_table(
                     limit_mm,
                 });
             }
+        }
+    }
+    Ok(())
+}
+
+/// What a rotary table must be for `controller` (module doc).
+fn check_rotary(
+    controller: Controller,
+    table: &CompensationTable,
+    options: &EmitOptions,
+) -> Result<(), EmitError> {
+    if options.kind != AxisKind::Rotary {
+        return Ok(());
+    }
+    match controller {
+        Controller::Fagor8055 | Controller::Fagor8065 => {
+            return Err(EmitError::RotaryNotSupported {
+                controller: controller.name(),
+            });
+        }
+        Controller::Sinumerik840d => {}
+        Controller::Itnc530 | Controller::Tnc640 | Controller::LinuxCnc => return Ok(()),
+    }
+    let (first, last) = (
+        table.positions_mm[0],
+        table.positions_mm[table.positions_mm.len() - 1],
+    );
+    if !options.is_full_turn(table) {
+        return Ok(());
+    }
+    if first.abs() > 1e-9 {
+        return Err(EmitError::ModuloRange {
+            first_deg: first,
+            last_deg: last,
+        });
+    }
+    let resolution = resolution_mm(controller, options.file_unit());
+    for direction in crate::measurement::Direction::BOTH {
+        let column = table.values.for_direction(direction);
+        let (first_deg, last_deg) = (column[0], column[column.len() - 1]);
+        if (first_deg - last_deg).abs() > resolution / 2.0 {
+            return Err(EmitError::ModuloEndsDiffer {
+                first_deg,
+                last_deg,
+            });
         }
     }
     Ok(())
@@ -528,7 +634,7 @@ fn check_read_back(
             controller.name()
         ))
     })?;
-    let tolerance_mm = resolution_mm(controller, options.machine_unit) / 2.0 + 1e-12;
+    let tolerance_mm = resolution_mm(controller, options.file_unit()) / 2.0 + 1e-12;
     let same_points = back.positions_mm.len() == table.positions_mm.len()
         && back
             .positions_mm
@@ -605,7 +711,7 @@ pub fn read_any(
         )?;
         (Controller::Sinumerik840d, table)
     } else if first.split_whitespace().count() == 3 {
-        let table = linuxcnc::read(text, &axis.axis, linuxcnc_type, options.machine_unit)?;
+        let table = linuxcnc::read(text, &axis.axis, linuxcnc_type, options.file_unit())?;
         (Controller::LinuxCnc, table)
     } else {
         return Err(ParseError::new(
@@ -741,6 +847,7 @@ mod tests {
             cec_first_table: 0,
             cec_values_are_corrections: controller == Controller::Sinumerik840d,
             tnc640_columns: Vec::new(),
+            kind: Default::default(),
         }
     }
 

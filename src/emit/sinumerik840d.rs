@@ -14,7 +14,10 @@
 //! setting (`cec_values`) because no public page states it outright.
 //!
 //! Numbers: mm, minimal digits with at least one decimal (`0.0023`,
-//! `100.0`), as the manual's examples; 1 nm resolution.
+//! `100.0`), as the manual's examples; 1 nm resolution. A rotary axis'
+//! table is in degrees; over a full turn it is a modulo table
+//! (`IS_MODULO = 1`, MIN 0, MAX 360, equal values at both ends: \[seen\]
+//! 840D / 808D function manuals, `../shared/spec/standards.md` §6).
 
 use std::collections::BTreeMap;
 
@@ -44,6 +47,9 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     })?;
     let first = table.positions_mm[0];
     let last = table.positions_mm[table.positions_mm.len() - 1];
+    // A rotary axis' full turn repeats: the table is cyclic, MIN 0°, MAX 360°
+    // with equal end values (checked by `emit::check_table`).
+    let modulo = u8::from(options.is_full_turn(table));
     let mut out = String::new();
     let mut line = |text: String| {
         out.push_str(&text);
@@ -61,7 +67,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
                 line(format!("$AA_ENC_COMP_STEP[{e},{name}]={}", number(step)));
                 line(format!("$AA_ENC_COMP_MIN[{e},{name}]={}", number(first)));
                 line(format!("$AA_ENC_COMP_MAX[{e},{name}]={}", number(last)));
-                line(format!("$AA_ENC_COMP_IS_MODULO[{e},{name}]=0"));
+                line(format!("$AA_ENC_COMP_IS_MODULO[{e},{name}]={modulo}"));
             }
         }
         TableValues::Bidirectional { up, down } => {
@@ -86,7 +92,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
                     line(format!("$AN_CEC_MAX[{t}]={}", number(last)));
                     line(format!("$AN_CEC_DIRECTION[{t}]={direction}"));
                     line(format!("$AN_CEC_MULT_BY_TABLE[{t}]=0"));
-                    line(format!("$AN_CEC_IS_MODULO[{t}]=0"));
+                    line(format!("$AN_CEC_IS_MODULO[{t}]={modulo}"));
                     t += 1;
                 }
             }
@@ -385,6 +391,7 @@ mod tests {
             cec_first_table: 0,
             cec_values_are_corrections: true,
             tnc640_columns: Vec::new(),
+            kind: Default::default(),
         }
     }
 

@@ -233,6 +233,7 @@ mod tests {
             cec_first_table: 0,
             cec_values_are_corrections: true,
             tnc640_columns: Vec::new(),
+            kind: Default::default(),
         }
     }
 

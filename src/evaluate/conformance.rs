@@ -16,6 +16,12 @@
 //!   step (within [`SAME_STEP_MM`]) is reported, but a recommendation does not
 //!   make the test non-conforming.
 //!
+//! A rotary axis ([`AxisKind::Rotary`], `standards.md` §6): one run per
+//! direction suffices over [`FULL_TURN_DEG`] (n = 1; R and A are then not
+//! evaluated, `evaluate::rotary`); the per-metre and spacing rules are
+//! linear ones and are not applied: a rotary test instead includes the
+//! principal angles (`evaluate::rotary` says which are missing).
+//!
 //! Not applied: the notes give a 250 mm average interval for axes over
 //! 2000 mm, unverified (`../shared/notes/anchors-and-standards.md` §4.2,
 //! marked \[U\]); the spec's 5 targets per metre is applied at every length.
@@ -25,7 +31,7 @@
 //! do) and the report's title.
 
 use crate::error::{Warning, mm_text};
-use crate::measurement::{Direction, Measurement};
+use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::units::MM_PER_M;
 
 /// The fewest targets ISO 230-2 accepts (spec "Test cycle").
@@ -37,6 +43,9 @@ pub const STANDARD_RUNS: usize = 5;
 /// Travel above which one run per direction suffices (spec "Edge cases";
 /// `standards.md` §6, GOST ISO 230-2-2016 §6.2), mm.
 pub const LONG_AXIS_MM: f64 = 2000.0;
+/// A rotary axis' range above which one run per direction suffices (n = 1,
+/// `standards.md` §6, GOST ISO 230-2-2016 §6.2), °.
+pub const FULL_TURN_DEG: f64 = 360.0;
 /// Steps between targets that differ by less than this are one step, mm: a
 /// micrometre, finer than any target is programmed.
 pub const SAME_STEP_MM: f64 = 0.001;
@@ -105,7 +114,9 @@ pub struct Check {
 /// The test against ISO 230-2's conditions.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TestConformance {
-    /// Travel: last target minus first, mm.
+    /// Linear or rotary: the unit of `length_mm`.
+    pub kind: AxisKind,
+    /// Travel: last target minus first, mm (° on a rotary axis).
     pub length_mm: f64,
     /// Number of targets.
     pub targets: usize,
@@ -149,14 +160,19 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
         .min()
         .unwrap_or(0);
     let directions = [runs_up, runs_down].iter().filter(|n| **n > 0).count();
-    let runs_required = if length_mm > LONG_AXIS_MM {
+    let kind = measurement.kind();
+    let one_run_length = match kind {
+        AxisKind::Linear => LONG_AXIS_MM,
+        AxisKind::Rotary => FULL_TURN_DEG,
+    };
+    let runs_required = if length_mm > one_run_length {
         1
     } else {
         STANDARD_RUNS
     };
     let per_metre = (length_mm > 0.0).then(|| targets as f64 / (length_mm / MM_PER_M));
     let step = constant_step_mm(targets_mm);
-    let checks = vec![
+    let mut checks = vec![
         Check {
             requirement: Requirement::Runs,
             met: fewest_runs >= runs_required,
@@ -189,7 +205,16 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
             required: None,
         },
     ];
+    if kind == AxisKind::Rotary {
+        checks.retain(|check| {
+            !matches!(
+                check.requirement,
+                Requirement::TargetsPerMetre | Requirement::IrregularSpacing
+            )
+        });
+    }
     TestConformance {
+        kind,
         length_mm,
         targets,
         runs_up,
@@ -226,7 +251,7 @@ impl TestConformance {
 
     /// Whether the travel is over [`LONG_AXIS_MM`].
     pub fn is_long_axis(&self) -> bool {
-        self.length_mm > LONG_AXIS_MM
+        self.kind == AxisKind::Linear && self.length_mm > LONG_AXIS_MM
     }
 
     /// What the test is, for the report's title: `bidirectional test, 5 runs,
@@ -244,12 +269,19 @@ impl TestConformance {
             (up, down) if up == down => format!("{up} runs"),
             (up, down) => format!("{up}↑ {down}↓ runs"),
         };
+        let (space, unit) = match self.kind {
+            AxisKind::Linear => (" ", "mm"),
+            AxisKind::Rotary => ("", "°"),
+        };
         let mut title = format!(
-            "{kind}, {runs}, {} target{} over {} mm",
+            "{kind}, {runs}, {} target{} over {}{space}{unit}",
             self.targets,
             if self.targets == 1 { "" } else { "s" },
             mm_text(self.length_mm)
         );
+        if self.kind == AxisKind::Rotary {
+            title.insert_str(0, "rotary axis, ");
+        }
         let missed: Vec<&str> = self
             .checks
             .iter()
@@ -262,6 +294,9 @@ impl TestConformance {
                 title.push_str(EDITION);
                 if self.is_long_axis() && self.runs_up.max(self.runs_down) == 1 {
                     title.push_str(" (one run: axis over 2000 mm)");
+                }
+                if self.kind == AxisKind::Rotary && self.length_mm > FULL_TURN_DEG {
+                    title.push_str(" (one run: rotary axis over 360°)");
                 }
             }
             [only] => title.push_str(&format!(": does not meet ISO 230-2's {only}")),
@@ -288,6 +323,7 @@ impl TestConformance {
         }
         if missed(Requirement::Runs) {
             warnings.push(Warning::TooFewRuns {
+                kind: self.kind,
                 runs_up: self.runs_up,
                 runs_down: self.runs_down,
                 required: STANDARD_RUNS,
@@ -295,7 +331,12 @@ impl TestConformance {
         }
         if missed(Requirement::Targets) || missed(Requirement::TargetsPerMetre) {
             let for_length = (MIN_TARGETS_PER_M * self.length_mm / MM_PER_M - 1e-9).ceil();
+            let for_length = match self.kind {
+                AxisKind::Linear => for_length,
+                AxisKind::Rotary => 0.0,
+            };
             warnings.push(Warning::TooFewTargets {
+                kind: self.kind,
                 targets: self.targets,
                 length_mm: self.length_mm,
                 required: MIN_TARGETS.max(for_length as usize),
@@ -382,6 +423,7 @@ mod tests {
         assert_eq!(
             c.warnings(),
             vec![Warning::TooFewTargets {
+                kind: AxisKind::Linear,
                 targets: 6,
                 length_mm: 1500.0,
                 required: 8

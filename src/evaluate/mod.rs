@@ -14,20 +14,23 @@
 //! [`environment`] checks the test conditions: the refractive index the laser
 //! used against Edlén's equation. [`conformance`] checks the test itself
 //! against ISO 230-2 (targets, runs, directions, spacing); its warnings come
-//! first in [`Evaluation::warnings`].
+//! first in [`Evaluation::warnings`]. A rotary axis is evaluated the same
+//! way in degrees; [`rotary`] adds what ISO 230-2 asks of one (the n = 1
+//! rule over 360°, the principal angles, the two ends of a full turn).
 //!
-//! Pure: no I/O, no printing. All lengths in mm.
+//! Pure: no I/O, no printing. All lengths in mm, angles in degrees.
 
 pub mod conformance;
 pub mod environment;
 pub mod outliers;
+pub mod rotary;
 pub mod standard;
 pub mod targets;
 pub mod uncertainty;
 pub mod verdict;
 
 use crate::error::Warning;
-use crate::measurement::{Direction, Measurement};
+use crate::measurement::{AxisKind, Direction, Measurement};
 pub use conformance::TestConformance;
 use environment::{RefractiveIndexCheck, check_refractive_index};
 pub use outliers::SuspectedOutlier;
@@ -186,13 +189,36 @@ pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Eval
     let runs_down = measurement.run_count(Direction::Down);
     let conformance = conformance::check_test(measurement);
     let mut warnings = conformance.warnings();
-    warnings.extend(coverage_warnings(&per_target, runs_up, runs_down));
-    let figures = standard.axis_figures(&per_target);
+    let kind = measurement.kind();
+    warnings.extend(coverage_warnings(&per_target, runs_up, runs_down, kind));
+    let mut figures = standard.axis_figures(&per_target);
+    let mut standard_figures = standard.figures(&per_target, &figures);
+    if kind == AxisKind::Rotary {
+        warnings.extend(rotary::warnings(&per_target));
+        if rotary::over_full_turn(measurement.targets_mm()) {
+            // ISO 230-2's n = 1 rule: the scatter figures are not evaluated.
+            for figure in [
+                &mut figures.a_mm,
+                &mut figures.a_up_mm,
+                &mut figures.a_down_mm,
+                &mut figures.r_mm,
+                &mut figures.r_up_mm,
+                &mut figures.r_down_mm,
+            ] {
+                *figure = None;
+            }
+            for figure in &mut standard_figures {
+                if rotary::FIGURES_NEEDING_REPEATS.contains(&figure.key) {
+                    figure.value_mm = None;
+                }
+            }
+        }
+    }
     Evaluation {
         conformance,
         refractive_index: check_refractive_index(&measurement.environment),
         standard: StandardUsed::of(standard),
-        standard_figures: standard.figures(&per_target, &figures),
+        standard_figures,
         figures,
         outliers: outliers::suspected_outliers(measurement),
         per_target,
@@ -204,7 +230,12 @@ pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Eval
 
 /// Says what is not evaluated and why: n = 1, or a target without enough
 /// readings (one direction only is said by [`conformance`]).
-fn coverage_warnings(per_target: &[TargetStats], runs_up: usize, runs_down: usize) -> Vec<Warning> {
+fn coverage_warnings(
+    per_target: &[TargetStats],
+    runs_up: usize,
+    runs_down: usize,
+    kind: AxisKind,
+) -> Vec<Warning> {
     let mut warnings = Vec::new();
     let measured: Vec<Direction> = Direction::BOTH
         .into_iter()
@@ -230,6 +261,7 @@ fn coverage_warnings(per_target: &[TargetStats], runs_up: usize, runs_down: usiz
                 _ => continue,
             };
             warnings.push(Warning::TargetNotEvaluated {
+                kind,
                 target_mm: target.target_mm,
                 missing,
             });

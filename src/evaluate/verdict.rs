@@ -927,6 +927,7 @@ mod tests {
             runs_down: 5,
             outliers: Vec::new(),
             conformance: crate::evaluate::TestConformance {
+                kind: Default::default(),
                 length_mm: last_mm - first_mm,
                 targets: 2,
                 runs_up: 5,

@@ -26,43 +26,67 @@
 //!   the two marks, or writes both in one number (`1.234,5`), is refused at
 //!   the number. Trailing separators after a `#` line (Excel pads every row
 //!   to the width of the sheet) and rows of empty fields are ignored.
+//! - A rotary axis has the header [`ROTARY_HEADER`],
+//!   `target_deg,run,direction,deviation_arcsec`: targets in degrees,
+//!   deviations in arc-seconds (″), otherwise the same layout; the header
+//!   alone says which ([`AxisKind`]).
 
 use std::collections::HashMap;
 
 use crate::error::{ParseError, Warning, describe_found};
 use crate::measurement::{
-    AXIS_PLACEHOLDER, AxisSource, Direction, Environment, Measurement, Metadata, Run, SourceFormat,
-    TestDate,
+    AXIS_PLACEHOLDER, AxisKind, AxisSource, Direction, Environment, Measurement, Metadata, Run,
+    SourceFormat, TestDate,
 };
 use crate::read::text::{
-    self, Line, check_deviation_mm, check_target_mm, end_of_file_line, split_key,
+    self, Line, check_deviation_deg, check_deviation_mm, check_target_mm, end_of_file_line,
+    split_key,
 };
-use crate::read::{missing_readings_warning, parse_date};
-use crate::units::{LengthUnit, um_text, um_to_mm};
+use crate::read::{missing_readings_warning_of, parse_date};
+use crate::units::{LengthUnit, arcsec_text, arcsec_to_deg, um_text, um_to_mm};
 
 /// The header line, lowercase, without spaces, as axcomp writes it.
 pub const HEADER: &str = "target_mm,run,direction,deviation_um";
 
-/// The header's field names, in order.
-const HEADER_FIELDS: [&str; 4] = ["target_mm", "run", "direction", "deviation_um"];
+/// The header of a rotary axis: degrees and arc-seconds.
+pub const ROTARY_HEADER: &str = "target_deg,run,direction,deviation_arcsec";
+
+/// The header's field names, in order, per kind.
+fn header_fields(kind: AxisKind) -> [&'static str; 4] {
+    match kind {
+        AxisKind::Linear => ["target_mm", "run", "direction", "deviation_um"],
+        AxisKind::Rotary => ["target_deg", "run", "direction", "deviation_arcsec"],
+    }
+}
 
 /// The field separator of a header line (`,`, `;` or tab), or `None` when
 /// the line is not the header.
 pub fn header_separator(line: &str) -> Option<char> {
-    [',', ';', '\t'].into_iter().find(|&separator| {
-        let mut fields = line.split(separator).map(str::trim);
-        HEADER_FIELDS
-            .iter()
-            .all(|name| fields.next().is_some_and(|f| f.eq_ignore_ascii_case(name)))
-            && fields.next().is_none()
-    })
+    header_layout(line).map(|(separator, _)| separator)
 }
 
-/// How the file writes its rows: the header's separator, and the decimal
-/// mark the first number with a fraction used (with its line).
+/// The separator and the kind of axis a header line states.
+fn header_layout(line: &str) -> Option<(char, AxisKind)> {
+    [AxisKind::Linear, AxisKind::Rotary]
+        .into_iter()
+        .find_map(|kind| {
+            [',', ';', '\t'].into_iter().find_map(|separator| {
+                let mut fields = line.split(separator).map(str::trim);
+                let matches = header_fields(kind)
+                    .iter()
+                    .all(|name| fields.next().is_some_and(|f| f.eq_ignore_ascii_case(name)))
+                    && fields.next().is_none();
+                matches.then_some((separator, kind))
+            })
+        })
+}
+
+/// How the file writes its rows: the header's separator and kind, and the
+/// decimal mark the first number with a fraction used (with its line).
 #[derive(Clone, Copy, Debug)]
 struct Layout {
     separator: char,
+    kind: AxisKind,
     decimal: Option<(char, usize)>,
 }
 
@@ -133,14 +157,17 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
             continue;
         }
         let Some(layout) = layout.as_mut() else {
-            let Some(separator) = header_separator(trimmed) else {
+            let Some((separator, kind)) = header_layout(trimmed) else {
                 return Err(line.expected_at(
                     trimmed,
-                    &format!("the header {HEADER} (or with ';' or tabs between the names)"),
+                    &format!(
+                        "the header {HEADER} or {ROTARY_HEADER} (or with ';' or tabs between the names)"
+                    ),
                 ));
             };
             layout = Some(Layout {
                 separator,
+                kind,
                 decimal: None,
             });
             continue;
@@ -161,20 +188,23 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
             return Err(line.error_at(
                 trimmed,
                 format!(
-                    "run {}{} at {} mm is listed twice (first at line {first})",
-                    reading.run, reading.direction, reading.target_mm
+                    "run {}{} at {} {} is listed twice (first at line {first})",
+                    reading.run,
+                    reading.direction,
+                    reading.target_mm,
+                    layout.kind.position_unit()
                 ),
             ));
         }
         readings.push(reading);
     }
-    if layout.is_none() {
+    let Some(layout) = layout else {
         return Err(ParseError::new(
             end_of_file_line(input),
             1,
             format!("expected the header {HEADER}, found end of file"),
         ));
-    }
+    };
     if readings.is_empty() {
         return Err(ParseError::new(
             end_of_file_line(input),
@@ -187,7 +217,7 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
     targets_mm.sort_by(f64::total_cmp);
     targets_mm.dedup();
     let runs = assemble_runs(&readings, &targets_mm, &mut warnings);
-    if let Some(warning) = missing_readings_warning(&runs, &targets_mm) {
+    if let Some(warning) = missing_readings_warning_of(&runs, &targets_mm, layout.kind) {
         warnings.push(warning);
     }
     metadata.source_format = Some(SourceFormat::Csv);
@@ -200,7 +230,8 @@ pub fn parse(input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
         None => AXIS_PLACEHOLDER.to_string(),
     };
     let measurement = Measurement::new(axis, targets_mm, runs, Environment::default(), metadata)
-        .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
+        .map_err(|error| ParseError::new(1, 1, error.to_string()))?
+        .with_kind(layout.kind);
     Ok((measurement, warnings))
 }
 
@@ -226,11 +257,20 @@ pub fn write(measurement: &Measurement) -> String {
             out.push_str(&format!("# {key}: {value}\n"));
         }
     }
-    out.push_str(HEADER);
+    let kind = measurement.kind();
+    out.push_str(match kind {
+        AxisKind::Linear => HEADER,
+        AxisKind::Rotary => ROTARY_HEADER,
+    });
     out.push('\n');
     for run in measurement.runs() {
         for (target_mm, deviation_mm) in measurement.targets_mm().iter().zip(&run.deviations_mm) {
-            let deviation = deviation_mm.map(um_text).unwrap_or_default();
+            let deviation = deviation_mm
+                .map(|value| match kind {
+                    AxisKind::Linear => um_text(value),
+                    AxisKind::Rotary => arcsec_text(value),
+                })
+                .unwrap_or_default();
             out.push_str(&format!(
                 "{target_mm},{},{},{deviation}\n",
                 run.number,
@@ -261,12 +301,17 @@ fn reading(line: &Line<'_>, layout: &mut Layout) -> Result<Reading, ParseError> 
         return Err(line.error_at(
             line.text.trim_start(),
             format!(
-                "row has {} field(s), expected 4: target_mm,run,direction,deviation_um{hint}",
-                fields.len()
+                "row has {} field(s), expected 4: {}{hint}",
+                fields.len(),
+                header_fields(layout.kind).join(",")
             ),
         ));
     }
-    let target_mm = layout.number(line, fields[0], "target in mm")?;
+    let target_what = match layout.kind {
+        AxisKind::Linear => "target in mm",
+        AxisKind::Rotary => "target in degrees",
+    };
+    let target_mm = layout.number(line, fields[0], target_what)?;
     check_target_mm(target_mm, line.number, line.column_of(fields[0]))?;
     let run = text::integer(line, fields[1], "run number")?;
     if run == 0 {
@@ -280,12 +325,18 @@ fn reading(line: &Line<'_>, layout: &mut Layout) -> Result<Reading, ParseError> 
     let deviation_mm = if fields[3].is_empty() {
         None
     } else {
-        let deviation_mm = um_to_mm(layout.number(line, fields[3], "deviation in µm")?);
-        Some(check_deviation_mm(
-            deviation_mm,
-            line.number,
-            line.column_of(fields[3]),
-        )?)
+        let column = line.column_of(fields[3]);
+        Some(match layout.kind {
+            AxisKind::Linear => {
+                let deviation_mm = um_to_mm(layout.number(line, fields[3], "deviation in µm")?);
+                check_deviation_mm(deviation_mm, line.number, column)?
+            }
+            AxisKind::Rotary => {
+                let deviation_deg =
+                    arcsec_to_deg(layout.number(line, fields[3], "deviation in ″")?);
+                check_deviation_deg(deviation_deg, line.number, column)?
+            }
+        })
     };
     Ok(Reading {
         target_mm,
@@ -420,6 +471,36 @@ mod tests {
         let (unnamed, _) = parse(&text.replace("# axis: Z\n", "")).unwrap();
         let (again, _) = parse(&write(&unnamed)).unwrap();
         assert_eq!(again.axis_source(), &AxisSource::NotRecorded);
+    }
+
+    #[test]
+    fn the_rotary_header_reads_degrees_and_arc_seconds() {
+        let text = "# axis: C\ntarget_deg;run;direction;deviation_arcsec\n0;1;up;1,8\n90;1;up;-3,6\n0;1;down;0\n90;1;down;\n";
+        let (c, warnings) = parse(text).unwrap();
+        assert_eq!(c.kind(), AxisKind::Rotary);
+        assert!(
+            warnings[0].to_string().contains("run 1↓ at 90°"),
+            "{warnings:?}"
+        );
+        assert_eq!(c.targets_mm(), &[0.0, 90.0]);
+        // 1.8″ = 0.0005°, −3.6″ = −0.001° (1° = 3600″, by hand).
+        let up = &c.runs()[0].deviations_mm;
+        assert!((up[0].unwrap() - 0.0005).abs() < 1e-15 && (up[1].unwrap() + 0.001).abs() < 1e-15);
+        let written = write(&c);
+        assert!(
+            written
+                .contains("target_deg,run,direction,deviation_arcsec\n0,1,up,1.8\n90,1,up,-3.6\n"),
+            "{written}"
+        );
+        let (again, _) = parse(&written).unwrap();
+        assert_eq!((again.kind(), again.runs()), (AxisKind::Rotary, c.runs()));
+        #[rustfmt::skip]
+        let cases = [
+            ("target_deg,run,direction,deviation_arcsec\n0,1,up,3601\n", (2, 8), "within ±3600″"),
+            ("target_deg,run,direction,deviation_arcsec\n0,1,up\n", (2, 1), "expected 4: target_deg,run,direction,deviation_arcsec"),
+            ("target_deg,run,direction,deviation_um\n", (1, 1), "or target_deg,run,direction,deviation_arcsec"),
+        ];
+        text::assert_errors_at(parse, &cases);
     }
 
     #[test]

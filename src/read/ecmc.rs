@@ -3,7 +3,8 @@
 //! The format, as the ecmc scripts write it and the real files under
 //! `../shared/data/ecmc/` show (`../shared/data/SOURCES.md`, "Format quirks"):
 //! `KEY=VALUE` lines, `#` comments, blank lines anywhere. Keys:
-//! `UNIT` (mm), `CYCLES` (n), `POSITIONS` (m), `DEC` (print decimals),
+//! `UNIT` (mm, inch, or an angle: `deg`, `degree`, `degrees`, `°`, which
+//! makes the measurement a rotary axis in degrees), `CYCLES` (n), `POSITIONS` (m), `DEC` (print decimals),
 //! `REF_PV`/`TEST_PV`/`TGT_SET_PV` (EPICS names, kept), `TGT_DATA[i]` (target i),
 //! `REF_DATA_FWD[i,j]` and `REF_DATA_BWD[i,j]` (actual position at target i in
 //! cycle j). The first line of most files glues a comment onto a key
@@ -41,11 +42,13 @@
 
 use crate::error::{ParseError, Warning};
 use crate::measurement::{
-    AXIS_PLACEHOLDER, AxisSource, Direction, Environment, Measurement, Metadata, Run, SourceFormat,
+    AXIS_PLACEHOLDER, AxisKind, AxisSource, Direction, Environment, Measurement, Metadata, Run,
+    SourceFormat,
 };
-use crate::read::missing_readings_warning;
+use crate::read::missing_readings_warning_of;
 use crate::read::text::{
-    self, Line, check_deviation_mm, check_target_mm, end_of_file_line, split_key,
+    self, Line, check_deviation_deg, check_deviation_mm, check_target_mm, end_of_file_line,
+    split_key,
 };
 use crate::units::LengthUnit;
 
@@ -106,7 +109,7 @@ struct Entry {
 
 #[derive(Default)]
 struct EcmcFile {
-    unit: Option<LengthUnit>,
+    unit: Option<Unit>,
     cycles: Option<Declared>,
     positions: Option<Declared>,
     targets: Vec<Entry>,
@@ -229,7 +232,7 @@ impl EcmcFile {
         for entry in self.forward.iter().chain(&self.backward) {
             check_range(entry, position_count, cycle_count)?;
         }
-        let unit = self.unit.unwrap_or_default();
+        let unit = self.unit.unwrap_or(Unit::Length(LengthUnit::Millimetre));
         let mut target_of_position = vec![None; position_count];
         for entry in &self.targets {
             if let Some(first) = target_of_position[entry.position_index - 1].replace(*entry) {
@@ -290,7 +293,11 @@ impl EcmcFile {
             .iter()
             .map(|&i| {
                 let target = targets[i];
-                check_target_mm(unit.to_mm(target.value), target.line, target.value_column)
+                check_target_mm(
+                    unit.to_inner(target.value),
+                    target.line,
+                    target.value_column,
+                )
             })
             .collect::<Result<_, _>>()?;
         let grid = |entries: &[Entry], name: &str| -> Result<Vec<Vec<Option<f64>>>, ParseError> {
@@ -308,11 +315,13 @@ impl EcmcFile {
                         ),
                     ));
                 }
-                let deviation = check_deviation_mm(
-                    unit.to_mm(entry.value - targets[position].value),
-                    entry.line,
-                    entry.value_column,
-                )?;
+                let deviation = unit.to_inner(entry.value - targets[position].value);
+                let deviation = match unit {
+                    Unit::Length(_) => {
+                        check_deviation_mm(deviation, entry.line, entry.value_column)?
+                    }
+                    Unit::Degree => check_deviation_deg(deviation, entry.line, entry.value_column)?,
+                };
                 grid[cycle][position] = Some(deviation);
                 lines[cycle][position] = entry.line;
             }
@@ -352,13 +361,16 @@ impl EcmcFile {
                 "expected REF_DATA_FWD[i,j]= or REF_DATA_BWD[i,j]= lines, found none",
             ));
         }
-        if let Some(warning) = missing_readings_warning(&runs, &targets_mm) {
+        if let Some(warning) = missing_readings_warning_of(&runs, &targets_mm, unit.kind()) {
             self.warnings.push(warning);
         }
         self.metadata.source_format = Some(SourceFormat::Ecmc);
         // The reference measuring system is known only by the signal it was read from.
         self.metadata.setup.instrument = reference_instrument(&self.metadata.extra);
-        self.metadata.length_unit = unit;
+        if let Unit::Length(length_unit) = unit {
+            self.metadata.length_unit = length_unit;
+        }
+        let kind = unit.kind();
         let axis = self.axis();
         let measurement = Measurement::new(
             axis,
@@ -367,7 +379,8 @@ impl EcmcFile {
             Environment::default(),
             self.metadata,
         )
-        .map_err(|error| ParseError::new(1, 1, error.to_string()))?;
+        .map_err(|error| ParseError::new(1, 1, error.to_string()))?
+        .with_kind(kind);
         Ok((measurement, self.warnings))
     }
 }
@@ -597,15 +610,39 @@ fn declared(line: &Line<'_>, value: &str, what: &str) -> Result<Declared, ParseE
     })
 }
 
-fn unit(line: &Line<'_>, value: &str) -> Result<LengthUnit, ParseError> {
-    match value.to_ascii_lowercase().as_str() {
-        "mm" => Ok(LengthUnit::Millimetre),
-        "inch" | "in" => Ok(LengthUnit::Inch),
+/// The unit of a file's values: a length (linear axis) or degrees (rotary).
+#[derive(Clone, Copy, Debug)]
+enum Unit {
+    Length(LengthUnit),
+    Degree,
+}
+
+impl Unit {
+    /// The kind of axis a file in this unit measured.
+    fn kind(self) -> AxisKind {
+        match self {
+            Unit::Length(_) => AxisKind::Linear,
+            Unit::Degree => AxisKind::Rotary,
+        }
+    }
+
+    /// A value of the file in axcomp's inner unit: mm, or degrees as they are.
+    fn to_inner(self, value: f64) -> f64 {
+        match self {
+            Unit::Length(length_unit) => length_unit.to_mm(value),
+            Unit::Degree => value,
+        }
+    }
+}
+
+fn unit(line: &Line<'_>, value: &str) -> Result<Unit, ParseError> {
+    match value.to_lowercase().as_str() {
+        "mm" => Ok(Unit::Length(LengthUnit::Millimetre)),
+        "inch" | "in" => Ok(Unit::Length(LengthUnit::Inch)),
+        "deg" | "degree" | "degrees" | "°" => Ok(Unit::Degree),
         _ => Err(line.error_at(
             value,
-            format!(
-                "expected UNIT=mm or UNIT=inch, found {value:?} (rotary axes are not supported)"
-            ),
+            format!("expected UNIT=mm, UNIT=inch or, for a rotary axis, UNIT=deg, found {value:?}"),
         )),
     }
 }
@@ -680,6 +717,19 @@ mod tests {
     }
 
     #[test]
+    fn an_angular_unit_makes_a_rotary_axis_in_degrees() {
+        let text = "UNIT=deg\nTGT_DATA[1]=0\nTGT_DATA[2]=90\n\
+            REF_DATA_FWD[1,1]=0.001\nREF_DATA_FWD[2,1]=89.998\n";
+        let c = parse_ok(text);
+        assert_eq!(c.kind(), AxisKind::Rotary);
+        assert_eq!(c.targets_mm(), &[0.0, 90.0]);
+        // 89.998° − 90° = −0.002° = −7.2″, kept in degrees.
+        let second = c.runs()[0].deviations_mm[1].unwrap();
+        assert!((second + 0.002).abs() < 1e-12, "{second}");
+        assert_eq!(parse_ok(SMALL).kind(), AxisKind::Linear);
+    }
+
+    #[test]
     fn counts_are_inferred_when_absent() {
         let text = "TGT_DATA[1]=0\nTGT_DATA[2]=5\nREF_DATA_FWD[1,1]=0\nREF_DATA_FWD[2,1]=5.001\n";
         let m = parse_ok(text);
@@ -695,7 +745,8 @@ mod tests {
             ("POSITIONS=1\nTGT_DATA[2]=1\nREF_DATA_FWD[2,1]=1\n", (2, 10), "beyond POSITIONS=1"),
             ("TGT_DATA[1]=1\nTGT_DATA[1]=2\nREF_DATA_FWD[1,1]=1\n", (2, 10), "given twice"),
             ("TGT_DATA[1]=1\nTGT_DATA[2]=1\nREF_DATA_FWD[1,1]=1\n", (2, 10), "duplicate target"),
-            ("UNIT=deg\n", (1, 6), "rotary"),
+            ("UNIT=rad\n", (1, 6), "for a rotary axis, UNIT=deg"),
+            ("UNIT=deg\nTGT_DATA[1]=90\nREF_DATA_FWD[1,1]=91.5\n", (3, 19), "within ±3600″ (±1°), found 5400″"),
             // Found by fuzzing: an index that sized a table of gigabytes.
             ("TGT_DATA[99239814]=5\n", (1, 10), "index 99239814 is too large"),
             ("TGT_DATA[1,2]=1\n", (1, 1), "takes 1 index"),

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use chrono::NaiveDateTime;
 
 use crate::error::{ParseError, Warning};
-use crate::measurement::{Measurement, MeasurementError, Run, SourceFormat};
+use crate::measurement::{AxisKind, Measurement, MeasurementError, Run, SourceFormat};
 use crate::together::{Input, NotTogether, Pairing, check_together};
 
 /// A measurement read from one or more files, with what the readers noticed.
@@ -299,6 +299,15 @@ pub fn parse_date(raw: &str) -> Option<NaiveDateTime> {
 
 /// A warning listing missing readings, or `None` when every reading is there.
 pub(crate) fn missing_readings_warning(runs: &[Run], targets_mm: &[f64]) -> Option<Warning> {
+    missing_readings_warning_of(runs, targets_mm, AxisKind::Linear)
+}
+
+/// [`missing_readings_warning`] for an axis of `kind` (its targets in ° on a rotary axis).
+pub(crate) fn missing_readings_warning_of(
+    runs: &[Run],
+    targets_mm: &[f64],
+    kind: AxisKind,
+) -> Option<Warning> {
     let mut count = 0;
     let mut examples = Vec::new();
     for run in runs {
@@ -306,7 +315,10 @@ pub(crate) fn missing_readings_warning(runs: &[Run], targets_mm: &[f64]) -> Opti
             if value.is_none() {
                 count += 1;
                 if examples.len() < 3 {
-                    examples.push(format!("run {} at {target_mm} mm", run.label()));
+                    examples.push(match kind {
+                        AxisKind::Linear => format!("run {} at {target_mm} mm", run.label()),
+                        AxisKind::Rotary => format!("run {} at {target_mm}°", run.label()),
+                    });
                 }
             }
         }

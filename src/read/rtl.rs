@@ -26,6 +26,12 @@
 
 use std::collections::HashMap;
 
+/// The `Owner` value taken to mark a rotary (XR20) test. No rotary `.rtl`
+/// sample is public (`../shared/spec/standards.md` §6), so this is the one
+/// assumption about one: its header says `Owner : Rotary`, and the rest of
+/// its layout is unknown, so such a file is refused at that line.
+pub const ROTARY_OWNER: &str = "Rotary";
+
 use nom::bytes::complete::{tag, take_while1};
 use nom::character::complete::space0;
 use nom::combinator::all_consuming;
@@ -355,6 +361,15 @@ impl RtlParser {
         let (key, value) = key_value(line)?;
         match key.to_ascii_lowercase().as_str() {
             "owner" => {
+                if value.eq_ignore_ascii_case(ROTARY_OWNER) {
+                    return Err(line.error_at(
+                        value,
+                        format!(
+                            "found Owner : {value}, a rotary axis test: the layout of Renishaw's rotary files is not public, \
+                             so it is not read; export the data as CSV with the header target_deg,run,direction,deviation_arcsec (README, CSV)"
+                        ),
+                    ));
+                }
                 if !value.eq_ignore_ascii_case("linear") {
                     return Err(line.error_at(
                         value,

@@ -18,7 +18,7 @@ use nom::sequence::pair;
 use nom::{IResult, Parser};
 
 use crate::error::{ParseError, describe_found};
-use crate::units::mm_to_um;
+use crate::units::{deg_to_arcsec, mm_to_um};
 
 /// One line of a file: its 1-based number and its text without the line end.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -189,6 +189,28 @@ pub fn check_deviation_mm(value_mm: f64, line: usize, column: usize) -> Result<f
         format!(
             "expected a deviation within ±{} µm (±1 m), found {found}: check the unit and the column of the file",
             mm_to_um(MAX_DEVIATION_MM),
+        ),
+    ))
+}
+
+/// Largest deviation of a rotary axis accepted, degrees, either sign: 1°,
+/// 3600″, where positioning errors are arc-seconds: beyond it is a wrong unit
+/// or column ([`check_deviation_deg`]).
+pub const MAX_DEVIATION_DEG: f64 = 1.0;
+
+/// Refuses a rotary deviation (already in degrees) that is not finite or
+/// beyond [`MAX_DEVIATION_DEG`], at the given line and column.
+pub fn check_deviation_deg(value_deg: f64, line: usize, column: usize) -> Result<f64, ParseError> {
+    if value_deg.abs() <= MAX_DEVIATION_DEG {
+        return Ok(value_deg);
+    }
+    Err(ParseError::new(
+        line,
+        column,
+        format!(
+            "expected a rotary deviation within ±{}″ (±1°), found {}″: check the unit and the column of the file",
+            deg_to_arcsec(MAX_DEVIATION_DEG),
+            shown(deg_to_arcsec(value_deg)),
         ),
     ))
 }

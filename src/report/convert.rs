@@ -19,6 +19,11 @@
 //! same reversal as the value to type into the controller, in its unit
 //! (`value` in `unit`), and is null where the controller has no parameter
 //! that works next to the table (LinuxCNC), when `backlash_note` says why.
+//!
+//! A rotary axis' object carries its units in the same keys: `file_unit`
+//! `deg`, `positions_deg`, `start_deg`, `step_deg`, `reference_deg`,
+//! `values_arcsec`, `suggested_backlash_arcsec`; its backlash is a
+//! `backlash_note` (the parameters' rotary inputs are degrees).
 
 use std::fmt::Write;
 
@@ -26,8 +31,9 @@ use serde::Serialize;
 
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::BacklashAdvice;
+use crate::measurement::AxisKind;
 use crate::report::format::{inch_text, um};
-use crate::units::{LengthUnit, mm_to_um, um_to_mm};
+use crate::units::{LengthUnit, deg_to_arcsec, mm_to_um, um_to_mm};
 
 /// The table's values, µm.
 #[derive(Clone, Debug, Serialize)]
@@ -65,9 +71,13 @@ pub struct BacklashParameterJson {
     pub value_text: String,
 }
 
-/// The whole `convert --json` object.
-#[derive(Clone, Debug, Serialize)]
+/// The whole `convert --json` object. On a rotary axis (`kind`) the `_mm`
+/// fields hold ° and the `_um` fields ″, serialised under `_deg` and
+/// `_arcsec` keys (module doc).
+#[derive(Clone, Debug)]
 pub struct ConvertJson {
+    /// Linear or rotary: the unit of the values and of the keys.
+    pub kind: AxisKind,
     /// The unit of the positions and values in the file written: `mm` or
     /// `inch` (the controller's, from the machine profile; for a Fagor 8055
     /// without one, the test's).
@@ -110,8 +120,9 @@ pub struct ConvertJson {
 }
 
 impl ConvertJson {
-    /// Builds the wire object.
+    /// Builds the wire object of an axis of `kind` (values in ″ on a rotary axis).
     pub fn new(
+        kind: AxisKind,
         controller: &'static str,
         file: String,
         table: &CompensationTable,
@@ -119,9 +130,17 @@ impl ConvertJson {
         activation: String,
         warnings: Vec<String>,
     ) -> ConvertJson {
-        let to_um = |values: &[f64]| values.iter().copied().map(mm_to_um).collect();
+        let shown = match kind {
+            AxisKind::Linear => mm_to_um,
+            AxisKind::Rotary => deg_to_arcsec,
+        };
+        let to_um = |values: &[f64]| values.iter().copied().map(shown).collect();
         ConvertJson {
-            file_unit: LengthUnit::Millimetre.as_str(),
+            kind,
+            file_unit: match kind {
+                AxisKind::Linear => LengthUnit::Millimetre.as_str(),
+                AxisKind::Rotary => "deg",
+            },
             controller,
             file,
             axis: table.axis.clone(),
@@ -141,7 +160,7 @@ impl ConvertJson {
                     down: to_um(down),
                 },
             },
-            suggested_backlash_um: table.suggested_backlash_mm.map(mm_to_um),
+            suggested_backlash_um: table.suggested_backlash_mm.map(shown),
             backlash_parameter: None,
             backlash_note: None,
             activation,
@@ -151,8 +170,19 @@ impl ConvertJson {
     }
 
     /// Sets what the controller does with the suggested backlash
-    /// ([`crate::emit::Controller::backlash_parameter`]).
+    /// ([`crate::emit::Controller::backlash_parameter`]). A rotary axis'
+    /// parameters take degrees, which the advice (in lengths) does not say:
+    /// it gets a note with the value in ° instead.
     pub fn set_backlash(&mut self, advice: BacklashAdvice) {
+        if self.kind == AxisKind::Rotary {
+            let backlash_arcsec = self.suggested_backlash_um.unwrap_or_default();
+            self.backlash_parameter = None;
+            self.backlash_note = Some(format!(
+                "a rotary axis: enter −B̄ = {backlash_arcsec:.2}″ = {:.4}° in the controller's backlash parameter for the axis, whose rotary input is degrees, or write the table with --mode bidirectional",
+                backlash_arcsec / 3600.0
+            ));
+            return;
+        }
         match advice {
             BacklashAdvice::Parameter(parameter) => {
                 self.backlash_parameter = Some(BacklashParameterJson {
@@ -175,9 +205,13 @@ impl ConvertJson {
     /// The terminal summary: what was written, the table, how to activate it.
     pub fn summary(&self) -> String {
         let mut out = String::new();
-        let step = self
-            .step_mm
-            .map_or("uneven spacing".to_string(), |s| format!("step {s} mm"));
+        let (position_unit, value_unit) = match self.kind {
+            AxisKind::Linear => (" mm", "µm"),
+            AxisKind::Rotary => ("°", "″"),
+        };
+        let step = self.step_mm.map_or("uneven spacing".to_string(), |s| {
+            format!("step {s}{position_unit}")
+        });
         let also = if self.also.is_empty() {
             String::new()
         } else {
@@ -185,7 +219,7 @@ impl ConvertJson {
         };
         let _ = writeln!(
             out,
-            "Wrote {} for {}: {} table of axis {}{also}, {} points from {} to {} mm, {step}, zero at {} mm",
+            "Wrote {} for {}: {} table of axis {}{also}, {} points from {} to {}{position_unit}, {step}, zero at {}{position_unit}",
             self.file,
             self.controller,
             self.mode,
@@ -203,7 +237,7 @@ impl ConvertJson {
                 (Some(parameter), _) => {
                     let _ = writeln!(
                         out,
-                        "Backlash parameter: {} = {} {} (−B̄ = {backlash_um:.2} µm)\n  sign: {}",
+                        "Backlash parameter: {} = {} {} (−B̄ = {backlash_um:.2} {value_unit})\n  sign: {}",
                         parameter.name, parameter.value_text, parameter.unit, parameter.sign
                     );
                     if let Some(note) = &parameter.note {
@@ -216,27 +250,28 @@ impl ConvertJson {
                 (None, None) => {
                     let _ = writeln!(
                         out,
-                        "Reversal left by the mean table: −B̄ = {backlash_um:.2} µm (set the controller's backlash parameter to it, in the controller's unit)"
+                        "Reversal left by the mean table: −B̄ = {backlash_um:.2} {value_unit} (set the controller's backlash parameter to it, in the controller's unit)"
                     );
                 }
             }
         }
         let _ = writeln!(
             out,
-            "\nCompensation table [µm] (axis error actual − target, zero at the reference)"
+            "\nCompensation table [{value_unit}] (axis error actual − target, zero at the reference)"
         );
+        let position_header = format!("position {}", position_unit.trim_start());
         if self.file_unit == LengthUnit::Inch.as_str() {
             return self.inch_table(out);
         }
         match &self.values_um {
             ValuesJson::Mean { mean } => {
-                let _ = writeln!(out, "{:>12}  {:>9}", "position mm", "value");
+                let _ = writeln!(out, "{position_header:>12}  {:>9}", "value");
                 for (p, v) in self.positions_mm.iter().zip(mean) {
                     let _ = writeln!(out, "{p:>12}  {:>9}", um(Some(*v)));
                 }
             }
             ValuesJson::Bidirectional { up, down } => {
-                let _ = writeln!(out, "{:>12}  {:>9}  {:>9}", "position mm", "↑", "↓");
+                let _ = writeln!(out, "{position_header:>12}  {:>9}  {:>9}", "↑", "↓");
                 for ((p, u), d) in self.positions_mm.iter().zip(up).zip(down) {
                     let _ = writeln!(out, "{p:>12}  {:>9}  {:>9}", um(Some(*u)), um(Some(*d)));
                 }
@@ -283,5 +318,38 @@ impl ConvertJson {
         }
         let _ = writeln!(out, "\nActivation:\n{}", self.activation);
         out
+    }
+}
+
+impl Serialize for ConvertJson {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let (position, value) = match self.kind {
+            AxisKind::Linear => ("mm", "um"),
+            AxisKind::Rotary => ("deg", "arcsec"),
+        };
+        let mut map = serializer.serialize_map(Some(18))?;
+        map.serialize_entry("file_unit", self.file_unit)?;
+        map.serialize_entry("controller", self.controller)?;
+        map.serialize_entry("file", &self.file)?;
+        map.serialize_entry("axis", &self.axis)?;
+        map.serialize_entry("also", &self.also)?;
+        map.serialize_entry("mode", self.mode)?;
+        map.serialize_entry(&format!("positions_{position}"), &self.positions_mm)?;
+        map.serialize_entry("count", &self.count)?;
+        map.serialize_entry(&format!("start_{position}"), &self.start_mm)?;
+        map.serialize_entry(&format!("step_{position}"), &self.step_mm)?;
+        map.serialize_entry(&format!("reference_{position}"), &self.reference_mm)?;
+        map.serialize_entry(&format!("values_{value}"), &self.values_um)?;
+        map.serialize_entry(
+            &format!("suggested_backlash_{value}"),
+            &self.suggested_backlash_um,
+        )?;
+        map.serialize_entry("backlash_parameter", &self.backlash_parameter)?;
+        map.serialize_entry("backlash_note", &self.backlash_note)?;
+        map.serialize_entry("activation", &self.activation)?;
+        map.serialize_entry("effects", &self.effects)?;
+        map.serialize_entry("warnings", &self.warnings)?;
+        map.end()
     }
 }

@@ -51,6 +51,14 @@
 //!
 //! `B` is max |B_i| (unsigned); `B_mean` (B̄) and `B_um` are signed, ↑ minus ↓.
 //!
+//! A rotary axis (`"axis_kind": "rotary"`, a key only rotary axes have)
+//! carries its unit in the same keys: `targets_deg` for `targets_mm`,
+//! `figures_arcsec` for `figures_um` (same figure keys), per target
+//! `target_deg`, `mean_up_arcsec`, …, `R_arcsec`, outliers
+//! `worst_target_deg` and `offset_arcsec`, `test_conformance.length_deg`;
+//! `length_unit` is `deg`, and there is no `uncertainty_um` (the budget is
+//! the laser's, for lengths). A linear axis' object is unchanged.
+//!
 //! `axis_source` says where `axis` came from: `{"kind": "file", "field": …}`
 //! (the field of the file that states it), `{"kind": "given"}` (`--axis`) or
 //! `{"kind": "not_recorded"}`, when `axis` is only the placeholder `X`.
@@ -62,9 +70,9 @@ use crate::evaluate::{
     AxisFigures, Evaluation, StandardFigure, SuspectedOutlier, TargetStats, TestConformance,
 };
 use crate::measurement::{
-    AxisSource, Environment, Measurement, RunSelector, SourceFormat, StartEnd, TestSetup,
+    AxisKind, AxisSource, Environment, Measurement, RunSelector, SourceFormat, StartEnd, TestSetup,
 };
-use crate::units::{mm_to_um, opt_mm_to_um};
+use crate::units::{deg_to_arcsec, mm_to_um, opt_deg_to_arcsec, opt_mm_to_um};
 
 /// The whole `evaluate --json` object.
 #[derive(Clone, Debug, Serialize)]
@@ -77,10 +85,18 @@ pub struct EvaluationJson {
     pub axis_source: AxisSourceJson,
     /// The file read (the first, when two were joined).
     pub source_file: Option<String>,
-    /// Length unit of the source file (`mm` or `inch`); all values here are mm or µm.
+    /// `rotary` for a rotary axis; absent for a linear one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_kind: Option<&'static str>,
+    /// Length unit of the source file (`mm` or `inch`; `deg` on a rotary
+    /// axis); all values here are mm or µm (° or ″).
     pub length_unit: &'static str,
-    /// Targets, mm.
+    /// Targets, mm (empty, and absent, on a rotary axis).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub targets_mm: Vec<f64>,
+    /// Targets, ° (empty, and absent, on a linear axis).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub targets_deg: Vec<f64>,
     /// Runs per direction, after exclusions.
     pub runs: RunCountsJson,
     /// Runs left out by `--exclude-run`, as `3`, `3:up` or `3:down`.
@@ -92,12 +108,17 @@ pub struct EvaluationJson {
     /// Whether its definitions are reconstructed from public sources
     /// (`../shared/spec/standards.md`), not read in the standard.
     pub definitions_reconstructed: bool,
-    /// That standard's axis figures, µm, under its keys.
+    /// That standard's axis figures, µm, under its keys (empty, and absent,
+    /// on a rotary axis).
+    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
     pub figures_um: FiguresJson,
     /// The ISO 230-2:2014 figures too, µm, when the standard's keys are
     /// others (VDI 3441): the report shows both; absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub figures_iso230_2_um: Option<FiguresJson>,
+    /// The same in ″ on a rotary axis (empty, and absent, on a linear one).
+    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
+    pub figures_arcsec: FiguresJson,
     /// Per-target statistics.
     pub per_target: Vec<PerTargetJson>,
     /// Suspected outlier runs (included in the figures).
@@ -167,8 +188,12 @@ pub struct ConformanceJson {
     pub title: String,
     /// Whether every requirement (not the recommendations) is met.
     pub meets_iso230_2: bool,
-    /// Travel, mm.
-    pub length_mm: f64,
+    /// Travel, mm (absent on a rotary axis).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub length_mm: Option<f64>,
+    /// Range, ° (a rotary axis only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub length_deg: Option<f64>,
     /// Every check.
     pub checks: Vec<CheckJson>,
 }
@@ -194,7 +219,8 @@ impl ConformanceJson {
         ConformanceJson {
             title: c.title(),
             meets_iso230_2: c.meets_iso230_2(),
-            length_mm: c.length_mm,
+            length_mm: (c.kind == AxisKind::Linear).then_some(c.length_mm),
+            length_deg: (c.kind == AxisKind::Rotary).then_some(c.length_mm),
             checks: c
                 .checks
                 .iter()
@@ -274,7 +300,7 @@ pub struct RunCountsJson {
 /// A standard's axis figures, µm, under its own keys and in its order
 /// (ISO 230-2: `A`, `A_up`, …, `B_mean`; VDI 3441: `P`, `Pa`, `Ps_max`,
 /// `Ps_mean`, `U_max`, `U_mean`); serialised as one JSON object.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct FiguresJson {
     /// (key, value µm), in the standard's order.
     pub values: Vec<(&'static str, Option<f64>)>,
@@ -319,6 +345,21 @@ impl FiguresJson {
         }
     }
 
+    /// Converts a standard's figures (°) to ″, for a rotary axis.
+    pub fn from_standard_deg(figures: &[StandardFigure]) -> FiguresJson {
+        FiguresJson {
+            values: figures
+                .iter()
+                .map(|f| (f.key, opt_deg_to_arcsec(f.value_mm)))
+                .collect(),
+        }
+    }
+
+    /// No figures: the other unit's field of a rotary or linear axis.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
     /// The value under `key`, µm (`None` when not evaluated or not this standard's).
     pub fn get(&self, key: &str) -> Option<f64> {
         self.values
@@ -344,10 +385,13 @@ impl Serialize for FiguresJson {
     }
 }
 
-/// Statistics at one target, µm.
+/// Statistics at one target, µm; on a rotary axis (`kind`) the same fields
+/// hold ° and ″ and serialise as `target_deg`, `mean_up_arcsec`, …
 #[allow(non_snake_case)]
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug)]
 pub struct PerTargetJson {
+    /// Linear or rotary: the unit of every value and of the JSON keys.
+    pub kind: AxisKind,
     /// Target, mm.
     pub target_mm: f64,
     /// Readings ↑.
@@ -375,28 +419,80 @@ pub struct PerTargetJson {
 }
 
 impl PerTargetJson {
-    /// Converts one target's statistics to µm.
+    /// Converts one target's statistics of a linear axis to µm.
     pub fn from_stats(t: &TargetStats) -> PerTargetJson {
+        PerTargetJson::from_stats_of(t, AxisKind::Linear)
+    }
+
+    /// Converts one target's statistics to µm, or ″ on a rotary axis.
+    pub fn from_stats_of(t: &TargetStats, kind: AxisKind) -> PerTargetJson {
+        let shown = deviation_in(kind);
         PerTargetJson {
+            kind,
             target_mm: t.target_mm,
             n_up: t.up.n,
             n_down: t.down.n,
-            mean_up_um: opt_mm_to_um(t.up.mean_mm),
-            mean_down_um: opt_mm_to_um(t.down.mean_mm),
-            mean_um: opt_mm_to_um(t.mean_mm),
-            s_up_um: opt_mm_to_um(t.up.s_mm),
-            s_down_um: opt_mm_to_um(t.down.s_mm),
-            B_um: opt_mm_to_um(t.reversal_mm),
-            R_up_um: opt_mm_to_um(t.repeatability_up_mm),
-            R_down_um: opt_mm_to_um(t.repeatability_down_mm),
-            R_um: opt_mm_to_um(t.repeatability_mm),
+            mean_up_um: t.up.mean_mm.map(shown),
+            mean_down_um: t.down.mean_mm.map(shown),
+            mean_um: t.mean_mm.map(shown),
+            s_up_um: t.up.s_mm.map(shown),
+            s_down_um: t.down.s_mm.map(shown),
+            B_um: t.reversal_mm.map(shown),
+            R_up_um: t.repeatability_up_mm.map(shown),
+            R_down_um: t.repeatability_down_mm.map(shown),
+            R_um: t.repeatability_mm.map(shown),
         }
     }
 }
 
-/// A suspected outlier run.
-#[derive(Clone, Copy, Debug, Serialize)]
+/// A deviation held inside (mm, or ° on a rotary axis) in its reported unit (µm or ″).
+fn deviation_in(kind: AxisKind) -> fn(f64) -> f64 {
+    match kind {
+        AxisKind::Linear => mm_to_um,
+        AxisKind::Rotary => deg_to_arcsec,
+    }
+}
+
+/// The key suffixes of a position and a deviation: `mm`, `um` or `deg`, `arcsec`.
+fn key_units(kind: AxisKind) -> (&'static str, &'static str) {
+    match kind {
+        AxisKind::Linear => ("mm", "um"),
+        AxisKind::Rotary => ("deg", "arcsec"),
+    }
+}
+
+impl Serialize for PerTargetJson {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let (position, deviation) = key_units(self.kind);
+        let mut map = serializer.serialize_map(Some(13))?;
+        map.serialize_entry(&format!("target_{position}"), &self.target_mm)?;
+        map.serialize_entry("n_up", &self.n_up)?;
+        map.serialize_entry("n_down", &self.n_down)?;
+        let values = [
+            ("mean_up", self.mean_up_um),
+            ("mean_down", self.mean_down_um),
+            ("mean", self.mean_um),
+            ("s_up", self.s_up_um),
+            ("s_down", self.s_down_um),
+            ("B", self.B_um),
+            ("R_up", self.R_up_um),
+            ("R_down", self.R_down_um),
+            ("R", self.R_um),
+        ];
+        for (stem, value) in values {
+            map.serialize_entry(&format!("{stem}_{deviation}"), &value)?;
+        }
+        map.end()
+    }
+}
+
+/// A suspected outlier run; on a rotary axis (`kind`) the position is ° and
+/// the offset ″, serialised as `worst_target_deg` and `offset_arcsec`.
+#[derive(Clone, Copy, Debug)]
 pub struct OutlierJson {
+    /// Linear or rotary.
+    pub kind: AxisKind,
     /// Run number within its direction.
     pub run: u32,
     /// `up` or `down`.
@@ -410,15 +506,30 @@ pub struct OutlierJson {
 }
 
 impl OutlierJson {
-    /// Converts a flagged run.
-    pub fn from_outlier(o: &SuspectedOutlier) -> OutlierJson {
+    /// Converts a flagged run of an axis of `kind`.
+    pub fn from_outlier(o: &SuspectedOutlier, kind: AxisKind) -> OutlierJson {
         OutlierJson {
+            kind,
             run: o.run,
             direction: o.direction.as_str(),
             score: o.score,
             worst_target_mm: o.worst_target_mm,
-            offset_um: mm_to_um(o.offset_mm),
+            offset_um: deviation_in(kind)(o.offset_mm),
         }
+    }
+}
+
+impl Serialize for OutlierJson {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let (position, deviation) = key_units(self.kind);
+        let mut map = serializer.serialize_map(Some(5))?;
+        map.serialize_entry("run", &self.run)?;
+        map.serialize_entry("direction", self.direction)?;
+        map.serialize_entry("score", &self.score)?;
+        map.serialize_entry(&format!("worst_target_{position}"), &self.worst_target_mm)?;
+        map.serialize_entry(&format!("offset_{deviation}"), &self.offset_um)?;
+        map.end()
     }
 }
 
@@ -498,6 +609,42 @@ pub struct MetadataJson {
 }
 
 impl EvaluationJson {
+    /// The targets, in their unit (mm, or ° on a rotary axis).
+    pub fn targets(&self) -> &[f64] {
+        if self.targets_deg.is_empty() {
+            &self.targets_mm
+        } else {
+            &self.targets_deg
+        }
+    }
+
+    /// The figures, in their unit (µm, or ″ on a rotary axis).
+    pub fn figures(&self) -> &FiguresJson {
+        if self.figures_arcsec.is_empty() {
+            &self.figures_um
+        } else {
+            &self.figures_arcsec
+        }
+    }
+
+    /// How a deviation's unit is printed: `µm`, or `″` on a rotary axis.
+    pub fn deviation_unit(&self) -> &'static str {
+        if self.axis_kind.is_some() {
+            "″"
+        } else {
+            "µm"
+        }
+    }
+
+    /// How a target's unit is printed after a number: ` mm`, or `°` on a rotary axis.
+    pub fn position_unit(&self) -> &'static str {
+        if self.axis_kind.is_some() {
+            "°"
+        } else {
+            " mm"
+        }
+    }
+
     /// Builds the wire object from a measurement, its evaluation and all warnings.
     pub fn new(
         measurement: &Measurement,
@@ -506,6 +653,25 @@ impl EvaluationJson {
         warnings: &[Warning],
     ) -> EvaluationJson {
         let metadata = &measurement.metadata;
+        let kind = measurement.kind();
+        let rotary = kind == AxisKind::Rotary;
+        let targets = measurement.targets_mm().to_vec();
+        let (targets_mm, targets_deg) = if rotary {
+            (Vec::new(), targets)
+        } else {
+            (targets, Vec::new())
+        };
+        let (figures_um, figures_arcsec) = if rotary {
+            (
+                FiguresJson::default(),
+                FiguresJson::from_standard_deg(&evaluation.standard_figures),
+            )
+        } else {
+            (
+                FiguresJson::from_standard(&evaluation.standard_figures),
+                FiguresJson::default(),
+            )
+        };
         EvaluationJson {
             format: metadata.source_format.map(|f| f.name()),
             axis: measurement.axis().to_string(),
@@ -514,8 +680,14 @@ impl EvaluationJson {
                 .source_file
                 .as_ref()
                 .map(|p| p.display().to_string()),
-            length_unit: metadata.length_unit.as_str(),
-            targets_mm: measurement.targets_mm().to_vec(),
+            axis_kind: rotary.then_some(kind.as_str()),
+            length_unit: if rotary {
+                "deg"
+            } else {
+                metadata.length_unit.as_str()
+            },
+            targets_mm,
+            targets_deg,
             runs: RunCountsJson {
                 up: evaluation.runs_up,
                 down: evaluation.runs_down,
@@ -524,18 +696,19 @@ impl EvaluationJson {
             standard: evaluation.standard.key,
             standard_name: evaluation.standard.name,
             definitions_reconstructed: evaluation.standard.reconstructed,
-            figures_um: FiguresJson::from_standard(&evaluation.standard_figures),
-            figures_iso230_2_um: (!iso_keys(&evaluation.standard_figures))
+            figures_iso230_2_um: (!rotary && !iso_keys(&evaluation.standard_figures))
                 .then(|| FiguresJson::from_figures(&evaluation.figures)),
+            figures_um,
+            figures_arcsec,
             per_target: evaluation
                 .per_target
                 .iter()
-                .map(PerTargetJson::from_stats)
+                .map(|t| PerTargetJson::from_stats_of(t, kind))
                 .collect(),
             outliers: evaluation
                 .outliers
                 .iter()
-                .map(OutlierJson::from_outlier)
+                .map(|o| OutlierJson::from_outlier(o, kind))
                 .collect(),
             environment: EnvironmentJson::from_environment(&measurement.environment),
             metadata: MetadataJson {

@@ -1,7 +1,8 @@
 //! The terminal report of `axcomp evaluate`: header, per-target table, axis figures.
 //!
 //! Renders from the JSON wire object, so the terminal and `--json` can never
-//! disagree. Values are µm with two decimals; `—` means "not evaluated".
+//! disagree. Values are µm (″ on a rotary axis) with two decimals; `—`
+//! means "not evaluated".
 
 use std::fmt::Write;
 
@@ -19,12 +20,13 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     let mut out = String::new();
     header(&mut out, report);
     out.push('\n');
-    out.push_str("Per target [µm]\n");
+    let unit = report.deviation_unit();
+    let _ = writeln!(out, "Per target [{unit}]");
     out.push_str(&per_target_table(report));
-    let _ = writeln!(out, "\n\nAxis figures [µm] ({})", report.standard_name);
+    let _ = writeln!(out, "\n\nAxis figures [{unit}] ({})", report.standard_name);
     // The ISO 230-2 family's figures in their table (↑, ↓ beside each);
     // another standard's one per row.
-    let iso_family = report.figures_um.values.iter().any(|(key, _)| *key == "A");
+    let iso_family = report.figures().values.iter().any(|(key, _)| *key == "A");
     if iso_family {
         out.push_str(&figures_table(report));
     } else {
@@ -45,8 +47,13 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
         for o in &report.outliers {
             let _ = writeln!(
                 out,
-                "  run {}:{}  score {:.1}  largest offset {:+.2} µm at {} mm",
-                o.run, o.direction, o.score, o.offset_um, o.worst_target_mm
+                "  run {}:{}  score {:.1}  largest offset {:+.2} {unit} at {}{}",
+                o.run,
+                o.direction,
+                o.score,
+                o.offset_um,
+                o.worst_target_mm,
+                report.position_unit()
             );
         }
     }
@@ -86,8 +93,8 @@ fn header(out: &mut String, r: &EvaluationJson) {
     if r.metadata.description.is_some() {
         rows.push(("Title", text(&r.metadata.description)));
     }
-    let first = r.targets_mm.first().copied().unwrap_or_default();
-    let last = r.targets_mm.last().copied().unwrap_or_default();
+    let first = r.targets().first().copied().unwrap_or_default();
+    let last = r.targets().last().copied().unwrap_or_default();
     let excluded = if r.excluded_runs.is_empty() {
         String::new()
     } else {
@@ -97,8 +104,9 @@ fn header(out: &mut String, r: &EvaluationJson) {
     rows.push((
         "Targets",
         format!(
-            "{} from {first} to {last} mm{}",
-            r.targets_mm.len(),
+            "{} from {first} to {last}{}{}",
+            r.targets().len(),
+            r.position_unit(),
             inch_beside(r.length_unit, &[first, last])
         ),
     ));
@@ -142,8 +150,9 @@ fn environment_line(r: &EvaluationJson) -> String {
 }
 
 fn per_target_table(r: &EvaluationJson) -> String {
-    const HEADER: [&str; 12] = [
-        "target [mm]",
+    let target_header = format!("target [{}]", r.position_unit().trim_start());
+    let header: [&str; 12] = [
+        &target_header,
         "n↑",
         "n↓",
         "x̄↑",
@@ -160,7 +169,7 @@ fn per_target_table(r: &EvaluationJson) -> String {
     // 10 000-target test has 120 000 cells, and a `String` each was most of
     // the time `evaluate` took to print it.
     let mut text = String::with_capacity(r.per_target.len() * 80);
-    let mut ends: Vec<usize> = Vec::with_capacity(r.per_target.len() * HEADER.len());
+    let mut ends: Vec<usize> = Vec::with_capacity(r.per_target.len() * header.len());
     for t in &r.per_target {
         let _ = write!(text, "{}", t.target_mm);
         ends.push(text.len());
@@ -188,8 +197,8 @@ fn per_target_table(r: &EvaluationJson) -> String {
         &text[start..ends[index]]
     };
     let rows = (0..r.per_target.len())
-        .map(|row| std::array::from_fn(|column| cell(row * HEADER.len() + column)));
-    psql_right_aligned(HEADER, rows)
+        .map(|row| std::array::from_fn(|column| cell(row * header.len() + column)));
+    psql_right_aligned(header, rows)
 }
 
 /// The rows as `tabled`'s `Style::psql()` with every column right-aligned
@@ -250,7 +259,7 @@ fn psql_right_aligned<'a, const N: usize>(
 fn keyed_figures_table(r: &EvaluationJson) -> String {
     let mut builder = Builder::default();
     builder.push_record(["figure", "value"]);
-    for (key, value) in &r.figures_um.values {
+    for (key, value) in &r.figures().values {
         builder.push_record([format!("{key}  {}", vdi_figure_name(key)), um(*value)]);
     }
     let mut table = builder.build();
@@ -261,7 +270,7 @@ fn keyed_figures_table(r: &EvaluationJson) -> String {
 }
 
 fn figures_table(r: &EvaluationJson) -> String {
-    let f = &r.figures_um;
+    let f = r.figures();
     // `11.96 ± 3.49` where U of the figure is evaluated (E, M, A).
     let u = r.uncertainty_um.as_ref();
     let with_u = |value: Option<f64>, expanded: Option<f64>| match (value, expanded) {

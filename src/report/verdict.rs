@@ -482,6 +482,7 @@ mod tests {
             runs_down: 1,
             outliers: Vec::new(),
             conformance: crate::evaluate::TestConformance {
+                kind: Default::default(),
                 length_mm: 0.0,
                 targets: 0,
                 runs_up: 1,

@@ -24,6 +24,7 @@
 //! per test and purpose, so the first test does not change when the re-test's
 //! settings do.
 
+pub mod rotary;
 pub mod truth;
 
 use chrono::{Duration, NaiveDateTime, Timelike};
@@ -41,6 +42,7 @@ use crate::measurement::{
     Direction, Environment, Measurement, MeasurementError, Metadata, Run, StartEnd, TestDate,
 };
 use crate::units::{mm_to_m, mm_to_um, per_m_over_mm, um_to_mm};
+pub use rotary::{RotaryTruth, rotary_test};
 pub use truth::{EffectSpec, TargetSpec, TestKind, Truth};
 
 /// Why a truth cannot be turned into measurements.

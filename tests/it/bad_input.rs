@@ -12,6 +12,13 @@ use crate::util::{axcomp, shared_data, test_data};
 const CASES: &[(&str, usize, usize, &str)] = &[
     // Renishaw .rtl
     ("rtl-truncated.rtl", 70, 1, "the file is truncated"),
+    // See: issue 14; no public sample: refused at the Owner line (read::rtl::ROTARY_OWNER).
+    (
+        "rtl-rotary.rtl",
+        3,
+        14,
+        "a rotary axis test: the layout of Renishaw's rotary files is not public",
+    ),
     (
         "rtl-target-count.rtl",
         8,
@@ -125,7 +132,12 @@ const CASES: &[(&str, usize, usize, &str)] = &[
         14,
         "cycle index 6 is beyond CYCLES=5",
     ),
-    ("ecmc-bad-unit.dat", 17, 6, "expected UNIT=mm or UNIT=inch"),
+    (
+        "ecmc-bad-unit.dat",
+        17,
+        6,
+        "expected UNIT=mm, UNIT=inch or, for a rotary axis, UNIT=deg",
+    ),
     ("ecmc-truncated.dat", 63, 1, "expected KEY=VALUE"),
     (
         "ecmc-absurd.dat",

@@ -231,7 +231,20 @@ fn cases() -> Vec<Case> {
         // (An updated .mp would copy the third-party file's other lines into
         // the repository: tests/it/fagor.rs checks the update instead.)
         case(inch(), "fagor8065", &[], "api-inch-X.mp"),
+        // A rotary C axis over a full turn (issue 14): degrees in every file,
+        // a Sinumerik modulo table, LinuxCNC with the ends held.
+        case(rotary(), "itnc530", &[], "rotary-c-mean.COM"),
+        case(rotary(), "tnc640", &[], "rotary-c-mean.COM"),
+        case(rotary(), "sinumerik840d", &[], "rotary-c-mean-lec.MPF"),
+        case(rotary(), "linuxcnc", &[], "rotary-c-mean-type0.txt"),
     ]
+}
+
+/// The synthetic rotary test (fixtures/rotary/truth.toml).
+const ROTARY: &str = "fixtures/rotary/c.csv";
+
+fn rotary() -> PathBuf {
+    root().join(ROTARY)
 }
 
 /// Runs convert into a temporary directory; returns (file bytes, --json object).
@@ -277,8 +290,9 @@ fn read_options(case: &Case) -> EmitOptions {
             .unwrap()
         })
         .unwrap_or_default();
+    let rotary = case.input.ends_with(ROTARY);
     EmitOptions {
-        axes: vec![profile.axis("X").unwrap()],
+        axes: vec![profile.axis(if rotary { "C" } else { "X" }).unwrap()],
         table_name: String::new(),
         // A Fagor 8055 table is in the test's unit (the API .pos files are inch).
         machine_unit: profile.table_unit(
@@ -295,11 +309,18 @@ fn read_options(case: &Case) -> EmitOptions {
         cec_first_table: 0,
         cec_values_are_corrections: true,
         tnc640_columns: Vec::new(),
+        kind: if rotary {
+            axcomp::measurement::AxisKind::Rotary
+        } else {
+            axcomp::measurement::AxisKind::Linear
+        },
     }
 }
 
+/// The table's values in µm (″ on a rotary axis, whose JSON says `values_arcsec`).
 fn values_um(json: &serde_json::Value, key: &str) -> Vec<f64> {
-    json["values_um"][key]
+    let values = json.get("values_um").unwrap_or(&json["values_arcsec"]);
+    values[key]
         .as_array()
         .unwrap()
         .iter()
@@ -322,8 +343,16 @@ fn golden_files_per_controller() {
         let (controller, table) =
             emit::read_any(&text, &options, Some(options.linuxcnc_type)).unwrap();
         assert_eq!(controller.name(), case.controller);
-        let resolution_um = emit::resolution_mm(controller, options.machine_unit) * 1000.0;
-        let positions: Vec<f64> = json["positions_mm"]
+        // µm per mm, or ″ per ° on a rotary axis.
+        let per_unit = if options.kind == axcomp::measurement::AxisKind::Rotary {
+            3600.0
+        } else {
+            1000.0
+        };
+        let resolution_um = emit::resolution_mm(controller, options.file_unit()) * per_unit;
+        let positions: Vec<f64> = json
+            .get("positions_mm")
+            .unwrap_or(&json["positions_deg"])
             .as_array()
             .unwrap()
             .iter()
@@ -332,7 +361,7 @@ fn golden_files_per_controller() {
         assert_eq!(table.positions_mm.len(), positions.len(), "{}", case.golden);
         for (a, b) in table.positions_mm.iter().zip(&positions) {
             assert!(
-                (a - b).abs() * 1000.0 <= resolution_um,
+                (a - b).abs() * per_unit <= resolution_um,
                 "{}: position {a} vs {b}",
                 case.golden
             );
@@ -344,7 +373,7 @@ fn golden_files_per_controller() {
         for (direction, expected) in [(Direction::Up, up), (Direction::Down, down)] {
             for (a, b) in table.values.for_direction(direction).iter().zip(&expected) {
                 assert!(
-                    (a * 1000.0 - b).abs() <= resolution_um / 2.0 + 1e-9,
+                    (a * per_unit - b).abs() <= resolution_um / 2.0 + 1e-9,
                     "{}: {direction} value {a} mm vs {b} µm",
                     case.golden
                 );

@@ -23,6 +23,7 @@ mod outputs;
 mod predict;
 mod read_api_pos;
 mod report;
+mod rotary;
 mod servo;
 mod standards;
 mod together;

@@ -220,6 +220,12 @@ fn errors_name_line_column_and_what_was_expected() {
             "only linear measurements",
         ),
         (
+            "Owner      : Linear",
+            "Owner      : Rotary",
+            (3, 14),
+            "a rotary axis test: the layout of Renishaw's rotary files is not public",
+        ),
+        (
             "1   2      1.270",
             "1   2",
             (28, 1),
