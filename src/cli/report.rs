@@ -9,8 +9,9 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::error::Warning;
 use axcomp::evaluate::uncertainty::{Budget, Equipment};
+use axcomp::evaluate::verdict::Decision;
 use axcomp::evaluate::{Evaluation, Standard, evaluate_with};
-use axcomp::measurement::{Measurement, SourceFormat};
+use axcomp::measurement::{AxisKind, Measurement, SourceFormat};
 use axcomp::output::write_all_new;
 use axcomp::read;
 use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
@@ -22,8 +23,8 @@ use axcomp::together::{Input, Pairing, check_together};
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
-    linear_only, load_equipment, load_profile, name_axis, print_text, print_warnings,
-    read_active_table, uncertainty_budget,
+    load_equipment, load_profile, name_axis, print_text, print_warnings, read_active_table,
+    uncertainty_budget,
 };
 
 /// Flags of `axcomp report`.
@@ -119,7 +120,8 @@ struct Test {
     measurement: Measurement,
     evaluation: Evaluation,
     warnings: Vec<Warning>,
-    budget: Budget,
+    /// `None` on a rotary axis: the budget is the laser's, for lengths.
+    budget: Option<Budget>,
 }
 
 impl Test {
@@ -135,10 +137,12 @@ impl Test {
             mut warnings,
         } = read::read_paths(&[path.to_path_buf()], format)?;
         name_axis(&mut measurement, axis);
-        linear_only(&measurement, "report")?;
         let evaluation = evaluate_with(&measurement, standard);
         warnings.extend(evaluation.warnings.iter().cloned());
-        let budget = uncertainty_budget(&measurement, equipment)?;
+        let budget = match measurement.kind() {
+            AxisKind::Linear => Some(uncertainty_budget(&measurement, equipment)?),
+            AxisKind::Rotary => None,
+        };
         Ok(Test {
             measurement,
             evaluation,
@@ -152,9 +156,41 @@ impl Test {
             measurement: &self.measurement,
             evaluation: &self.evaluation,
             warnings: &self.warnings,
-            budget: Some(&self.budget),
+            budget: self.budget.as_ref(),
         }
     }
+}
+
+/// What `report` does not do for a rotary axis yet, refused with the reason
+/// (the rest of the report is in ° and ″).
+fn refuse_for_rotary(args: &ReportArgs, measurement: &Measurement) -> Result<()> {
+    let refused = [
+        (
+            !args.acceptance.limits.is_empty(),
+            "acceptance limits (--limit) are µm, for linear axes only so far",
+        ),
+        (
+            args.uncertainty.equipment.is_some()
+                || args.uncertainty.decision != Decision::default(),
+            "the measurement uncertainty (--equipment, --decision) is the laser's budget, for lengths only so far",
+        ),
+        (
+            args.table.is_some(),
+            "the predicted re-test of a table (--table) is for linear axes only so far",
+        ),
+        (
+            args.diagnose,
+            "the diagnosis (--diagnose) is for linear axes only so far",
+        ),
+        (
+            args.standard.standard.key() != axcomp::evaluate::ISO_230_2.key(),
+            "a rotary axis is reported to ISO 230-2 only so far (--standard)",
+        ),
+    ];
+    if let Some((_, why)) = refused.iter().find(|(applies, _)| *applies) {
+        anyhow::bail!("axis {} is a rotary axis: {why}", measurement.axis());
+    }
+    Ok(())
 }
 
 /// Runs `axcomp report`.
@@ -168,12 +204,21 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         standard,
         &equipment,
     )?;
+    if before.measurement.kind() == AxisKind::Rotary {
+        refuse_for_rotary(args, &before.measurement)?;
+    }
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
         before.measurement.axis(),
         &before.evaluation,
         &args.acceptance,
     )?;
+    if before.measurement.kind() == AxisKind::Rotary && !limits.is_empty() {
+        anyhow::bail!(
+            "axis {} is a rotary axis: acceptance limits (a profile's [acceptance]) are µm, for linear axes only so far",
+            before.measurement.axis()
+        );
+    }
     let mut after = match &args.after {
         Some(path) => Some(Test::read(
             path,

@@ -17,9 +17,10 @@ use crate::error::Warning;
 use crate::evaluate::{
     DirectionStats, Evaluation, Standard, StandardFigure, TargetStats, evaluate_with,
 };
+use crate::measurement::AxisKind;
 use crate::measurement::{Direction, Measurement};
-use crate::report::chart::{Chart, Mark, Rgb, Series};
-use crate::units::mm_to_um;
+use crate::report::chart::{Chart, Mark, Polar, Rgb, Series};
+use crate::units::{deg_to_arcsec, mm_to_um};
 
 /// One test (the first, or the re-test) as the report shows it.
 #[derive(Clone, Copy, Debug)]
@@ -184,6 +185,18 @@ const EFFECT_COLOURS: [Rgb; 6] = [
 
 const POSITION_LABEL: &str = "target position [mm]";
 const DEVIATION_LABEL: &str = "positional deviation [µm]";
+/// The same on a rotary axis, whose targets are in ° and deviations in ″.
+const ANGLE_LABEL: &str = "target position [°]";
+const ANGULAR_DEVIATION_LABEL: &str = "positional deviation [″]";
+
+/// How a test's deviations are drawn: in µm (the `_mm` fields), or in ″ on a
+/// rotary axis (the same fields hold °).
+fn shown(test: &TestRecord<'_>) -> fn(f64) -> f64 {
+    match test.measurement.kind() {
+        AxisKind::Linear => mm_to_um,
+        AxisKind::Rotary => deg_to_arcsec,
+    }
+}
 
 /// All charts of the report, in the order the HTML shows them.
 pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
@@ -196,6 +209,12 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
                 name: "deviation",
                 chart: before,
             });
+            if let Some(polar) = polar_chart(&input.before, "", None) {
+                charts.push(NamedChart {
+                    name: "polar",
+                    chart: polar,
+                });
+            }
         }
         Some(after_record) => {
             let mut after = deviation_chart(after_record, "re-test");
@@ -215,6 +234,19 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
                 name: "deviation-after",
                 chart: after,
             });
+            // A rotary axis' polar plots, on one scale too.
+            let largest = [&input.before, after_record]
+                .into_iter()
+                .filter_map(|test| largest_mean(test))
+                .reduce(f64::max);
+            for (test, name, which) in [
+                (&input.before, "polar-before", ", first test"),
+                (after_record, "polar-after", ", re-test"),
+            ] {
+                if let Some(polar) = polar_chart(test, which, largest) {
+                    charts.push(NamedChart { name, chart: polar });
+                }
+            }
         }
     }
     if let Some(table) = &input.table {
@@ -290,11 +322,12 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
     let measurement = test.measurement;
     let targets = measurement.targets_mm();
     let per_target = &test.evaluation.per_target;
+    let shown = shown(test);
     let mut all = Vec::new();
     for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
         let (lower, upper): (Vec<(f64, f64)>, Vec<f64>) = per_target
             .iter()
-            .filter_map(|t| band(t.target_mm, t.direction(direction)))
+            .filter_map(|t| band(t.target_mm, t.direction(direction), shown))
             .map(|(x, low, high)| ((x, low), high))
             .unzip();
         if !lower.is_empty() {
@@ -318,7 +351,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
             let points: Vec<(f64, f64)> = targets
                 .iter()
                 .zip(&run.deviations_mm)
-                .filter_map(|(x, value)| value.map(|v| (*x, mm_to_um(v))))
+                .filter_map(|(x, value)| value.map(|v| (*x, shown(v))))
                 .collect();
             lines.push(series(None, light, Mark::Line(1), points.clone()));
             let runs = if count == 1 { "run" } else { "runs" };
@@ -329,7 +362,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
     all.extend(lines);
     all.extend(markers);
     for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
-        let means = means_um(per_target, direction);
+        let means = means_in(per_target, direction, shown);
         if !means.is_empty() {
             all.push(series(
                 Some(format!("mean {direction}")),
@@ -341,7 +374,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
     }
     let bidirectional: Vec<(f64, f64)> = per_target
         .iter()
-        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, mm_to_um(m))))
+        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, shown(m))))
         .collect();
     if !bidirectional.is_empty() {
         all.push(series(
@@ -353,28 +386,99 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
     }
     Chart {
         title: format!("Positional deviation, {which}{}", axis_suffix(test)),
-        x_label: POSITION_LABEL.into(),
-        y_label: DEVIATION_LABEL.into(),
+        x_label: match test.measurement.kind() {
+            AxisKind::Linear => POSITION_LABEL,
+            AxisKind::Rotary => ANGLE_LABEL,
+        }
+        .into(),
+        y_label: match test.measurement.kind() {
+            AxisKind::Linear => DEVIATION_LABEL,
+            AxisKind::Rotary => ANGULAR_DEVIATION_LABEL,
+        }
+        .into(),
         series: all,
         y_range: None,
+        polar: None,
     }
 }
 
-/// (target, x̄) in µm for one direction, where the mean is defined.
-fn means_um(per_target: &[TargetStats], direction: Direction) -> Vec<(f64, f64)> {
+/// (target, x̄) for one direction, where the mean is defined, the mean
+/// converted by `shown` (to µm, or ″).
+fn means_in(
+    per_target: &[TargetStats],
+    direction: Direction,
+    shown: fn(f64) -> f64,
+) -> Vec<(f64, f64)> {
     per_target
         .iter()
         .filter_map(|t| {
             let mean = t.direction(direction).mean_mm?;
-            Some((t.target_mm, mm_to_um(mean)))
+            Some((t.target_mm, shown(mean)))
         })
         .collect()
 }
 
-/// (target, x̄ − 2s, x̄ + 2s) in µm, where both are defined.
-fn band(target_mm: f64, stats: &DirectionStats) -> Option<(f64, f64, f64)> {
+/// (target, x̄ − 2s, x̄ + 2s) converted by `shown`, where both are defined.
+fn band(target_mm: f64, stats: &DirectionStats, shown: fn(f64) -> f64) -> Option<(f64, f64, f64)> {
     let (low, high) = stats.band(crate::evaluate::ISO_230_2.k)?;
-    Some((target_mm, mm_to_um(low), mm_to_um(high)))
+    Some((target_mm, shown(low), shown(high)))
+}
+
+/// The largest |x̄↑|, |x̄↓|, |x̄| of a rotary test, ″; `None` for a linear one.
+fn largest_mean(test: &TestRecord<'_>) -> Option<f64> {
+    if test.measurement.kind() != AxisKind::Rotary {
+        return None;
+    }
+    let per_target = &test.evaluation.per_target;
+    per_target
+        .iter()
+        .flat_map(|t| [t.up.mean_mm, t.down.mean_mm, t.mean_mm])
+        .flatten()
+        .map(|mean| deg_to_arcsec(mean).abs())
+        .reduce(f64::max)
+}
+
+/// A rotary test's polar plot: x̄↑, x̄↓ and x̄ around the circle, each a
+/// radial offset in ″ from the reference circle ([`Polar`], scaled to
+/// `largest` ″ or the test's own largest mean); `None` for a linear axis.
+fn polar_chart(test: &TestRecord<'_>, which: &str, largest: Option<f64>) -> Option<Chart> {
+    let largest = largest.or_else(|| largest_mean(test))?;
+    let per_target = &test.evaluation.per_target;
+    let mut all = Vec::new();
+    for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
+        let means = means_in(per_target, direction, deg_to_arcsec);
+        if !means.is_empty() {
+            all.push(series(
+                Some(format!("mean {direction}")),
+                color,
+                Mark::Line(2),
+                means,
+            ));
+        }
+    }
+    let bidirectional: Vec<(f64, f64)> = per_target
+        .iter()
+        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, deg_to_arcsec(m))))
+        .collect();
+    if !bidirectional.is_empty() {
+        all.push(series(
+            Some("bidirectional mean".into()),
+            BLACK,
+            Mark::Dashed(2),
+            bidirectional,
+        ));
+    }
+    Some(Chart {
+        title: format!(
+            "Mean deviation around the circle{which}{}",
+            axis_suffix(test)
+        ),
+        x_label: ANGLE_LABEL.into(),
+        y_label: ANGULAR_DEVIATION_LABEL.into(),
+        series: all,
+        y_range: None,
+        polar: Some(Polar::fitting(largest, "″")),
+    })
 }
 
 /// The table as the controller applies it (linear between points, the end
@@ -447,6 +551,7 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
         y_label: "axis error the table compensates [µm]".into(),
         series: all,
         y_range: None,
+        polar: None,
     }
 }
 
@@ -504,7 +609,7 @@ fn prediction_chart(
     if let Some(after) = after {
         for (direction, mark) in [(Direction::Up, Mark::Up), (Direction::Down, Mark::Down)] {
             let color = if direction == Direction::Up { UP } else { DOWN };
-            let means = means_um(&after.per_target, direction);
+            let means = means_in(&after.per_target, direction, mm_to_um);
             if !means.is_empty() {
                 all.push(series(
                     Some(format!("re-test mean {direction}, measured")),
@@ -521,6 +626,7 @@ fn prediction_chart(
         y_label: DEVIATION_LABEL.into(),
         series: all,
         y_range: None,
+        polar: None,
     }
 }
 
@@ -566,6 +672,7 @@ fn residual_chart(diagnosis: &Diagnosis) -> Chart {
             ),
         ],
         y_range: None,
+        polar: None,
     }
 }
 
@@ -634,6 +741,7 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
         y_label: "measured − predicted [µm]".into(),
         series: all,
         y_range: None,
+        polar: None,
     }
 }
 
@@ -703,6 +811,7 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
         y_label: "contribution [µm]".into(),
         series: all,
         y_range: None,
+        polar: None,
     }
 }
 

@@ -70,6 +70,55 @@ pub struct Chart {
     pub series: Vec<Series>,
     /// A fixed vertical range (to compare two charts on one scale); `None` fits the data.
     pub y_range: Option<(f64, f64)>,
+    /// Drawn around a circle instead of on x–y axes: each point is (angle in
+    /// °, deviation), drawn at the angle as a radial offset from a reference
+    /// circle; `None`: an x–y chart.
+    pub polar: Option<Polar>,
+}
+
+/// The scale of a polar chart: a deviation `d` is drawn at radius
+/// `reference + d` (one unit of deviation is one unit of radius), with rings
+/// at `reference ± ring` labelled `±ring` and the reference circle `0`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Polar {
+    /// Radius of the reference circle (zero deviation), in deviation units.
+    pub reference: f64,
+    /// The deviation of the inner and outer rings, in deviation units.
+    pub ring: f64,
+    /// The deviation's unit, after the ring labels (`″`).
+    pub unit: String,
+}
+
+impl Polar {
+    /// The scale for deviations up to `largest` in size: rings at the next
+    /// 1, 2 or 5 × 10ⁿ at or above it, the reference circle at twice that,
+    /// so every deviation lies between half and one and a half of its radius.
+    pub fn fitting(largest: f64, unit: &str) -> Polar {
+        let largest = if largest.is_finite() && largest > 0.0 {
+            largest
+        } else {
+            1.0
+        };
+        let power = 10f64.powf(largest.log10().floor());
+        let ring = [1.0, 2.0, 5.0, 10.0]
+            .into_iter()
+            .map(|step| step * power)
+            .find(|ring| *ring >= largest * (1.0 - 1e-12))
+            .unwrap_or(10.0 * power);
+        Polar {
+            reference: 2.0 * ring,
+            ring,
+            unit: unit.to_string(),
+        }
+    }
+
+    /// Where a point (angle °, deviation) is drawn: 0° to the right, angles
+    /// counter-clockwise.
+    pub fn xy(&self, (angle_deg, deviation): (f64, f64)) -> (f64, f64) {
+        let radius = self.reference + deviation;
+        let angle = angle_deg.to_radians();
+        (radius * angle.cos(), radius * angle.sin())
+    }
 }
 
 impl Chart {
@@ -95,13 +144,41 @@ impl Chart {
             self.y_label.as_str(),
         ];
         texts.extend(self.series.iter().filter_map(|s| s.label.as_deref()));
+        if let Some(polar) = &self.polar {
+            texts.push(polar.unit.as_str());
+        }
         texts
     }
 }
 
 /// Draws a chart as SVG text or PNG bytes of [`CHART_SIZE`].
+///
+/// The embedded font has no double prime: a PNG writes the arc-second sign
+/// ″ as `"` (the browser draws an SVG's ″ from the page's fonts).
 pub fn chart(chart: &Chart, format: PlotFormat) -> Result<Vec<u8>, PlotError> {
+    if format == PlotFormat::Png && chart.texts().iter().any(|t| t.contains(ARCSEC)) {
+        return render(&in_embedded_font(chart), CHART_SIZE, format);
+    }
     render(chart, CHART_SIZE, format)
+}
+
+/// The arc-second sign, which the embedded font lacks.
+const ARCSEC: char = '\u{2033}';
+
+/// The chart with every ″ written `"`, for a PNG.
+fn in_embedded_font(chart: &Chart) -> Chart {
+    let plain = |text: &str| text.replace(ARCSEC, "\"");
+    let mut chart = chart.clone();
+    chart.title = plain(&chart.title);
+    chart.x_label = plain(&chart.x_label);
+    chart.y_label = plain(&chart.y_label);
+    for series in &mut chart.series {
+        series.label = series.label.as_deref().map(plain);
+    }
+    if let Some(polar) = &mut chart.polar {
+        polar.unit = plain(&polar.unit);
+    }
+    chart
 }
 
 /// A tick label: up to three decimals, trailing zeros dropped, and the
@@ -169,6 +246,9 @@ impl Chart {
         &self,
         area: &DrawingArea<DB, Shift>,
     ) -> Result<(), PlotError> {
+        if let Some(polar) = &self.polar {
+            return self.draw_polar(area, polar);
+        }
         let x_range = padded(self.x_extent().unwrap_or((0.0, 1.0)), 0.02);
         let y_range = match self.y_range {
             Some(range) => range,
@@ -237,6 +317,117 @@ impl Chart {
                         )))
                         .map(|_| ())
                 }
+            }
+            .map_err(draw_error)?;
+        }
+        Ok(())
+    }
+}
+
+impl Chart {
+    /// A polar chart: a square of equal scales in the middle of `area`, the
+    /// reference circle and its rings, spokes every 30° labelled with their
+    /// angle, the ring labels on the 0° spoke; then the series.
+    fn draw_polar<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        polar: &Polar,
+    ) -> Result<(), PlotError> {
+        let area = area
+            .titled(&self.title, (FONT_FAMILY, 20))
+            .map_err(draw_error)?;
+        let (width, height) = area.dim_in_pixel();
+        let side = width.min(height).saturating_sub(8);
+        let left = (width - side) / 2;
+        let square = area.shrink((left, 4), (side, side));
+        // Room outside the outer ring for the angle labels.
+        let extent = (polar.reference + polar.ring) * 1.22;
+        let mut chart = ChartBuilder::on(&square)
+            .build_cartesian_2d(-extent..extent, -extent..extent)
+            .map_err(draw_error)?;
+        let circle = |radius: f64| -> Vec<(f64, f64)> {
+            (0..=360)
+                .map(|k| {
+                    let angle = f64::from(k).to_radians();
+                    (radius * angle.cos(), radius * angle.sin())
+                })
+                .collect()
+        };
+        let outer = polar.reference + polar.ring;
+        for angle in (0..360).step_by(30) {
+            let a = f64::from(angle).to_radians();
+            let spoke = vec![(0.0, 0.0), (outer * a.cos(), outer * a.sin())];
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    spoke,
+                    RGBColor(225, 225, 225).stroke_width(1),
+                )))
+                .map_err(draw_error)?;
+            let at = (outer + polar.ring * 0.35) * 1.0;
+            let style = TextStyle::from((FONT_FAMILY, 14).into_font())
+                .pos(Pos::new(HPos::Center, VPos::Center));
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    format!("{angle}°"),
+                    (at * a.cos(), at * a.sin()),
+                    style,
+                )))
+                .map_err(draw_error)?;
+        }
+        for (radius, colour, width) in [
+            (polar.reference - polar.ring, RGBColor(200, 200, 200), 1),
+            (outer, RGBColor(200, 200, 200), 1),
+            (polar.reference, RGBColor(110, 110, 110), 2),
+        ] {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    circle(radius),
+                    colour.stroke_width(width),
+                )))
+                .map_err(draw_error)?;
+        }
+        let label =
+            TextStyle::from((FONT_FAMILY, 13).into_font()).pos(Pos::new(HPos::Left, VPos::Bottom));
+        for (offset, text) in [
+            (
+                -polar.ring,
+                format!("{}{}", tick_label(-polar.ring), polar.unit),
+            ),
+            (0.0, format!("0{}", polar.unit)),
+            (
+                polar.ring,
+                format!("+{}{}", tick_label(polar.ring), polar.unit),
+            ),
+        ] {
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    text,
+                    (polar.reference + offset, 0.0),
+                    label.clone(),
+                )))
+                .map_err(draw_error)?;
+        }
+        for series in &self.series {
+            let rgb = color(series.color);
+            let points: Vec<(f64, f64)> = series.points.iter().map(|p| polar.xy(*p)).collect();
+            match &series.mark {
+                Mark::Dashed(width) => chart
+                    .draw_series(std::iter::once(DashedPathElement::new(
+                        points,
+                        9,
+                        6,
+                        rgb.stroke_width(*width),
+                    )))
+                    .map(|_| ()),
+                Mark::Line(width) => chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        points,
+                        rgb.stroke_width(*width),
+                    )))
+                    .map(|_| ()),
+                _ => chart
+                    .draw_series(points.into_iter().map(|p| Circle::new(p, 3, rgb.filled())))
+                    .map(|_| ()),
             }
             .map_err(draw_error)?;
         }
@@ -358,7 +549,40 @@ mod tests {
                 },
             ],
             y_range: None,
+            polar: None,
         }
+    }
+
+    #[test]
+    fn a_polar_scale_rings_at_a_round_value_above_the_largest_deviation() {
+        let polar = Polar::fitting(6.3, "″");
+        assert_eq!((polar.ring, polar.reference), (10.0, 20.0));
+        assert_eq!(Polar::fitting(1.5, "″").ring, 2.0);
+        assert_eq!(Polar::fitting(0.04, "″").ring, 0.05);
+        assert_eq!(Polar::fitting(0.0, "″").ring, 1.0);
+        // 90° is straight up, at the reference radius plus the deviation.
+        let (x, y) = polar.xy((90.0, 5.0));
+        assert!(x.abs() < 1e-12 && (y - 25.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_polar_chart_draws_its_circles_and_angles_and_a_png_writes_arcseconds_plainly() {
+        let mut polar = sample();
+        polar.series.truncate(0);
+        polar.series.push(Series {
+            label: Some("mean ↑".into()),
+            color: Rgb(30, 90, 170),
+            mark: Mark::Line(2),
+            points: vec![(0.0, 1.0), (90.0, -2.0), (180.0, 3.0)],
+        });
+        polar.polar = Some(Polar::fitting(3.0, "″"));
+        let svg = String::from_utf8(chart(&polar, PlotFormat::Svg).unwrap()).unwrap();
+        for text in ["0°", "90°", "330°", "0″", "+5″", "−5″", "mean ↑"] {
+            assert!(svg.contains(text), "{text} missing");
+        }
+        let plain = in_embedded_font(&polar);
+        assert!(plain.texts().iter().all(|t| !t.contains(ARCSEC)));
+        assert!(chart(&polar, PlotFormat::Png).is_ok());
     }
 
     #[test]

@@ -59,7 +59,7 @@ use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveInd
 use crate::evaluate::standard::{Vdi3441, vdi_figure_name};
 use crate::evaluate::verdict::{Decision, Figure, Limit};
 use crate::evaluate::{Standard, StandardUsed};
-use crate::measurement::{Direction, Measurement, StartEnd};
+use crate::measurement::{AxisKind, Direction, Measurement, StartEnd};
 use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts, prediction};
 use crate::report::chart::chart;
 use crate::report::format::{SourcedUm, inch_beside, inch_text, um};
@@ -68,7 +68,7 @@ use crate::report::json::{EvaluationJson, FiguresJson, PerTargetJson, iso_keys};
 use crate::report::plot::{FONT, PlotError, PlotFormat};
 use crate::report::uncertainty::{NOT_EVALUATED_NOTE, UncertaintyJson};
 use crate::report::verdict::{Judged, verdict_box};
-use crate::units::{LengthUnit, mm_to_um, um_to_mm};
+use crate::units::{LengthUnit, deg_to_arcsec, mm_to_um, um_to_mm};
 
 /// Renders the whole report.
 ///
@@ -129,6 +129,7 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
             axis_shown(input.before.measurement)
         ),
         font_base64: font_base64(),
+        units: Units::of(input.before.measurement.kind()),
         header: header(input),
         verdict: verdict_box(input),
         conditions: conditions(input),
@@ -139,6 +140,10 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
         } else {
             Deviation::Pair(plot("deviation-before"), plot("deviation-after"))
         },
+        polar: ["polar", "polar-before", "polar-after"]
+            .into_iter()
+            .filter_map(plot)
+            .collect(),
         per_target: per_target(input),
         table: input
             .table
@@ -163,18 +168,54 @@ struct Page<'a> {
     generator: &'a str,
     title: String,
     font_base64: String,
+    units: Units,
     header: Header,
     verdict: Option<Judged>,
     conditions: Conditions,
     figures: Figures,
     uncertainty: Option<UncertaintyView>,
     deviation: Deviation,
+    /// A rotary axis' polar plots (one per test); empty for a linear axis.
+    polar: Vec<Plot>,
     per_target: Vec<PerTargetTable>,
     table: Option<TableView>,
     diagnosis: Option<DiagnosisView>,
     notes: Vec<Note>,
     /// The `axcomp-data` JSON, safe inside `<script>` ([`json_in_script`]).
     json: String,
+}
+
+/// The units a report is written in: a linear axis in mm and µm, a rotary
+/// one in ° and ″ (its `Measurement` holds ° in the `_mm` fields).
+struct Units {
+    /// `linear` or `rotary`, as the subtitle names the axis.
+    kind: &'static str,
+    rotary: bool,
+    /// A deviation's unit: `µm` or `″`.
+    deviation: &'static str,
+    /// A position's unit: `mm` or `°`.
+    position: &'static str,
+}
+
+impl Units {
+    fn of(kind: AxisKind) -> Units {
+        let rotary = kind == AxisKind::Rotary;
+        Units {
+            kind: kind.as_str(),
+            rotary,
+            deviation: if rotary { "″" } else { "µm" },
+            position: if rotary { "°" } else { "mm" },
+        }
+    }
+}
+
+/// A deviation held in the `_mm` fields (mm, or ° on a rotary axis) in the
+/// unit the report shows (µm, or ″).
+fn deviation_shown(measurement: &Measurement) -> fn(f64) -> f64 {
+    match measurement.kind() {
+        AxisKind::Linear => mm_to_um,
+        AxisKind::Rotary => deg_to_arcsec,
+    }
 }
 
 /// `uncertainty.html`: the budget of the test being accepted, largest
@@ -573,7 +614,10 @@ fn source_line(measurement: &Measurement) -> SourceLine {
             .as_ref()
             .map(|p| p.display().to_string()),
         format: metadata.source_format.map_or("", |f| f.name()),
-        unit: metadata.length_unit.as_str(),
+        unit: match measurement.kind() {
+            AxisKind::Linear => metadata.length_unit.as_str(),
+            AxisKind::Rotary => "°",
+        },
         targets: measurement.targets_mm().len(),
         runs_up: measurement.run_count(Direction::Up),
         runs_down: measurement.run_count(Direction::Down),
@@ -633,6 +677,14 @@ fn text(text: Option<String>) -> Cell {
     Cell::Text { colspan: 2, text }
 }
 
+/// The unit of the tests' positions: `mm`, or `°` on a rotary axis.
+fn position_unit(tests: &[(&str, &TestRecord<'_>)]) -> &'static str {
+    match tests.first().map(|(_, t)| t.measurement.kind()) {
+        Some(AxisKind::Rotary) => "°",
+        _ => "mm",
+    }
+}
+
 fn test_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
     vec![
         wide_row(tests, "Runs", "", &|t| {
@@ -643,7 +695,7 @@ fn test_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
                 m.run_count(Direction::Down)
             )))
         }),
-        wide_row(tests, "Targets", "mm", &|t| {
+        wide_row(tests, "Targets", position_unit(tests), &|t| {
             let targets = t.measurement.targets_mm();
             text(Some(format!(
                 "{} from {} to {}",
@@ -666,6 +718,16 @@ fn test_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
 /// The instrument and set-up (`Metadata::setup`), in mm and, for an inch
 /// file, in inches beside; "not recorded" where the file does not say.
 fn setup_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
+    let mut rows = instrument_rows(tests);
+    if position_unit(tests) == "°" {
+        // The angle reference a rotary laser test turns against (an indexer
+        // such as Renishaw's XR20): no format axcomp reads records it yet.
+        rows.insert(0, wide_row(tests, "Rotary reference", "", &|_| text(None)));
+    }
+    rows
+}
+
+fn instrument_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
     let nothing = tests.iter().all(|(_, t)| {
         t.measurement.metadata.setup.is_empty()
             && t.measurement.environment.vacuum_wavelength_um.is_none()
@@ -753,8 +815,13 @@ fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
             };
             Cell::Conformance {
                 finding: format!(
-                    "{} per direction, {directions} (5 each way, 1 over 2000 mm)",
+                    "{} per direction, {directions} (5 each way, 1 over {})",
                     runs.and_then(|r| r.found).unwrap_or_default(),
+                    if c.kind == AxisKind::Rotary {
+                        "360°"
+                    } else {
+                        "2000 mm"
+                    },
                 ),
                 met: met(&[runs, both]),
             }
@@ -775,7 +842,14 @@ fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
             Cell::Conformance {
                 finding: spacing.and_then(|s| s.found).map_or_else(
                     || "irregular".to_string(),
-                    |step| format!("constant step {} mm", signed(step, 3)),
+                    |step| {
+                        let unit = if c.kind == AxisKind::Rotary {
+                            "°"
+                        } else {
+                            " mm"
+                        };
+                        format!("constant step {}{unit}", signed(step, 3))
+                    },
                 ),
                 met: met(&[spacing]),
             }
@@ -911,7 +985,10 @@ fn figures(input: &ReportInput<'_>) -> Figures {
     let tests = tests_of(input);
     let figures: Vec<FiguresJson> = tests
         .iter()
-        .map(|(_, test)| FiguresJson::from_figures(&test.evaluation.figures))
+        .map(|(_, test)| match test.measurement.kind() {
+            AxisKind::Linear => FiguresJson::from_figures(&test.evaluation.figures),
+            AxisKind::Rotary => FiguresJson::from_standard_deg(&test.evaluation.standard_figures),
+        })
         .collect();
     let rows = FIGURE_ROWS
         .into_iter()
@@ -923,7 +1000,9 @@ fn figures(input: &ReportInput<'_>) -> Figures {
                 .flat_map(|((f, (_, test)), prefix)| {
                     // Where these figures are in the test's JSON: its
                     // `figures_um`, or beside another standard's.
-                    let object = if iso_keys(&test.evaluation.standard_figures) {
+                    let object = if test.measurement.kind() == AxisKind::Rotary {
+                        "figures_arcsec"
+                    } else if iso_keys(&test.evaluation.standard_figures) {
                         "figures_um"
                     } else {
                         "figures_iso230_2_um"
@@ -1050,9 +1129,16 @@ fn per_target(input: &ReportInput<'_>) -> Vec<PerTargetTable> {
 
 fn per_target_rows(test: &TestRecord<'_>, prefix: &str) -> Vec<PerTargetRow> {
     let length_unit = test.measurement.metadata.length_unit.as_str();
+    let kind = test.measurement.kind();
+    let rotary = kind == AxisKind::Rotary;
     let mut rows = Vec::new();
     for (index, stats) in test.evaluation.per_target.iter().enumerate() {
-        let t = PerTargetJson::from_stats(stats);
+        let t = PerTargetJson::from_stats_of(stats, kind);
+        // The JSON key: `mean_up_um`, or `mean_up_arcsec` on a rotary axis.
+        let key = |name: &str| match (rotary, name.strip_suffix("_um")) {
+            (true, Some(stem)) => format!("{prefix}.per_target.{index}.{stem}_arcsec"),
+            _ => format!("{prefix}.per_target.{index}.{name}"),
+        };
         let cells = [
             ("mean_up_um", t.mean_up_um),
             ("mean_down_um", t.mean_down_um),
@@ -1064,13 +1150,17 @@ fn per_target_rows(test: &TestRecord<'_>, prefix: &str) -> Vec<PerTargetRow> {
             ("R_down_um", t.R_down_um),
             ("R_um", t.R_um),
         ]
-        .map(|(name, value)| SourcedUm::new(format!("{prefix}.per_target.{index}.{name}"), value));
+        .map(|(name, value)| SourcedUm::new(key(name), value));
         rows.push(PerTargetRow {
-            target: format!(
-                "{}{}",
-                t.target_mm,
-                inch_beside(length_unit, &[t.target_mm])
-            ),
+            target: if rotary {
+                format!("{}°", t.target_mm)
+            } else {
+                format!(
+                    "{}{}",
+                    t.target_mm,
+                    inch_beside(length_unit, &[t.target_mm])
+                )
+            },
             n_up: t.n_up,
             n_down: t.n_down,
             cells: cells.to_vec(),
@@ -1275,7 +1365,10 @@ fn notes(input: &ReportInput<'_>) -> Vec<Note> {
                     run: outlier.run,
                     direction: outlier.direction,
                     score: format!("{:.1}", outlier.score),
-                    offset_um: signed_plus(mm_to_um(outlier.offset_mm), 2),
+                    offset_um: signed_plus(
+                        deviation_shown(record.measurement)(outlier.offset_mm),
+                        2,
+                    ),
                     worst_target_mm: outlier.worst_target_mm,
                 },
             });
