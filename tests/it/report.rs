@@ -686,3 +686,87 @@ fn the_lack_of_fit_p_value_is_printed_once_with_one_sign() {
         );
     }
 }
+
+/// Issue 14: a rotary axis' report is in ° and ″, its keyed cells those of
+/// the rotary `evaluate --json` (`figures_arcsec`, `mean_up_arcsec`, …), with
+/// a polar plot of the mean deviation beside the linear one and the rotary
+/// reference named; it opens in the browser and is not blank.
+#[test]
+fn a_rotary_report_is_in_arcseconds_with_a_polar_plot() {
+    const ROTARY: &str = "fixtures/rotary/c.csv";
+    let page = artefacts().join("rotary-c.html");
+    let run = axcomp(["report", ROTARY, "-o", page.to_str().unwrap(), "--force"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&page).unwrap();
+    let evaluation = evaluate_json(&[Path::new(ROTARY)]);
+    assert_eq!(embedded_data(&html)["before"], evaluation);
+    let targets = evaluation["targets_deg"].as_array().unwrap().len();
+    // 12 axis figures and 9 values at each target, none in µm.
+    assert_eq!(
+        check_against_json(&html, "before", &evaluation),
+        12 + 9 * targets
+    );
+    assert!(html.contains("data-key=\"before.figures_arcsec.A\""));
+    assert!(html.contains("data-key=\"before.per_target.3.mean_up_arcsec\""));
+    let keys = keyed_values(&html);
+    assert!(
+        keys.iter()
+            .all(|(key, ..)| !key.ends_with("_um") && !key.contains("_um."))
+    );
+    for text in [
+        "Acceptance report: rotary axis C",
+        "ISO 230-2 figures [″]",
+        "Per target [″]",
+        "<th>target [°]</th>",
+        "<td class=\"num\">45°</td>",
+        "target position [°]",
+        "positional deviation [″]",
+        "Acceptance limits are not evaluated for a rotary axis yet",
+        "id=\"rotary-note\"",
+    ] {
+        assert!(html.contains(text), "{text} missing");
+    }
+    // The rotary reference: no file format records it.
+    let reference = html.find("<th>Rotary reference</th>").unwrap();
+    assert!(
+        html[reference..]
+            .split("</tr>")
+            .next()
+            .unwrap()
+            .contains("not recorded")
+    );
+    // The polar plot: an SVG with its caption, after the linear one.
+    let polar = html.find("id=\"plot-polar\"").expect("the polar plot");
+    assert!(html.find("id=\"plot-deviation\"").unwrap() < polar);
+    let figure = &html[polar..polar + html[polar..].find("</figure>").unwrap()];
+    assert!(figure.contains("<svg role=\"img\""));
+    assert!(figure.contains("<figcaption>The mean deviation around the circle"));
+    assert!(figure.contains("90°") && figure.contains("0″"));
+
+    let screenshot = artefacts().join("rotary-c.png");
+    let browser = open_in_browser(&page, (1280, 2800), BrowserOutput::Screenshot(&screenshot));
+    assert!(browser.console.is_empty(), "console: {:?}", browser.console);
+    let shot = Pixels::read(&screenshot);
+    assert!(shot.inked() > 0.05, "{} is blank", screenshot.display());
+    // The plots' blues (the ↑ band, runs and means): measured 0.004 of this
+    // tall page, none without plots.
+    let blue = shot.blue();
+    assert!(blue > 0.001, "no plot in {}: {blue}", screenshot.display());
+    assert_eq!(browser.dom.matches("<svg").count(), 2);
+    assert_eq!(
+        browser.dom.matches("data-key=\"before.per_target.").count(),
+        9 * targets
+    );
+    assert_eq!(embedded_data(&browser.dom)["before"], evaluation);
+
+    // What does not apply to a rotary axis yet is refused, naming it.
+    for (flag, value) in [
+        ("--limit", "A=5"),
+        ("--table", "X.COM"),
+        ("--equipment", "fixtures/equipment/hene-default.toml"),
+    ] {
+        let run = axcomp(["report", ROTARY, flag, value, "-o", "never.html"]);
+        assert_eq!(run.code, 2, "{flag}: {}", run.stderr);
+        assert!(run.stderr.contains("rotary axis"), "{flag}: {}", run.stderr);
+    }
+}
