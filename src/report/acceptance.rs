@@ -361,29 +361,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
     }
     all.extend(lines);
     all.extend(markers);
-    for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
-        let means = means_in(per_target, direction, shown);
-        if !means.is_empty() {
-            all.push(series(
-                Some(format!("mean {direction}")),
-                color,
-                Mark::Line(2),
-                means,
-            ));
-        }
-    }
-    let bidirectional: Vec<(f64, f64)> = per_target
-        .iter()
-        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, shown(m))))
-        .collect();
-    if !bidirectional.is_empty() {
-        all.push(series(
-            Some("bidirectional mean".into()),
-            BLACK,
-            Mark::Dashed(2),
-            bidirectional,
-        ));
-    }
+    all.extend(mean_lines(per_target, shown));
     Chart {
         title: format!("Positional deviation, {which}{}", axis_suffix(test)),
         x_label: match test.measurement.kind() {
@@ -400,6 +378,37 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
         y_range: None,
         polar: None,
     }
+}
+
+/// The mean lines of a test: x̄↑ and x̄↓ (solid, in their colours) and the
+/// bidirectional mean x̄ (dashed), converted by `shown`; the deviation plot
+/// and the polar plot draw the same three.
+fn mean_lines(per_target: &[TargetStats], shown: fn(f64) -> f64) -> Vec<Series> {
+    let mut lines = Vec::new();
+    for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
+        let means = means_in(per_target, direction, shown);
+        if !means.is_empty() {
+            lines.push(series(
+                Some(format!("mean {direction}")),
+                color,
+                Mark::Line(2),
+                means,
+            ));
+        }
+    }
+    let bidirectional: Vec<(f64, f64)> = per_target
+        .iter()
+        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, shown(m))))
+        .collect();
+    if !bidirectional.is_empty() {
+        lines.push(series(
+            Some("bidirectional mean".into()),
+            BLACK,
+            Mark::Dashed(2),
+            bidirectional,
+        ));
+    }
+    lines
 }
 
 /// (target, x̄) for one direction, where the mean is defined, the mean
@@ -443,31 +452,7 @@ fn largest_mean(test: &TestRecord<'_>) -> Option<f64> {
 /// `largest` ″ or the test's own largest mean); `None` for a linear axis.
 fn polar_chart(test: &TestRecord<'_>, which: &str, largest: Option<f64>) -> Option<Chart> {
     let largest = largest.or_else(|| largest_mean(test))?;
-    let per_target = &test.evaluation.per_target;
-    let mut all = Vec::new();
-    for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
-        let means = means_in(per_target, direction, deg_to_arcsec);
-        if !means.is_empty() {
-            all.push(series(
-                Some(format!("mean {direction}")),
-                color,
-                Mark::Line(2),
-                means,
-            ));
-        }
-    }
-    let bidirectional: Vec<(f64, f64)> = per_target
-        .iter()
-        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, deg_to_arcsec(m))))
-        .collect();
-    if !bidirectional.is_empty() {
-        all.push(series(
-            Some("bidirectional mean".into()),
-            BLACK,
-            Mark::Dashed(2),
-            bidirectional,
-        ));
-    }
+    let all = mean_lines(&test.evaluation.per_target, deg_to_arcsec);
     Some(Chart {
         title: format!(
             "Mean deviation around the circle{which}{}",

@@ -224,6 +224,8 @@ fn commands_for_linear_axes_only_refuse_a_rotary_one() {
             path.as_os_str(),
             "--axis".as_ref(),
             "C".as_ref(),
+            "--limit".as_ref(),
+            "E=5".as_ref(),
             "-o".as_ref(),
             "/nonexistent/r.html".as_ref(),
         ],
