@@ -832,6 +832,13 @@ fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
             let per_metre = density
                 .and_then(|d| d.found)
                 .map_or_else(String::new, |d| format!(", {d:.1} per metre"));
+            // A rotary axis has no per-metre rule (evaluate::conformance).
+            if c.kind == AxisKind::Rotary {
+                return Cell::Conformance {
+                    finding: format!("{} (at least 5)", c.targets),
+                    met: met(&[count]),
+                };
+            }
             Cell::Conformance {
                 finding: format!("{}{per_metre} (at least 5, and 5 per metre)", c.targets),
                 met: met(&[count, density]),
@@ -855,7 +862,12 @@ fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
             }
         }),
     ];
+    // Nor a spacing rule: a rotary test's even steps are its principal angles.
+    let rotary = tests
+        .iter()
+        .any(|(_, t)| t.evaluation.conformance.kind == AxisKind::Rotary);
     rows.into_iter()
+        .filter(|(label, _)| !(rotary && label.starts_with("Spacing")))
         .map(|(label, judge)| wide_row(tests, label, "", &|t| judge(&t.evaluation.conformance)))
         .collect()
 }
