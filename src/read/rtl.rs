@@ -724,7 +724,9 @@ impl RtlParser {
     }
 
     fn finish(mut self, input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
-        let end_line = end_of_file_line(input);
+        // Only a message needs it (counting the lines of a large file again
+        // is not free).
+        let end_line = || end_of_file_line(input);
         if self.section.is_none() {
             return Err(ParseError::expected(
                 1,
@@ -735,7 +737,7 @@ impl RtlParser {
         }
         if self.saw_eof.is_none() {
             return Err(ParseError::new(
-                end_line,
+                end_line(),
                 1,
                 "expected EOF:: at the end of the file, found end of file: the file is truncated",
             ));
@@ -747,7 +749,7 @@ impl RtlParser {
         ] {
             if !self.seen.contains_key(key) {
                 return Err(ParseError::new(
-                    end_line,
+                    end_line(),
                     1,
                     format!("expected a {name} section, found none"),
                 ));
