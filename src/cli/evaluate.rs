@@ -91,14 +91,20 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let budget = uncertainty_budget(&measurement, &equipment)?;
     let evaluation = evaluate_with(&measurement, args.standard.standard);
     warnings.extend(evaluation.warnings.iter().cloned());
-    let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
-    report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));
-    report.verdict = verdict::judge(
+    let verdict = verdict::judge(
         &evaluation,
         &limits,
         args.uncertainty.decision,
         Some(&budget),
     );
+    let mut report =
+        EvaluationJson::from_evaluation(&measurement, evaluation, &args.exclude_runs, &warnings);
+    report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));
+    report.verdict = verdict;
+    // The report holds all it prints. The readings go first, so that the
+    // text rendered from a large test (megabytes) takes memory already in
+    // use rather than new pages.
+    drop(measurement);
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

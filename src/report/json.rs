@@ -478,6 +478,37 @@ impl EvaluationJson {
         excluded: &[RunSelector],
         warnings: &[Warning],
     ) -> EvaluationJson {
+        let per_target = evaluation
+            .per_target
+            .iter()
+            .map(PerTargetJson::from_stats)
+            .collect();
+        EvaluationJson::with_per_target(measurement, evaluation, per_target, excluded, warnings)
+    }
+
+    /// [`EvaluationJson::new`], taking the evaluation: each target's
+    /// statistics are converted where they are (the two types have one
+    /// size), so a large test's table is not held twice.
+    pub fn from_evaluation(
+        measurement: &Measurement,
+        mut evaluation: Evaluation,
+        excluded: &[RunSelector],
+        warnings: &[Warning],
+    ) -> EvaluationJson {
+        let per_target = std::mem::take(&mut evaluation.per_target)
+            .into_iter()
+            .map(|stats| PerTargetJson::from_stats(&stats))
+            .collect();
+        EvaluationJson::with_per_target(measurement, &evaluation, per_target, excluded, warnings)
+    }
+
+    fn with_per_target(
+        measurement: &Measurement,
+        evaluation: &Evaluation,
+        per_target: Vec<PerTargetJson>,
+        excluded: &[RunSelector],
+        warnings: &[Warning],
+    ) -> EvaluationJson {
         let metadata = &measurement.metadata;
         EvaluationJson {
             format: metadata.source_format.map(|f| f.name()),
@@ -498,11 +529,7 @@ impl EvaluationJson {
             standard_name: evaluation.standard.name,
             definitions_reconstructed: evaluation.standard.reconstructed,
             figures_um: FiguresJson::from_standard(&evaluation.standard_figures),
-            per_target: evaluation
-                .per_target
-                .iter()
-                .map(PerTargetJson::from_stats)
-                .collect(),
+            per_target,
             outliers: evaluation
                 .outliers
                 .iter()
