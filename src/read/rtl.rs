@@ -422,6 +422,15 @@ impl RtlParser {
     }
 
     fn target_values(&mut self, line: &Line<'_>, values: &str) -> Result<(), ParseError> {
+        if self.targets.is_empty()
+            && let Some(count) = self.target_count
+        {
+            // Room for the targets the file announces, made once (bounded: a
+            // Target-count of a billion must not reserve gigabytes).
+            let room = count.value.min(1 << 16);
+            self.targets.reserve(room);
+            self.target_lookup.reserve(room);
+        }
         for token in values.split_whitespace() {
             let value = text::number(line, token, "target position in mm")?;
             check_target_mm(value, line.number, line.column_of(token))?;
