@@ -14,9 +14,9 @@
 //! and time both commands, paired (`farm-bench -n 10 --vs 'python3
 //! benches/reference/evaluate_rtl.py /tmp/big.rtl' -- target/release/axcomp
 //! evaluate /tmp/big.rtl -q`). Last measured (medians, 2-core machine shared
-//! with other builds): axcomp 13 ms CPU, 13 ms wall; Python 186 ms CPU, 199 ms
-//! wall; ratio 0.068 CPU, 0.066 wall (it was 0.117 and 0.116 before the reader
-//! filled each run's readings as it read them). The aim is 1/20.
+//! with other builds): axcomp 13 ms CPU, 13 ms wall; Python 185 ms CPU, 185 ms
+//! wall; ratio 0.068 CPU, 0.071 wall (it was 0.117 and 0.120, 22 ms, before the
+//! reader filled each run's readings as it read them). The aim is 1/20.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
