@@ -244,8 +244,6 @@ fn section_header(input: &str) -> IResult<&str, &str> {
 struct RunRows {
     /// Deviations in mm, indexed like the sorted targets; `None` until listed.
     deviations_mm: Vec<Option<f64>>,
-    /// Rows read so far.
-    rows: usize,
     /// Sorted position and target number of the run's last row so far.
     last: Option<(usize, usize)>,
     /// Whether the run goes towards larger targets, once it has two rows.
@@ -279,8 +277,10 @@ struct RtlParser {
     /// first deviation row (the target list is complete by then: a row
     /// needs its target listed, and TARGET DATA:: appears once).
     sorted_index: Vec<usize>,
-    /// Per file run, its rows so far (made on its first row).
-    run_rows: Vec<RunRows>,
+    /// Per file run, its rows so far (made on its first row). Boxed: a
+    /// slot is made for every run up to the largest number read, and a row
+    /// may name run 100 000 000 of a Run-count that large.
+    run_rows: Vec<Option<Box<RunRows>>>,
     /// Deviation rows read, over all runs.
     row_count: usize,
     metadata: Metadata,
@@ -633,12 +633,15 @@ impl RtlParser {
         }
         let run_index = file_run as usize - 1;
         if self.run_rows.len() <= run_index {
-            self.run_rows.resize_with(run_index + 1, RunRows::default);
+            self.run_rows.resize_with(run_index + 1, || None);
         }
-        let run = &mut self.run_rows[run_index];
-        if run.deviations_mm.is_empty() {
-            run.deviations_mm = vec![None; self.targets.len()];
-        }
+        let target_count = self.targets.len();
+        let run = self.run_rows[run_index].get_or_insert_with(|| {
+            Box::new(RunRows {
+                deviations_mm: vec![None; target_count],
+                ..RunRows::default()
+            })
+        });
         let position = self.sorted_index[target_number - 1];
         let cell = &mut run.deviations_mm[position];
         if cell.is_some() {
@@ -656,7 +659,6 @@ impl RtlParser {
             }
         }
         run.last = Some((position, target_number));
-        run.rows += 1;
         self.row_count += 1;
         true
     }
@@ -856,8 +858,7 @@ impl RtlParser {
         let mut numbers = [0u32; 2];
         let mut run_rows = std::mem::take(&mut self.run_rows).into_iter();
         for file_run in 1..=run_count.value {
-            let rows = run_rows.next().unwrap_or_default();
-            if rows.rows == 0 {
+            let Some(rows) = run_rows.next().flatten() else {
                 return Err(ParseError::new(
                     run_count.line,
                     run_count.column,
@@ -866,7 +867,7 @@ impl RtlParser {
                         run_count.value
                     ),
                 ));
-            }
+            };
             let direction = run_direction(&rows, file_run)?;
             let slot = usize::from(direction == Direction::Down);
             numbers[slot] += 1;
