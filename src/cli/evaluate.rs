@@ -91,26 +91,32 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     )?;
     let equipment = load_equipment(&args.uncertainty)?;
     warnings.extend(evaluation.warnings.iter().cloned());
-    let mut report = EvaluationJson::new(&measurement, &evaluation, &args.exclude_runs, &warnings);
-    if measurement.kind() == AxisKind::Rotary {
-        // The budget is the laser's, for lengths, and limits are µm: a
-        // rotary axis has neither yet (issue 14's later part).
-        if !limits.is_empty() {
-            bail!(
-                "axis {} is a rotary axis: acceptance limits (--limit, a profile's [acceptance]) are µm, for linear axes only so far",
-                measurement.axis()
-            );
-        }
-    } else {
-        let budget = uncertainty_budget(&measurement, &equipment)?;
-        report.uncertainty_um = Some(UncertaintyJson::from_budget(&budget));
-        report.verdict = verdict::judge(
+    // The budget is the laser's, for lengths, and limits are µm: a rotary
+    // axis has neither yet (issue 14's later part).
+    let budget = match measurement.kind() {
+        AxisKind::Rotary if !limits.is_empty() => bail!(
+            "axis {} is a rotary axis: acceptance limits (--limit, a profile's [acceptance]) are µm, for linear axes only so far",
+            measurement.axis()
+        ),
+        AxisKind::Rotary => None,
+        AxisKind::Linear => Some(uncertainty_budget(&measurement, &equipment)?),
+    };
+    let verdict = budget.as_ref().and_then(|budget| {
+        verdict::judge(
             &evaluation,
             &limits,
             args.uncertainty.decision,
-            Some(&budget),
-        );
-    }
+            Some(budget),
+        )
+    });
+    let mut report =
+        EvaluationJson::from_evaluation(&measurement, evaluation, &args.exclude_runs, &warnings);
+    report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
+    report.verdict = verdict;
+    // The report holds all it prints. The readings go first, so that the
+    // text rendered from a large test (megabytes) takes memory already in
+    // use rather than new pages.
+    drop(measurement);
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

@@ -71,7 +71,15 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
         }
     }
     let mut scores = Vec::with_capacity(runs.len());
-    for run in &runs {
+    for (run_index, run) in runs.iter().enumerate() {
+        // The other runs' readings, in their order (sliced once: this loop
+        // visits every reading of every other run).
+        let other_runs: Vec<&[Option<f64>]> = runs
+            .iter()
+            .enumerate()
+            .filter(|(other_index, _)| *other_index != run_index)
+            .map(|(_, other)| other.deviations_mm.as_slice())
+            .collect();
         // Pooled variance of the other runs, two-pass for accuracy.
         let mut sum_sq = 0.0;
         let mut degrees = 0usize;
@@ -81,8 +89,8 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
                 continue;
             }
             let mean_others = (sum[i] - own.unwrap_or(0.0)) / others as f64;
-            for other in runs.iter().filter(|r| !std::ptr::eq(**r, *run)) {
-                if let Some(v) = other.deviations_mm[i] {
+            for other in &other_runs {
+                if let Some(v) = other[i] {
                     sum_sq += (v - mean_others) * (v - mean_others);
                 }
             }
@@ -92,6 +100,11 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
             continue;
         }
         let sigma = (sum_sq / degrees as f64).sqrt();
+        // The standard deviation of a difference depends on the target only
+        // through its number of other readings: worked out once per number.
+        let difference_sd: Vec<f64> = (0..runs.len())
+            .map(|others| sigma * (1.0 + 1.0 / others as f64).sqrt())
+            .collect();
         let mut worst: Option<(f64, usize, f64)> = None;
         for (i, own) in run.deviations_mm.iter().enumerate() {
             let (Some(own), others) = (own, count[i] - usize::from(own.is_some())) else {
@@ -101,7 +114,7 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
                 continue;
             }
             let offset = own - (sum[i] - own) / others as f64;
-            let z = offset.abs() / (sigma * (1.0 + 1.0 / others as f64).sqrt());
+            let z = offset.abs() / difference_sd[others];
             if worst.is_none_or(|(best, _, _)| z > best) {
                 worst = Some((z, i, offset));
             }

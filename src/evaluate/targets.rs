@@ -87,13 +87,21 @@ pub(super) fn per_target_stats<T>(
     measurement: &Measurement,
     mut at_target: impl FnMut(f64, DirectionStats, DirectionStats) -> T,
 ) -> Vec<T> {
+    // Each direction's runs, found once rather than once per target.
+    let runs_of = |direction: Direction| -> Vec<&[Option<f64>]> {
+        measurement
+            .runs_in(direction)
+            .map(|run| run.deviations_mm.as_slice())
+            .collect()
+    };
+    let runs_by_direction = [runs_of(Direction::Up), runs_of(Direction::Down)];
     let mut readings: Vec<f64> = Vec::with_capacity(measurement.runs().len());
     let mut stats_of = |target_index: usize, direction: Direction| {
         readings.clear();
         readings.extend(
-            measurement
-                .runs_in(direction)
-                .filter_map(|run| run.deviations_mm[target_index]),
+            runs_by_direction[usize::from(direction == Direction::Down)]
+                .iter()
+                .filter_map(|deviations_mm| deviations_mm[target_index]),
         );
         DirectionStats::of(&readings)
     };

@@ -243,14 +243,20 @@ fn section_header(input: &str) -> IResult<&str, &str> {
         .parse(input)
 }
 
-/// One deviation row as read, before runs are assembled.
-#[derive(Clone, Copy, Debug)]
-struct DeviationRow {
-    line: usize,
-    column: usize,
-    file_run: u32,
-    target_number: usize,
-    deviation_um: f64,
+/// One file run's deviation rows as they are read: its readings, already
+/// in place, and what its direction needs (the module doc), so that no list
+/// of rows is kept (a large file has a hundred thousand).
+#[derive(Debug, Default)]
+struct RunRows {
+    /// Deviations in mm, indexed like the sorted targets; `None` until listed.
+    deviations_mm: Vec<Option<f64>>,
+    /// Sorted position and target number of the run's last row so far.
+    last: Option<(usize, usize)>,
+    /// Whether the run goes towards larger targets, once it has two rows.
+    up: Option<bool>,
+    /// The run's first row that turns back (line, column, its target number
+    /// and that of the row before it).
+    turns_back: Option<(usize, usize, usize, usize)>,
 }
 
 /// A number with the line and column it came from.
@@ -271,11 +277,18 @@ struct RtlParser {
     /// Target value (as bits, -0 folded into +0) → index into `targets`.
     target_lookup: HashMap<u64, usize>,
     run_count: Option<Located<u32>>,
-    rows: Vec<DeviationRow>,
-    /// Per file run, a bit per target number: the pairs listed so far, to
-    /// find a pair listed twice (a bit, not a hash map entry: a large file
-    /// has a hundred thousand pairs).
-    listed_pairs: Vec<Vec<u64>>,
+    /// Line of `DEVIATIONS::`, from where a pair listed twice is looked up.
+    deviations_line: usize,
+    /// Target number − 1 → position among the sorted targets; made on the
+    /// first deviation row (the target list is complete by then: a row
+    /// needs its target listed, and TARGET DATA:: appears once).
+    sorted_index: Vec<usize>,
+    /// Per file run, its rows so far (made on its first row). Boxed: a
+    /// slot is made for every run up to the largest number read, and a row
+    /// may name run 100 000 000 of a Run-count that large.
+    run_rows: Vec<Option<Box<RunRows>>>,
+    /// Deviation rows read, over all runs.
+    row_count: usize,
     metadata: Metadata,
     axis: Option<String>,
     last_user_key: Option<String>,
@@ -289,6 +302,10 @@ struct RtlParser {
 impl RtlParser {
     fn run(&mut self, input: &str) -> Result<(), ParseError> {
         for line in text::lines(input) {
+            // Most lines of a large file are plain deviation rows.
+            if self.section == Some(Section::Deviations) && self.plain_deviation_row(&line) {
+                continue;
+            }
             if line.is_blank() {
                 continue;
             }
@@ -320,7 +337,7 @@ impl RtlParser {
                 Section::TargetData => self.target_data_line(&line)?,
                 Section::UserText => self.user_text_line(&line),
                 Section::Runs => self.runs_line(&line)?,
-                Section::Deviations => self.deviation_line(&line)?,
+                Section::Deviations => self.deviation_line(&line, input)?,
                 Section::Environment => self.environment_line(&line)?,
                 Section::Eof | Section::Unknown => {}
             }
@@ -352,6 +369,9 @@ impl RtlParser {
         }
         if section == Section::Eof {
             self.saw_eof = Some(line.number);
+        }
+        if section == Section::Deviations {
+            self.deviations_line = line.number;
         }
         self.section = Some(section);
         Ok(())
@@ -417,6 +437,15 @@ impl RtlParser {
     }
 
     fn target_values(&mut self, line: &Line<'_>, values: &str) -> Result<(), ParseError> {
+        if self.targets.is_empty()
+            && let Some(count) = self.target_count
+        {
+            // Room for the targets the file announces, made once (bounded: a
+            // Target-count of a billion must not reserve gigabytes).
+            let room = count.value.min(1 << 16);
+            self.targets.reserve(room);
+            self.target_lookup.reserve(room);
+        }
         for token in values.split_whitespace() {
             let value = text::number(line, token, "target position in mm")?;
             check_target_mm(value, line.number, line.column_of(token))?;
@@ -507,7 +536,7 @@ impl RtlParser {
         Ok(())
     }
 
-    fn deviation_line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+    fn deviation_line(&mut self, line: &Line<'_>, input: &str) -> Result<(), ParseError> {
         if line.text.contains(':') {
             let (key, _) = key_value(line)?;
             if !key.eq_ignore_ascii_case("run target data") {
@@ -515,17 +544,7 @@ impl RtlParser {
             }
             return Ok(());
         }
-        // A row is ASCII in every file seen; splitting it on ASCII blanks is
-        // the same split and a good part faster than the Unicode one.
-        fn first_four<'a>(mut fields: impl Iterator<Item = &'a str>) -> [Option<&'a str>; 4] {
-            std::array::from_fn(|_| fields.next())
-        }
-        let fields = if line.text.is_ascii() {
-            first_four(line.text.split_ascii_whitespace())
-        } else {
-            first_four(line.fields())
-        };
-        let [Some(run), Some(target), Some(value), None] = fields else {
+        let [Some(run), Some(target), Some(value), None] = row_fields(line) else {
             let fields: Vec<&str> = line.fields().collect();
             let at = fields.get(3).copied().unwrap_or(line.text.trim_start());
             return Err(line.error_at(
@@ -560,22 +579,13 @@ impl RtlParser {
             ));
         }
         let deviation_um = text::number(line, value, "deviation in µm")?;
-        check_deviation_mm(um_to_mm(deviation_um), line.number, line.column_of(value))?;
+        let deviation_mm =
+            check_deviation_mm(um_to_mm(deviation_um), line.number, line.column_of(value))?;
         let file_run = file_run as u32;
         let target_number = target_number as usize;
-        if self.rows.is_empty() {
-            // Room for every row the file announces (bounded: a Run-count of
-            // a billion must not reserve gigabytes).
-            let pairs = u64::from(run_count.value).saturating_mul(listed);
-            self.rows
-                .reserve(usize::try_from(pairs.min(1 << 20)).unwrap_or(0));
-        }
-        if self.pair_listed_before(file_run, target_number) {
-            let first_line = self
-                .rows
-                .iter()
-                .find(|row| row.file_run == file_run && row.target_number == target_number)
-                .map_or(line.number, |row| row.line);
+        let row = (line.number, line.column_of(run));
+        if !self.record_row(row, file_run, target_number, deviation_mm) {
+            let first_line = self.first_row_line(input, line.number, file_run, target_number);
             return Err(line.error_at(
                 target,
                 format!(
@@ -583,33 +593,115 @@ impl RtlParser {
                 ),
             ));
         }
-        self.rows.push(DeviationRow {
-            line: line.number,
-            column: line.column_of(run),
-            file_run,
-            target_number,
-            deviation_um,
-        });
         Ok(())
     }
 
-    /// Marks the pair (file run, target number) as listed; whether it was
-    /// listed before. A run's bits are made on its first row (never more
-    /// runs than rows), an eighth of a byte per target.
-    fn pair_listed_before(&mut self, file_run: u32, target_number: usize) -> bool {
+    /// Reads and records a deviation row in its common form (ASCII, three
+    /// fields separated by blanks, every check passed); whether it did. Any
+    /// other line is left, unchanged, to `deviation_line`, which reads it the
+    /// same way or refuses it with its message.
+    fn plain_deviation_row(&mut self, line: &Line<'_>) -> bool {
+        let Some(run_count) = self.run_count else {
+            return false;
+        };
+        let Some(row) = PlainRow::of(line.text) else {
+            return false;
+        };
+        if row.file_run == 0
+            || row.file_run > u64::from(run_count.value)
+            || row.target_number == 0
+            || row.target_number > self.targets.len() as u64
+        {
+            return false;
+        }
+        let Ok(deviation_um) = text::number(line, row.value, "deviation in µm") else {
+            return false;
+        };
+        let Ok(deviation_mm) = check_deviation_mm(um_to_mm(deviation_um), 0, 0) else {
+            return false;
+        };
+        // The line is ASCII: the column is the byte offset + 1.
+        let at = (line.number, row.run_offset + 1);
+        self.record_row(
+            at,
+            row.file_run as u32,
+            row.target_number as usize,
+            deviation_mm,
+        )
+    }
+
+    /// Puts a checked row's reading in its run and follows the run's
+    /// direction; false, with nothing changed, when the run lists the target
+    /// already. `at` is the row's line and column.
+    fn record_row(
+        &mut self,
+        at: (usize, usize),
+        file_run: u32,
+        target_number: usize,
+        deviation_mm: f64,
+    ) -> bool {
+        if self.sorted_index.is_empty() {
+            self.sorted_index = vec![0; self.targets.len()];
+            for (index, target) in sorted_targets(&self.targets).iter().enumerate() {
+                self.sorted_index[target.original_index] = index;
+            }
+        }
         let run_index = file_run as usize - 1;
-        if self.listed_pairs.len() <= run_index {
-            self.listed_pairs.resize_with(run_index + 1, Vec::new);
+        if self.run_rows.len() <= run_index {
+            self.run_rows.resize_with(run_index + 1, || None);
         }
-        let bits = &mut self.listed_pairs[run_index];
-        if bits.len() * 64 < target_number {
-            // Sized to the targets listed so far (at least `target_number`).
-            bits.resize(self.targets.len().div_ceil(64), 0);
+        let target_count = self.targets.len();
+        let run = self.run_rows[run_index].get_or_insert_with(|| {
+            Box::new(RunRows {
+                deviations_mm: vec![None; target_count],
+                ..RunRows::default()
+            })
+        });
+        let position = self.sorted_index[target_number - 1];
+        let cell = &mut run.deviations_mm[position];
+        if cell.is_some() {
+            return false;
         }
-        let (word, bit) = ((target_number - 1) / 64, 1u64 << ((target_number - 1) % 64));
-        let before = bits[word] & bit != 0;
-        bits[word] |= bit;
-        before
+        *cell = Some(deviation_mm);
+        if let Some((last_position, last_target_number)) = run.last {
+            let forward = position > last_position;
+            match run.up {
+                None => run.up = Some(forward),
+                Some(up) if up != forward && run.turns_back.is_none() => {
+                    run.turns_back = Some((at.0, at.1, target_number, last_target_number));
+                }
+                Some(_) => {}
+            }
+        }
+        run.last = Some((position, target_number));
+        self.row_count += 1;
+        true
+    }
+
+    /// The line of the first row of `file_run` for `target_number`, searched
+    /// from `DEVIATIONS::` up to `before` (only for the message of a pair
+    /// listed twice: every row there has been read without error).
+    fn first_row_line(
+        &self,
+        input: &str,
+        before: usize,
+        file_run: u32,
+        target_number: usize,
+    ) -> usize {
+        let same_pair = |line: &Line<'_>| {
+            if line.text.contains(':') {
+                return false;
+            }
+            let [Some(run), Some(target), Some(_), None] = row_fields(line) else {
+                return false;
+            };
+            run.parse() == Ok(file_run) && target.parse() == Ok(target_number)
+        };
+        text::lines(input)
+            .skip(self.deviations_line)
+            .take_while(|line| line.number < before)
+            .find(same_pair)
+            .map_or(before, |line| line.number)
     }
 
     fn environment_line(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
@@ -658,7 +750,9 @@ impl RtlParser {
     }
 
     fn finish(mut self, input: &str) -> Result<(Measurement, Vec<Warning>), ParseError> {
-        let end_line = end_of_file_line(input);
+        // Only a message needs it (counting the lines of a large file again
+        // is not free).
+        let end_line = || end_of_file_line(input);
         if self.section.is_none() {
             return Err(ParseError::expected(
                 1,
@@ -669,7 +763,7 @@ impl RtlParser {
         }
         if self.saw_eof.is_none() {
             return Err(ParseError::new(
-                end_line,
+                end_line(),
                 1,
                 "expected EOF:: at the end of the file, found end of file: the file is truncated",
             ));
@@ -681,7 +775,7 @@ impl RtlParser {
         ] {
             if !self.seen.contains_key(key) {
                 return Err(ParseError::new(
-                    end_line,
+                    end_line(),
                     1,
                     format!("expected a {name} section, found none"),
                 ));
@@ -761,35 +855,25 @@ impl RtlParser {
         Ok((measurement, self.warnings))
     }
 
-    /// Groups the rows by file run, infers each run's direction and numbers the
+    /// Takes each file run's readings, tells its direction and numbers the
     /// runs per direction in the order measured.
-    fn assemble_runs(&self, run_count: Located<u32>) -> Result<Vec<Run>, ParseError> {
+    fn assemble_runs(&mut self, run_count: Located<u32>) -> Result<Vec<Run>, ParseError> {
         // Every run needs a row: refuse an impossible count before sizing anything by it.
-        if run_count.value as usize > self.rows.len() {
+        if run_count.value as usize > self.row_count {
             return Err(ParseError::new(
                 run_count.line,
                 run_count.column,
                 format!(
                     "Run-count is {} but there are only {} deviation rows",
-                    run_count.value,
-                    self.rows.len()
+                    run_count.value, self.row_count
                 ),
             ));
         }
-        let sorted = sorted_targets(&self.targets);
-        // Target number (1-based, as listed) → index into the sorted targets.
-        let mut sorted_index = vec![0; self.targets.len()];
-        for (index, target) in sorted.iter().enumerate() {
-            sorted_index[target.original_index] = index;
-        }
         let mut runs = Vec::with_capacity(run_count.value as usize);
         let mut numbers = [0u32; 2];
-        let mut rows_by_run: Vec<Vec<&DeviationRow>> = vec![Vec::new(); run_count.value as usize];
-        for row in &self.rows {
-            rows_by_run[row.file_run as usize - 1].push(row);
-        }
-        for (file_run, rows) in (1..=run_count.value).zip(rows_by_run) {
-            if rows.is_empty() {
+        let mut run_rows = std::mem::take(&mut self.run_rows).into_iter();
+        for file_run in 1..=run_count.value {
+            let Some(rows) = run_rows.next().flatten() else {
                 return Err(ParseError::new(
                     run_count.line,
                     run_count.column,
@@ -798,20 +882,15 @@ impl RtlParser {
                         run_count.value
                     ),
                 ));
-            }
-            let direction = run_direction(&rows, &sorted_index, file_run)?;
+            };
+            let direction = run_direction(&rows, file_run)?;
             let slot = usize::from(direction == Direction::Down);
             numbers[slot] += 1;
-            let mut deviations_mm = vec![None; self.targets.len()];
-            for row in &rows {
-                deviations_mm[sorted_index[row.target_number - 1]] =
-                    Some(um_to_mm(row.deviation_um));
-            }
             runs.push(Run {
                 direction,
                 number: numbers[slot],
                 start_time_s: None,
-                deviations_mm,
+                deviations_mm: rows.deviations_mm,
             });
         }
         Ok(runs)
@@ -819,38 +898,97 @@ impl RtlParser {
 }
 
 /// The direction of one run from the order of its rows (see the module doc).
-fn run_direction(
-    rows: &[&DeviationRow],
-    sorted_index: &[usize],
-    file_run: u32,
-) -> Result<Direction, ParseError> {
-    if rows.len() == 1 {
-        return Ok(if file_run % 2 == 1 {
-            Direction::Up
-        } else {
-            Direction::Down
-        });
+fn run_direction(rows: &RunRows, file_run: u32) -> Result<Direction, ParseError> {
+    if let Some((line, column, target_number, previous_target_number)) = rows.turns_back {
+        return Err(ParseError::new(
+            line,
+            column,
+            format!(
+                "run {file_run} visits the targets out of order (target {target_number} after target {previous_target_number}): expected the rows of a run to go all up or all down"
+            ),
+        ));
     }
-    let position = |row: &DeviationRow| sorted_index[row.target_number - 1];
-    let direction = if position(rows[1]) > position(rows[0]) {
-        Direction::Up
+    let up = rows.up.unwrap_or(file_run % 2 == 1);
+    Ok(if up { Direction::Up } else { Direction::Down })
+}
+
+/// The first four whitespace-separated fields of a deviation row.
+///
+/// A row is ASCII in every file seen; splitting it on ASCII blanks is the
+/// same split and a good part faster than the Unicode one.
+fn row_fields<'a>(line: &Line<'a>) -> [Option<&'a str>; 4] {
+    fn first_four<'a>(mut fields: impl Iterator<Item = &'a str>) -> [Option<&'a str>; 4] {
+        std::array::from_fn(|_| fields.next())
+    }
+    if line.text.is_ascii() {
+        first_four(line.text.split_ascii_whitespace())
     } else {
-        Direction::Down
-    };
-    for pair in rows.windows(2) {
-        let forward = position(pair[1]) > position(pair[0]);
-        if forward != (direction == Direction::Up) {
-            return Err(ParseError::new(
-                pair[1].line,
-                pair[1].column,
-                format!(
-                    "run {file_run} visits the targets out of order (target {} after target {}): expected the rows of a run to go all up or all down",
-                    pair[1].target_number, pair[0].target_number
-                ),
-            ));
-        }
+        first_four(line.fields())
     }
-    Ok(direction)
+}
+
+/// A deviation row in its common form, `run target value` separated by
+/// spaces or tabs, read in one pass over its bytes.
+struct PlainRow<'a> {
+    /// Byte offset of the run number in the line.
+    run_offset: usize,
+    file_run: u64,
+    target_number: u64,
+    /// The value's text, not yet parsed.
+    value: &'a str,
+}
+
+impl<'a> PlainRow<'a> {
+    /// The row, or `None` for anything else: a line with another byte, a
+    /// run or target number too long to be exact, fewer or more fields.
+    fn of(text: &'a str) -> Option<PlainRow<'a>> {
+        let bytes = text.as_bytes();
+        let blank = |b: u8| b == b' ' || b == b'\t';
+        let skip_blanks = |from: usize| {
+            from + bytes[from..]
+                .iter()
+                .position(|&b| !blank(b))
+                .unwrap_or(bytes.len() - from)
+        };
+        // Up to 18 digits: every such number fits a u64.
+        let digits = |from: usize| -> Option<(u64, usize)> {
+            let count = bytes[from..]
+                .iter()
+                .position(|b| !b.is_ascii_digit())
+                .unwrap_or(bytes.len() - from);
+            if count == 0 || count > 18 {
+                return None;
+            }
+            let number = bytes[from..from + count]
+                .iter()
+                .fold(0u64, |number, &b| number * 10 + u64::from(b - b'0'));
+            Some((number, from + count))
+        };
+        let run_offset = skip_blanks(0);
+        let (file_run, after_run) = digits(run_offset)?;
+        let target_at = skip_blanks(after_run);
+        let (target_number, after_target) = digits(target_at)?;
+        let value_at = skip_blanks(after_target);
+        if target_at == after_run || value_at == after_target {
+            return None;
+        }
+        let value_end = value_at
+            + bytes[value_at..]
+                .iter()
+                .position(|&b| {
+                    !(b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E'))
+                })
+                .unwrap_or(bytes.len() - value_at);
+        if value_end == value_at || skip_blanks(value_end) != bytes.len() {
+            return None;
+        }
+        Some(PlainRow {
+            run_offset,
+            file_run,
+            target_number,
+            value: &text[value_at..value_end],
+        })
+    }
 }
 
 #[derive(Clone, Copy)]

@@ -70,7 +70,24 @@ impl<'a> Line<'a> {
 
 /// Splits text into numbered lines, accepting LF and CRLF line ends.
 pub fn lines(text: &str) -> impl Iterator<Item = Line<'_>> {
-    text.split('\n').enumerate().map(|(index, raw)| Line {
+    // The pieces of `split('\n')`, found with a plain byte search: lines are
+    // short, and the string searcher's set-up costs more than the search.
+    let mut rest = Some(text);
+    std::iter::from_fn(move || {
+        let current = rest?;
+        match current.bytes().position(|b| b == b'\n') {
+            Some(end) => {
+                rest = Some(&current[end + 1..]);
+                Some(&current[..end])
+            }
+            None => {
+                rest = None;
+                Some(current)
+            }
+        }
+    })
+    .enumerate()
+    .map(|(index, raw)| Line {
         number: index + 1,
         text: raw.strip_suffix('\r').unwrap_or(raw),
     })
@@ -120,6 +137,9 @@ pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseErro
     // letters that the standard parser takes is a decimal of the grammar
     // below (which would parse the same token with the same parser); every
     // other token goes through the grammar for its message.
+    if let Some(value) = short_decimal(token) {
+        return Ok(value);
+    }
     let plain = token
         .bytes()
         .all(|b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E'));
@@ -155,6 +175,47 @@ pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseErro
         ));
     }
     Ok(value)
+}
+
+/// The value of `[+-]digits[.digits]` with at most 15 digits, or `None`
+/// for any other token (which the standard parser then reads).
+///
+/// The same value as `token.parse::<f64>()`, found faster: the digits as an
+/// integer (below 10^15, so exact as an f64) divided by 10^(digits after the
+/// point) (exact up to 10^22) is one correctly rounded division of two exact
+/// values, which is the correctly rounded decimal, as the standard parser
+/// gives (Clinger's fast path). A large file has a hundred thousand readings.
+fn short_decimal(token: &str) -> Option<f64> {
+    const MAX_DIGITS: usize = 15;
+    const POWERS_OF_TEN: [f64; MAX_DIGITS + 1] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    ];
+    let (negative, unsigned) = match token.as_bytes() {
+        [b'-', rest @ ..] => (true, rest),
+        [b'+', rest @ ..] => (false, rest),
+        all => (false, all),
+    };
+    let mut digits: u64 = 0;
+    let mut digit_count = 0;
+    let mut after_point: Option<usize> = None;
+    for &byte in unsigned {
+        match byte {
+            b'0'..=b'9' if digit_count < MAX_DIGITS => {
+                digits = digits * 10 + u64::from(byte - b'0');
+                digit_count += 1;
+                if let Some(count) = &mut after_point {
+                    *count += 1;
+                }
+            }
+            b'.' if after_point.is_none() => after_point = Some(0),
+            _ => return None,
+        }
+    }
+    if digit_count == 0 {
+        return None;
+    }
+    let magnitude = digits as f64 / POWERS_OF_TEN[after_point.unwrap_or(0)];
+    Some(if negative { -magnitude } else { magnitude })
 }
 
 /// Largest deviation accepted, mm, either sign: 1 m.
@@ -294,6 +355,15 @@ mod tests {
         assert_eq!(all[3].text, "c");
         assert_eq!(end_of_file_line("a\nb\n"), 3);
         assert_eq!(end_of_file_line("a\nb"), 3);
+        for text in ["", "\n", "a", "a\n", "\n\nb\r\n", "µ\r\nx\n\n"] {
+            let pieces: Vec<&str> = text.split('\n').collect();
+            let texts: Vec<&str> = lines(text).map(|line| line.text).collect();
+            let expected: Vec<&str> = pieces
+                .iter()
+                .map(|raw| raw.strip_suffix('\r').unwrap_or(raw))
+                .collect();
+            assert_eq!(texts, expected, "{text:?}");
+        }
     }
 
     #[test]
@@ -340,6 +410,54 @@ mod tests {
         assert!(comma.message.contains("decimal comma"), "{comma}");
         let huge = number(&l, "1e400", "target").unwrap_err();
         assert!(huge.message.contains("overflows"), "{huge}");
+    }
+
+    #[test]
+    fn short_decimals_are_the_standard_parse() {
+        for token in [
+            "0",
+            "-0",
+            "-0.0",
+            "+0.5",
+            ".5",
+            "5.",
+            "-.25",
+            "0.1",
+            "-1.019",
+            "999.9",
+            "0.3",
+            "123456789012345",
+            "1234567.89012345",
+            "-0.000000000000001",
+            "9007199254740993",
+        ] {
+            let expected: f64 = token.parse().unwrap();
+            let value = short_decimal(token).unwrap_or(expected);
+            assert_eq!(value.to_bits(), expected.to_bits(), "{token}");
+        }
+        for other in [
+            "",
+            ".",
+            "-",
+            "1e5",
+            "1.2.3",
+            "12a",
+            "--1",
+            "1,5",
+            "1234567890123456",
+        ] {
+            assert_eq!(short_decimal(other), None, "{other}");
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn short_decimals_match_the_standard_parser(token in "[+-]?[0-9]{0,9}([.][0-9]{0,9})?") {
+            if let Some(value) = short_decimal(&token) {
+                let expected: f64 = token.parse().unwrap();
+                proptest::prop_assert_eq!(value.to_bits(), expected.to_bits());
+            }
+        }
     }
 
     #[test]

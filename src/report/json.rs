@@ -652,6 +652,37 @@ impl EvaluationJson {
         excluded: &[RunSelector],
         warnings: &[Warning],
     ) -> EvaluationJson {
+        let per_target = evaluation
+            .per_target
+            .iter()
+            .map(|stats| PerTargetJson::from_stats_of(stats, measurement.kind()))
+            .collect();
+        EvaluationJson::with_per_target(measurement, evaluation, per_target, excluded, warnings)
+    }
+
+    /// [`EvaluationJson::new`], taking the evaluation: each target's
+    /// statistics are converted where they are (the two types have one
+    /// size), so a large test's table is not held twice.
+    pub fn from_evaluation(
+        measurement: &Measurement,
+        mut evaluation: Evaluation,
+        excluded: &[RunSelector],
+        warnings: &[Warning],
+    ) -> EvaluationJson {
+        let per_target = std::mem::take(&mut evaluation.per_target)
+            .into_iter()
+            .map(|stats| PerTargetJson::from_stats_of(&stats, measurement.kind()))
+            .collect();
+        EvaluationJson::with_per_target(measurement, &evaluation, per_target, excluded, warnings)
+    }
+
+    fn with_per_target(
+        measurement: &Measurement,
+        evaluation: &Evaluation,
+        per_target: Vec<PerTargetJson>,
+        excluded: &[RunSelector],
+        warnings: &[Warning],
+    ) -> EvaluationJson {
         let metadata = &measurement.metadata;
         let kind = measurement.kind();
         let rotary = kind == AxisKind::Rotary;
@@ -700,11 +731,7 @@ impl EvaluationJson {
                 .then(|| FiguresJson::from_figures(&evaluation.figures)),
             figures_um,
             figures_arcsec,
-            per_target: evaluation
-                .per_target
-                .iter()
-                .map(|t| PerTargetJson::from_stats_of(t, kind))
-                .collect(),
+            per_target,
             outliers: evaluation
                 .outliers
                 .iter()

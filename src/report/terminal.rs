@@ -22,7 +22,7 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     out.push('\n');
     let unit = report.deviation_unit();
     let _ = writeln!(out, "Per target [{unit}]");
-    out.push_str(&per_target_table(report));
+    per_target_table(&mut out, report);
     let _ = writeln!(out, "\n\nAxis figures [{unit}] ({})", report.standard_name);
     // The ISO 230-2 family's figures in their table (↑, ↓ beside each);
     // another standard's one per row.
@@ -149,7 +149,7 @@ fn environment_line(r: &EvaluationJson) -> String {
     }
 }
 
-fn per_target_table(r: &EvaluationJson) -> String {
+fn per_target_table(out: &mut String, r: &EvaluationJson) {
     let target_header = format!("target [{}]", r.position_unit().trim_start());
     let header: [&str; 12] = [
         &target_header,
@@ -165,18 +165,24 @@ fn per_target_table(r: &EvaluationJson) -> String {
         "R_i↓",
         "R_i",
     ];
-    // Every cell's text in one buffer and the rows as ranges of it: a
-    // 10 000-target test has 120 000 cells, and a `String` each was most of
-    // the time `evaluate` took to print it.
+    // Every cell's text in one buffer and each cell's length: a 10 000-target
+    // test has 120 000 cells, and a `String` each was most of the time
+    // `evaluate` took to print it. A cell is one number's text, a few hundred
+    // bytes at most, so its length fits a `u32` (half the memory of a `usize`).
     let mut text = String::with_capacity(r.per_target.len() * 80);
-    let mut ends: Vec<usize> = Vec::with_capacity(r.per_target.len() * header.len());
+    let mut lengths: Vec<u32> = Vec::with_capacity(r.per_target.len() * header.len());
+    let mut cell_start = 0;
+    let mut end_cell = |text: &String| {
+        lengths.push((text.len() - cell_start) as u32);
+        cell_start = text.len();
+    };
     for t in &r.per_target {
         let _ = write!(text, "{}", t.target_mm);
-        ends.push(text.len());
+        end_cell(&text);
         push_integer(&mut text, t.n_up as u64);
-        ends.push(text.len());
+        end_cell(&text);
         push_integer(&mut text, t.n_down as u64);
-        ends.push(text.len());
+        end_cell(&text);
         for value in [
             t.mean_up_um,
             t.mean_down_um,
@@ -189,16 +195,19 @@ fn per_target_table(r: &EvaluationJson) -> String {
             t.R_um,
         ] {
             push_um(&mut text, value);
-            ends.push(text.len());
+            end_cell(&text);
         }
     }
-    let cell = |index: usize| {
-        let start = if index == 0 { 0 } else { ends[index - 1] };
-        &text[start..ends[index]]
-    };
-    let rows = (0..r.per_target.len())
-        .map(|row| std::array::from_fn(|column| cell(row * header.len() + column)));
-    psql_right_aligned(header, rows)
+    let rows = lengths
+        .chunks_exact(header.len())
+        .scan(0, |offset: &mut usize, row_lengths| {
+            Some(std::array::from_fn(|column| {
+                let start = *offset;
+                *offset += row_lengths[column] as usize;
+                &text[start..*offset]
+            }))
+        });
+    psql_right_aligned(out, header, rows);
 }
 
 /// The rows as `tabled`'s `Style::psql()` with every column right-aligned
@@ -209,9 +218,10 @@ fn per_target_table(r: &EvaluationJson) -> String {
 /// and `tabled::tables::IterTable`, which streams, has no header rule. The
 /// small tables keep `tabled`.
 fn psql_right_aligned<'a, const N: usize>(
+    out: &mut String,
     header: [&'a str; N],
     rows: impl Iterator<Item = [&'a str; N]> + Clone,
-) -> String {
+) {
     fn width(cell: &str) -> usize {
         if cell.is_ascii() {
             cell.len()
@@ -228,19 +238,26 @@ fn psql_right_aligned<'a, const N: usize>(
         }
     }
     let line_width: usize = widths.iter().map(|w| w + 3).sum();
-    let mut out = String::with_capacity((count + 2) * (line_width + 8));
+    // Room for the table and what follows it (the figures are a few lines).
+    out.reserve((count + 2) * (line_width + 8));
+    const SPACES: &str = "                                ";
     let push_row = |out: &mut String, row: &[&str; N]| {
         for (column, cell) in row.iter().enumerate() {
             if column > 0 {
                 out.push('|');
             }
             out.push(' ');
-            out.extend(std::iter::repeat_n(' ', widths[column] - width(cell)));
+            let mut padding = widths[column] - width(cell);
+            while padding > 0 {
+                let spaces = padding.min(SPACES.len());
+                out.push_str(&SPACES[..spaces]);
+                padding -= spaces;
+            }
             out.push_str(cell);
             out.push(' ');
         }
     };
-    push_row(&mut out, &header);
+    push_row(out, &header);
     out.push('\n');
     for (column, w) in widths.iter().enumerate() {
         if column > 0 {
@@ -250,9 +267,8 @@ fn psql_right_aligned<'a, const N: usize>(
     }
     for row in rows {
         out.push('\n');
-        push_row(&mut out, &row);
+        push_row(out, &row);
     }
-    out
 }
 
 /// A standard's figures one per row, as its keys name them (VDI 3441).
