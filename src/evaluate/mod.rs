@@ -158,6 +158,39 @@ impl Evaluation {
     }
 }
 
+impl Evaluation {
+    /// An evaluation with only `figures` (ISO 230-2:2014), `runs` each way,
+    /// the given per-target statistics and nothing else, for the tests of
+    /// what is judged and shown from the figures.
+    #[cfg(test)]
+    pub(crate) fn of_figures(
+        figures: AxisFigures,
+        per_target: Vec<TargetStats>,
+        runs: usize,
+        length_mm: f64,
+    ) -> Evaluation {
+        Evaluation {
+            standard: StandardUsed::of(&ISO_230_2),
+            standard_figures: ISO_230_2.figures(&per_target, &figures),
+            conformance: TestConformance {
+                kind: Default::default(),
+                length_mm,
+                targets: per_target.len(),
+                runs_up: runs,
+                runs_down: runs,
+                checks: Vec::new(),
+            },
+            per_target,
+            figures,
+            runs_up: runs,
+            runs_down: runs,
+            outliers: Vec::new(),
+            refractive_index: check_refractive_index(&Default::default()),
+            warnings: Vec::new(),
+        }
+    }
+}
+
 /// Evaluates a measurement per ISO 230-2.
 ///
 /// # Example

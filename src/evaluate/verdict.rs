@@ -914,31 +914,12 @@ mod tests {
             repeatability_down_mm: None,
             repeatability_mm: None,
         };
-        Evaluation {
-            per_target: vec![target(first_mm), target(last_mm)],
-            standard: crate::evaluate::StandardUsed::of(&crate::evaluate::ISO_230_2),
-            standard_figures: crate::evaluate::Standard::figures(
-                &crate::evaluate::ISO_230_2,
-                &[],
-                &figures,
-            ),
+        Evaluation::of_figures(
             figures,
-            runs_up: 5,
-            runs_down: 5,
-            outliers: Vec::new(),
-            conformance: crate::evaluate::TestConformance {
-                kind: Default::default(),
-                length_mm: last_mm - first_mm,
-                targets: 2,
-                runs_up: 5,
-                runs_down: 5,
-                checks: Vec::new(),
-            },
-            refractive_index: crate::evaluate::environment::check_refractive_index(
-                &Default::default(),
-            ),
-            warnings: Vec::new(),
-        }
+            vec![target(first_mm), target(last_mm)],
+            5,
+            last_mm - first_mm,
+        )
     }
 
     fn per_length(per_um: f64, min_um: Option<f64>) -> Permissible {

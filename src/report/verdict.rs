@@ -469,31 +469,7 @@ mod tests {
             e_mm: Some(0.004),
             ..Default::default()
         };
-        let evaluation = crate::evaluate::Evaluation {
-            per_target: Vec::new(),
-            standard: crate::evaluate::StandardUsed::of(&crate::evaluate::ISO_230_2),
-            standard_figures: crate::evaluate::Standard::figures(
-                &crate::evaluate::ISO_230_2,
-                &[],
-                &figures,
-            ),
-            figures,
-            runs_up: 1,
-            runs_down: 1,
-            outliers: Vec::new(),
-            conformance: crate::evaluate::TestConformance {
-                kind: Default::default(),
-                length_mm: 0.0,
-                targets: 0,
-                runs_up: 1,
-                runs_down: 1,
-                checks: Vec::new(),
-            },
-            refractive_index: crate::evaluate::environment::check_refractive_index(
-                &Default::default(),
-            ),
-            warnings: Vec::new(),
-        };
+        let evaluation = crate::evaluate::Evaluation::of_figures(figures, Vec::new(), 1, 0.0);
         let limit = |figure, um: f64| Limit {
             figure,
             permissible: Permissible::Fixed {
