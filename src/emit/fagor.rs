@@ -43,13 +43,7 @@ pub(crate) fn table_of(
     } else {
         TableValues::Mean(positive)
     };
-    CompensationTable {
-        axis: axis.to_string(),
-        reference_mm: crate::emit::linuxcnc::reference_of(&positions_mm, &values),
-        positions_mm,
-        values,
-        suggested_backlash_mm: None,
-    }
+    super::table_as_read(axis, positions_mm, values)
 }
 
 /// A number with `places` decimals and no sign on a rounded zero, as both

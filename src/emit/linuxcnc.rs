@@ -188,25 +188,7 @@ pub fn read(
     } else {
         TableValues::Bidirectional { up, down }
     };
-    let reference_mm = reference_of(&positions_mm, &values);
-    Ok(CompensationTable {
-        axis: axis.to_string(),
-        positions_mm,
-        values,
-        reference_mm,
-        suggested_backlash_mm: None,
-    })
-}
-
-/// The first point where the table is zero (its reference), else the first point.
-pub(crate) fn reference_of(positions_mm: &[f64], values: &TableValues) -> f64 {
-    let up = values.for_direction(Direction::Up);
-    let down = values.for_direction(Direction::Down);
-    positions_mm
-        .iter()
-        .enumerate()
-        .find(|(i, _)| ((up[*i] + down[*i]) / 2.0).abs() < 1e-12)
-        .map_or(positions_mm[0], |(_, p)| *p)
+    Ok(super::table_as_read(axis, positions_mm, values))
 }
 
 /// Type 0 if every value sits within 1 mm of its nominal and some nominal is

@@ -29,10 +29,10 @@ pub mod sinumerik840d;
 pub mod tnc640;
 
 use crate::compensate::plan::Capabilities;
-use crate::compensate::{CompensationTable, TableMode};
+use crate::compensate::{CompensationTable, TableMode, TableValues};
 use crate::error::ParseError;
 use crate::evaluate::conformance::FULL_TURN_DEG;
-use crate::measurement::AxisKind;
+use crate::measurement::{AxisKind, Direction};
 use crate::units::LengthUnit;
 pub use fagor::{TextEncoding, decode as decode_table, encode as encode_table};
 pub use profile::{AxisProfile, CecValues, MachineProfile};
@@ -486,9 +486,7 @@ pub fn check_table(
         return Err(EmitError::NoBidirectional { controller: name });
     }
     // TNC 335/407 manuals: "The error curve must always start with correction value = 0 at the datum point."
-    let first_value = table
-        .values
-        .for_direction(crate::measurement::Direction::Up)[0];
+    let first_value = table.values.for_direction(Direction::Up)[0];
     if controller == Controller::Itnc530 && first_value.abs() >= 0.5e-4 {
         return Err(EmitError::NotZeroAtDatum {
             controller: name,
@@ -770,6 +768,35 @@ pub fn minimal(value: f64, max_decimals: usize) -> String {
     } else {
         text.to_string()
     }
+}
+
+/// A table as a controller file holds it: `values` at `positions_mm`, its
+/// reference the first point where it is zero (else the first point), no
+/// backlash suggestion. Every reader returns its table through this.
+pub(crate) fn table_as_read(
+    axis: &str,
+    positions_mm: Vec<f64>,
+    values: TableValues,
+) -> CompensationTable {
+    let reference_mm = reference_of(&positions_mm, &values);
+    CompensationTable {
+        axis: axis.to_string(),
+        positions_mm,
+        values,
+        reference_mm,
+        suggested_backlash_mm: None,
+    }
+}
+
+/// The first point where the table is zero (its reference), else the first point.
+fn reference_of(positions_mm: &[f64], values: &TableValues) -> f64 {
+    let up = values.for_direction(Direction::Up);
+    let down = values.for_direction(Direction::Down);
+    positions_mm
+        .iter()
+        .enumerate()
+        .find(|(i, _)| ((up[*i] + down[*i]) / 2.0).abs() < 1e-12)
+        .map_or(positions_mm[0], |(_, p)| *p)
 }
 
 #[cfg(test)]

@@ -282,7 +282,11 @@ pub fn read(
     }
     if let Some(table) = lec.get(axis) {
         let (positions_mm, values) = columns(table)?;
-        return Ok(finished(axis, positions_mm, TableValues::Mean(values)));
+        return Ok(super::table_as_read(
+            axis,
+            positions_mm,
+            TableValues::Mean(values),
+        ));
     }
     let sign = if cec_values_are_corrections {
         -1.0
@@ -313,7 +317,7 @@ pub fn read(
             } else {
                 TableValues::Bidirectional { up, down }
             };
-            Ok(finished(axis, positions, values))
+            Ok(super::table_as_read(axis, positions, values))
         }
         (Some(_), Some(_)) => Err(ParseError::new(
             1,
@@ -327,16 +331,6 @@ pub fn read(
                 "no $AA_ENC_COMP table and no complete pair of $AN_CEC tables (DIRECTION 1 and -1) for axis {axis}"
             ),
         )),
-    }
-}
-
-fn finished(axis: &str, positions_mm: Vec<f64>, values: TableValues) -> CompensationTable {
-    CompensationTable {
-        axis: axis.to_string(),
-        reference_mm: crate::emit::linuxcnc::reference_of(&positions_mm, &values),
-        positions_mm,
-        values,
-        suggested_backlash_mm: None,
     }
 }
 

@@ -206,14 +206,7 @@ pub fn read(input: &str, column: &str) -> Result<CompensationTable, ParseError> 
             "BACKLASH is filled in some rows only: fill it in every row or none",
         ));
     };
-    let reference_mm = crate::emit::linuxcnc::reference_of(&positions_mm, &values);
-    Ok(CompensationTable {
-        axis: column.to_string(),
-        positions_mm,
-        values,
-        reference_mm,
-        suggested_backlash_mm: None,
-    })
+    Ok(super::table_as_read(column, positions_mm, values))
 }
 
 #[cfg(test)]
