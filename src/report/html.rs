@@ -1188,7 +1188,7 @@ fn table_view(
 ) -> TableView {
     let table = record.table;
     let prediction = prediction(&input.before, table, input.standard).map(|predicted| {
-        let iso_family = predicted.figures.iter().any(|f| f.key == "A");
+        let iso_family = iso_keys(&predicted.figures);
         PredictionView {
             range_um: um(Some(predicted.range_um())),
             uncompensated_range_um: um(Some(predicted.uncompensated_range_um())),
@@ -1270,20 +1270,19 @@ fn diagnosis_figures(diagnosis: &Diagnosis) -> Vec<FigureRow> {
     ]
     .map(|(set, figures)| (set, FiguresJson::from_standard(figures)));
     // The ISO 230-2 family's bidirectional figures, or every figure of another standard.
-    let rows: Vec<(&'static str, &'static str, &'static str)> =
-        if sets[0].1.values.iter().any(|(key, _)| *key == "A") {
-            FIGURE_ROWS
-                .iter()
-                .map(|&(symbol, name, figure)| (symbol, name, figure.name()))
-                .collect()
-        } else {
-            sets[0]
-                .1
-                .values
-                .iter()
-                .map(|&(key, _)| (key, vdi_figure_name(key), key))
-                .collect()
-        };
+    let rows: Vec<(&'static str, &'static str, &'static str)> = if sets[0].1.is_iso230_2() {
+        FIGURE_ROWS
+            .iter()
+            .map(|&(symbol, name, figure)| (symbol, name, figure.name()))
+            .collect()
+    } else {
+        sets[0]
+            .1
+            .values
+            .iter()
+            .map(|&(key, _)| (key, vdi_figure_name(key), key))
+            .collect()
+    };
     rows.into_iter()
         .map(|(symbol, name, key)| FigureRow {
             symbol,

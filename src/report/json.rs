@@ -328,10 +328,15 @@ impl FiguresJson {
         }
     }
 
+    /// Whether these are the ISO 230-2 family's figures (keyed `A`, `E`, …).
+    pub fn is_iso230_2(&self) -> bool {
+        self.values.iter().any(|(key, _)| *key == "A")
+    }
+
     /// The rows a terminal table shows, (name, key): the ISO 230-2 family's
     /// bidirectional figures, or every figure of another standard (VDI 3441).
     pub fn terminal_rows(&self) -> Vec<(&'static str, &'static str)> {
-        if self.values.iter().any(|(key, _)| *key == "A") {
+        if self.is_iso230_2() {
             vec![
                 ("A", "A"),
                 ("E", "E"),

@@ -26,7 +26,7 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     let _ = writeln!(out, "\n\nAxis figures [{unit}] ({})", report.standard_name);
     // The ISO 230-2 family's figures in their table (↑, ↓ beside each);
     // another standard's one per row.
-    let iso_family = report.figures().values.iter().any(|(key, _)| *key == "A");
+    let iso_family = report.figures().is_iso230_2();
     if iso_family {
         out.push_str(&figures_table(report));
     } else {
