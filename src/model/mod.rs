@@ -78,6 +78,7 @@ pub use description::{AxisDescription, BranchDeviations, ChainCode, ErrorFrame, 
 pub use error_description::read_error_description;
 pub use guideway::{
     CarriageDeviations, Guideway, GuidewayMap, GuidewayResponse, OutputWeights, RailProfiles,
+    SaddleFaces,
 };
 pub use machine::Machine;
 pub use profile::ProfileShape;
