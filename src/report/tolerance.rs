@@ -252,25 +252,22 @@ impl HistogramJson {
 
 impl SensitivityJson {
     /// The rows in sweep order, each single tolerance ranked by its slope
-    /// (largest first; equal slopes keep the sweep order).
+    /// as the report shows it (to 0.1 µm/mm): 1 the largest, equal slopes
+    /// one rank (several tolerances that change nothing share the last).
     fn ranked(rows: &[Sensitivity]) -> Vec<SensitivityJson> {
-        let mut order: Vec<usize> = (0..rows.len())
-            .filter(|i| rows[*i].tolerance.side() != Side::All && rows[*i].slope.is_some())
-            .collect();
-        let slope = |i: usize| rows[i].slope.unwrap_or(f64::NEG_INFINITY);
-        order.sort_by(|a, b| slope(*b).total_cmp(&slope(*a)));
+        let shown = |row: &Sensitivity| -> Option<i64> {
+            let slope = row.slope?;
+            (row.tolerance.side() != Side::All).then(|| (mm_to_um(slope) * 10.0).round() as i64)
+        };
+        let ranked: Vec<i64> = rows.iter().filter_map(shown).collect();
         rows.iter()
-            .enumerate()
-            .map(|(index, row)| SensitivityJson {
+            .map(|row| SensitivityJson {
                 tolerance: row.tolerance.name(),
                 side: row.tolerance.side().as_str(),
                 values_mm: row.values_mm.clone(),
                 p90_um: row.p90_mm.iter().map(|v| mm_to_um(*v)).collect(),
                 slope_um_per_mm: row.slope.map(mm_to_um),
-                rank: order
-                    .iter()
-                    .position(|i| *i == index)
-                    .map(|place| place + 1),
+                rank: shown(row).map(|own| 1 + ranked.iter().filter(|s| **s > own).count()),
             })
             .collect()
     }
@@ -500,10 +497,10 @@ fn sensitivity_table(rows: &[SensitivityJson]) -> String {
             row.side.to_string(),
         ];
         record.extend(row.p90_um.iter().map(|v| format!("{v:.1}")));
-        record.push(
-            row.slope_um_per_mm
-                .map_or("—".to_string(), |s| format!("{s:.1}")),
-        );
+        // A slope that rounds to zero is 0.0, not −0.0 (a rounding of 1e-13).
+        record.push(row.slope_um_per_mm.map_or("—".to_string(), |s| {
+            format!("{s:.1}").replace("-0.0", "0.0")
+        }));
         builder.push_record(record);
     }
     let mut table = builder.build();
@@ -567,6 +564,59 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[0], "     0.0 –    1.0 │████████ 4");
         assert_eq!(lines[1], "     1.0 –    2.0 │██       1");
+    }
+
+    #[test]
+    fn ranks_both_sides_by_slope_and_ties_share_a_rank() {
+        use crate::model::monte_carlo::{CarriageFace, SweptTolerance};
+        let row = |tolerance, slope: f64| Sensitivity {
+            tolerance,
+            values_mm: vec![0.01, 0.02],
+            p90_mm: vec![0.08, 0.08 + 0.01 * slope],
+            slope: Some(slope),
+        };
+        let rows = [
+            row(
+                SweptTolerance::Straightness(Axis::X, RailDirection::Normal),
+                1.0,
+            ),
+            row(
+                SweptTolerance::Straightness(Axis::X, RailDirection::Lateral),
+                0.1,
+            ),
+            row(SweptTolerance::AllStraightness, 3.0),
+            row(
+                SweptTolerance::Carriage(Axis::X, CarriageFace::Parallelism),
+                0.25,
+            ),
+            row(
+                SweptTolerance::Carriage(Axis::X, CarriageFace::Flatness),
+                -4e-16,
+            ),
+            row(
+                SweptTolerance::Carriage(Axis::Z, CarriageFace::Flatness),
+                0.0,
+            ),
+        ];
+        let json = SensitivityJson::ranked(&rows);
+        let ranks: Vec<Option<usize>> = json.iter().map(|r| r.rank).collect();
+        // 1000 > 250 > 100 > 0 = 0 µm/mm; `all` is not ranked.
+        assert_eq!(ranks, [Some(1), Some(3), None, Some(2), Some(4), Some(4)]);
+        let sides: Vec<&str> = json.iter().map(|r| r.side).collect();
+        assert_eq!(
+            sides,
+            ["rail", "rail", "all", "carriage", "carriage", "carriage"]
+        );
+        let table = sensitivity_table(&json);
+        let flatness = table
+            .lines()
+            .find(|line| line.contains("X.carriage_flatness"))
+            .unwrap();
+        assert!(flatness.ends_with("|           0.0 |"), "{flatness}");
+        assert!(
+            table.contains("|    2 | X.carriage_parallelism | carriage |"),
+            "{table}"
+        );
     }
 
     #[test]
