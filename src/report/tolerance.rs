@@ -399,7 +399,7 @@ pub fn tolerance_report(report: &ToleranceJson) -> String {
     };
     let _ = writeln!(
         out,
-        "Carriages    parallelism {}; flatness {}",
+        "Saddle faces parallelism {}; flatness {}",
         describe(
             &faces(CarriageFace::Parallelism),
             "mm",

@@ -125,6 +125,19 @@ fn carriage_side_agrees_with_the_numpy_peer_extended_to_it() {
     let carriage = &json["tolerances"]["carriage_mm"];
     assert_eq!(carriage["Y.parallelism"], 0.02);
     assert_eq!(carriage["X.parallelism"], 0.0);
+    let text = axcomp([
+        "tolerance",
+        "--samples",
+        "10",
+        "--carriage",
+        "y.parallelism=0.02",
+    ]);
+    assert!(
+        text.stdout
+            .contains("Saddle faces parallelism X 0, Y 0.02, Z 0 mm; flatness none\n"),
+        "{}",
+        text.stdout
+    );
     let refused = axcomp(["tolerance", "--single-axis", "--carriage-flatness", "0.01"]);
     assert_eq!(refused.code, 2);
     assert!(
