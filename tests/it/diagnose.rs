@@ -71,6 +71,7 @@ fn run(truth_text: &str, seed: u64, angular: bool) -> Diagnosis {
         table: Some(&table),
         backlash_set: false,
         angular: profile.as_ref(),
+        known_periods: &[],
         timing: CycleTiming::ASSUMED,
         standard: &ISO_230_2,
     };
@@ -111,6 +112,7 @@ fn run_alone(truth_text: &str, seed: u64) -> Diagnosis {
         table: None,
         backlash_set: false,
         angular: None,
+        known_periods: &[],
         timing: CycleTiming::ASSUMED,
         standard: &ISO_230_2,
     };
@@ -548,6 +550,7 @@ fn real_ess_files_get_a_stated_diagnosis() {
             table: None,
             backlash_set: false,
             angular: None,
+            known_periods: &[],
             timing: CycleTiming::ASSUMED,
             standard: &ISO_230_2,
         };
@@ -606,6 +609,7 @@ fn tests_of_different_axes_are_refused() {
         table: None,
         backlash_set: false,
         angular: None,
+        known_periods: &[],
         timing: CycleTiming::ASSUMED,
         standard: &ISO_230_2,
     };
