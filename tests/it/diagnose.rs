@@ -11,16 +11,15 @@
 //! "Realistic noise (repeatability 0.5–2 µm)" is read as the ISO 230-2
 //! repeatability R = 4σ: σ cycles through 0.125, 0.25 and 0.5 µm.
 
-use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, Diagnosis, diagnose};
 use axcomp::effects::{Abbe, Drift, Effect, OutlierRun, Periodic, Reversal, Scale};
-use axcomp::evaluate::{ISO_230_2, evaluate};
+use axcomp::evaluate::ISO_230_2;
 use axcomp::measurement::Direction;
 use axcomp::read::read_path;
 use axcomp::synth::{self, EffectSpec, Truth};
 
-use crate::util::shared_files;
+use crate::util::{shared_files, synth_loop};
 
 const SIGMAS_UM: [f64; 3] = [0.125, 0.25, 0.5];
 const SEEDS: u64 = 20;
@@ -30,15 +29,7 @@ const SEEDS: u64 = 20;
 /// when asked for, as an angular measurement at 16 points would give it).
 fn run(truth_text: &str, seed: u64, angular: bool) -> Diagnosis {
     let truth = Truth::from_toml_str(truth_text).unwrap_or_else(|e| panic!("{e}\n{truth_text}"));
-    let before = synth::before(&truth, seed).unwrap();
-    let options = TableOptions {
-        mode: TableMode::Mean,
-        grid: GridSpec::Targets,
-        reference_mm: None,
-        extrapolate: Extrapolate::Hold,
-    };
-    let table = build_table(&before, &evaluate(&before), &options).unwrap();
-    let after = synth::after(&truth, &table, seed).unwrap();
+    let (before, table, after) = synth_loop(&truth, seed);
     let profile = angular.then(|| {
         let targets = before.targets_mm();
         let stroke = (targets[0], targets[targets.len() - 1]);
@@ -97,15 +88,7 @@ fn assert_found_or_not(d: &Diagnosis) {
 /// periodic errors in its own curve.
 fn run_alone(truth_text: &str, seed: u64) -> Diagnosis {
     let truth = Truth::from_toml_str(truth_text).unwrap();
-    let before = synth::before(&truth, seed).unwrap();
-    let options = TableOptions {
-        mode: TableMode::Mean,
-        grid: GridSpec::Targets,
-        reference_mm: None,
-        extrapolate: Extrapolate::Hold,
-    };
-    let table = build_table(&before, &evaluate(&before), &options).unwrap();
-    let after = synth::after(&truth, &table, seed).unwrap();
+    let (_, _, after) = synth_loop(&truth, seed);
     let input = DiagnoseInput {
         after: &after,
         before: None,

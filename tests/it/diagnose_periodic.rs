@@ -14,13 +14,15 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 use rand_distr::{Distribution, Uniform};
 use rayon::prelude::*;
+use std::path::Path;
 
-use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, Diagnosis, KnownPeriod, diagnose};
 use axcomp::effects::{Effect, Periodic};
-use axcomp::evaluate::{ISO_230_2, evaluate};
-use axcomp::synth::{self, Truth};
+use axcomp::evaluate::ISO_230_2;
+use axcomp::synth::Truth;
+
+use crate::util::{synth_loop, synth_loop_files};
 
 const SEEDS: u64 = 20;
 const LEADS_MM: [f64; 3] = [10.0, 15.0, 20.0];
@@ -74,15 +76,7 @@ fn case(lead_mm: f64, seed: u64, in_both: bool) -> Case {
 /// applied, and the diagnosis with the axis' known periods.
 fn run(case: &Case, seed: u64, known: &[KnownPeriod]) -> Diagnosis {
     let truth = Truth::from_toml_str(&case.truth).unwrap();
-    let before = synth::before(&truth, seed).unwrap();
-    let options = TableOptions {
-        mode: TableMode::Mean,
-        grid: GridSpec::Targets,
-        reference_mm: None,
-        extrapolate: Extrapolate::Hold,
-    };
-    let table = build_table(&before, &evaluate(&before), &options).unwrap();
-    let after = synth::after(&truth, &table, seed).unwrap();
+    let (before, table, after) = synth_loop(&truth, seed);
     let input = DiagnoseInput {
         after: &after,
         before: Some(&before),
@@ -255,38 +249,7 @@ fn diagnose_takes_the_screw_lead_from_the_machine_profile() {
         assert_eq!(run.code, 0, "axcomp {}: {}", args.join(" "), run.stderr);
         run.stdout
     };
-    let truth = path("truth.toml");
-    ok(&[
-        "synth",
-        "--truth",
-        &truth,
-        "-o",
-        &path("before.rtl"),
-        "--seed",
-        "3",
-    ]);
-    ok(&[
-        "convert",
-        &path("before.rtl"),
-        "--controller",
-        "tnc640",
-        "-o",
-        &path("X.COM"),
-        "-q",
-    ]);
-    ok(&[
-        "synth",
-        "--truth",
-        &truth,
-        "-o",
-        &path("before2.rtl"),
-        "--seed",
-        "3",
-        "--table",
-        &path("X.COM"),
-        "--o2",
-        &path("after.rtl"),
-    ]);
+    synth_loop_files(dir.path(), Path::new(&path("truth.toml")), Some("3"));
     let diagnose = |machine: bool| -> serde_json::Value {
         let mut args = vec![
             "diagnose".to_string(),
