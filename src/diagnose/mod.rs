@@ -512,7 +512,8 @@ fn period_notes(
     if tests == PeriodicIn::BothTests {
         notes.push("it is in both tests: the first test's targets sampled it without resolving it, and the prediction and the table carry those samples; the amplitude is the axis' whole periodic error".to_string());
     }
-    if let Some(k) = known.iter().find(|k| k.period_mm == period_mm) {
+    let known_here = known.iter().find(|k| k.period_mm == period_mm);
+    if let Some(k) = known_here {
         notes.push(format!(
             "the period is {} the machine profile gives ({} mm), looked for first",
             k.name(),
@@ -521,8 +522,13 @@ fn period_notes(
     }
     if !aliases_mm.is_empty() {
         let list: Vec<String> = aliases_mm.iter().map(|p| format!("{p:.2} mm")).collect();
+        let advice = if known_here.is_some() {
+            "the profile's period was taken; re-measure at other irregular targets to confirm it"
+        } else {
+            "re-measure at other irregular targets, or give the axis' screw lead in the machine profile, to tell them apart"
+        };
         notes.push(format!(
-            "these targets cannot tell a period of {period_mm:.2} mm from {} (the fits differ by less than a BIC of {MIN_DELTA_BIC}); re-measure at other irregular targets, or give the axis' screw lead in the machine profile, to tell them apart",
+            "these targets cannot tell a period of {period_mm:.2} mm from {} (the fits differ by less than a BIC of {MIN_DELTA_BIC}); {advice}",
             list.join(", ")
         ));
     }

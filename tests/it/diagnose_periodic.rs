@@ -295,3 +295,34 @@ fn diagnose_takes_the_screw_lead_from_the_machine_profile() {
     assert!((period / 15.0 - 1.0).abs() < 0.02, "{without:#}");
     assert!(!without["warnings"].to_string().contains("machine profile"));
 }
+
+/// Targets 25 mm apart moved by at most ±0.5 mm cannot tell a 15 mm lead
+/// from its alias at 1/(1/15 − 1/25) = 37.5 mm: the diagnosis says so, and
+/// with the lead in the profile takes the lead.
+#[test]
+fn nearly_even_targets_name_the_periods_they_cannot_separate() {
+    let truth = "[cycle]\nstart_mm = 0.0\nend_mm = 750.0\ncount = 31\njitter_mm = 0.5\nruns = 5\n\n\
+                 [error]\nscale_um_per_m = 9.5\n\n[noise]\nsigma_um = 0.3\n\n\
+                 [[effect]]\nkind = \"periodic\"\nperiod_mm = 15.0\namplitude_um = 2.0\nphase_rad = 0.3\ntests = [\"after\"]\n";
+    let case = Case {
+        truth: truth.to_string(),
+        period_mm: 15.0,
+        amplitude_um: 2.0,
+    };
+    let d = run(&case, 1, &[KnownPeriod::screw_lead(15.0)]);
+    assert_eq!(miss(&case, &d), None);
+    let periodic = d
+        .accepted
+        .iter()
+        .find(|a| a.effect.kind().name() == "periodic")
+        .unwrap();
+    let notes = periodic.warnings.join("\n");
+    let alias: f64 = notes
+        .split("cannot tell a period of 15.00 mm from ")
+        .nth(1)
+        .and_then(|rest| rest.split(" mm").next())
+        .and_then(|number| number.parse().ok())
+        .unwrap_or_else(|| panic!("{notes}"));
+    assert!((alias / 37.5 - 1.0).abs() < 0.005, "{notes}");
+    assert!(notes.contains("the profile's period was taken"), "{notes}");
+}
