@@ -238,12 +238,6 @@ fn diagnose_takes_the_screw_lead_from_the_machine_profile() {
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     let case = case(15.0, 3, true);
     std::fs::write(path("truth.toml"), &case.truth).unwrap();
-    // Seed 001's VC1810: a 15 mm lead on every axis (Tab. 7).
-    std::fs::write(
-        path("vc1810.toml"),
-        "[controller.axes.X]\nscrew_lead_mm = 15.0\n",
-    )
-    .unwrap();
     let ok = |args: &[&str]| {
         let run = crate::util::axcomp(args);
         assert_eq!(run.code, 0, "axcomp {}: {}", args.join(" "), run.stderr);
@@ -262,7 +256,9 @@ fn diagnose_takes_the_screw_lead_from_the_machine_profile() {
             "--json".into(),
         ];
         if machine {
-            args.extend(["--machine".into(), path("vc1810.toml")]);
+            // Seed 001's VC1810: a 15 mm lead on every axis (Tab. 7).
+            let profile = crate::util::root().join("fixtures/machines/vc1810.toml");
+            args.extend(["--machine".into(), profile.to_str().unwrap().to_string()]);
         }
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         serde_json::from_str(&ok(&args)).unwrap()
