@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 
 use axcomp::cycle::CycleTiming;
-use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
+use axcomp::diagnose::{AngularProfile, DiagnoseInput, KnownPeriod, diagnose};
+use axcomp::emit::AxisPeriods;
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
@@ -99,9 +100,22 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         }
         None => None,
     };
+    let profile = load_profile(args.machine_file.machine.as_deref())?;
+    // The profile's periods of the axis the re-test states (never of a guessed axis).
+    let periods = if after.measurement.axis_recorded() {
+        profile.axis_periods(after.measurement.axis())
+    } else {
+        AxisPeriods::default()
+    };
+    let known_periods: Vec<KnownPeriod> = [
+        periods.screw_lead_mm.map(KnownPeriod::screw_lead),
+        periods.scale_period_mm.map(KnownPeriod::scale_period),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     let table = match &args.table {
         Some(path) => {
-            let profile = load_profile(args.machine_file.machine.as_deref())?;
             // The table was active during the re-test.
             let (_, table, doubts) = read_active_table(
                 path,
@@ -122,6 +136,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         table: table.as_ref(),
         backlash_set: args.backlash_set,
         angular: angular.as_ref(),
+        known_periods: &known_periods,
         timing: CycleTiming::ASSUMED,
         standard: args.standard.standard,
     };

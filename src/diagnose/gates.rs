@@ -4,6 +4,7 @@
 
 use super::{
     DiagnoseInput, MIN_DELTA_BIC, MIN_PERIODS_IN_CURVE, MIN_PERIODS_IN_SPAN, RejectedEffect,
+    SHORTEST_PERIOD_MM,
 };
 use crate::effects::Kind;
 use crate::measurement::Direction;
@@ -24,7 +25,7 @@ pub(super) fn applicable_kinds(
                 "needs a prediction (--before and --table): in a test alone a position-dependent error is part of the systematic curve the table compensates".to_string(),
             ),
             Kind::Abbe if input.angular.is_none() => Some("needs the axis' angular error along the stroke (--angular)".to_string()),
-            Kind::Periodic if period_range(after.targets_mm(), min_periods(input)).is_none() => Some(format!(
+            Kind::Periodic if period_range(after.targets_mm(), min_periods(input)).is_none() && !knows_a_period(input) => Some(format!(
                 "the targets are too coarse to resolve a period shorter than 1/{} of the measured span",
                 min_periods(input)
             )),
@@ -39,6 +40,16 @@ pub(super) fn applicable_kinds(
         }
     }
     kinds
+}
+
+/// Whether a known period of the axis fits enough times in the re-test's span.
+fn knows_a_period(input: &DiagnoseInput<'_>) -> bool {
+    let targets = input.after.targets_mm();
+    let span = targets[targets.len() - 1] - targets[0];
+    input
+        .known_periods
+        .iter()
+        .any(|k| k.period_mm > 0.0 && span / k.period_mm >= min_periods(input))
 }
 
 /// How many periods the span must hold: fewer against a prediction (a
@@ -98,9 +109,13 @@ pub(super) fn set_rejection(rejected: &mut Vec<RejectedEffect>, kind: Kind, why:
     }
 }
 
-/// The periods a periodic error is looked for at: from twice the median target
-/// spacing to the span / `min_periods` ([`MIN_PERIODS_IN_SPAN`] against a
-/// prediction, [`MIN_PERIODS_IN_CURVE`] in a test's own curve).
+/// The periods a periodic error is looked for at, up to the span /
+/// `min_periods` ([`MIN_PERIODS_IN_SPAN`] against a prediction,
+/// [`MIN_PERIODS_IN_CURVE`] in a test's own curve), from twice the step of
+/// evenly spaced targets (below it every period has an alias above: Nyquist)
+/// or, on irregular targets, which tell a period from its aliases (ISO
+/// 230-2's reason to recommend them; Eyer & Bartholdi 1999), from
+/// [`SHORTEST_PERIOD_MM`] or twice the median spacing if that is shorter.
 pub(super) fn period_range(targets_mm: &[f64], min_periods: f64) -> Option<(f64, f64)> {
     if targets_mm.len() < 8 {
         return None;
@@ -109,6 +124,10 @@ pub(super) fn period_range(targets_mm: &[f64], min_periods: f64) -> Option<(f64,
     gaps.sort_by(f64::total_cmp);
     let median = gaps[gaps.len() / 2];
     let span = targets_mm[targets_mm.len() - 1] - targets_mm[0];
-    let (shortest, longest) = (2.0 * median, span / min_periods);
+    let shortest = match crate::compensate::regular_step(targets_mm) {
+        Some(step) => 2.0 * step,
+        None => (2.0 * median).min(SHORTEST_PERIOD_MM),
+    };
+    let longest = span / min_periods;
     (shortest < longest).then_some((shortest, longest))
 }

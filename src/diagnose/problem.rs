@@ -27,6 +27,8 @@ pub(super) struct Problem {
     /// The predicted re-test as `predict` gives it on the measured line: the
     /// first test's readings with the predicted systematic error.
     pub(super) first_test_prediction: Option<Measurement>,
+    /// The first test's targets that `prediction_weights` index, mm (none without one).
+    pub(super) first_test_positions_mm: Vec<f64>,
     /// Variance of the first test's bidirectional mean at each of its targets, µm².
     pub(super) first_test_variance_um2: Vec<f64>,
     /// Variance of the first test's reversal x̄↑ − x̄↓ at each of its targets
@@ -163,23 +165,29 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     if readings.len() < 4 || after.runs().len() < 2 {
         return Err(DiagnoseError::TooFewReadings(readings.len()));
     }
-    let (prediction_weights, first_test_variance_um2, first_test_reversal_variance_um2) =
-        match &first {
-            Some((_, variances)) => (
-                after
-                    .targets_mm()
-                    .iter()
-                    .map(|&x| interpolation_weights(&variances.positions_mm, x))
-                    .collect(),
-                variances.mean_um2.clone(),
-                variances.reversal_um2.clone(),
-            ),
-            None => (
-                vec![Vec::new(); after.targets_mm().len()],
-                Vec::new(),
-                Vec::new(),
-            ),
-        };
+    let (
+        prediction_weights,
+        first_test_positions_mm,
+        first_test_variance_um2,
+        first_test_reversal_variance_um2,
+    ) = match &first {
+        Some((_, variances)) => (
+            after
+                .targets_mm()
+                .iter()
+                .map(|&x| interpolation_weights(&variances.positions_mm, x))
+                .collect(),
+            variances.positions_mm.clone(),
+            variances.mean_um2.clone(),
+            variances.reversal_um2.clone(),
+        ),
+        None => (
+            vec![Vec::new(); after.targets_mm().len()],
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        ),
+    };
     let mut cells: Vec<(usize, Direction)> = Vec::new();
     for t in 0..after.targets_mm().len() {
         for direction in Direction::BOTH {
@@ -215,6 +223,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         predicted_um,
         prediction_weights,
         first_test_prediction,
+        first_test_positions_mm,
         first_test_variance_um2,
         first_test_reversal_variance_um2,
         run_count: after.runs().len(),

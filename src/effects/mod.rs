@@ -69,13 +69,25 @@ pub struct Line<'a> {
     pub angle_urad: Option<&'a [f64]>,
 }
 
+/// Which tests a periodic error is in, as a diagnosis fits it: its columns
+/// at the readings are the same; against a prediction from a first test they
+/// differ by what that prediction carries of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PeriodicIn {
+    /// The re-test only: a change since the first test (or no first test).
+    ReTest,
+    /// Both tests: the prediction carries the first test's samples of it,
+    /// interpolated between its targets (too far apart to resolve it).
+    BothTests,
+}
+
 /// The nonlinear part of an effect's shape, fixed before the linear fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shape {
     /// No free shape.
     Fixed(Kind),
-    /// A periodic error of this period, mm.
-    Period(f64),
+    /// A periodic error of this period, mm, in these tests.
+    Period(f64, PeriodicIn),
     /// One run: (direction, number).
     Run(Direction, u32),
 }
@@ -85,7 +97,7 @@ impl Shape {
     pub fn kind(self) -> Kind {
         match self {
             Shape::Fixed(kind) => kind,
-            Shape::Period(_) => Kind::Periodic,
+            Shape::Period(..) => Kind::Periodic,
             Shape::Run(..) => Kind::OutlierRun,
         }
     }

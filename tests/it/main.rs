@@ -14,6 +14,7 @@ mod conformance;
 mod convert;
 mod demo;
 mod diagnose;
+mod diagnose_periodic;
 mod evaluate_ecmc;
 mod fagor;
 mod flags;
