@@ -17,6 +17,7 @@ mod diagnose;
 mod evaluate_ecmc;
 mod fagor;
 mod flags;
+mod injected;
 mod linuxcnc;
 mod model;
 mod outputs;
