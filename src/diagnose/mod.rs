@@ -34,6 +34,7 @@ mod angular_profile;
 mod between_runs;
 mod findings;
 pub mod fit;
+pub mod friction;
 mod gates;
 mod levels;
 mod problem;

@@ -168,3 +168,101 @@ fn force_step_reports_peak_and_recovery() {
     let recovery = step["recovery_s"].as_f64().unwrap();
     assert!((0.035..0.065).contains(&recovery), "{recovery}");
 }
+
+/// Issue 16: `servo-sim --identify` recovers the friction it was simulated
+/// with. The thesis's identified X axis (notes §4.2–4.5: F_C 103–110 N,
+/// μ_v 430 N·s/m from the linear fit, k_s 2.8·10⁷ N/m with the force along
+/// the previous motion and 2.1·10⁶ N/m against it, Tab. 5.3) is simulated
+/// (`servo::force_step::run_constant_velocity` at the feeds of Tab. 5.1 in
+/// both directions, `servo::circle::run_circle` at 3.2 m/min), noise is
+/// added (0.01 A on each mean current, 0.1 µm on each following-error
+/// sample; ChaCha8 seed 16), and the fit must give each parameter back
+/// within 10 %.
+mod identify {
+    use axcomp::servo::axis::Axis;
+    use axcomp::servo::circle::run_circle;
+    use axcomp::servo::force_step::run_constant_velocity;
+    use axcomp::servo::friction::FrictionKind;
+    use axcomp::servo::friction_fit::{
+        ConstantVelocityRow, FollowingErrorSample, axis_with_friction, identify,
+    };
+    use axcomp::servo::simulate::Stepping;
+    use axcomp::servo::trajectory::{Circle, CircleAxis, MoveLimits};
+    use rand_chacha::ChaCha8Rng;
+    use rand_chacha::rand_core::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+
+    /// The records of the thesis's X axis with F_C = 110 N, μ_v = 430 N·s/m and this k_s.
+    pub fn records(
+        stiffness_n_per_m: f64,
+        seed: u64,
+    ) -> (Vec<ConstantVelocityRow>, Vec<FollowingErrorSample>) {
+        let axis = axis_with_friction(
+            &Axis::bundled("mcfv5050-x").unwrap(),
+            Some(110.0),
+            Some(430.0),
+            Some(stiffness_n_per_m),
+        );
+        let friction = axis.friction(FrictionKind::LuGre);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let current_noise = Normal::new(0.0, 0.01).unwrap();
+        let mut rows = Vec::new();
+        for feed in [1.0, 3.2, 5.0, 8.0, 10.0, 16.0, 24.0] {
+            for sign in [1.0, -1.0] {
+                let limits = MoveLimits {
+                    feed_m_per_s: feed / 60.0,
+                    acceleration_m_per_s2: 1.0,
+                    jerk_m_per_s3: 20.0,
+                };
+                let run =
+                    run_constant_velocity(&axis, friction, sign * 0.45, limits, Stepping::DEFAULT);
+                rows.push(ConstantVelocityRow {
+                    feed_m_per_min: sign * feed,
+                    current_a: run.mean_current_a + current_noise.sample(&mut rng),
+                });
+            }
+        }
+        let circle = Circle::thesis(3.2, CircleAxis::X);
+        let error_noise = Normal::new(0.0, 0.1e-6).unwrap();
+        let trace = run_circle(&axis, friction, &circle, Stepping::DEFAULT, &mut |_| {}).trace;
+        let samples = trace
+            .iter()
+            .map(|s| FollowingErrorSample {
+                time_s: s.time_s,
+                following_error_m: s.following_error_m() + error_noise.sample(&mut rng),
+            })
+            .collect();
+        (rows, samples)
+    }
+
+    #[test]
+    fn the_thesis_x_axis_friction_is_recovered_within_10_percent() {
+        let axis = Axis::bundled("mcfv5050-x").unwrap();
+        let circle = Circle::thesis(3.2, CircleAxis::X);
+        for stiffness in [2.8e7, 2.1e6] {
+            let (rows, samples) = records(stiffness, 16);
+            let found = identify(&axis, &rows, Some((&circle, &samples)), &mut |_| {}).unwrap();
+            let k = found.stiffness.unwrap();
+            println!(
+                "k_s {stiffness:e}: F_C {:.2} N, μ_v {:.1} N·s/m, k_s {:.4e} N/m ({} simulations, rms {:.3} µm)",
+                found.coulomb_n,
+                found.viscous_n_s_per_m,
+                k.stiffness_n_per_m,
+                k.simulations,
+                k.rms_residual_m * 1e6
+            );
+            let within = |found: f64, truth: f64| (found - truth).abs() <= 0.1 * truth;
+            assert!(within(found.coulomb_n, 110.0), "F_C {}", found.coulomb_n);
+            assert!(
+                within(found.viscous_n_s_per_m, 430.0),
+                "μ_v {}",
+                found.viscous_n_s_per_m
+            );
+            assert!(
+                within(k.stiffness_n_per_m, stiffness),
+                "k_s {:e}",
+                k.stiffness_n_per_m
+            );
+        }
+    }
+}
