@@ -23,7 +23,7 @@
 use super::Diagnosis;
 use crate::effects::Effect;
 use crate::servo::axis::Axis;
-use crate::servo::reversal::friction_from_reversal_n;
+use crate::servo::reversal::{friction_from_reversal_n, reversal_from_friction_um};
 use crate::units::m_to_um;
 
 /// The friction force a found reversal means.
@@ -45,6 +45,9 @@ pub struct ReversalFriction {
     pub compliance_n_per_um: f64,
     /// The servo description's F_C, N.
     pub axis_coulomb_n: f64,
+    /// The reversal the description's F_C would give through k_c,
+    /// −2·F_C/k_c, µm (F_res ≈ F_C for the classic and LuGre models).
+    pub expected_reversal_um: f64,
     /// F_C for `servo-sim` to start from, N: F_res, or the description's
     /// F_C changed by it when the reversal is a change.
     pub start_coulomb_n: f64,
@@ -86,6 +89,7 @@ pub fn friction_behind_reversal(
         scale_part_n: friction_from_reversal_n(increment_um, compliance_n_per_um),
         compliance_n_per_um,
         axis_coulomb_n,
+        expected_reversal_um: -reversal_from_friction_um(axis_coulomb_n, compliance_n_per_um),
         start_coulomb_n: if change {
             (axis_coulomb_n + friction_n).max(0.0)
         } else {

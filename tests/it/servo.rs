@@ -193,7 +193,7 @@ mod identify {
     use rand_distr::{Distribution, Normal};
 
     /// The records of the thesis's X axis with F_C = 110 N, μ_v = 430 N·s/m and this k_s.
-    pub fn records(
+    pub(super) fn records(
         stiffness_n_per_m: f64,
         seed: u64,
     ) -> (Vec<ConstantVelocityRow>, Vec<FollowingErrorSample>) {
@@ -264,5 +264,164 @@ mod identify {
                 k.stiffness_n_per_m
             );
         }
+    }
+}
+
+/// Issue 16 through the binary: `servo-sim --identify` on records written
+/// as CSV, and `diagnose --servo-axis` reading a reversal as friction.
+mod identify_cli {
+    use serde_json::Value;
+
+    use super::identify::records;
+    use crate::util::axcomp;
+
+    #[test]
+    fn identify_reads_the_records_and_gives_the_flags_to_start_from() {
+        let dir = tempfile::tempdir().unwrap();
+        let (rows, samples) = records(2.1e6, 17);
+        let mut cv = String::from("# simulated, seed 17\nfeed_m_per_min,current_a\n");
+        for row in &rows {
+            cv += &format!("{},{}\n", row.feed_m_per_min, row.current_a);
+        }
+        let mut circle = String::from("time_s,following_error_um\n");
+        for sample in &samples {
+            circle += &format!("{},{}\n", sample.time_s, sample.following_error_m * 1e6);
+        }
+        let cv_path = dir.path().join("cv.csv");
+        let circle_path = dir.path().join("circle.csv");
+        std::fs::write(&cv_path, cv).unwrap();
+        std::fs::write(&circle_path, circle).unwrap();
+        let run = axcomp([
+            "servo-sim",
+            "--axis",
+            "mcfv5050-x",
+            "--identify",
+            cv_path.to_str().unwrap(),
+            "--reversal",
+            circle_path.to_str().unwrap(),
+            "--feed-m-min",
+            "3.2",
+            "--json",
+        ]);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let json: Value = serde_json::from_str(&run.stdout).unwrap();
+        let value = |key: &str| json[key].as_f64().unwrap();
+        assert!((value("coulomb_n") - 110.0).abs() <= 11.0, "{json}");
+        assert!((value("viscous_n_s_per_m") - 430.0).abs() <= 43.0, "{json}");
+        assert!(
+            (value("lugre_stiffness_n_per_m") - 2.1e6).abs() <= 2.1e5,
+            "{json}"
+        );
+        assert!(
+            json["servo_sim"]
+                .as_str()
+                .unwrap()
+                .starts_with("--coulomb-n ")
+        );
+
+        // A bad record: the path, line and column, exit code 2.
+        std::fs::write(&cv_path, "feed_m_per_min,current_a\n1,1.2\n3.2,nan\n").unwrap();
+        let run = axcomp([
+            "servo-sim",
+            "--axis",
+            "mcfv5050-x",
+            "--identify",
+            cv_path.to_str().unwrap(),
+        ]);
+        assert_eq!(run.code, 2);
+        assert!(
+            run.stderr
+                .contains("cv.csv:3:5: expected a number for current_a"),
+            "{}",
+            run.stderr
+        );
+    }
+
+    /// A reversal of −3 µm that appears after the first test, on an axis
+    /// described by the bundled X axis with k_c = 100 N/µm: the friction
+    /// held grew by −B·k_c/2 = 150 N (by hand); without the first test the
+    /// whole reversal is the force, and the bundled F_C of 90 N would give
+    /// −2·90/100 = −1.8 µm.
+    #[test]
+    fn diagnose_reads_the_reversal_as_friction() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+        std::fs::write(
+            path("truth.toml"),
+            "[axis]\nname = \"X\"\n\n[cycle]\nstart_mm = 0.0\nend_mm = 750.0\ncount = 21\njitter_mm = 6.0\nruns = 5\n\n\
+             [error]\nscale_um_per_m = 9.5\n\n[noise]\nsigma_um = 0.25\n\n\
+             [[effect]]\nkind = \"reversal\"\nB_um = -3.0\ntests = [\"after\"]\n",
+        )
+        .unwrap();
+        let ok = |args: &[&str]| {
+            let run = axcomp(args);
+            assert_eq!(run.code, 0, "{}", run.stderr);
+            run.stdout
+        };
+        ok(&[
+            "synth",
+            "--truth",
+            &path("truth.toml"),
+            "-o",
+            &path("before.rtl"),
+            "-q",
+        ]);
+        ok(&[
+            "convert",
+            &path("before.rtl"),
+            "--controller",
+            "tnc640",
+            "-o",
+            &path("X.COM"),
+            "-q",
+        ]);
+        ok(&[
+            "synth",
+            "--truth",
+            &path("truth.toml"),
+            "-o",
+            &path("b2.rtl"),
+            "--table",
+            &path("X.COM"),
+            "--o2",
+            &path("after.rtl"),
+            "-q",
+        ]);
+        let servo = ["--servo-axis", "mcfv5050-x", "--compliance-n-um", "100"];
+        let (after, before, table) = (path("after.rtl"), path("before.rtl"), path("X.COM"));
+        let mut args = vec!["diagnose", "--after", &after];
+        args.extend(["--before", &before, "--table", &table, "--json"]);
+        args.extend(servo);
+        let json: Value = serde_json::from_str(&ok(&args)).unwrap();
+        let friction = &json["friction"];
+        assert_eq!(friction["change_since_first_test"], true, "{json}");
+        let force = friction["friction_n"].as_f64().unwrap();
+        assert!((force - 150.0).abs() <= 15.0, "{friction}");
+        assert_eq!(friction["expected_reversal_um"].as_f64().unwrap(), -1.8);
+        assert_eq!(friction["scale_part_n"].as_f64().unwrap(), 50.0);
+        // The start value: the description's 90 N plus the change.
+        assert!((friction["start_coulomb_n"].as_f64().unwrap() - (90.0 + force)).abs() < 1e-9);
+
+        let text = ok(&[
+            "diagnose",
+            "--after",
+            &after,
+            "--servo-axis",
+            "mcfv5050-x",
+            "--compliance-n-um",
+            "100",
+        ]);
+        assert!(
+            text.contains("friction: B̄ = B̄_scale − 2·F_res/k_c with k_c = 100 N/µm"),
+            "{text}"
+        );
+        assert!(
+            text.contains("servo-sim starts from it: axcomp servo-sim --axis mcfv5050-x"),
+            "{text}"
+        );
+        // Without the servo description, no friction line and no key.
+        let json: Value =
+            serde_json::from_str(&ok(&["diagnose", "--after", &after, "--json"])).unwrap();
+        assert!(json.get("friction").is_none());
     }
 }
