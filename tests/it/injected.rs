@@ -95,7 +95,7 @@ fn name_of(path: &std::path::Path) -> String {
     path.file_name().unwrap().to_string_lossy().into_owned()
 }
 
-fn run(after: &Measurement, before: Option<&Measurement>) -> Diagnosis {
+fn try_run(after: &Measurement, before: Option<&Measurement>) -> Result<Diagnosis, DiagnoseError> {
     let input = DiagnoseInput {
         after,
         before,
@@ -105,7 +105,11 @@ fn run(after: &Measurement, before: Option<&Measurement>) -> Diagnosis {
         timing: CycleTiming::ASSUMED,
         standard: &ISO_230_2,
     };
-    diagnose(&input).unwrap()
+    diagnose(&input)
+}
+
+fn run(after: &Measurement, before: Option<&Measurement>) -> Diagnosis {
+    try_run(after, before).unwrap()
 }
 
 fn kinds(d: &Diagnosis) -> Vec<&'static str> {
@@ -321,16 +325,7 @@ fn one_run_in_one_direction_is_refused() {
         .unwrap();
         copy.metadata.source_file = None;
         for before in [None, Some(&m)] {
-            let input = DiagnoseInput {
-                after: &copy,
-                before,
-                table: None,
-                backlash_set: false,
-                angular: None,
-                timing: CycleTiming::ASSUMED,
-                standard: &ISO_230_2,
-            };
-            let error = diagnose(&input).unwrap_err();
+            let error = try_run(&copy, before).unwrap_err();
             assert!(
                 matches!(error, DiagnoseError::TooFewReadings(_)),
                 "{name}: {error}"
