@@ -3,20 +3,22 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 
 use axcomp::cycle::CycleTiming;
+use axcomp::diagnose::friction::friction_behind_reversal;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, KnownPeriod, diagnose};
 use axcomp::emit::AxisPeriods;
 use axcomp::output::write_new;
 use axcomp::read;
-use axcomp::report::diagnose::{DiagnoseJson, render};
+use axcomp::report::diagnose::{DiagnoseJson, FrictionJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load, load_profile,
     name_axis, print_json, print_text, print_warnings, read_active_table,
 };
+use super::servo_sim::load_axis;
 
 /// Flags of `axcomp diagnose`.
 #[derive(Debug, clap::Args)]
@@ -53,6 +55,23 @@ pub struct DiagnoseArgs {
     /// to tell an Abbe error.
     #[arg(long, value_name = "FILE")]
     pub angular: Option<PathBuf>,
+
+    /// The axis's servo description, to read a reversal found as friction.
+    ///
+    /// A bundled axis (mcfv5050-x, mcfv5050-y) or an axis TOML file as
+    /// servo-sim takes it; with --compliance-n-um the reversal B found is
+    /// reported as the force F_res = −B·k_c/2 held against friction
+    /// (B̄ = B̄_scale − 2·F_res/k_c), in the terminal and as "friction" in JSON.
+    #[arg(long = "servo-axis", value_name = "AXIS", requires = "compliance_n_um")]
+    pub servo_axis: Option<String>,
+
+    /// Structural stiffness k_c between the drive's force line and the laser, N/µm.
+    #[arg(
+        long = "compliance-n-um",
+        value_name = "N_PER_UM",
+        requires = "servo_axis"
+    )]
+    pub compliance_n_um: Option<f64>,
 
     /// Save the accepted effects (TOML) for predict --effects and convert --effects.
     #[arg(long = "write-effects", value_name = "E.toml")]
@@ -146,12 +165,20 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         let text = diagnosis.effects_file(&name(&args.after));
         write_new(path, text.as_bytes(), args.overwrite.force)?;
     }
-    let report = DiagnoseJson::new(
+    let mut report = DiagnoseJson::new(
         &diagnosis,
         name(&args.after),
         args.before.as_deref().map(name),
         args.table.as_deref().map(name),
     );
+    if let (Some(servo_axis), Some(compliance)) = (&args.servo_axis, args.compliance_n_um) {
+        if !(compliance.is_finite() && compliance > 0.0) {
+            bail!("--compliance-n-um: expected a number > 0, found {compliance}");
+        }
+        let axis = load_axis(servo_axis)?;
+        report.friction = friction_behind_reversal(&diagnosis, &axis, compliance)
+            .map(|f| FrictionJson::new(servo_axis, &f));
+    }
     if args.json_output.json {
         print_json(&report)
     } else {

@@ -36,6 +36,7 @@ mod angular_profile;
 mod between_runs;
 mod findings;
 pub mod fit;
+pub mod friction;
 mod gates;
 mod levels;
 mod periodogram;

@@ -9,7 +9,7 @@ use crate::compensate::retest::{
     Applied, BacklashRefusal, KnownError, predicted_deviation_mm, with_scatter,
 };
 use crate::compensate::{CompensateError, interpolate_hold};
-use crate::cycle::{self, CycleTiming};
+use crate::cycle;
 use crate::effects::{Line, Reading, Shape};
 use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::{Direction, Measurement};
@@ -99,7 +99,7 @@ impl Problem {
 /// Builds the readings, their prediction and its covariance, and the cells.
 pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> {
     let after = input.after;
-    let (times, time_assumed) = times_h(after, input.timing);
+    let (times, time_assumed) = cycle::reading_times_h(after, input.timing);
     let first = match input.before {
         Some(before) => {
             // The doubts (machine names, units, ranges) are the caller's to
@@ -293,24 +293,4 @@ pub(super) fn interpolation_weights(positions: &[f64], x: f64) -> Vec<(usize, f6
         .enumerate()
         .filter(|(_, w)| *w != 0.0)
         .collect()
-}
-
-/// Reading times in hours from the cycle model, scaled to the recorded
-/// duration when the file records one that differs from the model's by more
-/// than its one-minute resolution.
-pub(super) fn times_h(measurement: &Measurement, timing: CycleTiming) -> (Vec<Vec<f64>>, bool) {
-    let seconds = cycle::reading_times(measurement, timing);
-    let model = cycle::duration_s(&seconds);
-    let (scale, assumed) = match measurement.metadata.duration_s() {
-        Some(recorded) if (recorded - model).abs() > 60.0 && model > 0.0 => {
-            (recorded / model, false)
-        }
-        Some(_) => (1.0, false),
-        None => (1.0, true),
-    };
-    let hours = seconds
-        .iter()
-        .map(|run| run.iter().map(|t| t * scale / 3600.0).collect())
-        .collect();
-    (hours, assumed)
 }

@@ -32,7 +32,8 @@ pub mod scale;
 
 use serde::Deserialize;
 
-use crate::measurement::Direction;
+use crate::measurement::{Direction, Measurement, MeasurementError};
+use crate::units::um_to_mm;
 
 pub use abbe::Abbe;
 pub use drift::Drift;
@@ -398,6 +399,43 @@ impl Effect {
         first_target_mm: f64,
     ) -> Option<f64> {
         self.model().systematic_um(x_mm, direction, first_target_mm)
+    }
+
+    /// The measurement with this effect added to every reading, at the
+    /// times `times_h` (`[run][target]`, hours, as `cycle::reading_times_h`
+    /// gives them): a known effect put into a measured test, defined by the
+    /// same [`Model::value_um`] the diagnosis fits (tests on real files).
+    pub fn added_to(
+        &self,
+        measurement: &Measurement,
+        times_h: &[Vec<f64>],
+    ) -> Result<Measurement, MeasurementError> {
+        let targets_mm = measurement.targets_mm();
+        let line = Line {
+            first_target_mm: targets_mm.first().copied().unwrap_or(0.0),
+            angle_urad: None,
+        };
+        let runs = measurement.runs();
+        measurement.map_readings(|run, target_index, value_mm| {
+            // Runs are unique by direction and number (`Measurement`'s invariant).
+            let run_index = runs
+                .iter()
+                .position(|r| r.direction == run.direction && r.number == run.number)
+                .unwrap_or(0);
+            let reading = Reading {
+                target_index,
+                target_mm: targets_mm[target_index],
+                direction: run.direction,
+                run: run.number,
+                run_index,
+                time_h: times_h
+                    .get(run_index)
+                    .and_then(|run_times| run_times.get(target_index))
+                    .copied()
+                    .unwrap_or(0.0),
+            };
+            value_mm + um_to_mm(self.value_um(&reading, &line))
+        })
     }
 
     /// What it does to a compensation table.

@@ -18,6 +18,7 @@ mod diagnose_periodic;
 mod evaluate_ecmc;
 mod fagor;
 mod flags;
+mod injected;
 mod linuxcnc;
 mod model;
 mod outputs;
