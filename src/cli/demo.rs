@@ -111,6 +111,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let measured = [MeasuredAxis {
         measurement: &before,
         line_mm: machine.reference_mm(),
+        optics_offset_mm: [0.0; 3],
     }];
     let prediction = predict(&PredictInput {
         machine: &machine,

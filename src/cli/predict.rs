@@ -137,6 +137,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         .map(|(measurement, line_mm)| MeasuredAxis {
             measurement,
             line_mm: *line_mm,
+            optics_offset_mm: [0.0; 3],
         })
         .collect();
     let tables = args

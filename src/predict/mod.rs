@@ -74,6 +74,8 @@ use crate::model::{
 };
 use crate::units::um_to_mm;
 
+pub mod survey;
+
 /// A measured file and the line it was measured on.
 #[derive(Clone, Copy, Debug)]
 pub struct MeasuredAxis<'a> {
@@ -81,6 +83,9 @@ pub struct MeasuredAxis<'a> {
     pub measurement: &'a Measurement,
     /// Machine position of the line (the measured axis's own coordinate is ignored), mm.
     pub line_mm: [f64; 3],
+    /// Where the laser's moving optics sit relative to the tool tip, mm
+    /// (zero: at the tool tip); the Abbe arms of the test are the tool's plus this.
+    pub optics_offset_mm: [f64; 3],
 }
 
 /// What `predict` is given.
@@ -242,6 +247,14 @@ pub enum PredictError {
     /// The model refused a value.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// A survey that cannot be assembled (a test it names, a pair it asks for).
+    #[error("{what}: {why}")]
+    Survey {
+        /// The survey's test file or table.
+        what: String,
+        /// What is wrong.
+        why: String,
+    },
     /// A bug.
     #[error("internal error, please report: {0}")]
     Internal(String),
@@ -381,7 +394,18 @@ fn line_deviation(
 /// The errors with each measured axis's positioning error set so that the
 /// model reproduces the measured means on the measured line.
 fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, PredictError> {
-    let mut errors = input.errors.clone();
+    calibrate_positioning(input.machine, input.errors, input.measured)
+}
+
+/// The 21 errors with each measured axis's positioning error set so that the
+/// model reproduces the measured means on the measured line (module doc):
+/// what `predict` predicts with, and what `predict --survey` assembles.
+pub fn calibrate_positioning(
+    machine: &Machine,
+    errors: &GeometricErrors,
+    measured: &[MeasuredAxis<'_>],
+) -> Result<GeometricErrors, PredictError> {
+    let mut errors = errors.clone();
     let mut given: Vec<ErrorName> = ErrorName::ALL
         .into_iter()
         .filter(|name| {
@@ -390,7 +414,7 @@ fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, Predic
                 .is_some_and(|f| *f != ErrorFunction::Constant(0.0))
         })
         .collect();
-    for measured in input.measured {
+    for measured in measured {
         let axis = axis_named("a measurement", measured.measurement.axis())?;
         let name = positioning_error(axis);
         if given.contains(&name) {
@@ -399,20 +423,30 @@ fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, Predic
         given.push(name);
         let known = KnownError::from_evaluation(&evaluate(measured.measurement))
             .ok_or(PredictError::NoMeans(axis))?;
-        let sign = positioning_sign(input.machine, axis)?;
+        let machine = with_optics(machine, measured.optics_offset_mm)?;
+        let sign = positioning_sign(&machine, axis)?;
         // The others' contribution on the measured line, with EAA still zero.
         let values: Vec<f64> = known
             .positions_mm()
             .iter()
             .zip(known.mean_values_mm())
             .map(|(&x, mean)| {
-                mean - line_deviation(input.machine, &errors, axis, sign, measured.line_mm, x)
+                mean - line_deviation(&machine, &errors, axis, sign, measured.line_mm, x)
             })
             .collect();
         let table = ErrorTable::new(known.positions_mm().to_vec(), values, Interpolation::Spline)?;
         errors.set(name, ErrorFunction::Table(table))?;
     }
     Ok(errors)
+}
+
+/// The machine as a test with optics `offset_mm` from the tool tip sees it.
+pub fn with_optics(machine: &Machine, offset_mm: [f64; 3]) -> Result<Machine, PredictError> {
+    if offset_mm == [0.0; 3] {
+        return Ok(machine.clone());
+    }
+    let tool = machine.tool_offset_mm();
+    Ok(machine.with_tool_offset([0, 1, 2].map(|i| tool[i] + offset_mm[i]))?)
 }
 
 /// An axis and the line its re-test runs on.
