@@ -15,6 +15,7 @@ use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
 use axcomp::evaluate::verdict::Decision;
 use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
+use axcomp::predict::survey::SurveyError;
 use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
@@ -107,7 +108,12 @@ macro_rules! positioned {
     )*};
 }
 
-positioned!(ModelError::Toml, ServoError::Parse, SynthError::Toml);
+positioned!(
+    ModelError::Toml,
+    ServoError::Parse,
+    SynthError::Toml,
+    SurveyError::Toml
+);
 
 impl From<EmitError> for FileError {
     fn from(error: EmitError) -> FileError {

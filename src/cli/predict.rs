@@ -9,9 +9,10 @@ use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
 use axcomp::measurement::Measurement;
 use axcomp::model::{GeometricErrors, read_error_description};
+use axcomp::predict::survey::{MeasuredState, Survey, SurveyFile, assemble};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
-use axcomp::report::predict::{PredictJson, render};
+use axcomp::report::predict::{PredictJson, SurveyJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::{LengthUnit, mm_to_um};
 
@@ -32,6 +33,13 @@ pub struct PredictArgs {
     /// tables or constants, µm and µrad).
     #[arg(long, value_name = "E.toml", help_heading = "Errors")]
     pub errors: Option<PathBuf>,
+
+    /// A machine's measured state: a TOML listing its measurement files
+    /// (geometry and positioning tests, lines, optics offsets, squareness;
+    /// README, Geometry tests), from which the 21 errors are built. Errors it
+    /// does not measure are the survey's `errors` file's, or zero.
+    #[arg(long, value_name = "S.toml", help_heading = "Errors")]
+    pub survey: Option<PathBuf>,
 
     /// A linear test of an axis: its positioning error along the line it was
     /// measured on, FILE or FILE@y=250,z=-275 (default: the --line).
@@ -105,10 +113,22 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     }
     let machine = load_machine(args.machine_file.machine.as_deref())?;
     let profile = load_profile(args.machine_file.machine.as_deref())?;
-    let errors = match &args.errors {
+    let mut errors = match &args.errors {
         Some(path) => load_errors(path)?,
         None => GeometricErrors::default(),
     };
+    let mut state = None;
+    let mut surveyed: Vec<(Measurement, [f64; 3], [f64; 3])> = Vec::new();
+    if let Some(path) = &args.survey {
+        let measured = load_survey(path, &machine, &errors, args.errors.is_some())?;
+        errors = measured.errors.clone();
+        surveyed = measured
+            .positioning
+            .iter()
+            .map(|p| (p.measurement.clone(), p.line_mm, p.optics_offset_mm))
+            .collect();
+        state = Some(measured);
+    }
     let effects = match &args.effects {
         Some(path) => load_effects(path)?,
         None => Vec::new(),
@@ -116,6 +136,11 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     let reference = machine.reference_mm();
     let line_mm = complete(args.line, reference);
     let mut measurements: Vec<(Measurement, [f64; 3])> = Vec::new();
+    let mut optics: Vec<[f64; 3]> = Vec::new();
+    for (measurement, line, offset) in surveyed {
+        measurements.push((measurement, line));
+        optics.push(offset);
+    }
     for spec in &args.measured {
         let (axis, spec) = split_axis(spec);
         let (path, line) = split_measured(spec)?;
@@ -131,13 +156,15 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         }
         let line = line.map_or(line_mm, |l| complete(Some(l), reference));
         measurements.push((result.measurement, line));
+        optics.push([0.0; 3]);
     }
     let measured: Vec<MeasuredAxis<'_>> = measurements
         .iter()
-        .map(|(measurement, line_mm)| MeasuredAxis {
+        .zip(&optics)
+        .map(|((measurement, line_mm), optics_offset_mm)| MeasuredAxis {
             measurement,
             line_mm: *line_mm,
-            optics_offset_mm: [0.0; 3],
+            optics_offset_mm: *optics_offset_mm,
         })
         .collect();
     let tables = args
@@ -193,7 +220,8 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         args.grid,
         effects.iter().map(|e| e.kind().name()).collect(),
         notes,
-    );
+    )
+    .with_survey(state.as_ref().map(SurveyJson::new));
     if args.json_output.json {
         print_json(&report)
     } else {
@@ -229,6 +257,48 @@ fn split_measured(spec: &str) -> Result<(PathBuf, Option<[Option<f64>; 3]>)> {
 
 fn load_errors(path: &Path) -> Result<GeometricErrors> {
     load(path, read_error_description)
+}
+
+/// Reads a survey and every file it names (relative to the survey's
+/// folder), and assembles the measured state.
+fn load_survey(
+    path: &Path,
+    machine: &axcomp::model::Machine,
+    declared: &GeometricErrors,
+    errors_given: bool,
+) -> Result<MeasuredState> {
+    let survey = load(path, Survey::from_toml_str)?;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let declared = match &survey.errors_file {
+        Some(_) if errors_given => bail!(
+            "{}: the survey names an errors file and so does --errors: give the declared errors once",
+            path.display()
+        ),
+        Some(file) => load_errors(&folder.join(file))?,
+        None => declared.clone(),
+    };
+    let mut files = Vec::new();
+    for test in &survey.tests {
+        let file = folder.join(&test.file);
+        let text = std::fs::read(&file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+        let is_geometry = String::from_utf8_lossy(&text)
+            .lines()
+            .map(str::trim)
+            .find(|l| !l.is_empty() && !l.starts_with('#'))
+            .is_some_and(axcomp::read::geometry::is_header);
+        if is_geometry {
+            files.push(SurveyFile::Geometry(read::read_geometry_path(&file)?));
+        } else {
+            let mut result = read::read_path(&file, None)?;
+            if let Some(axis) = test.axis {
+                name_axis(&mut result.measurement, Some(&axis.letter().to_string()));
+            }
+            super::common::linear_only(&result.measurement, "predict")?;
+            files.push(SurveyFile::Positioning(Box::new(result.measurement)));
+        }
+    }
+    assemble(machine, &survey, &declared, &files)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 /// `[AXIS=]FILE`: the axis defaults to the one measured axis.

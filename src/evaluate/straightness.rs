@@ -109,8 +109,8 @@ pub fn straightness(
         (_, 0) => (0.0, 0.0),
         (_, 1) => (0.0, deviations_mm[0]),
         (ReferenceLine::EndPoints, _) => {
-            let slope = (deviations_mm[n - 1] - deviations_mm[0])
-                / (positions_mm[n - 1] - positions_mm[0]);
+            let slope =
+                (deviations_mm[n - 1] - deviations_mm[0]) / (positions_mm[n - 1] - positions_mm[0]);
             (slope, deviations_mm[0] - slope * positions_mm[0])
         }
         (ReferenceLine::LeastSquares, _) => {

@@ -197,7 +197,11 @@ impl Survey {
         let reference_line = match raw.reference_line.as_deref() {
             None => ReferenceLine::default(),
             Some(name) => ReferenceLine::from_name(name).ok_or_else(|| {
-                invalid("reference_line", "\"least-squares\" or \"end-points\"", name)
+                invalid(
+                    "reference_line",
+                    "\"least-squares\" or \"end-points\"",
+                    name,
+                )
             })?,
         };
         let squareness = raw.squareness.unwrap_or(RawSquareness {
@@ -262,7 +266,12 @@ impl Survey {
             };
             let line_mm = position(test.line_mm);
             let optics = position(test.optics_offset_mm);
-            if let Some(bad) = line_mm.iter().chain(&optics).flatten().find(|v| !v.is_finite()) {
+            if let Some(bad) = line_mm
+                .iter()
+                .chain(&optics)
+                .flatten()
+                .find(|v| !v.is_finite())
+            {
                 return Err(invalid(what("position"), "finite mm", bad.to_string()));
             }
             tests.push(SurveyTest {
@@ -290,7 +299,7 @@ pub enum SurveyFile {
     /// A geometry test (CSV with error columns).
     Geometry(GeometryTest),
     /// A positioning test in any format `read` takes.
-    Positioning(Measurement),
+    Positioning(Box<Measurement>),
 }
 
 /// Where the value of one of the 21 errors came from.
@@ -428,7 +437,7 @@ pub fn assemble(
                 };
                 claim(positioning_error(axis), Source::Measured(test.file.clone()))?;
                 positioning.push(PositioningTest {
-                    measurement: measurement.clone(),
+                    measurement: (**measurement).clone(),
                     file: test.file.clone(),
                     line_mm: line_of(axis),
                     optics_offset_mm: test.optics_offset_mm,
@@ -439,7 +448,10 @@ pub fn assemble(
                 if test.axis.is_some_and(|a| a != axis) {
                     return Err(survey_error(
                         &test.file,
-                        format!("the survey says axis {:?}, the file's columns are of axis {axis}", test.axis),
+                        format!(
+                            "the survey says axis {:?}, the file's columns are of axis {axis}",
+                            test.axis
+                        ),
                     ));
                 }
                 if let Some(wanted) = &test.errors
@@ -489,8 +501,9 @@ pub fn assemble(
     for taken in &angles {
         let axis = axis_of(taken.name);
         let (positions, values) = present_means(taken)?;
-        let at_reference = ErrorTable::new(positions.clone(), values.clone(), Interpolation::Linear)?
-            .value_at(reference[axis.index()]);
+        let at_reference =
+            ErrorTable::new(positions.clone(), values.clone(), Interpolation::Linear)?
+                .value_at(reference[axis.index()]);
         let values = values.iter().map(|v| v - at_reference).collect();
         let table = ErrorTable::new(positions, values, Interpolation::Linear)?;
         errors.set(taken.name, ErrorFunction::Table(table))?;
@@ -586,11 +599,14 @@ pub fn assemble(
         .iter()
         .enumerate()
         .map(|(i, name)| {
-            let source = sources.get(&i).cloned().unwrap_or(if declared_nonzero(*name) {
-                Source::Declared
-            } else {
-                Source::AssumedZero
-            });
+            let source = sources
+                .get(&i)
+                .cloned()
+                .unwrap_or(if declared_nonzero(*name) {
+                    Source::Declared
+                } else {
+                    Source::AssumedZero
+                });
             (*name, source)
         })
         .collect();

@@ -139,20 +139,31 @@ impl GeometryTest {
 fn column_of(field: &str) -> Result<(String, Quantity, ColumnUnit), String> {
     let expected = "an error column NAME_UNIT: EYX_um (straightness of X in Y, µm), EBX_urad or EBX_arcsec (pitch of X), … (ISO 230-1 names)";
     let Some((name, unit)) = field.rsplit_once('_') else {
-        return Err(format!("expected {expected}, found {}", describe_found(field)));
+        return Err(format!(
+            "expected {expected}, found {}",
+            describe_found(field)
+        ));
     };
     let name = name.to_ascii_uppercase();
     let letters: Vec<char> = name.chars().collect();
     let axis_letter = |c: char| matches!(c, 'X' | 'Y' | 'Z');
     if letters.len() != 3 || letters[0] != 'E' || !axis_letter(letters[2]) {
-        return Err(format!("expected {expected}, found {}", describe_found(field)));
+        return Err(format!(
+            "expected {expected}, found {}",
+            describe_found(field)
+        ));
     }
     let quantity = match letters[1] {
         c if axis_letter(c) => Quantity::Translation(c),
         'A' => Quantity::Rotation('X'),
         'B' => Quantity::Rotation('Y'),
         'C' => Quantity::Rotation('Z'),
-        _ => return Err(format!("expected {expected}, found {}", describe_found(field))),
+        _ => {
+            return Err(format!(
+                "expected {expected}, found {}",
+                describe_found(field)
+            ));
+        }
     };
     let unit = match (quantity, unit.to_ascii_lowercase().as_str()) {
         (Quantity::Translation(_), "um") => ColumnUnit::Micrometre,
@@ -185,14 +196,20 @@ pub fn is_header(line: &str) -> bool {
         && fields[3..].iter().all(|f| column_of(f).is_ok())
 }
 
+/// A header's error column: name, quantity, unit.
+type ColumnSpec = (String, Quantity, ColumnUnit);
+
+/// One data row of a run: target, values, line number.
+type Row = (f64, Vec<Option<f64>>, usize);
+
 /// Parses the text of a geometry test.
 pub fn parse(input: &str) -> Result<GeometryTest, ParseError> {
     let mut stated_axis: Option<(String, usize)> = None;
     let mut machine = None;
-    let mut header: Option<(Vec<(String, Quantity, ColumnUnit)>, Line<'_>)> = None;
+    let mut header: Option<(Vec<ColumnSpec>, Line<'_>)> = None;
     // (direction, run) → index in `runs`; per run, (target, values) rows.
     let mut run_index: HashMap<(Direction, u64), usize> = HashMap::new();
-    let mut runs: Vec<(Direction, u64, Vec<(f64, Vec<Option<f64>>, usize)>)> = Vec::new();
+    let mut runs: Vec<(Direction, u64, Vec<Row>)> = Vec::new();
     for line in text::lines(input) {
         let trimmed = line.text.trim();
         if trimmed.is_empty() {
@@ -481,17 +498,53 @@ mod tests {
     #[test]
     fn bad_files_name_line_and_column() {
         let cases = [
-            ("target_mm,run,direction,EYX_urad\n0,1,up,1\n", (1, 25), "EYX_um"),
-            ("target_mm,run,direction,EBX_um\n0,1,up,1\n", (1, 25), "EBX_urad"),
-            ("target_mm,run,direction,EYX_um,EZY_um\n", (1, 32), "another axis"),
+            (
+                "target_mm,run,direction,EYX_urad\n0,1,up,1\n",
+                (1, 25),
+                "EYX_um",
+            ),
+            (
+                "target_mm,run,direction,EBX_um\n0,1,up,1\n",
+                (1, 25),
+                "EBX_urad",
+            ),
+            (
+                "target_mm,run,direction,EYX_um,EZY_um\n",
+                (1, 32),
+                "another axis",
+            ),
             ("target_mm,run,direction,EQX_um\n", (1, 25), "error column"),
-            ("target_mm,run,direction,EYX_um\n0,1,up,x\n", (2, 8), "EYX in um"),
-            ("target_mm,run,direction,EBX_urad\n0,1,up,1\n9,1,up,20000\n", (3, 8), "unit mistake"),
-            ("target_mm,run,direction,EYX_um\n0,1,up\n", (2, 1), "expected 4"),
-            ("# axis: Y\ntarget_mm,run,direction,EYX_um\n0,1,up,1\n5,1,up,1\n", (1, 1), "axis X"),
-            ("target_mm,run,direction,EYX_um\n0,1,up,1\n0,1,up,2\n", (3, 1), "twice"),
+            (
+                "target_mm,run,direction,EYX_um\n0,1,up,x\n",
+                (2, 8),
+                "EYX in um",
+            ),
+            (
+                "target_mm,run,direction,EBX_urad\n0,1,up,1\n9,1,up,20000\n",
+                (3, 8),
+                "unit mistake",
+            ),
+            (
+                "target_mm,run,direction,EYX_um\n0,1,up\n",
+                (2, 1),
+                "expected 4",
+            ),
+            (
+                "# axis: Y\ntarget_mm,run,direction,EYX_um\n0,1,up,1\n5,1,up,1\n",
+                (1, 1),
+                "axis X",
+            ),
+            (
+                "target_mm,run,direction,EYX_um\n0,1,up,1\n0,1,up,2\n",
+                (3, 1),
+                "twice",
+            ),
             ("target_mm,run,direction\n", (1, 1), "header"),
-            ("target_mm,run,direction,EYX_um\n0,1,up,1\n", (1, 1), "two targets"),
+            (
+                "target_mm,run,direction,EYX_um\n0,1,up,1\n",
+                (1, 1),
+                "two targets",
+            ),
         ];
         for (text, (line, column), needle) in cases {
             let error = parse(text).unwrap_err();

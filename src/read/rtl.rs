@@ -390,7 +390,14 @@ impl RtlParser {
                         ),
                     ));
                 }
-                let geometry = ["straightness", "angular", "pitch", "yaw", "roll", "squareness"];
+                let geometry = [
+                    "straightness",
+                    "angular",
+                    "pitch",
+                    "yaw",
+                    "roll",
+                    "squareness",
+                ];
                 if geometry
                     .iter()
                     .any(|word| value.to_ascii_lowercase().contains(word))

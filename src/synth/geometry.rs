@@ -78,7 +78,8 @@ pub fn random_truth(
     seed: u64,
 ) -> Result<GeometricErrors, ModelError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let unit = Uniform::new(-1.0, 1.0).map_err(|e| ModelError::invalid("rng", "a range", e.to_string()))?;
+    let unit = Uniform::new(-1.0, 1.0)
+        .map_err(|e| ModelError::invalid("rng", "a range", e.to_string()))?;
     let reference = machine.reference_mm();
     let mut errors = GeometricErrors::default();
     for name in ErrorName::ALL {
@@ -95,7 +96,11 @@ pub fn random_truth(
         let waves: Vec<(f64, f64, f64)> = (0..3)
             .map(|_| {
                 let period = 400.0 + 1200.0 * (unit.sample(&mut rng) + 1.0) / 2.0;
-                (period, amplitude / 2.0 * unit.sample(&mut rng), 3.0 * unit.sample(&mut rng))
+                (
+                    period,
+                    amplitude / 2.0 * unit.sample(&mut rng),
+                    3.0 * unit.sample(&mut rng),
+                )
             })
             .collect();
         let f = |x: f64| -> f64 {
@@ -170,7 +175,11 @@ pub fn measure(
         for (quantity, other) in Axis::ALL
             .iter()
             .map(|d| (Quantity::Translation(d.letter()), *d))
-            .chain(Axis::ALL.iter().map(|d| (Quantity::Rotation(d.letter()), *d)))
+            .chain(
+                Axis::ALL
+                    .iter()
+                    .map(|d| (Quantity::Rotation(d.letter()), *d)),
+            )
         {
             let component = match quantity {
                 Quantity::Translation(_) => ErrorComponent::Translation {

@@ -26,6 +26,7 @@ mod report;
 mod rotary;
 mod servo;
 mod standards;
+mod survey;
 mod together;
 mod util;
 mod verdict;

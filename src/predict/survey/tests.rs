@@ -22,7 +22,11 @@ pub(crate) fn plan() -> GeometryPlan {
             [600.0, 0.0, -400.0],
             [200.0, 400.0, 0.0],
         ],
-        optics_offset_mm: [[0.0, 120.0, -150.0], [100.0, 0.0, -150.0], [-80.0, -120.0, 0.0]],
+        optics_offset_mm: [
+            [0.0, 120.0, -150.0],
+            [100.0, 0.0, -150.0],
+            [-80.0, -120.0, 0.0],
+        ],
     }
 }
 
@@ -128,7 +132,9 @@ fn squareness_equals_the_truth_in_both_conventions() {
         }
         // A given value signed in the convention comes back as the same model value.
         let mut given = survey.clone();
-        given.squareness_from_straightness.retain(|p| *p != SquarenessPair::XY);
+        given
+            .squareness_from_straightness
+            .retain(|p| *p != SquarenessPair::XY);
         let xy = state.squareness[0].signed_rad;
         given.squareness_given = vec![(SquarenessPair::XY, xy)];
         let again = assemble(&machine, &given, &GeometricErrors::default(), &files).unwrap();
@@ -188,14 +194,26 @@ fn unmeasured_errors_stay_as_declared_or_zero() {
 fn survey_file_errors_name_the_key() {
     let cases = [
         ("reference_line = \"ends\"\n", "reference_line"),
-        ("[squareness]\nconvention = \"left\"\n", "squareness.convention"),
-        ("[squareness]\nfrom_straightness = [\"XW\"]\n", "pair XY, XZ or YZ"),
+        (
+            "[squareness]\nconvention = \"left\"\n",
+            "squareness.convention",
+        ),
+        (
+            "[squareness]\nfrom_straightness = [\"XW\"]\n",
+            "pair XY, XZ or YZ",
+        ),
         (
             "[squareness]\nfrom_straightness = [\"XY\"]\ngiven_urad = { XY = 3.0 }\n",
             "not also taken",
         ),
-        ("[[test]]\nfile = \"a.csv\"\naxis = \"Q\"\n", "test 1 (a.csv): axis"),
-        ("[[test]]\nfile = \"a.csv\"\nerrors = [\"EQQ\"]\n", "ISO 230-1 names"),
+        (
+            "[[test]]\nfile = \"a.csv\"\naxis = \"Q\"\n",
+            "test 1 (a.csv): axis",
+        ),
+        (
+            "[[test]]\nfile = \"a.csv\"\nerrors = [\"EQQ\"]\n",
+            "ISO 230-1 names",
+        ),
         ("[[test]]\nfile = \"a.csv\"\nline = 3\n", "unknown field"),
     ];
     for (text, needle) in cases {
