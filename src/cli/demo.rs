@@ -118,6 +118,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         errors: &GeometricErrors::default(),
         measured: &measured,
         tables: std::slice::from_ref(&active),
+        cross_tables: &[],
         line_mm: machine.reference_mm(),
         retest_tool_offset_mm: None,
         grid_step_mm: 50.0,

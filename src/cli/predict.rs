@@ -200,6 +200,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         errors: &errors,
         measured: &measured,
         tables: &tables,
+        cross_tables: &[],
         line_mm,
         retest_tool_offset_mm: tool,
         grid_step_mm: args.grid,

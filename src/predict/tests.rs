@@ -41,6 +41,7 @@ fn input<'a>(
         errors,
         measured,
         tables,
+        cross_tables: &[],
         line_mm,
         retest_tool_offset_mm: None,
         grid_step_mm: 50.0,

@@ -12,6 +12,7 @@ mod cli;
 mod close_loop;
 mod conformance;
 mod convert;
+mod cross_axis;
 mod demo;
 mod diagnose;
 mod evaluate_ecmc;
