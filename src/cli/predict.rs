@@ -5,8 +5,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
+use axcomp::compensate::cross_axis::CrossAxisTable;
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
+use axcomp::emit::{sinumerik840d, tnc640};
+use axcomp::error::ParseError;
 use axcomp::measurement::Measurement;
 use axcomp::model::{GeometricErrors, read_error_description};
 use axcomp::predict::survey::{MeasuredState, Survey, SurveyFile, assemble};
@@ -54,10 +57,21 @@ pub struct PredictArgs {
     #[arg(
         long,
         value_name = "[AXIS=]TABLE",
-        required = true,
+        required_unless_present = "cross_table",
         help_heading = "Tables"
     )]
     pub table: Vec<String>,
+
+    /// A cross-axis (straightness) table, COLUMN=F(AXIS):FILE: a TNC 640
+    /// `.COM` whose COLUMN holds the values along AXIS (entered in AXIS's
+    /// `.CMA` column), or a Sinumerik CEC program with that input and output
+    /// axis. Applied as the controller does: COLUMN moved by −value.
+    #[arg(
+        long = "cross-table",
+        value_name = "Y=F(X):FILE",
+        help_heading = "Tables"
+    )]
+    pub cross_table: Vec<String>,
 
     /// The re-test line as machine positions, x=…,y=…,z=… mm (missing
     /// coordinates: the machine's reference position).
@@ -172,6 +186,11 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         .iter()
         .map(|spec| load_table(spec, &measurements, &profile, args.table_type.linuxcnc_type))
         .collect::<Result<Vec<CompensationTable>>>()?;
+    let cross_tables = args
+        .cross_table
+        .iter()
+        .map(|spec| load_cross_table(spec, &profile))
+        .collect::<Result<Vec<CrossAxisTable>>>()?;
     // Each table against the test of its axis: the range it is predicted over.
     let mut doubts = Vec::new();
     for (table, spec) in tables.iter().zip(&args.table) {
@@ -200,7 +219,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         errors: &errors,
         measured: &measured,
         tables: &tables,
-        cross_tables: &[],
+        cross_tables: &cross_tables,
         line_mm,
         retest_tool_offset_mm: tool,
         grid_step_mm: args.grid,
@@ -327,6 +346,46 @@ fn load_table(
         .or(measurements.first().map(|(m, _)| m))
         .map_or(LengthUnit::Millimetre, |m| m.metadata.length_unit);
     Ok(read_table(Path::new(path), &axis, profile, linuxcnc_type, test_unit)?.1)
+}
+
+/// `COLUMN=F(AXIS):FILE`: a cross-axis table from a TNC 640 `.COM` or a
+/// Sinumerik CEC program.
+fn load_cross_table(spec: &str, profile: &axcomp::emit::MachineProfile) -> Result<CrossAxisTable> {
+    let chars: Vec<char> = spec.chars().collect();
+    let well_formed = chars.len() > 7
+        && chars[1] == '='
+        && chars[2..4] == ['F', '(']
+        && chars[5..7] == [')', ':'];
+    if !well_formed {
+        bail!("--cross-table {spec}: expected COLUMN=F(AXIS):FILE, e.g. Y=F(X):X.COM");
+    }
+    let column = chars[0].to_ascii_uppercase().to_string();
+    let axis = chars[4].to_ascii_uppercase().to_string();
+    let path = Path::new(&spec[7..]);
+    let cec = profile.controller.cec_values != Some(axcomp::emit::CecValues::Error);
+    load(path, |text| {
+        if text.contains("%_N_NC_CEC_INI") {
+            let input = profile
+                .axis(&axis)
+                .map_err(|e| ParseError::new(1, 1, e.to_string()))?;
+            let output = profile
+                .axis(&column)
+                .map_err(|e| ParseError::new(1, 1, e.to_string()))?;
+            sinumerik840d::read_cross_axis(
+                text,
+                (&input.sinumerik_axis, &output.sinumerik_axis),
+                (&axis, &column),
+                cec,
+            )
+        } else {
+            let output = profile
+                .axis(&column)
+                .map_err(|e| ParseError::new(1, 1, e.to_string()))?;
+            let mut table = tnc640::read_cross_axis(text, &axis, &output.tnc640_column)?;
+            table.table.axis = column.clone();
+            Ok(table)
+        }
+    })
 }
 
 /// What the reader should know about this prediction.

@@ -21,6 +21,10 @@
 //!   "also": [{"axis": "Y", …}],
 //!   "volumetric_max_um": …, "volumetric_max_at_mm": {"x", "y", "z"},
 //!   "volumetric_max_before_um": …, "volumetric_max_before_at_mm": {…},
+//!   "volumetric_max_positioning_only_um": …, "volumetric_max_positioning_only_at_mm": {…},
+//!                                             (the positioning tables only, without --cross-table)
+//!   "shares": [{"error": "EYX", "share": 0.41, "contribution_um": …}, …],
+//!                                             (at volumetric_max_at_mm, largest first; add up to 1)
 //!   "grid_step_mm": 50.0, "grid_points": 2112,
 //!   "effects": ["reversal"], "notes": ["…"],
 //!   "survey": {                               (only with --survey)
@@ -137,6 +141,17 @@ impl RetestJson {
     }
 }
 
+/// One error's share of the largest residual volumetric error.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShareJson {
+    /// ISO 230-1 name.
+    pub error: &'static str,
+    /// Its contribution along ‖E‖'s direction over ‖E‖ (the shares add up to 1).
+    pub share: f64,
+    /// Its contribution's size there, µm.
+    pub contribution_um: f64,
+}
+
 /// The whole `predict --json` object.
 #[derive(Clone, Debug, Serialize)]
 pub struct PredictJson {
@@ -163,6 +178,12 @@ pub struct PredictJson {
     pub volumetric_max_before_um: f64,
     /// Where, mm.
     pub volumetric_max_before_at_mm: PositionJson,
+    /// Largest volumetric error with the positioning tables only, µm.
+    pub volumetric_max_positioning_only_um: f64,
+    /// Where, mm.
+    pub volumetric_max_positioning_only_at_mm: PositionJson,
+    /// Each error's share of the largest residual, largest first.
+    pub shares: Vec<ShareJson>,
     /// Step of the map, mm.
     pub grid_step_mm: f64,
     /// Points of the map.
@@ -337,6 +358,22 @@ impl PredictJson {
             volumetric_max_at_mm: prediction.volumetric_after.at_mm.into(),
             volumetric_max_before_um: mm_to_um(prediction.volumetric_before.max_mm),
             volumetric_max_before_at_mm: prediction.volumetric_before.at_mm.into(),
+            volumetric_max_positioning_only_um: mm_to_um(
+                prediction.volumetric_positioning_only.max_mm,
+            ),
+            volumetric_max_positioning_only_at_mm: prediction
+                .volumetric_positioning_only
+                .at_mm
+                .into(),
+            shares: prediction
+                .shares
+                .iter()
+                .map(|s| ShareJson {
+                    error: s.name.as_str(),
+                    share: s.share,
+                    contribution_um: mm_to_um(s.contribution_mm),
+                })
+                .collect(),
             grid_step_mm,
             grid_points: prediction.grid_points,
             effects,
@@ -376,6 +413,27 @@ pub fn render(report: &PredictJson) -> String {
         um(Some(report.volumetric_max_um)),
         at(&report.volumetric_max_at_mm),
     );
+    if report.volumetric_max_positioning_only_um != report.volumetric_max_um {
+        let _ = writeln!(
+            out,
+            "  positioning tables only {} µm at {} (the cross-axis tables take the rest)",
+            um(Some(report.volumetric_max_positioning_only_um)),
+            at(&report.volumetric_max_positioning_only_at_mm),
+        );
+    }
+    if !report.shares.is_empty() {
+        let top: Vec<String> = report
+            .shares
+            .iter()
+            .take(5)
+            .map(|s| format!("{} {:.0} %", s.error, 100.0 * s.share))
+            .collect();
+        let _ = writeln!(
+            out,
+            "  where it is largest, by error (compensate the first next): {}",
+            top.join(", ")
+        );
+    }
     if let Some(survey) = &report.survey {
         render_survey(&mut out, survey);
     }

@@ -166,3 +166,43 @@ fn bad_surveys_exit_2_naming_the_file() {
         run.stderr
     );
 }
+
+#[test]
+fn cross_axis_tables_change_the_map_and_the_shares_add_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let survey = write_survey(dir.path(), |text| text);
+    let mut maxima = Vec::new();
+    for golden in [
+        "formats/tnc640/golden/cross-Y-of-X.COM",
+        "formats/sinumerik840d/golden/cross-Y-of-X-cec.MPF",
+    ] {
+        let spec = format!("Y=F(X):{}", crate::util::root().join(golden).display());
+        let run = predict(&survey, &["--cross-table", &spec, "--json"]);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let json: Value = serde_json::from_str(&run.stdout).unwrap();
+        let after = json["volumetric_max_um"].as_f64().unwrap();
+        let positioning = json["volumetric_max_positioning_only_um"].as_f64().unwrap();
+        assert_ne!(after, positioning);
+        let shares = json["shares"].as_array().unwrap();
+        let total: f64 = shares.iter().map(|s| s["share"].as_f64().unwrap()).sum();
+        // First order: the shares add up to the whole (the map is full transforms).
+        assert!((total - 1.0).abs() < 1e-3, "{total}");
+        maxima.push(after);
+    }
+    // The two controllers' files hold the same table: the same prediction.
+    assert!((maxima[0] - maxima[1]).abs() < 1e-9, "{maxima:?}");
+    let run = predict(&survey, &["--cross-table", "Y=G(X):x.COM"]);
+    assert_eq!(run.code, 2);
+    assert!(
+        run.stderr.contains("expected COLUMN=F(AXIS):FILE"),
+        "{}",
+        run.stderr
+    );
+    let run = predict(&survey, &[]);
+    assert!(
+        run.stdout
+            .contains("where it is largest, by error (compensate the first next): EXOY"),
+        "{}",
+        run.stdout
+    );
+}
