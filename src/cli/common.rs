@@ -15,7 +15,6 @@ use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
 use axcomp::evaluate::verdict::Decision;
 use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
-use axcomp::predict::survey::SurveyError;
 use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
@@ -108,12 +107,7 @@ macro_rules! positioned {
     )*};
 }
 
-positioned!(
-    ModelError::Toml,
-    ServoError::Parse,
-    SynthError::Toml,
-    SurveyError::Toml
-);
+positioned!(ModelError::Toml, ServoError::Parse, SynthError::Toml);
 
 impl From<EmitError> for FileError {
     fn from(error: EmitError) -> FileError {

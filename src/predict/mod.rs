@@ -634,14 +634,7 @@ pub(crate) fn cross_compensated(
         }
         let name = ErrorName::of(ErrorComponent::Translation { axis, direction });
         let own = compensated.function(name).cloned().unwrap_or_default();
-        let mut positions: Vec<f64> = grid
-            .axis_mm(axis)
-            .iter()
-            .chain(&cross.table.positions_mm)
-            .copied()
-            .collect();
-        positions.sort_by(f64::total_cmp);
-        positions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        let positions = merged_positions(grid.axis_mm(axis), &cross.table.positions_mm);
         let values = positions
             .iter()
             .map(|&x| own.value_at(x) - cross.value_at(x))
@@ -693,6 +686,15 @@ fn shares_at(machine: &Machine, errors: &GeometricErrors, at_mm: [f64; 3]) -> Ve
     shares
 }
 
+/// The grid's and a table's positions in order, once each (within 1 nm): the
+/// points where a compensated error is exact.
+fn merged_positions(grid_mm: &[f64], table_mm: &[f64]) -> Vec<f64> {
+    let mut positions: Vec<f64> = grid_mm.iter().chain(table_mm).copied().collect();
+    positions.sort_by(f64::total_cmp);
+    positions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    positions
+}
+
 /// A cross-axis table of the straightness `name` (EYX: X's in Y) as the
 /// errors hold it, at `points` evenly spaced positions over its axis's
 /// stroke, zero at the machine's reference position.
@@ -739,14 +741,7 @@ fn compensated_errors(
         let axis = axis_named("a table", &table.axis)?;
         let name = positioning_error(axis);
         let own = errors.function(name).cloned().unwrap_or_default();
-        let mut positions: Vec<f64> = grid
-            .axis_mm(axis)
-            .iter()
-            .chain(&table.positions_mm)
-            .copied()
-            .collect();
-        positions.sort_by(f64::total_cmp);
-        positions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        let positions = merged_positions(grid.axis_mm(axis), &table.positions_mm);
         let values = positions
             .iter()
             .map(|&x| {

@@ -57,8 +57,12 @@ use crate::evaluate::straightness::{
 use crate::measurement::{AxisSource, Measurement, Metadata, Run};
 use crate::model::{
     Axis, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Interpolation,
-    Machine, Method, SquarenessPair,
+    Machine, Method, ModelError, SquarenessPair,
 };
+
+/// Why a survey file is not valid: the model's error (TOML at a position, or
+/// a value it cannot use, named by its key).
+pub type SurveyError = ModelError;
 use crate::read::geometry::{GeometryColumn, GeometryTest, Quantity};
 use crate::units::um_per_m_to_rad;
 
@@ -132,30 +136,8 @@ struct RawPosition {
     z: Option<f64>,
 }
 
-/// Why a survey file is not valid.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum SurveyError {
-    /// Not TOML, or a wrong type, at a position.
-    #[error("{0}")]
-    Toml(ParseError),
-    /// A value that cannot be used.
-    #[error("{what}: expected {expected}, found {found}")]
-    Invalid {
-        /// The key.
-        what: String,
-        /// What would be accepted.
-        expected: String,
-        /// What was given.
-        found: String,
-    },
-}
-
 fn invalid(what: impl Into<String>, expected: &str, found: impl Into<String>) -> SurveyError {
-    SurveyError::Invalid {
-        what: what.into(),
-        expected: expected.to_string(),
-        found: found.into(),
-    }
+    ModelError::invalid(what, expected, found)
 }
 
 fn pair_named(name: &str) -> Option<SquarenessPair> {
@@ -189,11 +171,11 @@ impl Survey {
     ///      [[test]]\nfile = \"x.csv\"\nline_mm = { y = 250.0 }\n",
     /// )?;
     /// assert_eq!(survey.tests[0].line_mm, [None, Some(250.0), None]);
-    /// # Ok::<(), axcomp::predict::survey::SurveyError>(())
+    /// # Ok::<(), axcomp::model::ModelError>(())
     /// ```
     pub fn from_toml_str(text: &str) -> Result<Survey, SurveyError> {
         let raw: RawSurvey = toml::from_str(text)
-            .map_err(|error| SurveyError::Toml(ParseError::from_toml(text, &error)))?;
+            .map_err(|error| ModelError::Toml(ParseError::from_toml(text, &error)))?;
         let reference_line = match raw.reference_line.as_deref() {
             None => ReferenceLine::default(),
             Some(name) => ReferenceLine::from_name(name).ok_or_else(|| {

@@ -280,15 +280,7 @@ pub fn parse(input: &str) -> Result<GeometryTest, ParseError> {
         }
         let target_mm = text::number(&line, fields[0], "target in mm")?;
         check_target_mm(target_mm, line.number, line.column_of(fields[0]))?;
-        let run = text::integer(&line, fields[1], "run number")?;
-        if run == 0 {
-            return Err(line.error_at(fields[1], "expected a run number from 1, found 0"));
-        }
-        let direction = match fields[2].to_ascii_lowercase().as_str() {
-            "up" | "↑" => Direction::Up,
-            "down" | "↓" => Direction::Down,
-            _ => return Err(line.expected_at(fields[2], "direction up or down")),
-        };
+        let (run, direction) = text::run_and_direction(&line, fields[1], fields[2])?;
         let mut values = Vec::with_capacity(columns.len());
         for ((name, quantity, unit), field) in columns.iter().zip(&fields[3..]) {
             if field.is_empty() {

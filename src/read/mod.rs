@@ -40,15 +40,11 @@ pub struct ReadResult {
 
 /// Reads one measurement file. `format` overrides detection.
 pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult, ReadError> {
-    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
     let located = |error: ParseError| ReadError::Parse {
         path: path.to_path_buf(),
         error,
     };
-    let text = decode(&bytes).map_err(located)?;
+    let text = read_text(path)?;
     let format = match format {
         Some(format) => format,
         None => detect(&text).ok_or_else(|| located(not_a_positioning_test(&text)))?,
@@ -71,16 +67,26 @@ pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult
 /// Reads a geometry test (straightness, angular or several errors of one
 /// axis, [`geometry`]): the CSV layout with error columns.
 pub fn read_geometry_path(path: &Path) -> Result<geometry::GeometryTest, ReadError> {
+    let text = read_text(path)?;
+    geometry::parse(&text).map_err(|error| ReadError::Parse {
+        path: path.to_path_buf(),
+        error,
+    })
+}
+
+/// The decoded text of a file ([`decode`]), errors with the path.
+fn read_text(path: &Path) -> Result<Cow<'static, str>, ReadError> {
     let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
         path: path.to_path_buf(),
         error,
     })?;
-    let located = |error: ParseError| ReadError::Parse {
-        path: path.to_path_buf(),
-        error,
-    };
-    let text = decode(&bytes).map_err(located)?;
-    geometry::parse(&text).map_err(located)
+    match decode(&bytes) {
+        Ok(text) => Ok(Cow::Owned(text.into_owned())),
+        Err(error) => Err(ReadError::Parse {
+            path: path.to_path_buf(),
+            error,
+        }),
+    }
 }
 
 /// The error for a file no positioning reader takes: a geometry test is

@@ -58,25 +58,39 @@ pub(crate) fn predicted_errors(machine: &Machine, state: &MeasuredState) -> Geom
     calibrate_positioning(machine, &state.errors, &measured).unwrap()
 }
 
+/// `count` machine positions uniformly over the strokes, from `seed`.
+fn random_points(machine: &Machine, seed: u64, count: usize) -> Vec<[f64; 3]> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let unit = Uniform::new(0.0, 1.0).unwrap();
+    (0..count)
+        .map(|_| {
+            Axis::ALL.map(|axis| {
+                let [low, high] = machine.axis(axis).stroke_mm;
+                low + (high - low) * unit.sample(&mut rng)
+            })
+        })
+        .collect()
+}
+
+/// The truth of seed 15 and its survey measured with seed 16, parsed.
+fn seed_15(machine: &Machine, convention: &str) -> (GeometricErrors, Survey, Vec<SurveyFile>) {
+    let plan = plan();
+    let truth = random_truth(machine, &plan, 15).unwrap();
+    let synthetic = measure(machine, &truth, &plan, 16).unwrap();
+    let (survey, files) = parsed(&synthetic, convention);
+    (truth, survey, files)
+}
+
 #[test]
 fn a_synthetic_machine_is_predicted_off_the_measured_lines() {
     // Issue 15's done-when: 20 random points off the lines within 0.5 µm.
     let machine = Machine::bundled();
-    let plan = plan();
-    let truth = random_truth(&machine, &plan, 15).unwrap();
-    let synthetic = measure(&machine, &truth, &plan, 16).unwrap();
-    let (survey, files) = parsed(&synthetic, "right-handed");
+    let (truth, survey, files) = seed_15(&machine, "right-handed");
     let state = assemble(&machine, &survey, &GeometricErrors::default(), &files).unwrap();
     assert!(state.sources.iter().all(|(_, s)| s.is_measured()));
     let predicted = predicted_errors(&machine, &state);
-    let mut rng = ChaCha8Rng::seed_from_u64(2026);
-    let unit = Uniform::new(0.0, 1.0).unwrap();
     let mut worst: f64 = 0.0;
-    for _ in 0..20 {
-        let p = Axis::ALL.map(|axis| {
-            let [low, high] = machine.axis(axis).stroke_mm;
-            low + (high - low) * unit.sample(&mut rng)
-        });
+    for p in random_points(&machine, 2026, 20) {
         let t = machine.volumetric_error(&truth, p, Method::Full);
         let e = machine.volumetric_error(&predicted, p, Method::Full);
         worst = worst.max((t.translation_mm - e.translation_mm).norm());
@@ -230,10 +244,7 @@ fn the_residual_after_cross_axis_tables_is_the_truth_minus_the_tables() {
     // axis at its table axis's position.
     use crate::predict::{cross_axis_table, cross_compensated};
     let machine = Machine::bundled();
-    let plan = plan();
-    let truth = random_truth(&machine, &plan, 15).unwrap();
-    let synthetic = measure(&machine, &truth, &plan, 16).unwrap();
-    let (survey, files) = parsed(&synthetic, "right-handed");
+    let (truth, survey, files) = seed_15(&machine, "right-handed");
     let state = assemble(&machine, &survey, &GeometricErrors::default(), &files).unwrap();
     let predicted = predicted_errors(&machine, &state);
     let names = [
@@ -250,14 +261,8 @@ fn the_residual_after_cross_axis_tables_is_the_truth_minus_the_tables() {
         .collect();
     let grid = crate::model::Grid::over_strokes(&machine, 5.0).unwrap();
     let residual = cross_compensated(&predicted, &tables, &grid).unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let unit = Uniform::new(0.0, 1.0).unwrap();
     let (mut worst, mut largest_table): (f64, f64) = (0.0, 0.0);
-    for _ in 0..20 {
-        let p = Axis::ALL.map(|axis| {
-            let [low, high] = machine.axis(axis).stroke_mm;
-            low + (high - low) * unit.sample(&mut rng)
-        });
+    for p in random_points(&machine, 7, 20) {
         let mut direct = machine
             .volumetric_error(&truth, p, Method::Full)
             .translation_mm;
