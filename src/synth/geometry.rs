@@ -49,6 +49,32 @@ pub struct GeometryPlan {
     pub optics_offset_mm: [[f64; 3]; 3],
 }
 
+impl GeometryPlan {
+    /// The plan of the tests of issue 15 on the bundled MCV 754 Quick:
+    /// 25 mm targets, 2 runs each way, 0.1 µm and 0.1 µrad of noise a
+    /// reading, the laser's reference turned by tens of µrad, each axis on
+    /// a line away from the reference with optics 120–150 mm from the tool.
+    pub fn example() -> GeometryPlan {
+        GeometryPlan {
+            step_mm: 25.0,
+            runs: 2,
+            noise_mm: 0.0001,
+            noise_rad: 0.1e-6,
+            laser_rotation_rad: [30e-6, -45e-6, 25e-6],
+            lines_mm: [
+                [0.0, 100.0, -120.0],
+                [600.0, 0.0, -400.0],
+                [200.0, 400.0, 0.0],
+            ],
+            optics_offset_mm: [
+                [0.0, 120.0, -150.0],
+                [100.0, 0.0, -150.0],
+                [-80.0, -120.0, 0.0],
+            ],
+        }
+    }
+}
+
 /// The files of a synthetic survey: (file name, text), the survey last.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SyntheticSurvey {

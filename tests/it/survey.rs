@@ -11,19 +11,13 @@ use crate::util::axcomp;
 /// A table that changes nothing (X, 0 … 750 mm), so the prediction is the survey's.
 const NULL_TABLE: &str = "BEGIN X.COM MM\r\nNR   AXISPOS       BACKLASH      X\r\n0    +0                          +0.0000\r\n1    +750                        +0.0000\r\n[END]\r\n";
 
+/// The example plan, lighter: 50 mm targets, one run each way, optics at the tool.
 fn plan() -> GeometryPlan {
     GeometryPlan {
         step_mm: 50.0,
         runs: 1,
-        noise_mm: 0.0001,
-        noise_rad: 0.1e-6,
-        laser_rotation_rad: [30e-6, -45e-6, 25e-6],
-        lines_mm: [
-            [0.0, 100.0, -120.0],
-            [600.0, 0.0, -400.0],
-            [200.0, 400.0, 0.0],
-        ],
         optics_offset_mm: [[0.0; 3]; 3],
+        ..GeometryPlan::example()
     }
 }
 

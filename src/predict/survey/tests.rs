@@ -11,23 +11,7 @@ use crate::read::geometry;
 use crate::synth::geometry::{GeometryPlan, SyntheticSurvey, measure, random_truth};
 
 pub(crate) fn plan() -> GeometryPlan {
-    GeometryPlan {
-        step_mm: 25.0,
-        runs: 2,
-        noise_mm: 0.0001,
-        noise_rad: 0.1e-6,
-        laser_rotation_rad: [30e-6, -45e-6, 25e-6],
-        lines_mm: [
-            [0.0, 100.0, -120.0],
-            [600.0, 0.0, -400.0],
-            [200.0, 400.0, 0.0],
-        ],
-        optics_offset_mm: [
-            [0.0, 120.0, -150.0],
-            [100.0, 0.0, -150.0],
-            [-80.0, -120.0, 0.0],
-        ],
-    }
+    GeometryPlan::example()
 }
 
 /// The survey's files parsed as `read` would, with the survey's convention replaced.
