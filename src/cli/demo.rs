@@ -111,12 +111,14 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let measured = [MeasuredAxis {
         measurement: &before,
         line_mm: machine.reference_mm(),
+        optics_offset_mm: [0.0; 3],
     }];
     let prediction = predict(&PredictInput {
         machine: &machine,
         errors: &GeometricErrors::default(),
         measured: &measured,
         tables: std::slice::from_ref(&active),
+        cross_tables: &[],
         line_mm: machine.reference_mm(),
         retest_tool_offset_mm: None,
         grid_step_mm: 50.0,

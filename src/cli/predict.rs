@@ -5,13 +5,17 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
+use axcomp::compensate::cross_axis::CrossAxisTable;
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
+use axcomp::emit::{sinumerik840d, tnc640};
+use axcomp::error::ParseError;
 use axcomp::measurement::Measurement;
 use axcomp::model::{GeometricErrors, read_error_description};
+use axcomp::predict::survey::{MeasuredState, Survey, SurveyFile, assemble};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
-use axcomp::report::predict::{PredictJson, render};
+use axcomp::report::predict::{PredictJson, SurveyJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::{LengthUnit, mm_to_um};
 
@@ -33,6 +37,13 @@ pub struct PredictArgs {
     #[arg(long, value_name = "E.toml", help_heading = "Errors")]
     pub errors: Option<PathBuf>,
 
+    /// A machine's measured state: a TOML listing its measurement files
+    /// (geometry and positioning tests, lines, optics offsets, squareness;
+    /// README, Geometry tests), from which the 21 errors are built. Errors it
+    /// does not measure are the survey's `errors` file's, or zero.
+    #[arg(long, value_name = "S.toml", help_heading = "Errors")]
+    pub survey: Option<PathBuf>,
+
     /// A linear test of an axis: its positioning error along the line it was
     /// measured on, FILE or FILE@y=250,z=-275 (default: the --line).
     ///
@@ -46,10 +57,21 @@ pub struct PredictArgs {
     #[arg(
         long,
         value_name = "[AXIS=]TABLE",
-        required = true,
+        required_unless_present = "cross_table",
         help_heading = "Tables"
     )]
     pub table: Vec<String>,
+
+    /// A cross-axis (straightness) table, COLUMN=F(AXIS):FILE: a TNC 640
+    /// `.COM` whose COLUMN holds the values along AXIS (entered in AXIS's
+    /// `.CMA` column), or a Sinumerik CEC program with that input and output
+    /// axis. Applied as the controller does: COLUMN moved by −value.
+    #[arg(
+        long = "cross-table",
+        value_name = "Y=F(X):FILE",
+        help_heading = "Tables"
+    )]
+    pub cross_table: Vec<String>,
 
     /// The re-test line as machine positions, x=…,y=…,z=… mm (missing
     /// coordinates: the machine's reference position).
@@ -105,10 +127,22 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     }
     let machine = load_machine(args.machine_file.machine.as_deref())?;
     let profile = load_profile(args.machine_file.machine.as_deref())?;
-    let errors = match &args.errors {
+    let mut errors = match &args.errors {
         Some(path) => load_errors(path)?,
         None => GeometricErrors::default(),
     };
+    let mut state = None;
+    let mut surveyed: Vec<(Measurement, [f64; 3], [f64; 3])> = Vec::new();
+    if let Some(path) = &args.survey {
+        let measured = load_survey(path, &machine, &errors, args.errors.is_some())?;
+        errors = measured.errors.clone();
+        surveyed = measured
+            .positioning
+            .iter()
+            .map(|p| (p.measurement.clone(), p.line_mm, p.optics_offset_mm))
+            .collect();
+        state = Some(measured);
+    }
     let effects = match &args.effects {
         Some(path) => load_effects(path)?,
         None => Vec::new(),
@@ -116,6 +150,11 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     let reference = machine.reference_mm();
     let line_mm = complete(args.line, reference);
     let mut measurements: Vec<(Measurement, [f64; 3])> = Vec::new();
+    let mut optics: Vec<[f64; 3]> = Vec::new();
+    for (measurement, line, offset) in surveyed {
+        measurements.push((measurement, line));
+        optics.push(offset);
+    }
     for spec in &args.measured {
         let (axis, spec) = split_axis(spec);
         let (path, line) = split_measured(spec)?;
@@ -131,12 +170,15 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         }
         let line = line.map_or(line_mm, |l| complete(Some(l), reference));
         measurements.push((result.measurement, line));
+        optics.push([0.0; 3]);
     }
     let measured: Vec<MeasuredAxis<'_>> = measurements
         .iter()
-        .map(|(measurement, line_mm)| MeasuredAxis {
+        .zip(&optics)
+        .map(|((measurement, line_mm), optics_offset_mm)| MeasuredAxis {
             measurement,
             line_mm: *line_mm,
+            optics_offset_mm: *optics_offset_mm,
         })
         .collect();
     let tables = args
@@ -144,6 +186,11 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         .iter()
         .map(|spec| load_table(spec, &measurements, &profile, args.table_type.linuxcnc_type))
         .collect::<Result<Vec<CompensationTable>>>()?;
+    let cross_tables = args
+        .cross_table
+        .iter()
+        .map(|spec| load_cross_table(spec, &profile))
+        .collect::<Result<Vec<CrossAxisTable>>>()?;
     // Each table against the test of its axis: the range it is predicted over.
     let mut doubts = Vec::new();
     for (table, spec) in tables.iter().zip(&args.table) {
@@ -172,6 +219,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         errors: &errors,
         measured: &measured,
         tables: &tables,
+        cross_tables: &cross_tables,
         line_mm,
         retest_tool_offset_mm: tool,
         grid_step_mm: args.grid,
@@ -192,7 +240,8 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         args.grid,
         effects.iter().map(|e| e.kind().name()).collect(),
         notes,
-    );
+    )
+    .with_survey(state.as_ref().map(SurveyJson::new));
     if args.json_output.json {
         print_json(&report)
     } else {
@@ -230,6 +279,48 @@ fn load_errors(path: &Path) -> Result<GeometricErrors> {
     load(path, read_error_description)
 }
 
+/// Reads a survey and every file it names (relative to the survey's
+/// folder), and assembles the measured state.
+fn load_survey(
+    path: &Path,
+    machine: &axcomp::model::Machine,
+    declared: &GeometricErrors,
+    errors_given: bool,
+) -> Result<MeasuredState> {
+    let survey = load(path, Survey::from_toml_str)?;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let declared = match &survey.errors_file {
+        Some(_) if errors_given => bail!(
+            "{}: the survey names an errors file and so does --errors: give the declared errors once",
+            path.display()
+        ),
+        Some(file) => load_errors(&folder.join(file))?,
+        None => declared.clone(),
+    };
+    let mut files = Vec::new();
+    for test in &survey.tests {
+        let file = folder.join(&test.file);
+        let text = std::fs::read(&file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+        let is_geometry = String::from_utf8_lossy(&text)
+            .lines()
+            .map(str::trim)
+            .find(|l| !l.is_empty() && !l.starts_with('#'))
+            .is_some_and(axcomp::read::geometry::is_header);
+        if is_geometry {
+            files.push(SurveyFile::Geometry(read::read_geometry_path(&file)?));
+        } else {
+            let mut result = read::read_path(&file, None)?;
+            if let Some(axis) = test.axis {
+                name_axis(&mut result.measurement, Some(&axis.letter().to_string()));
+            }
+            super::common::linear_only(&result.measurement, "predict")?;
+            files.push(SurveyFile::Positioning(Box::new(result.measurement)));
+        }
+    }
+    assemble(machine, &survey, &declared, &files)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
 /// `[AXIS=]FILE`: the axis defaults to the one measured axis.
 fn load_table(
     spec: &str,
@@ -255,6 +346,46 @@ fn load_table(
         .or(measurements.first().map(|(m, _)| m))
         .map_or(LengthUnit::Millimetre, |m| m.metadata.length_unit);
     Ok(read_table(Path::new(path), &axis, profile, linuxcnc_type, test_unit)?.1)
+}
+
+/// `COLUMN=F(AXIS):FILE`: a cross-axis table from a TNC 640 `.COM` or a
+/// Sinumerik CEC program.
+fn load_cross_table(spec: &str, profile: &axcomp::emit::MachineProfile) -> Result<CrossAxisTable> {
+    let chars: Vec<char> = spec.chars().collect();
+    let well_formed = chars.len() > 7
+        && chars[1] == '='
+        && chars[2..4] == ['F', '(']
+        && chars[5..7] == [')', ':'];
+    if !well_formed {
+        bail!("--cross-table {spec}: expected COLUMN=F(AXIS):FILE, e.g. Y=F(X):X.COM");
+    }
+    let column = chars[0].to_ascii_uppercase().to_string();
+    let axis = chars[4].to_ascii_uppercase().to_string();
+    let path = Path::new(&spec[7..]);
+    let cec = profile.controller.cec_values != Some(axcomp::emit::CecValues::Error);
+    load(path, |text| {
+        if text.contains("%_N_NC_CEC_INI") {
+            let input = profile
+                .axis(&axis)
+                .map_err(|e| ParseError::new(1, 1, e.to_string()))?;
+            let output = profile
+                .axis(&column)
+                .map_err(|e| ParseError::new(1, 1, e.to_string()))?;
+            sinumerik840d::read_cross_axis(
+                text,
+                (&input.sinumerik_axis, &output.sinumerik_axis),
+                (&axis, &column),
+                cec,
+            )
+        } else {
+            let output = profile
+                .axis(&column)
+                .map_err(|e| ParseError::new(1, 1, e.to_string()))?;
+            let mut table = tnc640::read_cross_axis(text, &axis, &output.tnc640_column)?;
+            table.table.axis = column.clone();
+            Ok(table)
+        }
+    })
 }
 
 /// What the reader should know about this prediction.

@@ -36,6 +36,7 @@
 //!
 //! Pure: no I/O. Lengths in mm.
 
+pub mod cross_axis;
 pub mod effects;
 pub mod plan;
 pub mod retest;

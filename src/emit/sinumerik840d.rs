@@ -21,6 +21,7 @@
 
 use std::collections::BTreeMap;
 
+use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::{BacklashAdvice, BacklashParameter, EmitError, EmitOptions, minimal};
 use crate::error::ParseError;
@@ -100,6 +101,104 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     }
     line("M17".to_string());
     Ok(out)
+}
+
+/// Writes a cross-axis table as one CEC table: `$AN_CEC_INPUT_AXIS` the
+/// table axis (`input_axis`, its Sinumerik name), `$AN_CEC_OUTPUT_AXIS` the
+/// column axis (`options.axes[0]`), `$AN_CEC_DIRECTION` 0 (a straightness
+/// has no direction), values signed as `options.cec_values_are_corrections`
+/// says, as the axis's own CEC tables (K3 p.248, the sag example).
+pub fn write_cross_axis(
+    cross: &CrossAxisTable,
+    input_axis: &str,
+    options: &EmitOptions,
+) -> Result<String, EmitError> {
+    let table = &cross.table;
+    let step = table.regular_step_mm().ok_or(EmitError::UnevenSpacing {
+        controller: "sinumerik840d",
+    })?;
+    let output = options.axes.first().ok_or_else(|| {
+        EmitError::Profile("a cross-axis table needs the axis it moves".to_string())
+    })?;
+    let sign = if options.cec_values_are_corrections {
+        -1.0
+    } else {
+        1.0
+    };
+    let t = options.cec_first_table;
+    let values = table
+        .values
+        .for_direction(crate::measurement::Direction::Up);
+    let mut out = String::from("%_N_NC_CEC_INI\nCHANDATA(1)\n");
+    for (n, value) in values.iter().enumerate() {
+        out.push_str(&format!("$AN_CEC[{t},{n}]={}\n", number(sign * value)));
+    }
+    let first = table.positions_mm[0];
+    let last = table.positions_mm[table.positions_mm.len() - 1];
+    for (key, value) in [
+        ("INPUT_AXIS", format!("({input_axis})")),
+        ("OUTPUT_AXIS", format!("({})", output.sinumerik_axis)),
+        ("STEP", number(step)),
+        ("MIN", number(first)),
+        ("MAX", number(last)),
+        ("DIRECTION", "0".to_string()),
+        ("MULT_BY_TABLE", "0".to_string()),
+        ("IS_MODULO", "0".to_string()),
+    ] {
+        out.push_str(&format!("$AN_CEC_{key}[{t}]={value}\n"));
+    }
+    out.push_str("M17\n");
+    Ok(out)
+}
+
+/// Reads the CEC table with `$AN_CEC_INPUT_AXIS` = `input_axis` and
+/// `$AN_CEC_OUTPUT_AXIS` = `output_axis` (Sinumerik names); the table's axes
+/// in the result are `table_axis` and `column_axis` (the model's letters).
+pub fn read_cross_axis(
+    input: &str,
+    (input_axis, output_axis): (&str, &str),
+    (table_axis, column_axis): (&str, &str),
+    cec_values_are_corrections: bool,
+) -> Result<CrossAxisTable, ParseError> {
+    let (_, cec) = raw_tables(input)?;
+    let table = cec
+        .values()
+        .find(|t| {
+            t.input_axis.as_deref() == Some(input_axis)
+                && t.output_axis.as_deref() == Some(output_axis)
+        })
+        .ok_or_else(|| {
+            ParseError::new(
+                1,
+                1,
+                format!(
+                    "expected a CEC table with $AN_CEC_INPUT_AXIS ({input_axis}) and $AN_CEC_OUTPUT_AXIS ({output_axis}), found none"
+                ),
+            )
+        })?;
+    if table.direction != 0 {
+        let at = table.first_line.map_or(1, |l| l.number);
+        return Err(ParseError::new(
+            at,
+            1,
+            format!(
+                "the cross-axis table {output_axis} = F({input_axis}) applies in one direction only ($AN_CEC_DIRECTION {}): a straightness table applies in both (0)",
+                table.direction
+            ),
+        ));
+    }
+    let (positions, values) = columns(table)?;
+    let sign = if cec_values_are_corrections {
+        -1.0
+    } else {
+        1.0
+    };
+    let values: Vec<f64> = values.iter().map(|v| sign * v).collect();
+    let read = super::table_as_read(column_axis, positions, TableValues::Mean(values));
+    Ok(CrossAxisTable {
+        table_axis: table_axis.to_string(),
+        table: read,
+    })
 }
 
 /// The backlash parameter for the reversal a mean (LEC) table leaves.
@@ -206,6 +305,7 @@ struct RawTable<'a> {
     max: Option<f64>,
     direction: i32,
     output_axis: Option<String>,
+    input_axis: Option<String>,
     first_line: Option<Line<'a>>,
 }
 
@@ -216,6 +316,72 @@ pub fn read(
     axis: &str,
     cec_values_are_corrections: bool,
 ) -> Result<CompensationTable, ParseError> {
+    let (lec, cec) = raw_tables(input)?;
+    if let Some(table) = lec.get(axis) {
+        let (positions_mm, values) = columns(table)?;
+        return Ok(super::table_as_read(
+            axis,
+            positions_mm,
+            TableValues::Mean(values),
+        ));
+    }
+    let sign = if cec_values_are_corrections {
+        -1.0
+    } else {
+        1.0
+    };
+    let mut up = None;
+    let mut down = None;
+    for table in cec
+        .values()
+        // A cross-axis table (input ≠ output) is not the axis's own.
+        .filter(|t| {
+            t.output_axis.as_deref() == Some(axis)
+                && t.input_axis.as_deref().is_none_or(|input| input == axis)
+        })
+    {
+        let (positions, values) = columns(table)?;
+        let values: Vec<f64> = values.iter().map(|v| sign * v).collect();
+        match table.direction {
+            1 => up = Some((positions, values)),
+            -1 => down = Some((positions, values)),
+            _ => {
+                up = Some((positions.clone(), values.clone()));
+                down = Some((positions, values));
+            }
+        }
+    }
+    match (up, down) {
+        (Some((positions, up)), Some((down_positions, down))) if positions == down_positions => {
+            let values = if up == down {
+                TableValues::Mean(up)
+            } else {
+                TableValues::Bidirectional { up, down }
+            };
+            Ok(super::table_as_read(axis, positions, values))
+        }
+        (Some(_), Some(_)) => Err(ParseError::new(
+            1,
+            1,
+            format!("the ↑ and ↓ CEC tables of {axis} have different points"),
+        )),
+        _ => Err(ParseError::new(
+            1,
+            1,
+            format!(
+                "no $AA_ENC_COMP table and no complete pair of $AN_CEC tables (DIRECTION 1 and -1) for axis {axis}"
+            ),
+        )),
+    }
+}
+
+/// The LEC tables by axis name and the CEC tables by index, as written.
+type RawTables<'a> = (
+    BTreeMap<String, RawTable<'a>>,
+    BTreeMap<usize, RawTable<'a>>,
+);
+
+fn raw_tables(input: &str) -> Result<RawTables<'_>, ParseError> {
     let mut lec: BTreeMap<String, RawTable<'_>> = BTreeMap::new();
     let mut cec: BTreeMap<usize, RawTable<'_>> = BTreeMap::new();
     for line in text::lines(input) {
@@ -270,6 +436,10 @@ pub fn read(
                             }
                         }
                     }
+                    "AN_CEC_INPUT_AXIS" => {
+                        table.input_axis =
+                            Some(a.value.trim_matches(|c| c == '(' || c == ')').to_string())
+                    }
                     "AN_CEC_OUTPUT_AXIS" => {
                         table.output_axis =
                             Some(a.value.trim_matches(|c| c == '(' || c == ')').to_string())
@@ -280,58 +450,7 @@ pub fn read(
             _ => {}
         }
     }
-    if let Some(table) = lec.get(axis) {
-        let (positions_mm, values) = columns(table)?;
-        return Ok(super::table_as_read(
-            axis,
-            positions_mm,
-            TableValues::Mean(values),
-        ));
-    }
-    let sign = if cec_values_are_corrections {
-        -1.0
-    } else {
-        1.0
-    };
-    let mut up = None;
-    let mut down = None;
-    for table in cec
-        .values()
-        .filter(|t| t.output_axis.as_deref() == Some(axis))
-    {
-        let (positions, values) = columns(table)?;
-        let values: Vec<f64> = values.iter().map(|v| sign * v).collect();
-        match table.direction {
-            1 => up = Some((positions, values)),
-            -1 => down = Some((positions, values)),
-            _ => {
-                up = Some((positions.clone(), values.clone()));
-                down = Some((positions, values));
-            }
-        }
-    }
-    match (up, down) {
-        (Some((positions, up)), Some((down_positions, down))) if positions == down_positions => {
-            let values = if up == down {
-                TableValues::Mean(up)
-            } else {
-                TableValues::Bidirectional { up, down }
-            };
-            Ok(super::table_as_read(axis, positions, values))
-        }
-        (Some(_), Some(_)) => Err(ParseError::new(
-            1,
-            1,
-            format!("the ↑ and ↓ CEC tables of {axis} have different points"),
-        )),
-        _ => Err(ParseError::new(
-            1,
-            1,
-            format!(
-                "no $AA_ENC_COMP table and no complete pair of $AN_CEC tables (DIRECTION 1 and -1) for axis {axis}"
-            ),
-        )),
-    }
+    Ok((lec, cec))
 }
 
 /// Positions MIN + N·STEP and the values, checking the table is complete.

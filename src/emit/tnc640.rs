@@ -15,6 +15,7 @@
 //! is the mean measured deviation (actual − target), not negated; seed 001's
 //! after-test confirms the sign (A 9.7 µm → 2.3 µm).
 
+use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::heidenhain::{BACKLASH_DECIMALS, BACKLASH_SIGN, Envelope, empty_cell};
 use crate::emit::{
@@ -142,6 +143,43 @@ pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAd
                 .to_string(),
         ),
     ))
+}
+
+/// Writes a cross-axis table: the `.COM` of the table axis (name it
+/// `options.table_name`, e.g. `X.COM`) with the values in the column of the
+/// axis they move (`options.axes`, e.g. Y), "[axis in column] = F(axis in
+/// whose .CMA column the .COM is entered)" (MANUALplus 620 TM p.716/718).
+/// The value is the column axis's error, not negated, as the axis's own
+/// column (module doc).
+pub fn write_cross_axis(
+    cross: &CrossAxisTable,
+    options: &EmitOptions,
+) -> Result<String, EmitError> {
+    write(&cross.table, options)
+}
+
+/// Reads a cross-axis `.COM`: the values of `column_axis`'s column as a
+/// function of `table_axis`, which the file does not state (the `.CMA`
+/// column it is entered in does). BACKLASH must be empty.
+pub fn read_cross_axis(
+    input: &str,
+    table_axis: &str,
+    column_axis: &str,
+) -> Result<CrossAxisTable, ParseError> {
+    let table = read(input, column_axis)?;
+    if table.values.mode() != crate::compensate::TableMode::Mean {
+        return Err(ParseError::new(
+            2,
+            1,
+            format!(
+                "a cross-axis table {column_axis} = F({table_axis}) has values in BACKLASH: a straightness has no direction, leave BACKLASH empty"
+            ),
+        ));
+    }
+    Ok(CrossAxisTable {
+        table_axis: table_axis.to_string(),
+        table,
+    })
 }
 
 /// Reads a TNC 640 `.COM` table: the values of `column`, and BACKLASH as the ↓ values.

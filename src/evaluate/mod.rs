@@ -25,6 +25,7 @@ pub mod environment;
 pub mod outliers;
 pub mod rotary;
 pub mod standard;
+pub mod straightness;
 pub mod targets;
 pub mod uncertainty;
 pub mod verdict;

@@ -432,3 +432,118 @@ proptest! {
         prop_assert!((e(&sum) - e(&a) - e(&b)).norm() < 1e-13);
     }
 }
+
+/// Seed 000's simplified model, eqs 72–79, typed in from the notes (§2.6):
+/// no kinematic dimensions, each axis's error matrix applied at its own
+/// frame's origin (so angles do not enter), squareness matrices in front of
+/// Y (EXOY) and Z (EXOZ, EYOZ). `delta(axis, q)` gives the axis's three
+/// translation errors at its coordinate; the squareness values in rad.
+fn simplified_model(
+    delta: impl Fn(Axis, f64) -> Vector3<f64>,
+    squareness: Squareness,
+    [x, y, z]: [f64; 3],
+) -> Vector3<f64> {
+    use nalgebra::{Matrix4, Vector4};
+    let translation = |v: Vector3<f64>| Matrix4::new_translation(&v);
+    // Eqs 51–53: rotations about Z (EXOY), Y (EXOZ), X (EYOZ), linearised.
+    let rotation = |about: usize, angle: f64| {
+        let mut m = Matrix4::identity();
+        let (i, j) = [(1, 2), (2, 0), (0, 1)][about];
+        m[(i, j)] = -angle;
+        m[(j, i)] = angle;
+        m
+    };
+    let r1 = Vector4::new(0.0, 0.0, 0.0, 1.0);
+    let rx = translation(Vector3::new(x, 0.0, 0.0)) * translation(delta(Axis::X, x)) * r1;
+    let ry = rotation(2, squareness.xy_rad)
+        * translation(Vector3::new(0.0, y, 0.0))
+        * translation(delta(Axis::Y, y))
+        * r1;
+    let rz = rotation(1, squareness.xz_rad)
+        * rotation(0, squareness.yz_rad)
+        * translation(Vector3::new(0.0, 0.0, z))
+        * translation(delta(Axis::Z, z))
+        * r1;
+    // Eq. 79: the sum of each axis's deviation from its ideal point.
+    (rx.xyz() - Vector3::new(x, 0.0, 0.0))
+        + (ry.xyz() - Vector3::new(0.0, y, 0.0))
+        + (rz.xyz() - Vector3::new(0.0, 0.0, z))
+}
+
+#[test]
+fn the_simplified_model_agrees_with_the_full_chain_along_lines_through_the_origin() {
+    // Seed 000 §3.3.5 (notes §5): with errors identified from volumetric
+    // measurements without the machine's dimensions (Trac-cal), the
+    // simplified model (eqs 72–79) matched the measured error along lines
+    // through the origin [0, 0, 0] and deviated away from it. Here the
+    // "measurement" is the full chain (ZFYX, all 21 errors at µm/µrad
+    // scale), and the dimensionless identification takes each axis's
+    // translation errors as the full chain's error along that axis's line
+    // through the origin (squareness and Abbe terms included, so the
+    // simplified model's own squareness is zero).
+    let machine = Machine::bundled();
+    let errors = random_errors(&machine, 72, 0.005, 10e-6);
+    let full = |p: [f64; 3]| {
+        machine
+            .volumetric_error(&errors, p, Method::Full)
+            .translation_mm
+    };
+    let on_axis = |axis: Axis, q: f64| {
+        let mut p = [0.0; 3];
+        p[axis.index()] = q;
+        full(p)
+    };
+    let simplified = |p| simplified_model(on_axis, Squareness::default(), p);
+    let mut along_origin_lines: f64 = 0.0;
+    for axis in Axis::ALL {
+        let [low, high] = machine.axis(axis).stroke_mm;
+        for i in 0..=20 {
+            let mut p = [0.0; 3];
+            p[axis.index()] = low + (high - low) * f64::from(i) / 20.0;
+            along_origin_lines = along_origin_lines.max((full(p) - simplified(p)).norm());
+        }
+    }
+    assert!(along_origin_lines < 1e-12, "{along_origin_lines}");
+    // Away from the origin the two part: the full chain has each angle
+    // times the other axes' positions (notes §2.5: EBX·Z, ECX·Y, EAX·Z, …),
+    // which no dimensionless model holds. X's line at Y = 500, Z = −550:
+    let mut off_origin: f64 = 0.0;
+    for i in 0..=20 {
+        let p = [750.0 * f64::from(i) / 20.0, 500.0, -550.0];
+        off_origin = off_origin.max((full(p) - simplified(p)).norm());
+    }
+    assert!(off_origin > 0.002, "{off_origin}");
+    // Without angles the errors add, so the two agree on every line (only
+    // products of two errors differ, ≤ 1e-9 mm).
+    let mut flat = errors.clone();
+    for name in ErrorName::ALL {
+        if matches!(name.component(), ErrorComponent::Rotation { .. }) {
+            flat.set(name, ErrorFunction::Constant(0.0)).unwrap();
+        }
+    }
+    let full_flat = |p: [f64; 3]| {
+        machine
+            .volumetric_error(&flat, p, Method::Full)
+            .translation_mm
+    };
+    let on_axis_flat = |axis: Axis, q: f64| {
+        let mut p = [0.0; 3];
+        p[axis.index()] = q;
+        full_flat(p)
+    };
+    let p = [600.0, 350.0, -420.0];
+    let gap = (full_flat(p) - simplified_model(on_axis_flat, Squareness::default(), p)).norm();
+    assert!(gap < 1e-9, "{gap}");
+    // The typed-in squareness terms against the notes' first order (§2.6):
+    // E_x = −EXOY·Y + EXOZ·Z, E_y = −EYOZ·Z.
+    let none = |_: Axis, _: f64| Vector3::zeros();
+    let s = Squareness {
+        xy_rad: 1e-5,
+        xz_rad: 2e-5,
+        yz_rad: 3e-5,
+    };
+    let e = simplified_model(none, s, [0.0, 100.0, -200.0]);
+    assert!((e.x - (-1e-5 * 100.0 + 2e-5 * -200.0)).abs() < 1e-15, "{e}");
+    assert!((e.y - (-3e-5 * -200.0)).abs() < 1e-15, "{e}");
+    assert_eq!(e.z, 0.0);
+}

@@ -61,6 +61,7 @@
 //!
 //! Pure: values in, values out.
 
+use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::retest::{Applied, BacklashRefusal, KnownError};
 use crate::compensate::{CompensationTable, TableMode};
 use crate::effects::Effect;
@@ -69,10 +70,12 @@ use crate::evaluate::{
 };
 use crate::measurement::{Direction, Measurement, Run};
 use crate::model::{
-    Axis, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid, Interpolation, Machine,
-    Method, ModelError,
+    Axis, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid,
+    Interpolation, Machine, Method, ModelError,
 };
 use crate::units::um_to_mm;
+
+pub mod survey;
 
 /// A measured file and the line it was measured on.
 #[derive(Clone, Copy, Debug)]
@@ -81,6 +84,9 @@ pub struct MeasuredAxis<'a> {
     pub measurement: &'a Measurement,
     /// Machine position of the line (the measured axis's own coordinate is ignored), mm.
     pub line_mm: [f64; 3],
+    /// Where the laser's moving optics sit relative to the tool tip, mm
+    /// (zero: at the tool tip); the Abbe arms of the test are the tool's plus this.
+    pub optics_offset_mm: [f64; 3],
 }
 
 /// What `predict` is given.
@@ -95,6 +101,9 @@ pub struct PredictInput<'a> {
     pub measured: &'a [MeasuredAxis<'a>],
     /// Tables, each for its axis (at most one per axis).
     pub tables: &'a [CompensationTable],
+    /// Cross-axis (straightness) tables, applied as the controller does:
+    /// the column axis moved by −value at the table axis's position.
+    pub cross_tables: &'a [CrossAxisTable],
     /// The re-test line: machine position, mm (each table's own axis coordinate is ignored).
     pub line_mm: [f64; 3],
     /// The tool of the re-test, if not the machine description's: last
@@ -204,8 +213,27 @@ pub struct Prediction {
     pub volumetric_before: VolumetricMaximum,
     /// With the tables (the worse direction).
     pub volumetric_after: VolumetricMaximum,
+    /// With the positioning tables only (no cross-axis tables; the same as
+    /// `volumetric_after` when there are none).
+    pub volumetric_positioning_only: VolumetricMaximum,
+    /// At `volumetric_after`'s point, each error's share of the error there
+    /// (its first-order contribution along ‖E‖'s direction over ‖E‖; they
+    /// add up to 1), largest first: which error to compensate next.
+    pub shares: Vec<ErrorShare>,
     /// Grid points of the map.
     pub grid_points: usize,
+}
+
+/// One error's part of the largest residual volumetric error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorShare {
+    /// The error.
+    pub name: ErrorName,
+    /// Its contribution along the error's direction over ‖E‖ (negative: it
+    /// takes some of the error away).
+    pub share: f64,
+    /// Its contribution's size there, mm.
+    pub contribution_mm: f64,
 }
 
 /// Why a prediction cannot be made.
@@ -242,6 +270,14 @@ pub enum PredictError {
     /// The model refused a value.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// A survey that cannot be assembled (a test it names, a pair it asks for).
+    #[error("{what}: {why}")]
+    Survey {
+        /// The survey's test file or table.
+        what: String,
+        /// What is wrong.
+        why: String,
+    },
     /// A bug.
     #[error("internal error, please report: {0}")]
     Internal(String),
@@ -252,7 +288,7 @@ pub enum PredictError {
 
 /// Predicts the re-tests and the residual volumetric error.
 pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
-    if input.tables.is_empty() {
+    if input.tables.is_empty() && input.cross_tables.is_empty() {
         return Err(PredictError::NoTable);
     }
     let errors = calibrated_errors(input)?;
@@ -286,19 +322,30 @@ pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
     }
     let grid = Grid::over_strokes(&retest_machine, input.grid_step_mm)?;
     let before = retest_machine.error_map(&errors, &grid, Method::Full);
-    let mut after = VolumetricMaximum {
+    let zero = VolumetricMaximum {
         max_mm: 0.0,
         at_mm: [0.0; 3],
     };
+    let (mut after, mut positioning_only) = (zero, zero);
+    let mut after_errors = errors.clone();
     for direction in Direction::BOTH {
-        let compensated = compensated_errors(&errors, input.tables, &grid, direction)?;
+        let positioned = compensated_errors(&errors, input.tables, &grid, direction)?;
+        let (max_mm, at_mm) = retest_machine
+            .error_map(&positioned, &grid, Method::Full)
+            .max_translation();
+        if max_mm >= positioning_only.max_mm {
+            positioning_only = VolumetricMaximum { max_mm, at_mm };
+        }
+        let compensated = cross_compensated(&positioned, input.cross_tables, &grid)?;
         let (max_mm, at_mm) = retest_machine
             .error_map(&compensated, &grid, Method::Full)
             .max_translation();
         if max_mm >= after.max_mm {
             after = VolumetricMaximum { max_mm, at_mm };
+            after_errors = compensated;
         }
     }
+    let shares = shares_at(&retest_machine, &after_errors, after.at_mm);
     let (max_mm, at_mm) = before.max_translation();
     Ok(Prediction {
         standard: StandardUsed::of(input.standard),
@@ -306,6 +353,8 @@ pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
         retests,
         volumetric_before: VolumetricMaximum { max_mm, at_mm },
         volumetric_after: after,
+        volumetric_positioning_only: positioning_only,
+        shares,
         grid_points: grid.len(),
     })
 }
@@ -381,7 +430,18 @@ fn line_deviation(
 /// The errors with each measured axis's positioning error set so that the
 /// model reproduces the measured means on the measured line.
 fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, PredictError> {
-    let mut errors = input.errors.clone();
+    calibrate_positioning(input.machine, input.errors, input.measured)
+}
+
+/// The 21 errors with each measured axis's positioning error set so that the
+/// model reproduces the measured means on the measured line (module doc):
+/// what `predict` predicts with, and what `predict --survey` assembles.
+pub fn calibrate_positioning(
+    machine: &Machine,
+    errors: &GeometricErrors,
+    measured: &[MeasuredAxis<'_>],
+) -> Result<GeometricErrors, PredictError> {
+    let mut errors = errors.clone();
     let mut given: Vec<ErrorName> = ErrorName::ALL
         .into_iter()
         .filter(|name| {
@@ -390,7 +450,7 @@ fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, Predic
                 .is_some_and(|f| *f != ErrorFunction::Constant(0.0))
         })
         .collect();
-    for measured in input.measured {
+    for measured in measured {
         let axis = axis_named("a measurement", measured.measurement.axis())?;
         let name = positioning_error(axis);
         if given.contains(&name) {
@@ -399,20 +459,30 @@ fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, Predic
         given.push(name);
         let known = KnownError::from_evaluation(&evaluate(measured.measurement))
             .ok_or(PredictError::NoMeans(axis))?;
-        let sign = positioning_sign(input.machine, axis)?;
+        let machine = with_optics(machine, measured.optics_offset_mm)?;
+        let sign = positioning_sign(&machine, axis)?;
         // The others' contribution on the measured line, with EAA still zero.
         let values: Vec<f64> = known
             .positions_mm()
             .iter()
             .zip(known.mean_values_mm())
             .map(|(&x, mean)| {
-                mean - line_deviation(input.machine, &errors, axis, sign, measured.line_mm, x)
+                mean - line_deviation(&machine, &errors, axis, sign, measured.line_mm, x)
             })
             .collect();
         let table = ErrorTable::new(known.positions_mm().to_vec(), values, Interpolation::Spline)?;
         errors.set(name, ErrorFunction::Table(table))?;
     }
     Ok(errors)
+}
+
+/// The machine as a test with optics `offset_mm` from the tool tip sees it.
+pub fn with_optics(machine: &Machine, offset_mm: [f64; 3]) -> Result<Machine, PredictError> {
+    if offset_mm == [0.0; 3] {
+        return Ok(machine.clone());
+    }
+    let tool = machine.tool_offset_mm();
+    Ok(machine.with_tool_offset([0, 1, 2].map(|i| tool[i] + offset_mm[i]))?)
 }
 
 /// An axis and the line its re-test runs on.
@@ -543,6 +613,120 @@ fn one_run_each_way(
     .map_err(PredictError::from)
 }
 
+/// The errors with each cross-axis table applied to the straightness it
+/// compensates: E<column><table axis>_c(x) = E(x) − v(x), linear through
+/// the grid's positions and the table's points (the column axis's own
+/// errors move by v, a few µm: below a nanometre, as for positioning).
+pub(crate) fn cross_compensated(
+    errors: &GeometricErrors,
+    tables: &[CrossAxisTable],
+    grid: &Grid,
+) -> Result<GeometricErrors, PredictError> {
+    let mut compensated = errors.clone();
+    for cross in tables {
+        let axis = axis_named("a cross-axis table", &cross.table_axis)?;
+        let direction = axis_named("a cross-axis table's column", &cross.table.axis)?;
+        if axis == direction {
+            return Err(PredictError::Survey {
+                what: format!("the cross-axis table {direction} = F({axis})"),
+                why: "moves its own axis: that is a positioning table (--table)".to_string(),
+            });
+        }
+        let name = ErrorName::of(ErrorComponent::Translation { axis, direction });
+        let own = compensated.function(name).cloned().unwrap_or_default();
+        let positions = merged_positions(grid.axis_mm(axis), &cross.table.positions_mm);
+        let values = positions
+            .iter()
+            .map(|&x| own.value_at(x) - cross.value_at(x))
+            .collect();
+        compensated.set(
+            name,
+            ErrorFunction::Table(ErrorTable::new(positions, values, Interpolation::Linear)?),
+        )?;
+    }
+    Ok(compensated)
+}
+
+/// Each error's share of the volumetric error at `at_mm` (first order, so
+/// the shares add up to 1), largest |share| first.
+fn shares_at(machine: &Machine, errors: &GeometricErrors, at_mm: [f64; 3]) -> Vec<ErrorShare> {
+    let total = machine
+        .volumetric_error(errors, at_mm, Method::FirstOrder)
+        .translation_mm;
+    let norm = total.norm();
+    if norm == 0.0 {
+        return Vec::new();
+    }
+    let mut shares: Vec<ErrorShare> = ErrorName::ALL
+        .iter()
+        .map(|&name| {
+            let mut single = GeometricErrors::default();
+            match (name.component(), errors.function(name)) {
+                (ErrorComponent::Squareness(pair), _) => {
+                    single.squareness.set(pair, errors.squareness.get(pair));
+                }
+                (_, Some(function)) => {
+                    // A motion error's function is always settable.
+                    let _ = single.set(name, function.clone());
+                }
+                _ => {}
+            }
+            let part = machine
+                .volumetric_error(&single, at_mm, Method::FirstOrder)
+                .translation_mm;
+            ErrorShare {
+                name,
+                share: part.dot(&total) / (norm * norm),
+                contribution_mm: part.norm(),
+            }
+        })
+        .filter(|s| s.contribution_mm > 0.0)
+        .collect();
+    shares.sort_by(|a, b| b.share.abs().total_cmp(&a.share.abs()));
+    shares
+}
+
+/// The grid's and a table's positions in order, once each (within 1 nm): the
+/// points where a compensated error is exact.
+fn merged_positions(grid_mm: &[f64], table_mm: &[f64]) -> Vec<f64> {
+    let mut positions: Vec<f64> = grid_mm.iter().chain(table_mm).copied().collect();
+    positions.sort_by(f64::total_cmp);
+    positions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    positions
+}
+
+/// A cross-axis table of the straightness `name` (EYX: X's in Y) as the
+/// errors hold it, at `points` evenly spaced positions over its axis's
+/// stroke, zero at the machine's reference position.
+pub fn cross_axis_table(
+    machine: &Machine,
+    errors: &GeometricErrors,
+    name: ErrorName,
+    points: usize,
+) -> Result<CrossAxisTable, PredictError> {
+    let ErrorComponent::Translation { axis, direction } = name.component() else {
+        return Err(PredictError::Internal(format!("{name} is no straightness")));
+    };
+    if axis == direction || points < 2 {
+        return Err(PredictError::Internal(format!(
+            "{name} with {points} points is no straightness table"
+        )));
+    }
+    let [low, high] = machine.axis(axis).stroke_mm;
+    let positions: Vec<f64> = (0..points)
+        .map(|i| low + (high - low) * i as f64 / (points - 1) as f64)
+        .collect();
+    let function = errors.function(name).cloned().unwrap_or_default();
+    let values = positions.iter().map(|&x| function.value_at(x)).collect();
+    Ok(CrossAxisTable::new(
+        &axis.to_string(),
+        &direction.to_string(),
+        positions,
+        values,
+        machine.reference_mm()[axis.index()],
+    ))
+}
+
 /// The errors with each table applied to its axis's positioning error, for
 /// one direction: EAA_c(x) = EAA(x − v) − v, linear through the grid's
 /// positions and the table's points (exact at both).
@@ -557,14 +741,7 @@ fn compensated_errors(
         let axis = axis_named("a table", &table.axis)?;
         let name = positioning_error(axis);
         let own = errors.function(name).cloned().unwrap_or_default();
-        let mut positions: Vec<f64> = grid
-            .axis_mm(axis)
-            .iter()
-            .chain(&table.positions_mm)
-            .copied()
-            .collect();
-        positions.sort_by(f64::total_cmp);
-        positions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        let positions = merged_positions(grid.axis_mm(axis), &table.positions_mm);
         let values = positions
             .iter()
             .map(|&x| {

@@ -313,15 +313,7 @@ fn reading(line: &Line<'_>, layout: &mut Layout) -> Result<Reading, ParseError> 
     };
     let target_mm = layout.number(line, fields[0], target_what)?;
     check_target_mm(target_mm, line.number, line.column_of(fields[0]))?;
-    let run = text::integer(line, fields[1], "run number")?;
-    if run == 0 {
-        return Err(line.error_at(fields[1], "expected a run number from 1, found 0"));
-    }
-    let direction = match fields[2].to_ascii_lowercase().as_str() {
-        "up" | "↑" => Direction::Up,
-        "down" | "↓" => Direction::Down,
-        _ => return Err(line.expected_at(fields[2], "direction up or down")),
-    };
+    let (run, direction) = text::run_and_direction(line, fields[1], fields[2])?;
     let deviation_mm = if fields[3].is_empty() {
         None
     } else {

@@ -9,10 +9,14 @@
 //!
 //! One module per format, each with its parser and, where axcomp writes the
 //! format too, its writer: [`rtl`], [`ecmc`], [`api_pos`], [`csv`].
+//! Geometry tests (straightness, angular, multi-error) are not a
+//! `Measurement` of one positioning error: [`read_geometry_path`] reads
+//! them into a [`geometry::GeometryTest`].
 
 pub mod api_pos;
 pub mod csv;
 pub mod ecmc;
+pub mod geometry;
 pub mod rtl;
 pub mod text;
 
@@ -36,18 +40,14 @@ pub struct ReadResult {
 
 /// Reads one measurement file. `format` overrides detection.
 pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult, ReadError> {
-    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
     let located = |error: ParseError| ReadError::Parse {
         path: path.to_path_buf(),
         error,
     };
-    let text = decode(&bytes).map_err(located)?;
+    let text = read_text(path)?;
     let format = match format {
         Some(format) => format,
-        None => detect(&text).ok_or_else(|| located(unknown_format_error()))?,
+        None => detect(&text).ok_or_else(|| located(not_a_positioning_test(&text)))?,
     };
     let (mut measurement, mut warnings) = parse_str(&text, format).map_err(located)?;
     // The file name is the last place an ecmc file can state its axis
@@ -62,6 +62,48 @@ pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult
         measurement,
         warnings,
     })
+}
+
+/// Reads a geometry test (straightness, angular or several errors of one
+/// axis, [`geometry`]): the CSV layout with error columns.
+pub fn read_geometry_path(path: &Path) -> Result<geometry::GeometryTest, ReadError> {
+    let text = read_text(path)?;
+    geometry::parse(&text).map_err(|error| ReadError::Parse {
+        path: path.to_path_buf(),
+        error,
+    })
+}
+
+/// The decoded text of a file ([`decode`]), errors with the path.
+fn read_text(path: &Path) -> Result<Cow<'static, str>, ReadError> {
+    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    match decode(&bytes) {
+        Ok(text) => Ok(Cow::Owned(text.into_owned())),
+        Err(error) => Err(ReadError::Parse {
+            path: path.to_path_buf(),
+            error,
+        }),
+    }
+}
+
+/// The error for a file no positioning reader takes: a geometry test is
+/// named as one (at its header line), anything else lists the formats.
+fn not_a_positioning_test(text: &str) -> ParseError {
+    let header = text::lines(text).find(|line| {
+        let trimmed = line.text.trim();
+        !trimmed.is_empty() && !trimmed.starts_with('#')
+    });
+    match header {
+        Some(line) if geometry::is_header(line.text.trim()) => line.error_at(
+            line.text.trim(),
+            "this is a geometry test (straightness or angular error columns), not a positioning test: \
+             list it in a survey and give predict --survey S.toml (README, Geometry tests)",
+        ),
+        _ => unknown_format_error(),
+    }
 }
 
 /// An error from reading a measurement file: the parse error plus the path.

@@ -390,6 +390,27 @@ impl RtlParser {
                         ),
                     ));
                 }
+                let geometry = [
+                    "straightness",
+                    "angular",
+                    "pitch",
+                    "yaw",
+                    "roll",
+                    "squareness",
+                ];
+                if geometry
+                    .iter()
+                    .any(|word| value.to_ascii_lowercase().contains(word))
+                {
+                    return Err(line.error_at(
+                        value,
+                        format!(
+                            "found Owner : {value}, a straightness or angular test: no sample of Renishaw's layout for it is public, \
+                             so it is not read (a wrong guess would put the wrong error in the model); export the readings as CSV \
+                             with error columns (target_mm,run,direction,EYX_um,… or EBX_urad,…; README, Geometry tests)"
+                        ),
+                    ));
+                }
                 if !value.eq_ignore_ascii_case("linear") {
                     return Err(line.error_at(
                         value,

@@ -312,6 +312,26 @@ pub fn integer(line: &Line<'_>, token: &str, what: &str) -> Result<u64, ParseErr
         .map_err(|_| line.error_at(token, format!("{what} {token} is too large")))
 }
 
+/// The run number (from 1) and direction (`up`/`down`, `↑`/`↓`) fields of
+/// a CSV row, as the positioning and geometry layouts write them.
+pub fn run_and_direction(
+    line: &Line<'_>,
+    run_field: &str,
+    direction_field: &str,
+) -> Result<(u64, crate::measurement::Direction), ParseError> {
+    use crate::measurement::Direction;
+    let run = integer(line, run_field, "run number")?;
+    if run == 0 {
+        return Err(line.error_at(run_field, "expected a run number from 1, found 0"));
+    }
+    let direction = match direction_field.to_ascii_lowercase().as_str() {
+        "up" | "↑" => Direction::Up,
+        "down" | "↓" => Direction::Down,
+        _ => return Err(line.expected_at(direction_field, "direction up or down")),
+    };
+    Ok((run, direction))
+}
+
 /// Splits `key<sep>value` at the first `sep`; the key is trimmed, the value is
 /// trimmed and still a slice of the line (so columns stay right).
 pub fn split_key(text: &str, sep: char) -> Option<(&str, &str)> {

@@ -21,9 +21,25 @@
 //!   "also": [{"axis": "Y", …}],
 //!   "volumetric_max_um": …, "volumetric_max_at_mm": {"x", "y", "z"},
 //!   "volumetric_max_before_um": …, "volumetric_max_before_at_mm": {…},
+//!   "volumetric_max_positioning_only_um": …, "volumetric_max_positioning_only_at_mm": {…},
+//!                                             (the positioning tables only, without --cross-table)
+//!   "shares": [{"error": "EYX", "share": 0.41, "contribution_um": …}, …],
+//!                                             (at volumetric_max_at_mm, largest first; add up to 1)
 //!   "grid_step_mm": 50.0, "grid_points": 2112,
-//!   "effects": ["reversal"], "notes": ["…"] }
+//!   "effects": ["reversal"], "notes": ["…"],
+//!   "survey": {                               (only with --survey)
+//!     "measured": ["EXX", "EYX", …], "assumed": [{"error": "EAX", "as": "declared" | "zero"}],
+//!     "sources": [{"error": "EYX", "source": "measured", "files": ["X.csv"]}, …],
+//!     "straightness": [{"error": "EYX", "file": "X.csv", "reference_line": "least-squares",
+//!                       "straightness_um": …, "slope_urad": …}],
+//!     "squareness": [{"pair": "XY", "error": "EXOY", "convention": "right-handed",
+//!                     "value_urad": …, "angle_minus_90_urad": …, "model_urad": …}] } }
 //! ```
+//!
+//! A straightness's `slope_urad` is its reference line's slope, kept apart
+//! (alignment, or squareness against the pair's other test); `value_urad`
+//! of a squareness is signed in the survey's convention (`right-handed`:
+//! positive when the angle is below 90°; `larger-than-90`: above).
 //!
 //! Deviations are actual − target as the laser reads them on the line, µm.
 
@@ -31,10 +47,11 @@ use std::fmt::Write;
 
 use serde::Serialize;
 
+use crate::predict::survey::{MeasuredState, Source, pair_name, squareness_name};
 use crate::predict::{PredictedRetest, Prediction};
 use crate::report::format::{pad_name, um};
 use crate::report::json::FiguresJson;
-use crate::units::mm_to_um;
+use crate::units::{mm_to_um, rad_to_um_per_m};
 
 /// A machine position, mm.
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -124,6 +141,17 @@ impl RetestJson {
     }
 }
 
+/// One error's share of the largest residual volumetric error.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShareJson {
+    /// ISO 230-1 name.
+    pub error: &'static str,
+    /// Its contribution along ‖E‖'s direction over ‖E‖ (the shares add up to 1).
+    pub share: f64,
+    /// Its contribution's size there, µm.
+    pub contribution_um: f64,
+}
+
 /// The whole `predict --json` object.
 #[derive(Clone, Debug, Serialize)]
 pub struct PredictJson {
@@ -150,6 +178,12 @@ pub struct PredictJson {
     pub volumetric_max_before_um: f64,
     /// Where, mm.
     pub volumetric_max_before_at_mm: PositionJson,
+    /// Largest volumetric error with the positioning tables only, µm.
+    pub volumetric_max_positioning_only_um: f64,
+    /// Where, mm.
+    pub volumetric_max_positioning_only_at_mm: PositionJson,
+    /// Each error's share of the largest residual, largest first.
+    pub shares: Vec<ShareJson>,
     /// Step of the map, mm.
     pub grid_step_mm: f64,
     /// Points of the map.
@@ -158,6 +192,144 @@ pub struct PredictJson {
     pub effects: Vec<&'static str>,
     /// What the reader should know, as sentences.
     pub notes: Vec<String>,
+    /// The measured state, with `--survey`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub survey: Option<SurveyJson>,
+}
+
+/// Where one error's value came from.
+#[derive(Clone, Debug, Serialize)]
+pub struct SourceJson {
+    /// ISO 230-1 name.
+    pub error: &'static str,
+    /// `measured`, `squareness from straightness`, `given`, `declared` or `zero`.
+    pub source: &'static str,
+    /// The files it was measured in.
+    pub files: Vec<String>,
+}
+
+/// An error not measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct AssumedJson {
+    /// ISO 230-1 name.
+    pub error: &'static str,
+    /// `declared` (the errors file) or `zero`.
+    #[serde(rename = "as")]
+    pub taken_as: &'static str,
+}
+
+/// A straightness test as evaluated.
+#[derive(Clone, Debug, Serialize)]
+pub struct StraightnessJson {
+    /// ISO 230-1 name.
+    pub error: &'static str,
+    /// The file.
+    pub file: String,
+    /// `least-squares` or `end-points`.
+    pub reference_line: &'static str,
+    /// Range of the residuals about the line, µm.
+    pub straightness_um: f64,
+    /// The line's slope, µrad (µm/m): alignment or squareness.
+    pub slope_urad: f64,
+}
+
+/// A squareness found or given.
+#[derive(Clone, Debug, Serialize)]
+pub struct SquarenessJson {
+    /// `XY`, `XZ` or `YZ`.
+    pub pair: &'static str,
+    /// The model's name: `EXOY`, `EXOZ`, `EYOZ`.
+    pub error: &'static str,
+    /// `right-handed` or `larger-than-90`.
+    pub convention: &'static str,
+    /// Signed in the convention, µrad.
+    pub value_urad: f64,
+    /// The angle between the positive directions minus 90°, µrad.
+    pub angle_minus_90_urad: f64,
+    /// The model's value, µrad (its chain's own sign and scale).
+    pub model_urad: f64,
+}
+
+/// The measured state of `predict --survey`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SurveyJson {
+    /// Errors a test measured (or the survey gives as measured), ISO order.
+    pub measured: Vec<&'static str>,
+    /// Errors not measured, and how they were taken.
+    pub assumed: Vec<AssumedJson>,
+    /// Every error's source.
+    pub sources: Vec<SourceJson>,
+    /// The straightness tests.
+    pub straightness: Vec<StraightnessJson>,
+    /// The squareness errors.
+    pub squareness: Vec<SquarenessJson>,
+}
+
+impl SurveyJson {
+    /// From the measured state.
+    pub fn new(state: &MeasuredState) -> SurveyJson {
+        let source = |s: &Source| -> (&'static str, Vec<String>) {
+            match s {
+                Source::Measured(file) => ("measured", vec![file.clone()]),
+                Source::Squareness(files) => ("squareness from straightness", files.to_vec()),
+                Source::GivenSquareness => ("given", Vec::new()),
+                Source::Declared => ("declared", Vec::new()),
+                Source::AssumedZero => ("zero", Vec::new()),
+            }
+        };
+        SurveyJson {
+            measured: state
+                .sources
+                .iter()
+                .filter(|(_, s)| s.is_measured())
+                .map(|(n, _)| n.as_str())
+                .collect(),
+            assumed: state
+                .sources
+                .iter()
+                .filter(|(_, s)| !s.is_measured())
+                .map(|(n, s)| AssumedJson {
+                    error: n.as_str(),
+                    taken_as: source(s).0,
+                })
+                .collect(),
+            sources: state
+                .sources
+                .iter()
+                .map(|(n, s)| {
+                    let (source, files) = source(s);
+                    SourceJson {
+                        error: n.as_str(),
+                        source,
+                        files,
+                    }
+                })
+                .collect(),
+            straightness: state
+                .straightness
+                .iter()
+                .map(|s| StraightnessJson {
+                    error: s.name.as_str(),
+                    file: s.file.clone(),
+                    reference_line: s.straightness.reference.as_str(),
+                    straightness_um: mm_to_um(s.straightness.deviation_mm()),
+                    slope_urad: rad_to_um_per_m(s.straightness.slope),
+                })
+                .collect(),
+            squareness: state
+                .squareness
+                .iter()
+                .map(|s| SquarenessJson {
+                    pair: pair_name(s.pair),
+                    error: squareness_name(s.pair).as_str(),
+                    convention: state.convention.as_str(),
+                    value_urad: rad_to_um_per_m(s.signed_rad),
+                    angle_minus_90_urad: rad_to_um_per_m(s.excess_rad),
+                    model_urad: rad_to_um_per_m(s.model_rad),
+                })
+                .collect(),
+        }
+    }
 }
 
 impl PredictJson {
@@ -186,11 +358,33 @@ impl PredictJson {
             volumetric_max_at_mm: prediction.volumetric_after.at_mm.into(),
             volumetric_max_before_um: mm_to_um(prediction.volumetric_before.max_mm),
             volumetric_max_before_at_mm: prediction.volumetric_before.at_mm.into(),
+            volumetric_max_positioning_only_um: mm_to_um(
+                prediction.volumetric_positioning_only.max_mm,
+            ),
+            volumetric_max_positioning_only_at_mm: prediction
+                .volumetric_positioning_only
+                .at_mm
+                .into(),
+            shares: prediction
+                .shares
+                .iter()
+                .map(|s| ShareJson {
+                    error: s.name.as_str(),
+                    share: s.share,
+                    contribution_um: mm_to_um(s.contribution_mm),
+                })
+                .collect(),
             grid_step_mm,
             grid_points: prediction.grid_points,
             effects,
             notes,
+            survey: None,
         }
+    }
+
+    /// The same report with the survey's measured state.
+    pub fn with_survey(self, survey: Option<SurveyJson>) -> PredictJson {
+        PredictJson { survey, ..self }
     }
 }
 
@@ -219,6 +413,30 @@ pub fn render(report: &PredictJson) -> String {
         um(Some(report.volumetric_max_um)),
         at(&report.volumetric_max_at_mm),
     );
+    if report.volumetric_max_positioning_only_um != report.volumetric_max_um {
+        let _ = writeln!(
+            out,
+            "  positioning tables only {} µm at {} (the cross-axis tables take the rest)",
+            um(Some(report.volumetric_max_positioning_only_um)),
+            at(&report.volumetric_max_positioning_only_at_mm),
+        );
+    }
+    if !report.shares.is_empty() {
+        let top: Vec<String> = report
+            .shares
+            .iter()
+            .take(5)
+            .map(|s| format!("{} {:.0} %", s.error, 100.0 * s.share))
+            .collect();
+        let _ = writeln!(
+            out,
+            "  where it is largest, by error (compensate the first next): {}",
+            top.join(", ")
+        );
+    }
+    if let Some(survey) = &report.survey {
+        render_survey(&mut out, survey);
+    }
     if !report.effects.is_empty() {
         let _ = writeln!(out, "Effects      {}", report.effects.join(", "));
     }
@@ -253,6 +471,51 @@ fn render_retest(out: &mut String, retest: &RetestJson) {
             pad_name(name, 11),
             um(b.get(key)),
             um(p.get(key))
+        );
+    }
+}
+
+fn render_survey(out: &mut String, survey: &SurveyJson) {
+    let _ = writeln!(
+        out,
+        "\nSurvey: {} of the 21 errors measured, {} assumed",
+        survey.measured.len(),
+        survey.assumed.len()
+    );
+    let _ = writeln!(out, "  measured  {}", survey.measured.join(" "));
+    for (label, taken_as) in [("declared", "declared"), ("zero", "zero")] {
+        let names: Vec<&str> = survey
+            .assumed
+            .iter()
+            .filter(|a| a.taken_as == taken_as)
+            .map(|a| a.error)
+            .collect();
+        if !names.is_empty() {
+            let _ = writeln!(out, "  {label:<9} {}", names.join(" "));
+        }
+    }
+    for s in &survey.straightness {
+        let _ = writeln!(
+            out,
+            "  {} straightness {:.2} µm ({} line; slope {:.2} µrad kept apart) from {}",
+            s.error, s.straightness_um, s.reference_line, s.slope_urad, s.file
+        );
+    }
+    for s in &survey.squareness {
+        let _ = writeln!(
+            out,
+            "  squareness {} {:.2} µrad ({}; the angle is 90° {} {:.2} µrad; model {} = {:.2} µrad)",
+            s.pair,
+            s.value_urad,
+            s.convention,
+            if s.angle_minus_90_urad < 0.0 {
+                "−"
+            } else {
+                "+"
+            },
+            s.angle_minus_90_urad.abs(),
+            s.error,
+            s.model_urad
         );
     }
 }

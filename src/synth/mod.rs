@@ -24,6 +24,7 @@
 //! per test and purpose, so the first test does not change when the re-test's
 //! settings do.
 
+pub mod geometry;
 pub mod rotary;
 pub mod truth;
 

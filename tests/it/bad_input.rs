@@ -19,6 +19,13 @@ const CASES: &[(&str, usize, usize, &str)] = &[
         14,
         "a rotary axis test: the layout of Renishaw's rotary files is not public",
     ),
+    // See: issue 15; no public sample of a straightness or angular .rtl.
+    (
+        "rtl-straightness.rtl",
+        3,
+        14,
+        "a straightness or angular test: no sample of Renishaw's layout for it is public",
+    ),
     (
         "rtl-target-count.rtl",
         8,
@@ -72,7 +79,7 @@ const CASES: &[(&str, usize, usize, &str)] = &[
         "rtl-angular.rtl",
         3,
         14,
-        "only linear measurements are supported",
+        "found Owner : Angular, a straightness or angular test",
     ),
     (
         "rtl-duplicate-row.rtl",

@@ -217,6 +217,12 @@ fn errors_name_line_column_and_what_was_expected() {
             "Owner      : Linear",
             "Owner      : Angular",
             (3, 14),
+            "a straightness or angular test",
+        ),
+        (
+            "Owner      : Linear",
+            "Owner      : Velocity",
+            (3, 14),
             "only linear measurements",
         ),
         (
