@@ -411,7 +411,10 @@ pub fn render(report: &PredictJson) -> String {
         um(Some(report.volumetric_max_um)),
         at(&report.volumetric_max_at_mm),
     );
-    if report.volumetric_max_positioning_only_um != report.volumetric_max_um {
+    // Without a positioning table that line would repeat "without the tables".
+    if report.retest.is_some()
+        && report.volumetric_max_positioning_only_um != report.volumetric_max_um
+    {
         let _ = writeln!(
             out,
             "  positioning tables only {} µm at {} (the cross-axis tables take the rest)",

@@ -104,8 +104,16 @@ mod convert {
         path
     }
 
-    fn convert(file: &Path, extra: &[&str]) -> Run {
-        let mut args: Vec<std::ffi::OsString> = vec!["convert".into(), file.into()];
+    /// `axcomp convert FILE --controller CONTROLLER -o OUT EXTRA…`.
+    fn convert(file: &Path, controller: &str, out: &Path, extra: &[&str]) -> Run {
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "convert".into(),
+            file.into(),
+            "--controller".into(),
+            controller.into(),
+            "-o".into(),
+            out.into(),
+        ];
         args.extend(extra.iter().map(Into::into));
         axcomp(args)
     }
@@ -115,10 +123,7 @@ mod convert {
         let dir = tempfile::tempdir().unwrap();
         let file = eyx_file(dir.path());
         let out = dir.path().join("X.COM");
-        let run = convert(
-            &file,
-            &["--controller", "tnc640", "-o", out.to_str().unwrap()],
-        );
+        let run = convert(&file, "tnc640", &out, &[]);
         assert_eq!(run.code, 0, "{}", run.stderr);
         // The least-squares slope of the bow, by hand: Σ(x − 375)·g / Σ(x − 375)²
         // = 0.255 mm² / 393 750 mm² = 0.6476 µrad; the table is g − b·x
@@ -163,10 +168,7 @@ mod convert {
         assert_eq!(text, tnc640::write_cross_axis(&by_hand, &options).unwrap());
         // Sinumerik: the same table as a CEC X → Y, read back.
         let cec = dir.path().join("X-Y.MPF");
-        let run = convert(
-            &file,
-            &["--controller", "sinumerik840d", "-o", cec.to_str().unwrap()],
-        );
+        let run = convert(&file, "sinumerik840d", &cec, &[]);
         assert_eq!(run.code, 0, "{}", run.stderr);
         assert!(run.stdout.contains("correction (−error)"), "{}", run.stdout);
         let text = std::fs::read_to_string(&cec).unwrap();
@@ -206,9 +208,9 @@ mod convert {
         let out = geo.join("X-Y.COM");
         let run = convert(
             &geo.join("X.csv"),
+            "tnc640",
+            &out,
             &[
-                "--controller",
-                "tnc640",
                 "--straightness",
                 "EYX",
                 "--line",
@@ -217,8 +219,6 @@ mod convert {
                 "y=120,z=-150",
                 "--step",
                 "50",
-                "-o",
-                out.to_str().unwrap(),
             ],
         );
         assert_eq!(run.code, 0, "{}", run.stderr);
@@ -227,16 +227,9 @@ mod convert {
         let wrong = geo.join("X-Y-no-optics.COM");
         let run = convert(
             &geo.join("X.csv"),
-            &[
-                "--controller",
-                "tnc640",
-                "--straightness",
-                "EYX",
-                "--step",
-                "50",
-                "-o",
-                wrong.to_str().unwrap(),
-            ],
+            "tnc640",
+            &wrong,
+            &["--straightness", "EYX", "--step", "50"],
         );
         assert_eq!(run.code, 0, "{}", run.stderr);
         assert_ne!(std::fs::read_to_string(&wrong).unwrap(), expected_text);
@@ -266,10 +259,7 @@ mod convert {
         let dir = tempfile::tempdir().unwrap();
         let file = eyx_file(dir.path());
         let out = dir.path().join("X.COM");
-        let run = convert(
-            &file,
-            &["--controller", "itnc530", "-o", out.to_str().unwrap()],
-        );
+        let run = convert(&file, "itnc530", &out, &[]);
         assert_eq!(run.code, 2, "{}", run.stdout);
         assert!(
             run.stderr.contains("tnc640") && run.stderr.contains("sinumerik840d"),
@@ -284,10 +274,7 @@ mod convert {
             "# axis: X\ntarget_mm,run,direction,EBX_urad\n0,1,up,0\n375,1,up,2.5\n750,1,up,1\n",
         )
         .unwrap();
-        let run = convert(
-            &angular,
-            &["--controller", "tnc640", "-o", out.to_str().unwrap()],
-        );
+        let run = convert(&angular, "tnc640", &out, &[]);
         assert_eq!(run.code, 2, "{}", run.stdout);
         assert!(
             run.stderr.contains("written from a straightness") && run.stderr.contains("EBX"),
@@ -295,17 +282,7 @@ mod convert {
             run.stderr
         );
         // A positioning flag has no meaning here.
-        let run = convert(
-            &file,
-            &[
-                "--controller",
-                "tnc640",
-                "--mode",
-                "bidirectional",
-                "-o",
-                out.to_str().unwrap(),
-            ],
-        );
+        let run = convert(&file, "tnc640", &out, &["--mode", "bidirectional"]);
         assert_eq!(run.code, 2, "{}", run.stdout);
         assert!(run.stderr.contains("--mode"), "{}", run.stderr);
         assert!(!out.exists(), "nothing written");
