@@ -183,7 +183,7 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
         report.table, report.controller, report.output
     );
     out.push_str(&format!(
-        "  straightness {:.2} µm ({} reference line); its slope {:.2} µrad is taken out and not compensated: it is the optics' alignment and, with the other test of the pair, squareness (predict --survey)\n",
+        "  straightness {:.2} µm ({} reference line); its slope {:.2} µrad is taken out and not compensated: it is the optics' alignment and, with the other test of the pair, squareness (predict --survey, which also takes the other axes' angles out of the slope)\n",
         report.straightness_um, report.reference_line, report.slope_urad
     ));
     out.push_str(&format!(
