@@ -5,6 +5,8 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use axum::extract::Multipart;
+use axum::extract::multipart::MultipartError;
+use axum::http::StatusCode;
 
 /// The file fields: `file` (one, or two of one axis: API forward and
 /// reverse), `after` (the re-test) and `table` (the table that was active).
@@ -41,33 +43,32 @@ pub struct Form {
 }
 
 impl Form {
-    /// Reads a multipart form; an unknown field or a setting sent twice is refused.
-    pub async fn read(mut multipart: Multipart) -> Result<Form, String> {
+    /// Reads a multipart form; an unknown field or a setting sent twice is
+    /// refused (400), and so is a form over the upload limit (413).
+    pub async fn read(mut multipart: Multipart) -> Result<Form, (StatusCode, String)> {
+        let refused = |error: MultipartError| (error.status(), error.body_text());
+        let bad = |message: String| (StatusCode::BAD_REQUEST, message);
         let mut form = Form::default();
-        while let Some(field) = multipart
-            .next_field()
-            .await
-            .map_err(|error| error.body_text())?
-        {
+        while let Some(field) = multipart.next_field().await.map_err(refused)? {
             let name = field.name().unwrap_or_default().to_string();
             if let Some(&key) = FILE_FIELDS.iter().find(|k| **k == name) {
                 let file_name = base_name(field.file_name().unwrap_or_default());
-                let bytes = field.bytes().await.map_err(|error| error.body_text())?;
+                let bytes = field.bytes().await.map_err(refused)?;
                 form.files
                     .entry(key)
                     .or_default()
                     .push((PathBuf::from(file_name), bytes.to_vec()));
             } else if let Some(&key) = TEXT_FIELDS.iter().find(|k| **k == name) {
-                let value = field.text().await.map_err(|error| error.body_text())?;
+                let value = field.text().await.map_err(refused)?;
                 let value = value.trim().to_string();
                 if value.is_empty() {
                     continue;
                 }
                 if form.text.insert(key, value).is_some() {
-                    return Err(format!("the setting {key} was sent twice"));
+                    return Err(bad(format!("the setting {key} was sent twice")));
                 }
             } else {
-                return Err(format!("unknown form field {name:?}"));
+                return Err(bad(format!("unknown form field {name:?}")));
             }
         }
         Ok(form)

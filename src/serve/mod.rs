@@ -229,7 +229,9 @@ async fn answer<T: Send + 'static>(
     multipart: Multipart,
     work: impl FnOnce(Form) -> Result<T, ApiError> + Send + 'static,
 ) -> Result<T, ApiError> {
-    let form = Form::read(multipart).await?;
+    let form = Form::read(multipart)
+        .await
+        .map_err(|(status, message)| ApiError::new(status, message))?;
     tokio::task::spawn_blocking(move || work(form))
         .await
         .map_err(|error| ApiError::new(StatusCode::INTERNAL_SERVER_ERROR, error.to_string()))?
