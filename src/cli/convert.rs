@@ -60,7 +60,7 @@ pub struct ConvertArgs {
     ///
     /// Default: mean, or bidirectional when --effects has a reversal and the
     /// controller takes bidirectional tables.
-    #[arg(long, value_name = "MODE", value_parser = parse_mode, help_heading = "Table")]
+    #[arg(long, value_name = "MODE", value_parser = TableMode::from_name, help_heading = "Table")]
     pub mode: Option<TableMode>,
 
     /// First compensation point, mm (default: the first target).
@@ -97,7 +97,7 @@ pub struct ConvertArgs {
 
     /// Points outside the measured range: hold the end value, or zero.
     /// Without it such points are refused.
-    #[arg(long, value_name = "RULE", value_parser = parse_extrapolate, help_heading = "Grid")]
+    #[arg(long, value_name = "RULE", value_parser = Extrapolate::from_name, help_heading = "Grid")]
     pub extrapolate: Option<Extrapolate>,
 
     /// The table that was active during the measurement (any format convert writes).
@@ -156,22 +156,6 @@ fn parse_controller(name: &str) -> Result<Controller, String> {
             names.join(", ")
         )
     })
-}
-
-fn parse_mode(name: &str) -> Result<TableMode, String> {
-    match name {
-        "mean" => Ok(TableMode::Mean),
-        "bidirectional" => Ok(TableMode::Bidirectional),
-        _ => Err(format!("expected mean or bidirectional, found {name:?}")),
-    }
-}
-
-fn parse_extrapolate(name: &str) -> Result<Extrapolate, String> {
-    match name {
-        "hold" => Ok(Extrapolate::Hold),
-        "zero" => Ok(Extrapolate::Zero),
-        _ => Err(format!("expected hold or zero, found {name:?}")),
-    }
 }
 
 /// Runs `axcomp convert`.

@@ -376,26 +376,6 @@ struct Table {
     controller: Controller,
 }
 
-fn parse_mode(name: &str) -> Result<TableMode, String> {
-    match name {
-        "mean" => Ok(TableMode::Mean),
-        "bidirectional" => Ok(TableMode::Bidirectional),
-        _ => Err(format!(
-            "mode: expected mean or bidirectional, found {name:?}"
-        )),
-    }
-}
-
-fn parse_extrapolate(name: &str) -> Result<Extrapolate, String> {
-    match name {
-        "hold" => Ok(Extrapolate::Hold),
-        "zero" => Ok(Extrapolate::Zero),
-        _ => Err(format!(
-            "extrapolate: expected hold or zero, found {name:?}"
-        )),
-    }
-}
-
 /// The active table of the form's `table` field, read for `test`'s axis,
 /// and the doubts about the two together (as `convert --existing` and
 /// `report --table` read it).
@@ -497,15 +477,20 @@ fn table_of(form: &Form, field: &str, effects: &[Effect]) -> Result<Table, ApiEr
             controller,
             options: &options,
             request: &TableGrid {
-                mode: form.text("mode").map(parse_mode).transpose()?,
+                mode: form
+                    .text("mode")
+                    .map(TableMode::from_name)
+                    .transpose()
+                    .map_err(|e| format!("mode: {e}"))?,
                 step_mm: form.number("step", "a number of mm")?,
                 start_mm: form.number("start", "a number of mm")?,
                 count: form.number("count", "a whole number of points")?,
                 reference_mm: form.number("reference", "a number of mm")?,
                 extrapolate: form
                     .text("extrapolate")
-                    .map(parse_extrapolate)
-                    .transpose()?,
+                    .map(Extrapolate::from_name)
+                    .transpose()
+                    .map_err(|e| format!("extrapolate: {e}"))?,
             },
             effects,
             existing: existing.as_deref(),

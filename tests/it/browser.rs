@@ -64,19 +64,11 @@ impl Pixels {
 
 /// Debian's chromium; `scripts/test` installs it. Missing is a failure, not a skip.
 pub fn chromium() -> PathBuf {
-    let path = std::env::var_os("PATH").unwrap_or_default();
-    for directory in std::env::split_paths(&path) {
-        for name in ["chromium", "chromium-browser"] {
-            let candidate = directory.join(name);
-            if candidate.is_file() {
-                return candidate;
-            }
-        }
-    }
-    panic!(
-        "chromium not found on PATH: the report is tested in a real browser; install Debian's \
-         chromium (apt-get install chromium), or run the tests with scripts/test, which installs it"
-    );
+    crate::util::program_on_path(
+        &["chromium", "chromium-browser"],
+        "the report is tested in a real browser; install Debian's chromium (apt-get install \
+         chromium), or run the tests with scripts/test, which installs it",
+    )
 }
 
 /// What the browser made of a page.
@@ -168,17 +160,11 @@ pub fn wait_with_timeout(
 /// Debian's chromedriver (package `chromium-driver`; `scripts/test`
 /// installs it). Missing is a failure, not a skip.
 pub fn chromedriver() -> PathBuf {
-    let path = std::env::var_os("PATH").unwrap_or_default();
-    std::env::split_paths(&path)
-        .map(|directory| directory.join("chromedriver"))
-        .find(|candidate| candidate.is_file())
-        .unwrap_or_else(|| {
-            panic!(
-                "chromedriver not found on PATH: the web app is tested in a real browser; install \
-                 Debian's chromium-driver (apt-get install chromium-driver), or run the tests with \
-                 scripts/test, which installs it"
-            )
-        })
+    crate::util::program_on_path(
+        &["chromedriver"],
+        "the web app is tested in a real browser; install Debian's chromium-driver (apt-get \
+         install chromium-driver), or run the tests with scripts/test, which installs it",
+    )
 }
 
 /// Headless Chromium driven over WebDriver (W3C, JSON over HTTP through

@@ -14,7 +14,7 @@ use std::process::{Child, Command, Stdio};
 
 use crate::browser::{Pixels, WebDriver, artefacts};
 use crate::http::{Form, Response, request};
-use crate::util::root;
+use crate::util::{root, without_time};
 
 /// A running `axcomp serve --port 0 --no-open`, stopped when dropped.
 struct Server {
@@ -159,30 +159,13 @@ fn the_table_download_is_what_convert_writes() {
         );
         let output = work.path().join(controller).join(name);
         std::fs::create_dir_all(output.parent().unwrap()).unwrap();
-        let mut args = vec![
-            "convert".to_string(),
-            sample().display().to_string(),
-            "--controller".into(),
-            controller.into(),
-            "--step".into(),
-            "50".into(),
-            "-o".into(),
-            output.display().to_string(),
-        ];
+        let (sample, output_arg) = (sample().display().to_string(), output.display().to_string());
+        let mut args = vec!["convert", &sample, "--controller", controller];
+        args.extend(["--step", "50", "-o", &output_arg]);
         if others {
-            args.extend(
-                [
-                    "--reference",
-                    "100",
-                    "--mode",
-                    "bidirectional",
-                    "--extrapolate",
-                    "hold",
-                ]
-                .map(String::from),
-            );
+            args.extend(["--reference", "100", "--mode", "bidirectional"]);
+            args.extend(["--extrapolate", "hold"]);
         }
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
         cli_in(&root(), &args);
         assert_eq!(answer.body, read(&output), "{controller}: {name} differs");
         assert!(
@@ -326,12 +309,6 @@ fn the_report_download_is_the_acceptance_report() {
     );
     let cli_page = std::fs::read_to_string(cli_page).unwrap();
     // The same page but for the minute it was made in.
-    let without_time = |page: &str| {
-        page.lines()
-            .filter(|line| !line.contains(concat!("axcomp ", env!("CARGO_PKG_VERSION"), " on ")))
-            .collect::<Vec<_>>()
-            .join("\n")
-    };
     assert_eq!(without_time(&page), without_time(&cli_page));
     assert!(page.contains("Edlén"));
 }
