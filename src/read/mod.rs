@@ -55,7 +55,7 @@ pub fn read_bytes(
         path: path.to_path_buf(),
         error,
     };
-    let text = decode(&bytes).map_err(located)?;
+    let text = decode(bytes).map_err(located)?;
     let format = match format {
         Some(format) => format,
         None => detect(&text).ok_or_else(|| located(unknown_format_error()))?,

@@ -376,6 +376,15 @@ struct Table {
     controller: Controller,
 }
 
+/// A table that was active: the upload, its controller, the table, the
+/// doubts about it and the test together.
+type ActiveTable = (
+    Upload,
+    Controller,
+    compensate::CompensationTable,
+    Vec<Warning>,
+);
+
 /// The active table of the form's `table` field, read for `test`'s axis,
 /// and the doubts about the two together (as `convert --existing` and
 /// `report --table` read it).
@@ -385,15 +394,7 @@ fn active_table(
     test_label: String,
     profile: &MachineProfile,
     linuxcnc_type: Option<u8>,
-) -> Result<
-    Option<(
-        Upload,
-        Controller,
-        compensate::CompensationTable,
-        Vec<Warning>,
-    )>,
-    ApiError,
-> {
+) -> Result<Option<ActiveTable>, ApiError> {
     let Some((name, bytes)) = form.one_file("table")? else {
         return Ok(None);
     };
