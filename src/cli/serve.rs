@@ -7,6 +7,8 @@ use anyhow::{Context, Result};
 
 use axcomp::serve::{DEFAULT_PORT, serve, url};
 
+use super::common::Verbosity;
+
 /// Flags of `axcomp serve`.
 #[derive(Debug, clap::Args)]
 pub struct ServeArgs {
@@ -22,12 +24,16 @@ pub struct ServeArgs {
     /// Do not open the browser.
     #[arg(long)]
     pub no_open: bool,
+
+    /// -q/--quiet (the same in every command): no warning about --listen.
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Runs `axcomp serve` until interrupted.
 pub fn run(args: &ServeArgs) -> Result<()> {
     let ip = args.listen.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
-    if !ip.is_loopback() {
+    if !ip.is_loopback() && !args.verbosity.quiet {
         eprintln!(
             "axcomp: warning: listening on {ip}, not only this machine: anyone who reaches port {} can upload files and read what the app computes",
             args.port
@@ -41,13 +47,13 @@ pub fn run(args: &ServeArgs) -> Result<()> {
     println!("axcomp serve: {url} (Ctrl-C stops it)");
     std::io::Write::flush(&mut std::io::stdout())?;
     if !args.no_open {
-        open_browser(&url);
+        open_browser(&url, args.verbosity.quiet);
     }
     serve(listener).context("the web app stopped")
 }
 
 /// Opens `url` in the desktop's browser; when that fails the printed address is enough.
-fn open_browser(url: &str) {
+fn open_browser(url: &str, quiet: bool) {
     let mut command = if cfg!(windows) {
         let mut command = std::process::Command::new("cmd");
         command.args(["/C", "start", ""]);
@@ -63,7 +69,7 @@ fn open_browser(url: &str) {
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .spawn();
-    if opened.is_err() {
+    if opened.is_err() && !quiet {
         eprintln!("axcomp: could not open a browser; open {url} yourself");
     }
 }
