@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use axcomp::compensate::CompensationTable;
 use axcomp::effects::{Effect, read_effects};
-use axcomp::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
+use axcomp::emit::{Controller, EmitError, EmitOptions, MachineProfile};
 use axcomp::error::{ParseError, Warning};
 use axcomp::evaluate::Standard;
 use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
@@ -19,6 +19,7 @@ use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::LengthUnit;
+use axcomp::workflow;
 
 /// `--format NAME`: one of the input formats.
 pub fn parse_format(name: &str) -> Result<SourceFormat, String> {
@@ -195,15 +196,7 @@ pub fn read_table_of(
     options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
     options.kind = kind;
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
-    let (text, _) = emit::decode_table(&bytes).map_err(|error| in_file(path, error))?;
-    if emit::fagor8055::looks_like(&text) {
-        options.machine_unit = profile.table_unit(Controller::Fagor8055, test_unit);
-    }
-    emit::read_any(&text, &options, None)
-        .or_else(|error| match linuxcnc_type {
-            Some(kind) => emit::read_any(&text, &options, Some(kind)),
-            None => Err(error),
-        })
+    workflow::read_table(&bytes, options, profile, test_unit, linuxcnc_type)
         .map_err(|error| in_file(path, error))
 }
 
