@@ -7,6 +7,7 @@ use anyhow::Result;
 
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
+use axcomp::measurement::AxisKind;
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, render};
@@ -83,7 +84,22 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let mut after = read::read_path(&args.after, None)?;
     print_warnings(&after.warnings, args.verbosity.quiet);
     name_axis(&mut after.measurement, args.axis.as_ref());
-    super::common::linear_only(&after.measurement, "diagnose")?;
+    if after.measurement.kind() == AxisKind::Rotary {
+        // Issue 14: a rotary re-test is diagnosed in ″ (per-revolution
+        // harmonics, reversal, outlier runs); its effects file and an Abbe
+        // profile are lengths, for linear axes only so far.
+        for (given, flag) in [
+            (args.write_effects.is_some(), "--write-effects"),
+            (args.angular.is_some(), "--angular"),
+        ] {
+            if given {
+                anyhow::bail!(
+                    "axis {} is a rotary axis: {flag} is for linear axes only so far (an effects file and an angular profile are in mm and µm)",
+                    after.measurement.axis()
+                );
+            }
+        }
+    }
     let before = match &args.before {
         Some(path) => {
             let mut result = read::read_path(path, None)?;

@@ -13,14 +13,14 @@
 use nalgebra::DMatrix;
 
 use super::fit::{Design, WeightedFit, fit_gls};
-use super::gates::{period_range, set_rejection};
+use super::gates::{Periods, periods, set_rejection};
 use super::levels::{Fold, Level};
 use super::problem::Problem;
 use super::selection::{Chosen, Search, forward_selection, shapes};
 use super::stats::chi2_p;
 use super::{Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
 use crate::effects::Reading;
-use crate::measurement::Direction;
+use crate::measurement::{AxisKind, Direction};
 
 /// Covariance of the per-target levels, µm²: each level's own scatter on the
 /// diagonal, plus the prediction's, which targets share when they interpolate
@@ -131,10 +131,6 @@ pub(super) fn select_along_axis(
         let dof = m.saturating_sub(fit.rank).max(1) as f64;
         covariance *= (fit.chi2 / dof).max(1.0);
     }
-    let min_periods = match background {
-        Background::Constant => super::MIN_PERIODS_IN_SPAN,
-        Background::Smooth => super::MIN_PERIODS_IN_CURVE,
-    };
     let search = AlongAxis {
         problem,
         levels,
@@ -143,7 +139,11 @@ pub(super) fn select_along_axis(
         background,
         values: &values,
         covariance: &covariance,
-        periods: period_range(&problem.targets_mm, min_periods),
+        periods: periods(
+            &problem.targets_mm,
+            problem.kind,
+            background == Background::Constant,
+        ),
     };
     let (mut chosen, mut model_fit) = forward_selection(&search, base.clone(), kinds, rejected);
     // Never the nearest kind: what is accepted along the axis must leave no
@@ -175,7 +175,7 @@ struct AlongAxis<'a> {
     background: Background,
     values: &'a [f64],
     covariance: &'a DMatrix<f64>,
-    periods: Option<(f64, f64)>,
+    periods: Option<Periods>,
 }
 
 impl Search for AlongAxis<'_> {
@@ -191,7 +191,11 @@ impl Search for AlongAxis<'_> {
     }
 
     fn periods(&self) -> Option<(f64, f64)> {
-        self.periods
+        self.periods.and_then(Periods::range)
+    }
+
+    fn kind(&self) -> AxisKind {
+        self.problem.kind
     }
 
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {

@@ -3,10 +3,11 @@
 //! (used between runs and along the axis).
 
 use super::fit::Design;
-use super::gates::{predicts_better, set_rejection, strong_evidence};
+use super::gates::{Periods, predicts_better, set_rejection, strong_evidence};
 use super::{Evidence, RejectedEffect};
 use crate::effects::{Kind, Shape};
-use crate::measurement::{Direction, Run};
+use crate::evaluate::conformance::FULL_TURN_DEG;
+use crate::measurement::{AxisKind, Direction, Run};
 
 /// An accepted shape, where its columns start in its model, and why.
 #[derive(Clone, Copy, Debug)]
@@ -20,14 +21,20 @@ pub(super) struct Chosen {
 pub(super) fn shapes(
     kind: Kind,
     after_targets: &[f64],
-    periods: Option<(f64, f64)>,
+    periods: Option<Periods>,
     runs: &[Run],
     chosen: &[Chosen],
 ) -> Vec<Shape> {
     match kind {
         Kind::Periodic => {
-            let Some((shortest, longest)) = periods else {
-                return Vec::new();
+            let (shortest, longest) = match periods {
+                None => return Vec::new(),
+                Some(Periods::Orders(lowest, highest)) => {
+                    return (lowest..=highest)
+                        .map(|k| Shape::Period(FULL_TURN_DEG / f64::from(k)))
+                        .collect();
+                }
+                Some(Periods::Range(shortest, longest)) => (shortest, longest),
             };
             let span = after_targets[after_targets.len() - 1] - after_targets[0];
             // Frequencies 5 times finer than 1/span; the best is refined afterwards.
@@ -104,8 +111,11 @@ pub(super) trait Search {
     /// The shapes of `kind` to try.
     fn shapes(&self, kind: Kind, chosen: &[Chosen]) -> Vec<Shape>;
 
-    /// The periods scanned (shortest, longest), mm, if any.
+    /// The range a best period is refined within (shortest, longest), mm, if any.
     fn periods(&self) -> Option<(f64, f64)>;
+
+    /// Linear or rotary (the unit of the sentences).
+    fn kind(&self) -> AxisKind;
 
     /// A shape's columns.
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>>;
@@ -179,7 +189,7 @@ pub(super) fn forward_selection<S: Search>(
             }
             let with = model.with(&search.columns(shape));
             let cv_with = search.cross_validated_rmse(&with);
-            if !predicts_better(rejected, shape.kind(), cv_with, cv_without) {
+            if !predicts_better(rejected, shape.kind(), search.kind(), cv_with, cv_without) {
                 continue;
             }
             let evidence = Evidence {
