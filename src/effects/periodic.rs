@@ -117,7 +117,7 @@ impl Periodic {
             .map(|s| format!("; the table's step of {s}° cannot follow it"))
             .unwrap_or_default();
         format!(
-            "{order} of {} amplitude and {:.2}° period{table}; compensate with a step of at most {:.2}° (convert --effects), or check the encoder's mounting and the table's run-out.",
+            "{order} of {} amplitude and {:.2}° period{table}; the re-test's own table takes it out at a step of at most {:.2}° (convert the re-test with --existing and the active table), or check the encoder's mounting and the table's run-out.",
             context.deviation(self.amplitude_um),
             self.period_mm,
             self.period_mm / 10.0
