@@ -1,7 +1,8 @@
 //! The Monte Carlo tolerance study: 50,000 random machines of the bundled
 //! MCV 754 Quick (the thesis's baseline: all six straightness tolerances
 //! 0.03 mm, no positioning or squareness errors, 50 mm grid), on all cores
-//! and on one; and the single-axis study.
+//! and on one; the same with the carriage side (parallelism and flatness
+//! 0.03 mm on every saddle); and the single-axis study.
 //!
 //! Criterion reports the throughput in samples per second ("elem/s"). The
 //! whole-process comparison with the NumPy peer (`../shared/tools/mc_peer.py`)
@@ -35,6 +36,11 @@ fn bench(c: &mut Criterion) {
     let options = baseline(SAMPLES);
     group.bench_function("tolerance_study_all_cores", |b| {
         b.iter(|| tolerance_study(&machine, black_box(&options), &|_| {}).unwrap())
+    });
+    let mut carriage_side = options;
+    carriage_side.tolerances.carriage_mm = [[0.03, 0.03]; 3];
+    group.bench_function("tolerance_study_with_carriage_side_all_cores", |b| {
+        b.iter(|| tolerance_study(&machine, black_box(&carriage_side), &|_| {}).unwrap())
     });
     let one_thread = rayon::ThreadPoolBuilder::new()
         .num_threads(1)

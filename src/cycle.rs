@@ -79,6 +79,28 @@ pub fn reading_times_for(
     times
 }
 
+/// Reading times in hours, as `[run][target]`, and whether they are assumed:
+/// the cycle model ([`reading_times`]) scaled to the duration the file
+/// records when it differs from the model's by more than its one-minute
+/// resolution. The one clock of `diagnose` and of effects added to a
+/// measured test (`Effect::added_to`), so a drift put in is the drift found.
+pub fn reading_times_h(measurement: &Measurement, timing: CycleTiming) -> (Vec<Vec<f64>>, bool) {
+    let seconds = reading_times(measurement, timing);
+    let model = duration_s(&seconds);
+    let (scale, assumed) = match measurement.metadata.duration_s() {
+        Some(recorded) if (recorded - model).abs() > 60.0 && model > 0.0 => {
+            (recorded / model, false)
+        }
+        Some(_) => (1.0, false),
+        None => (1.0, true),
+    };
+    let hours = seconds
+        .iter()
+        .map(|run| run.iter().map(|t| t * scale / 3600.0).collect())
+        .collect();
+    (hours, assumed)
+}
+
 /// The time of the last reading, s.
 pub fn duration_s(times: &[Vec<f64>]) -> f64 {
     times.iter().flatten().fold(0.0, |max: f64, t| max.max(*t))

@@ -5,6 +5,15 @@
 
 mod cli;
 
+// mimalloc rather than the system allocator: a large test (10 000 targets,
+// 1.9 MB) spent a third of its time in the kernel faulting in fresh pages
+// for the file, the runs, the statistics and the printed table; mimalloc
+// reuses freed pages and asks for transparent huge pages, and evaluate of
+// that file takes a fifth less CPU time (README, Speed). ripgrep makes the
+// same choice (jemalloc) for the same reason.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> std::process::ExitCode {
     cli::main()
 }

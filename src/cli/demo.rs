@@ -145,6 +145,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         table: Some(&active),
         backlash_set: false,
         angular: None,
+        known_periods: &[],
         timing: CycleTiming::ASSUMED,
         standard: &ISO_230_2,
     })?;

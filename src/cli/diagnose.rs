@@ -3,20 +3,23 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 
 use axcomp::cycle::CycleTiming;
-use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
+use axcomp::diagnose::friction::friction_behind_reversal;
+use axcomp::diagnose::{AngularProfile, DiagnoseInput, KnownPeriod, diagnose};
+use axcomp::emit::AxisPeriods;
 use axcomp::measurement::AxisKind;
 use axcomp::output::write_new;
 use axcomp::read;
-use axcomp::report::diagnose::{DiagnoseJson, render};
+use axcomp::report::diagnose::{DiagnoseJson, FrictionJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load, load_profile,
     name_axis, print_json, print_text, print_warnings, read_active_table,
 };
+use super::servo_sim::load_axis;
 
 /// Flags of `axcomp diagnose`.
 #[derive(Debug, clap::Args)]
@@ -53,6 +56,23 @@ pub struct DiagnoseArgs {
     /// to tell an Abbe error.
     #[arg(long, value_name = "FILE")]
     pub angular: Option<PathBuf>,
+
+    /// The axis's servo description, to read a reversal found as friction.
+    ///
+    /// A bundled axis (mcfv5050-x, mcfv5050-y) or an axis TOML file as
+    /// servo-sim takes it; with --compliance-n-um the reversal B found is
+    /// reported as the force F_res = −B·k_c/2 held against friction
+    /// (B̄ = B̄_scale − 2·F_res/k_c), in the terminal and as "friction" in JSON.
+    #[arg(long = "servo-axis", value_name = "AXIS", requires = "compliance_n_um")]
+    pub servo_axis: Option<String>,
+
+    /// Structural stiffness k_c between the drive's force line and the laser, N/µm.
+    #[arg(
+        long = "compliance-n-um",
+        value_name = "N_PER_UM",
+        requires = "servo_axis"
+    )]
+    pub compliance_n_um: Option<f64>,
 
     /// Save the accepted effects (TOML) for predict --effects and convert --effects.
     #[arg(long = "write-effects", value_name = "E.toml")]
@@ -91,10 +111,11 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         for (given, flag) in [
             (args.write_effects.is_some(), "--write-effects"),
             (args.angular.is_some(), "--angular"),
+            (args.servo_axis.is_some(), "--servo-axis"),
         ] {
             if given {
                 anyhow::bail!(
-                    "axis {} is a rotary axis: {flag} is for linear axes only so far (an effects file and an angular profile are in mm and µm)",
+                    "axis {} is a rotary axis: {flag} is for linear axes only so far (an effects file, an angular profile and a servo description are in mm, µm and N)",
                     after.measurement.axis()
                 );
             }
@@ -115,9 +136,22 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         }
         None => None,
     };
+    let profile = load_profile(args.machine_file.machine.as_deref())?;
+    // The profile's periods of the axis the re-test states (never of a guessed axis).
+    let periods = if after.measurement.axis_recorded() {
+        profile.axis_periods(after.measurement.axis())
+    } else {
+        AxisPeriods::default()
+    };
+    let known_periods: Vec<KnownPeriod> = [
+        periods.screw_lead_mm.map(KnownPeriod::screw_lead),
+        periods.scale_period_mm.map(KnownPeriod::scale_period),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     let table = match &args.table {
         Some(path) => {
-            let profile = load_profile(args.machine_file.machine.as_deref())?;
             // The table was active during the re-test.
             let (_, table, doubts) = read_active_table(
                 path,
@@ -138,6 +172,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         table: table.as_ref(),
         backlash_set: args.backlash_set,
         angular: angular.as_ref(),
+        known_periods: &known_periods,
         timing: CycleTiming::ASSUMED,
         standard: args.standard.standard,
     };
@@ -147,12 +182,22 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         let text = diagnosis.effects_file(&name(&args.after));
         write_new(path, text.as_bytes(), args.overwrite.force)?;
     }
-    let report = DiagnoseJson::new(
+    let mut report = DiagnoseJson::new(
         &diagnosis,
         name(&args.after),
         args.before.as_deref().map(name),
         args.table.as_deref().map(name),
     );
+    if let (Some(servo_axis), Some(compliance)) = (&args.servo_axis, args.compliance_n_um) {
+        if !(compliance.is_finite() && compliance > 0.0) {
+            bail!("--compliance-n-um: expected a number > 0, found {compliance}");
+        }
+        let axis = load_axis(servo_axis)?;
+        report.set_friction(
+            friction_behind_reversal(&diagnosis, &axis, compliance)
+                .map(|f| FrictionJson::new(servo_axis, &f)),
+        );
+    }
     if args.json_output.json {
         print_json(&report)
     } else {

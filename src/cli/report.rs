@@ -261,6 +261,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
                 table: table.as_ref().map(|(_, _, t)| t),
                 backlash_set: false,
                 angular: None,
+                known_periods: &[],
                 timing: CycleTiming::ASSUMED,
                 standard,
             };

@@ -8,19 +8,22 @@ use anyhow::{Context, Result, bail};
 
 use axcomp::output::write_new;
 use axcomp::report::servo::{
-    CircleJson, ConstantVelocityJson, ForceStepJson, IsoJson, MacroStepsJson, ServoSimJson,
-    iso_csv, text, trace_csv,
+    CircleJson, ConstantVelocityJson, ForceStepJson, IdentifyJson, IsoJson, MacroStepsJson,
+    ServoSimJson, identify_text, iso_csv, text, trace_csv,
 };
 use axcomp::servo::axis::Axis;
 use axcomp::servo::circle::run_circle;
 use axcomp::servo::force_step::{run_constant_velocity, run_force_step};
 use axcomp::servo::friction::FrictionKind;
+use axcomp::servo::friction_fit::{
+    axis_with_friction, identify, parse_constant_velocity, parse_following_error,
+};
 use axcomp::servo::iso_cycle::{DEFAULT_COMPLIANCE_N_PER_UM, IsoCycle, IsoOptions, run_iso_cycle};
 use axcomp::servo::simulate::{ForceStep, Stepping};
 use axcomp::servo::trajectory::{Circle, CircleAxis, MoveLimits};
 use axcomp::units::{mm_to_m, um_to_mm};
 
-use super::common::{JsonOutput, Overwrite, Verbosity, in_file, print_json, print_text};
+use super::common::{JsonOutput, Overwrite, Verbosity, in_file, load, print_json, print_text};
 use super::progress;
 
 /// Which test to simulate.
@@ -59,12 +62,46 @@ pub struct ServoSimArgs {
     pub axis: String,
 
     /// Friction model: classic (A), ramp (B1), power (B2) or lugre (C).
-    #[arg(long, value_name = "MODEL", value_parser = parse_friction, help_heading = "Model")]
-    pub friction: FrictionKind,
+    #[arg(long, value_name = "MODEL", value_parser = parse_friction, help_heading = "Model",
+          required_unless_present = "identify")]
+    pub friction: Option<FrictionKind>,
 
     /// Test: circle, step, constant-velocity or iso230-2.
-    #[arg(long, value_enum, value_name = "TEST", help_heading = "Model")]
-    pub test: TestKind,
+    #[arg(
+        long,
+        value_enum,
+        value_name = "TEST",
+        help_heading = "Model",
+        required_unless_present = "identify"
+    )]
+    pub test: Option<TestKind>,
+
+    /// The axis's friction instead of the file's: `--coulomb-n` and the others.
+    #[command(flatten, next_help_heading = "Friction")]
+    pub friction_values: FrictionValues,
+
+    /// Fit F_C and μ_v to this constant-velocity record (CSV feed_m_per_min,current_a).
+    ///
+    /// One row per constant feed (signed: a run in −x has a negative feed
+    /// and current), the mean motor current there; F = K_F3·I of the axis
+    /// file. With --reversal also k_s. Prints the values and the servo-sim
+    /// flags that start from them. See README "Identifying the friction".
+    #[arg(long, value_name = "CSV", help_heading = "Identification")]
+    pub identify: Option<PathBuf>,
+
+    /// The measured reversal for k_s: the circle's following error (CSV time_s,following_error_um).
+    ///
+    /// Time from the start of the circle (φ = π/2, with the 0.3 s run-up of
+    /// servo-sim --test circle), the following error x_z − x at the position
+    /// samples; --feed-m-min and --radius-mm say which circle it is
+    /// (servo-sim --test circle --csv writes this layout, among other columns).
+    #[arg(
+        long,
+        value_name = "CSV",
+        requires = "identify",
+        help_heading = "Identification"
+    )]
+    pub reversal: Option<PathBuf>,
 
     /// `--radius-mm`, `--circle-axis`.
     #[command(flatten, next_help_heading = "Circle")]
@@ -104,6 +141,23 @@ pub struct ServoSimArgs {
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
     pub verbosity: Verbosity,
+}
+
+/// Friction values that replace the axis file's (heading "Friction"):
+/// what `--identify` or a diagnosis (`diagnose --servo-axis`) found.
+#[derive(Debug, clap::Args)]
+pub struct FrictionValues {
+    /// Coulomb friction F_C, N (F_Ts keeps the file's ratio F_Ts/F_C).
+    #[arg(long = "coulomb-n", value_name = "N")]
+    pub coulomb_n: Option<f64>,
+
+    /// Viscous coefficient μ_v, N·s/m.
+    #[arg(long = "viscous-n-s-m", value_name = "N_S_PER_M")]
+    pub viscous_n_s_m: Option<f64>,
+
+    /// LuGre stiffness k_s, N/m (b_s follows by eq. 4.15 with the file's ζ_s).
+    #[arg(long = "lugre-stiffness-n-m", value_name = "N_PER_M")]
+    pub lugre_stiffness_n_m: Option<f64>,
 }
 
 /// The circle test's flags (heading "Circle").
@@ -208,8 +262,8 @@ fn parse_circle_axis(name: &str) -> Result<CircleAxis, String> {
     }
 }
 
-/// Reads `--axis`: a bundled name, else a TOML file.
-fn load_axis(source: &str) -> Result<Axis> {
+/// Reads `--axis` (and diagnose's `--servo-axis`): a bundled name, else a TOML file.
+pub(super) fn load_axis(source: &str) -> Result<Axis> {
     if let Ok(axis) = Axis::bundled(source) {
         return Ok(axis);
     }
@@ -231,21 +285,42 @@ fn positive(flag: &str, value: f64) -> Result<f64> {
 
 /// Runs `axcomp servo-sim`.
 pub fn run(args: &ServoSimArgs) -> Result<()> {
-    let axis = load_axis(&args.axis)?;
-    let friction = axis.friction(args.friction);
+    let values = &args.friction_values;
+    for (flag, value) in [
+        ("--coulomb-n", values.coulomb_n),
+        ("--viscous-n-s-m", values.viscous_n_s_m),
+        ("--lugre-stiffness-n-m", values.lugre_stiffness_n_m),
+    ] {
+        if let Some(value) = value {
+            positive(flag, value)?;
+        }
+    }
+    let axis = axis_with_friction(
+        &load_axis(&args.axis)?,
+        values.coulomb_n,
+        values.viscous_n_s_m,
+        values.lugre_stiffness_n_m,
+    );
+    if let Some(record) = &args.identify {
+        return run_identify(args, &axis, record);
+    }
+    let (Some(friction_kind), Some(test)) = (args.friction, args.test) else {
+        bail!("--friction and --test are needed to simulate (or give --identify)");
+    };
+    let friction = axis.friction(friction_kind);
     let stepping = if args.reference {
         Stepping::Uniform
     } else {
         Stepping::DEFAULT
     };
-    let bar = progress::bar(1000, args.test.name(), args.verbosity.quiet);
+    let bar = progress::bar(1000, test.name(), args.verbosity.quiet);
     let mut report_progress = |fraction: f64| bar.set_position((fraction * 1000.0) as u64);
     let mut report = ServoSimJson {
         axis: axis.name.clone(),
         axis_source: args.axis.clone(),
-        friction: args.friction.name(),
-        friction_label: args.friction.thesis_label(),
-        test: args.test.name(),
+        friction: friction_kind.name(),
+        friction_label: friction_kind.thesis_label(),
+        test: test.name(),
         stepping: if args.reference {
             "uniform-1us"
         } else {
@@ -258,24 +333,9 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
         constant_velocity: None,
         iso230_2: None,
     };
-    let csv: Vec<u8> = match args.test {
+    let csv: Vec<u8> = match test {
         TestKind::Circle => {
-            let feed = positive("--feed-m-min", args.motion.feed_m_min.unwrap_or(16.0))?;
-            let circle_axis = match (
-                args.circle.circle_axis,
-                axis.name.to_ascii_uppercase().as_str(),
-            ) {
-                (Some(chosen), _) => chosen,
-                (None, "X") => CircleAxis::X,
-                (None, "Y") => CircleAxis::Y,
-                (None, other) => bail!(
-                    "axis {other:?}: say which circle coordinate it follows with --circle-axis x|y"
-                ),
-            };
-            let circle = Circle {
-                radius_m: mm_to_m(positive("--radius-mm", args.circle.radius_mm)?),
-                ..Circle::thesis(feed, circle_axis)
-            };
+            let circle = circle_of(args, &axis, 16.0)?;
             let result = run_circle(&axis, friction, &circle, stepping, &mut report_progress);
             report.simulated_s = result.simulated_s;
             report.macro_steps = MacroStepsJson::new(result.counts);
@@ -340,7 +400,7 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
     bar.finish_and_clear();
     if let Some(path) = &args.csv {
         if csv.is_empty() {
-            bail!("--csv: the {} test has no trace to write", args.test.name());
+            bail!("--csv: the {} test has no trace to write", test.name());
         }
         write_new(path, &csv, args.overwrite.force)?;
     }
@@ -349,6 +409,62 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
     } else {
         print_text(&text(&report))
     }
+}
+
+/// `--identify`: the fit, printed with the flags that start a simulation from it.
+fn run_identify(args: &ServoSimArgs, axis: &Axis, record: &Path) -> Result<()> {
+    let rows = load(record, parse_constant_velocity)?;
+    let samples = match &args.reversal {
+        Some(path) => Some(load(path, parse_following_error)?),
+        None => None,
+    };
+    let circle = circle_of(args, axis, 3.2)?;
+    let bar = progress::bar(1000, "identify", args.verbosity.quiet);
+    let mut report_progress = |fraction: f64| bar.set_position((fraction * 1000.0) as u64);
+    let found = identify(
+        axis,
+        &rows,
+        samples.as_deref().map(|s| (&circle, s)),
+        &mut report_progress,
+    )
+    .with_context(|| format!("{}", record.display()))?;
+    bar.finish_and_clear();
+    let json = IdentifyJson::new(
+        &args.axis,
+        found,
+        args.reversal
+            .as_ref()
+            .map(|_| (&circle, circle.feed_m_per_s * 60.0)),
+    );
+    if args.json_output.json {
+        print_json(&json)
+    } else {
+        print_text(&identify_text(&json))
+    }
+}
+
+/// The circle of `--feed-m-min` (default `default_feed`), `--radius-mm`
+/// and `--circle-axis` (or the axis name).
+fn circle_of(args: &ServoSimArgs, axis: &Axis, default_feed: f64) -> Result<Circle> {
+    let feed = positive(
+        "--feed-m-min",
+        args.motion.feed_m_min.unwrap_or(default_feed),
+    )?;
+    let circle_axis = match (
+        args.circle.circle_axis,
+        axis.name.to_ascii_uppercase().as_str(),
+    ) {
+        (Some(chosen), _) => chosen,
+        (None, "X") => CircleAxis::X,
+        (None, "Y") => CircleAxis::Y,
+        (None, other) => {
+            bail!("axis {other:?}: say which circle coordinate it follows with --circle-axis x|y")
+        }
+    };
+    Ok(Circle {
+        radius_m: mm_to_m(positive("--radius-mm", args.circle.radius_mm)?),
+        ..Circle::thesis(feed, circle_axis)
+    })
 }
 
 fn move_limits(motion: &MotionFlags, default_feed_m_min: f64) -> Result<MoveLimits> {
@@ -391,8 +507,49 @@ mod tests {
             "iso230-2",
         ])
         .unwrap();
-        assert_eq!(args.friction, FrictionKind::LuGre);
-        assert_eq!(args.test, TestKind::Iso230_2);
+        assert_eq!(args.friction, Some(FrictionKind::LuGre));
+        assert_eq!(args.test, Some(TestKind::Iso230_2));
+    }
+
+    #[test]
+    fn identify_needs_no_model_or_test() {
+        let args = parse(&[
+            "--axis",
+            "mcfv5050-x",
+            "--identify",
+            "cv.csv",
+            "--reversal",
+            "c.csv",
+        ])
+        .unwrap();
+        assert_eq!(args.identify, Some(PathBuf::from("cv.csv")));
+        assert_eq!((args.friction, args.test), (None, None));
+        // --reversal only with --identify.
+        assert!(
+            parse(&[
+                "--axis",
+                "x",
+                "--friction",
+                "lugre",
+                "--test",
+                "circle",
+                "--reversal",
+                "c.csv"
+            ])
+            .is_err()
+        );
+        let args = parse(&[
+            "--axis",
+            "x",
+            "--friction",
+            "lugre",
+            "--test",
+            "circle",
+            "--coulomb-n",
+            "165",
+        ])
+        .unwrap();
+        assert_eq!(args.friction_values.coulomb_n, Some(165.0));
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! `axcomp tolerance`: the Monte Carlo tolerance study of seed 000.
 //!
-//! Random machines from straightness, positioning and squareness tolerances,
-//! the distribution of their largest volumetric error, the sensitivity of its
-//! 90th percentile to each straightness tolerance (`--sweep`), and the
+//! Random machines from straightness, positioning, squareness and
+//! carriage-side (saddle mounting face) tolerances, the distribution of their
+//! largest volumetric error, the sensitivity of its 90th percentile to each
+//! rail and carriage-side tolerance (`--sweep`), and the
 //! single-axis study of the guideway model (`--single-axis`). The work is in
 //! `axcomp::model::monte_carlo`; this file turns flags into its options,
 //! shows progress and prints.
@@ -12,8 +13,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 
 use axcomp::model::monte_carlo::{
-    AxisStudyOptions, RailDirection, StudyOptions, SweptTolerance, THESIS_SWEEP_MM, Tolerances,
-    sensitivity_sweep, single_axis_study, sweep_runs, tolerance_study,
+    AxisStudyOptions, CarriageFace, RailDirection, StudyOptions, SweptTolerance, THESIS_SWEEP_MM,
+    Tolerances, sensitivity_sweep, single_axis_study, sweep_runs, tolerance_study,
 };
 use axcomp::model::{Axis, Grid, Guideway, ProfileShape};
 use axcomp::output::write_new;
@@ -75,6 +76,25 @@ pub struct ToleranceArgs {
     #[arg(long, value_name = "UM_PER_M", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
     pub squareness: f64,
 
+    /// Parallelism of each saddle's carriage mounting faces to its datum face, mm (0: none).
+    ///
+    /// The carriage side (seed 002 Obr. 8): the plane of the four pads the
+    /// carriages are bolted to, tilted across and along the rails within a
+    /// zone of this width; a constant roll and pitch of the moving body.
+    #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
+    pub carriage_parallelism: f64,
+
+    /// Flatness of each saddle's four carriage mounting faces, mm (0: none).
+    ///
+    /// Their twist, which the carriages take up: it loads them, and moves the
+    /// saddle only where their stiffnesses differ.
+    #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
+    pub carriage_flatness: f64,
+
+    /// One saddle's carriage-side tolerance instead: AXIS.parallelism=MM or AXIS.flatness=MM (repeatable).
+    #[arg(long = "carriage", value_name = "AXIS.FACE=MM", value_parser = parse_carriage, help_heading = "Tolerances")]
+    pub carriages: Vec<(Axis, CarriageFace, f64)>,
+
     /// Grid step over the work volume, mm.
     #[arg(long = "grid", value_name = "MM", default_value_t = 50.0, value_parser = parse_positive, help_heading = "Study")]
     pub grid_mm: f64,
@@ -93,10 +113,11 @@ pub struct ToleranceArgs {
     #[arg(long, value_name = "FACTOR", default_value_t = 1.0, value_parser = parse_positive, help_heading = "Profiles")]
     pub band_width: f64,
 
-    /// Also vary each straightness tolerance in turn and fit the slopes of P90.
+    /// Also vary each tolerance in turn and fit the slopes of P90.
     ///
     /// One study per tolerance and value (the thesis's Tabs 4.6–4.12: X, Y, Z
-    /// normal and lateral, then all six together), the other tolerances as set.
+    /// normal and lateral, then all six together; then each saddle's
+    /// carriage parallelism and flatness), the other tolerances as set.
     #[arg(long, help_heading = "Study")]
     pub sweep: bool,
 
@@ -179,6 +200,13 @@ pub fn run(args: &ToleranceArgs) -> Result<()> {
     for (axis, direction, value) in &args.surfaces {
         tolerances.set_straightness(*axis, *direction, *value);
     }
+    for axis in Axis::ALL {
+        tolerances.set_carriage(axis, CarriageFace::Parallelism, args.carriage_parallelism);
+        tolerances.set_carriage(axis, CarriageFace::Flatness, args.carriage_flatness);
+    }
+    for (axis, face, value) in &args.carriages {
+        tolerances.set_carriage(*axis, *face, *value);
+    }
     let options = StudyOptions {
         samples: args.samples,
         seed: args.seed,
@@ -240,6 +268,9 @@ fn run_single_axis(args: &ToleranceArgs, shape: ProfileShape) -> Result<()> {
         ("--histogram", args.histogram.is_some()),
         ("--machine", args.machine_file.machine.is_some()),
         ("--surface", !args.surfaces.is_empty()),
+        ("--carriage", !args.carriages.is_empty()),
+        ("--carriage-parallelism", args.carriage_parallelism != 0.0),
+        ("--carriage-flatness", args.carriage_flatness != 0.0),
     ] {
         if given {
             bail!("{flag} applies to the machine study, not to --single-axis");
@@ -298,20 +329,42 @@ fn parse_surface(text: &str) -> Result<(Axis, RailDirection, f64), String> {
     let expected = || {
         format!("expected AXIS.normal=MM or AXIS.lateral=MM (e.g. X.normal=0.02), found {text:?}")
     };
-    let (surface, value) = text.split_once('=').ok_or_else(expected)?;
-    let (axis, direction) = surface.trim().split_once('.').ok_or_else(expected)?;
-    let axis = match axis.trim().to_ascii_uppercase().as_str() {
-        "X" => Axis::X,
-        "Y" => Axis::Y,
-        "Z" => Axis::Z,
-        _ => return Err(expected()),
-    };
-    let direction = match direction.trim().to_ascii_lowercase().as_str() {
+    let (axis, direction, value) = split_axis_setting(text).ok_or_else(expected)?;
+    let direction = match direction.as_str() {
         "normal" | "vertical" => RailDirection::Normal,
         "lateral" | "horizontal" => RailDirection::Lateral,
         _ => return Err(expected()),
     };
     Ok((axis, direction, parse_length(value)?))
+}
+
+/// `X.parallelism=0.02`, `y.flatness=0.01`.
+fn parse_carriage(text: &str) -> Result<(Axis, CarriageFace, f64), String> {
+    let expected = || {
+        format!(
+            "expected AXIS.parallelism=MM or AXIS.flatness=MM (e.g. X.parallelism=0.02), found {text:?}"
+        )
+    };
+    let (axis, face, value) = split_axis_setting(text).ok_or_else(expected)?;
+    let face = match face.as_str() {
+        "parallelism" => CarriageFace::Parallelism,
+        "flatness" => CarriageFace::Flatness,
+        _ => return Err(expected()),
+    };
+    Ok((axis, face, parse_length(value)?))
+}
+
+/// `AXIS.what=value` as the axis, `what` in lower case and the value's text.
+fn split_axis_setting(text: &str) -> Option<(Axis, String, &str)> {
+    let (setting, value) = text.split_once('=')?;
+    let (axis, what) = setting.trim().split_once('.')?;
+    let axis = match axis.trim().to_ascii_uppercase().as_str() {
+        "X" => Axis::X,
+        "Y" => Axis::Y,
+        "Z" => Axis::Z,
+        _ => return None,
+    };
+    Some((axis, what.trim().to_ascii_lowercase(), value))
 }
 
 #[cfg(test)]
@@ -336,6 +389,11 @@ mod tests {
         assert_eq!(args.seed, 1);
         assert_eq!(args.straightness, 0.03);
         assert_eq!((args.positioning, args.squareness), (0.0, 0.0));
+        assert_eq!(
+            (args.carriage_parallelism, args.carriage_flatness),
+            (0.0, 0.0)
+        );
+        assert!(args.carriages.is_empty());
         assert_eq!(
             (args.grid_mm, args.period, args.step_factor, args.band_width),
             (50.0, 100.0, 0.5, 1.0)
@@ -369,9 +427,31 @@ mod tests {
             &["--samples", "0"],
             &["--grid", "0"],
             &["--sweep-values", "0.01,inf"],
+            &["--carriage", "X=0.02"],
+            &["--carriage", "X.normal=0.02"],
+            &["--carriage", "Q.flatness=0.02"],
+            &["--carriage", "X.flatness=-0.01"],
+            &["--carriage-parallelism", "nan"],
         ] {
             assert!(parse(bad).is_err(), "{bad:?} must be refused");
         }
+        let args = parse(&[
+            "--carriage",
+            "x.Parallelism=0.02",
+            "--carriage",
+            "Z.flatness=0.005",
+            "--carriage-parallelism",
+            "0.01",
+        ])
+        .unwrap();
+        assert_eq!(
+            args.carriages,
+            vec![
+                (Axis::X, CarriageFace::Parallelism, 0.02),
+                (Axis::Z, CarriageFace::Flatness, 0.005)
+            ]
+        );
+        assert_eq!(args.carriage_parallelism, 0.01);
         let args = parse(&["--samples", "2_000", "--sweep-values", "0.01,0.02"]).unwrap();
         assert_eq!((args.samples, args.sweep_values), (2000, vec![0.01, 0.02]));
     }

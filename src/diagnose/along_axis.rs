@@ -10,16 +10,18 @@
 //! smooth background (a regression spline with knots every span / 6), with the
 //! background's misfit counted as noise.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 use super::fit::{Design, WeightedFit, fit_gls};
-use super::gates::{Periods, periods, set_rejection};
+use super::gates::{period_range, rotary_orders, set_rejection};
 use super::levels::{Fold, Level};
+use super::periodogram::{aliases, frequency_uncertainty, period_sets};
 use super::problem::Problem;
-use super::selection::{Chosen, Search, forward_selection, shapes};
+use super::selection::{Chosen, Search, ShapeSet, forward_selection, shapes};
 use super::stats::chi2_p;
-use super::{Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
-use crate::effects::Reading;
+use super::{Kind, KnownPeriod, LACK_OF_FIT_P, RejectedEffect, Shape};
+use crate::effects::{PeriodicIn, Reading};
+use crate::evaluate::conformance::FULL_TURN_DEG;
 use crate::measurement::{AxisKind, Direction};
 
 /// Covariance of the per-target levels, µm²: each level's own scatter on the
@@ -92,32 +94,62 @@ fn background_columns(
         .collect()
 }
 
-/// The columns of a position-dependent shape over the levels.
+/// The columns of a position-dependent shape over the levels. A periodic
+/// error in both tests is less what the prediction carries of it: its values
+/// at the first test's targets, interpolated as the prediction is.
 fn level_columns(problem: &Problem, levels: &[Level], shape: Shape) -> Vec<Vec<f64>> {
-    let readings: Vec<Reading> = levels
-        .iter()
-        .map(|l| Reading {
-            target_index: l.target_index,
-            target_mm: l.target_mm,
-            direction: Direction::Up,
-            run: 0,
-            run_index: 0,
-            time_h: 0.0,
-        })
-        .collect();
-    crate::effects::columns(shape, &readings, &problem.line())
+    // (target index, position): the index is the re-test's (Abbe's angles are per target).
+    let at = |positions: &mut dyn Iterator<Item = (usize, f64)>| -> Vec<Reading> {
+        positions
+            .map(|(target_index, target_mm)| Reading {
+                target_index,
+                target_mm,
+                direction: Direction::Up,
+                run: 0,
+                run_index: 0,
+                time_h: 0.0,
+            })
+            .collect()
+    };
+    let readings = at(&mut levels.iter().map(|l| (l.target_index, l.target_mm)));
+    let mut columns = crate::effects::columns(shape, &readings, &problem.line());
+    if let Shape::Period(_, PeriodicIn::BothTests) = shape {
+        let first = at(&mut problem.first_test_positions_mm.iter().map(|&x| (0, x)));
+        let carried = crate::effects::columns(shape, &first, &problem.line());
+        for (column, samples) in columns.iter_mut().zip(&carried) {
+            for (value, level) in column.iter_mut().zip(levels) {
+                *value -= problem.prediction_weights[level.target_index]
+                    .iter()
+                    .map(|(k, w)| w * samples[*k])
+                    .sum::<f64>();
+            }
+        }
+    }
+    columns
 }
 
-/// Forward selection of scale, periodic and Abbe on the per-target levels.
+/// What the selection along the axis found: the effects, the fit of the
+/// grown model, and the periods the targets cannot tell from an accepted
+/// periodic error's (mm, best first).
+pub(super) struct AlongAxisSelection {
+    pub(super) chosen: Vec<Chosen>,
+    pub(super) fit: WeightedFit,
+    pub(super) aliases_mm: Vec<f64>,
+}
+
+/// Forward selection of scale, periodic and Abbe on the per-target levels;
+/// `known` are the axis' known periods, tried before the scan.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn select_along_axis(
     problem: &Problem,
     levels: &[Level],
     folds: &[Fold],
     reversal_b: f64,
     kinds: &[Kind],
+    known: &[KnownPeriod],
     background: Background,
     rejected: &mut Vec<RejectedEffect>,
-) -> (Vec<Chosen>, WeightedFit) {
+) -> AlongAxisSelection {
     let m = levels.len();
     let values: Vec<f64> = levels.iter().map(|l| l.value_um).collect();
     let base = Design {
@@ -131,6 +163,10 @@ pub(super) fn select_along_axis(
         let dof = m.saturating_sub(fit.rank).max(1) as f64;
         covariance *= (fit.chi2 / dof).max(1.0);
     }
+    let min_periods = match background {
+        Background::Constant => super::MIN_PERIODS_IN_SPAN,
+        Background::Smooth => super::MIN_PERIODS_IN_CURVE,
+    };
     let search = AlongAxis {
         problem,
         levels,
@@ -139,11 +175,12 @@ pub(super) fn select_along_axis(
         background,
         values: &values,
         covariance: &covariance,
-        periods: periods(
-            &problem.targets_mm,
-            problem.kind,
-            background == Background::Constant,
-        ),
+        // A rotary axis' orders are its own (`shape_sets`): no scan, no aliases in mm.
+        periods: (problem.kind == AxisKind::Linear)
+            .then(|| period_range(&problem.targets_mm, min_periods))
+            .flatten(),
+        min_periods,
+        known,
     };
     let (mut chosen, mut model_fit) = forward_selection(&search, base.clone(), kinds, rejected);
     // Never the nearest kind: what is accepted along the axis must leave no
@@ -162,7 +199,32 @@ pub(super) fn select_along_axis(
         chosen.clear();
         model_fit = fit_gls(&base, &values, &covariance, None);
     }
-    (chosen, model_fit)
+    let aliases_mm = match (
+        chosen.iter().find(|c| c.shape.kind() == Kind::Periodic),
+        search.periods,
+    ) {
+        (Some(periodic), Some(range)) => {
+            // The model with everything else that was accepted, and a period.
+            let others = chosen
+                .iter()
+                .filter(|c| c.shape.kind() != Kind::Periodic)
+                .fold(base.clone(), |d, c| d.with(&search.columns(c.shape)));
+            let Shape::Period(found, tests) = periodic.shape else {
+                unreachable!("a periodic effect's shape is its period")
+            };
+            aliases(found, range, search.span_mm(), |p| {
+                search
+                    .fit(&others.with(&search.columns(Shape::Period(p, tests))))
+                    .chi2
+            })
+        }
+        _ => Vec::new(),
+    };
+    AlongAxisSelection {
+        chosen,
+        fit: model_fit,
+        aliases_mm,
+    }
 }
 
 /// The search along the axis: generalised least squares on the per-target
@@ -175,7 +237,16 @@ struct AlongAxis<'a> {
     background: Background,
     values: &'a [f64],
     covariance: &'a DMatrix<f64>,
-    periods: Option<Periods>,
+    periods: Option<(f64, f64)>,
+    min_periods: f64,
+    known: &'a [KnownPeriod],
+}
+
+impl AlongAxis<'_> {
+    fn span_mm(&self) -> f64 {
+        let targets = &self.problem.targets_mm;
+        targets[targets.len() - 1] - targets[0]
+    }
 }
 
 impl Search for AlongAxis<'_> {
@@ -186,16 +257,46 @@ impl Search for AlongAxis<'_> {
         kind.is_positional() && !chosen.iter().any(|c| c.shape.kind() == kind)
     }
 
-    fn shapes(&self, kind: Kind, chosen: &[Chosen]) -> Vec<Shape> {
-        shapes(kind, &self.problem.targets_mm, self.periods, &[], chosen)
-    }
-
-    fn periods(&self) -> Option<(f64, f64)> {
-        self.periods.and_then(Periods::range)
-    }
-
     fn kind(&self) -> AxisKind {
         self.problem.kind
+    }
+
+    fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet> {
+        match kind {
+            // A rotary axis' error repeats every turn: whole orders k per
+            // revolution, the period 360°/k, each tried on its own.
+            Kind::Periodic if self.problem.kind == AxisKind::Rotary => {
+                let against_prediction = self.background == Background::Constant;
+                let orders = rotary_orders(&self.problem.targets_mm, against_prediction);
+                vec![ShapeSet::each(orders.map_or_else(
+                    Vec::new,
+                    |(lowest, highest)| {
+                        (lowest..=highest)
+                            .map(|k| {
+                                Shape::Period(FULL_TURN_DEG / f64::from(k), PeriodicIn::ReTest)
+                            })
+                            .collect()
+                    },
+                ))]
+            }
+            Kind::Periodic => {
+                // Against a prediction, the error may be in both tests (see `periodogram`).
+                let first = &self.problem.first_test_positions_mm;
+                let unresolved_below_mm = (first.len() >= 2).then(|| {
+                    let mut gaps: Vec<f64> = first.windows(2).map(|p| p[1] - p[0]).collect();
+                    gaps.sort_by(f64::total_cmp);
+                    2.0 * gaps[gaps.len() / 2]
+                });
+                period_sets(
+                    self.periods,
+                    self.span_mm(),
+                    self.known,
+                    self.min_periods,
+                    unresolved_below_mm,
+                )
+            }
+            kind => vec![ShapeSet::each(shapes(kind, &[], chosen))],
+        }
     }
 
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
@@ -242,6 +343,11 @@ impl Search for AlongAxis<'_> {
     }
 }
 
+/// The largest turn of the phase between the halves, rad, that a period's
+/// uncertainty may explain in the split-half check: 1 standard deviation of
+/// half a radian keeps the first-order (linear) allowance honest.
+const MAX_TURN_RAD: f64 = 0.5;
+
 /// A position-dependent effect must be the same along the whole axis: its
 /// parameters fitted on each half of the span must agree (Wald χ², p ≥ [`LACK_OF_FIT_P`]).
 fn inconsistent_along_axis(
@@ -278,13 +384,63 @@ fn inconsistent_along_axis(
         ));
     }
     // The halves as independent (their shared prediction error is small next to their own):
-    // χ² = Σ (θ₁ − θ₂)² / (σ₁² + σ₂²), the periodic's two coefficients treated as independent.
-    let chi2: f64 = (0..k)
-        .map(|j| {
-            (halves[0].0[j] - halves[1].0[j]).powi(2)
-                / (halves[0].1[j].powi(2) + halves[1].1[j].powi(2)).max(1e-300)
-        })
-        .sum();
+    // χ² = dᵀ S⁻¹ d of the difference d = θ₁ − θ₂, S = diag(σ₁² + σ₂²), the periodic's two
+    // coefficients treated as independent.
+    let difference = DVector::from_iterator(k, (0..k).map(|j| halves[0].0[j] - halves[1].0[j]));
+    let mut spread = DMatrix::from_fn(k, k, |a, b| {
+        if a == b {
+            halves[0].1[a].powi(2) + halves[1].1[a].powi(2)
+        } else {
+            0.0
+        }
+    });
+    if let Shape::Period(period, tests) = shape {
+        // The period is fitted on the whole span; its error δf turns each half's phase by
+        // 2π·δf·(the half's centre), so the halves' (a, b) differ by 2π·δf·Δc·(−b, a) even
+        // when the error is the same along the axis: a period the whole span determines
+        // well is not rejected for what its halves cannot (σ_f from χ²'s curvature).
+        let base = Design {
+            columns: background_columns(background, levels, None),
+        };
+        let whole = |p: f64| {
+            fit_gls(
+                &base.with(&level_columns(problem, levels, Shape::Period(p, tests))),
+                values,
+                covariance,
+                None,
+            )
+        };
+        let fitted = whole(period);
+        let (a, b) = (
+            fitted.coefficients[base.parameters()],
+            fitted.coefficients[base.parameters() + 1],
+        );
+        let span = levels[levels.len() - 1].target_mm - levels[0].target_mm;
+        let centre = |first_half: bool| {
+            let here: Vec<f64> = levels
+                .iter()
+                .filter(|l| (l.target_mm <= middle) == first_half)
+                .map(|l| l.target_mm)
+                .collect();
+            here.iter().sum::<f64>() / here.len() as f64
+        };
+        // Only while the turn is small (the linearisation holds): a period the whole span
+        // determines poorly gets no allowance, and a bow cannot pose as a long period.
+        if let Some(sigma_f) = frequency_uncertainty(period, span, |p| whole(p).chi2)
+            && let turn = std::f64::consts::TAU * sigma_f * (centre(true) - centre(false))
+            && turn.abs() <= MAX_TURN_RAD
+        {
+            let direction = [-b, a];
+            for (i, u) in direction.iter().enumerate() {
+                for (j, v) in direction.iter().enumerate() {
+                    spread[(i, j)] += turn * turn * u * v;
+                }
+            }
+        }
+    }
+    let chi2 = spread.try_inverse().map_or(0.0, |inverse| {
+        (difference.transpose() * inverse * &difference)[(0, 0)]
+    });
     let p = chi2_p(chi2, k);
     let rounded = |v: &[f64]| {
         v.iter()

@@ -7,7 +7,7 @@ use super::fit::{self, Design, Fit, bic, leave_one_run_out_rmse};
 use super::gates::{predicts_better, set_rejection, strong_evidence};
 use super::levels::{Cell, Fold, reversals};
 use super::problem::Problem;
-use super::selection::{Chosen, Search, forward_selection, shapes};
+use super::selection::{Chosen, Search, ShapeSet, forward_selection, shapes};
 use super::stats::{chi2_p, partial_f_p};
 use super::{Evidence, Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
 use nalgebra::{DMatrix, DVector};
@@ -58,12 +58,8 @@ impl Search for BetweenRuns<'_> {
         }
     }
 
-    fn shapes(&self, kind: Kind, chosen: &[Chosen]) -> Vec<Shape> {
-        shapes(kind, &self.problem.targets_mm, None, &self.runs, chosen)
-    }
-
-    fn periods(&self) -> Option<(f64, f64)> {
-        None
+    fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet> {
+        vec![ShapeSet::each(shapes(kind, &self.runs, chosen))]
     }
 
     fn kind(&self) -> AxisKind {

@@ -47,7 +47,7 @@ pub(super) fn accepted_effect(
     n: usize,
 ) -> AcceptedEffect {
     let width = match chosen.shape {
-        Shape::Period(_) => 2,
+        Shape::Period(..) => 2,
         _ => 1,
     };
     let coefficients = &coefficients[chosen.first_column..chosen.first_column + width];

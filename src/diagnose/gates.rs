@@ -4,6 +4,7 @@
 
 use super::{
     DiagnoseInput, MIN_DELTA_BIC, MIN_PERIODS_IN_CURVE, MIN_PERIODS_IN_SPAN, RejectedEffect,
+    SHORTEST_PERIOD_MM,
 };
 use crate::effects::{Kind, deviation_text};
 use crate::evaluate::conformance::FULL_TURN_DEG;
@@ -24,6 +25,10 @@ pub(super) fn applicable_kinds(
             Kind::Scale | Kind::Drift | Kind::Abbe if rotary => Some(
                 "not looked for on a rotary axis: modelled for linear axes only so far".to_string(),
             ),
+            Kind::Periodic if rotary && rotary_orders(after.targets_mm(), input.before.is_some()).is_none() => Some(
+                "the targets are too coarse, or the range too short, to hold a whole order per revolution".to_string(),
+            ),
+            Kind::Periodic if rotary => None,
             Kind::Reversal if after.run_count(Direction::Up) == 0 || after.run_count(Direction::Down) == 0 => {
                 Some("needs runs in both directions".to_string())
             }
@@ -31,13 +36,9 @@ pub(super) fn applicable_kinds(
                 "needs a prediction (--before and --table): in a test alone a position-dependent error is part of the systematic curve the table compensates".to_string(),
             ),
             Kind::Abbe if input.angular.is_none() => Some("needs the axis' angular error along the stroke (--angular)".to_string()),
-            Kind::Periodic if rotary && periods(after.targets_mm(), after.kind(), input.before.is_some()).is_none() => Some(format!(
-                "the targets are too coarse, or the range too short, to hold {} period(s) of a whole order per revolution",
-                min_periods(after.kind(), input.before.is_some())
-            )),
-            Kind::Periodic if periods(after.targets_mm(), after.kind(), input.before.is_some()).is_none() => Some(format!(
+            Kind::Periodic if period_range(after.targets_mm(), min_periods(input)).is_none() && !knows_a_period(input) => Some(format!(
                 "the targets are too coarse to resolve a period shorter than 1/{} of the measured span",
-                min_periods(after.kind(), input.before.is_some())
+                min_periods(input)
             )),
             Kind::OutlierRun if after.run_count(Direction::Up) < 3 && after.run_count(Direction::Down) < 3 => {
                 Some("needs at least 3 runs in a direction to tell one apart".to_string())
@@ -52,15 +53,23 @@ pub(super) fn applicable_kinds(
     kinds
 }
 
+/// Whether a known period of the axis fits enough times in the re-test's span.
+fn knows_a_period(input: &DiagnoseInput<'_>) -> bool {
+    let targets = input.after.targets_mm();
+    let span = targets[targets.len() - 1] - targets[0];
+    input
+        .known_periods
+        .iter()
+        .any(|k| k.period_mm > 0.0 && span / k.period_mm >= min_periods(input))
+}
+
 /// How many periods the span must hold: fewer against a prediction (a
 /// constant background) than in a test's own curve (a smooth background).
-/// On a rotary axis one against a prediction: over a full turn a
-/// once-per-revolution term is periodic by the geometry, not a slope.
-pub(super) fn min_periods(kind: AxisKind, against_prediction: bool) -> f64 {
-    match (against_prediction, kind) {
-        (true, AxisKind::Linear) => MIN_PERIODS_IN_SPAN,
-        (true, AxisKind::Rotary) => 1.0,
-        (false, _) => MIN_PERIODS_IN_CURVE,
+pub(super) fn min_periods(input: &DiagnoseInput<'_>) -> f64 {
+    if input.before.is_some() {
+        MIN_PERIODS_IN_SPAN
+    } else {
+        MIN_PERIODS_IN_CURVE
     }
 }
 
@@ -114,35 +123,14 @@ pub(super) fn set_rejection(rejected: &mut Vec<RejectedEffect>, kind: Kind, why:
     }
 }
 
-/// The periods a periodic error is looked for at.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Periods {
-    /// A linear axis: any period from the shortest to the longest, mm,
-    /// scanned and the best refined.
-    Range(f64, f64),
-    /// A rotary axis: whole orders per revolution, lowest to highest, the
-    /// period 360°/order (a rotary error repeats every turn).
-    Orders(u32, u32),
-}
-
-impl Periods {
-    /// The range a best period is refined within; none for whole orders.
-    pub(super) fn range(self) -> Option<(f64, f64)> {
-        match self {
-            Periods::Range(shortest, longest) => Some((shortest, longest)),
-            Periods::Orders(..) => None,
-        }
-    }
-}
-
-/// The periods a periodic error is looked for at: from twice the median target
-/// spacing (Nyquist) to the span / [`min_periods`]; on a rotary axis the
-/// whole orders per revolution whose period lies within that.
-pub(super) fn periods(
-    targets_mm: &[f64],
-    kind: AxisKind,
-    against_prediction: bool,
-) -> Option<Periods> {
+/// The periods a periodic error is looked for at, up to the span /
+/// `min_periods` ([`MIN_PERIODS_IN_SPAN`] against a prediction,
+/// [`MIN_PERIODS_IN_CURVE`] in a test's own curve), from twice the step of
+/// evenly spaced targets (below it every period has an alias above: Nyquist)
+/// or, on irregular targets, which tell a period from its aliases (ISO
+/// 230-2's reason to recommend them; Eyer & Bartholdi 1999), from
+/// [`SHORTEST_PERIOD_MM`] or twice the median spacing if that is shorter.
+pub(super) fn period_range(targets_mm: &[f64], min_periods: f64) -> Option<(f64, f64)> {
     if targets_mm.len() < 8 {
         return None;
     }
@@ -150,14 +138,36 @@ pub(super) fn periods(
     gaps.sort_by(f64::total_cmp);
     let median = gaps[gaps.len() / 2];
     let span = targets_mm[targets_mm.len() - 1] - targets_mm[0];
-    let (shortest, longest) = (2.0 * median, span / min_periods(kind, against_prediction));
-    match kind {
-        AxisKind::Linear => (shortest < longest).then_some(Periods::Range(shortest, longest)),
-        AxisKind::Rotary => {
-            // 1e-9: a full turn of 360° holds order 1 exactly once.
-            let lowest = (FULL_TURN_DEG / longest - 1e-9).ceil().max(1.0) as u32;
-            let highest = (FULL_TURN_DEG / shortest + 1e-9).floor() as u32;
-            (lowest <= highest).then_some(Periods::Orders(lowest, highest))
-        }
+    let shortest = match crate::compensate::regular_step(targets_mm) {
+        Some(step) => 2.0 * step,
+        None => (2.0 * median).min(SHORTEST_PERIOD_MM),
+    };
+    let longest = span / min_periods;
+    (shortest < longest).then_some((shortest, longest))
+}
+
+/// A rotary axis' periods: the whole orders per revolution (lowest,
+/// highest), the period 360°/order, from one period within the range
+/// against a prediction (over a full turn a once-per-revolution term is
+/// periodic by the geometry, not a slope; [`MIN_PERIODS_IN_CURVE`] in a
+/// test's own curve) up to twice the median spacing (Nyquist).
+pub(super) fn rotary_orders(targets_deg: &[f64], against_prediction: bool) -> Option<(u32, u32)> {
+    if targets_deg.len() < 8 {
+        return None;
     }
+    let mut gaps: Vec<f64> = targets_deg.windows(2).map(|p| p[1] - p[0]).collect();
+    gaps.sort_by(f64::total_cmp);
+    let median = gaps[gaps.len() / 2];
+    let span = targets_deg[targets_deg.len() - 1] - targets_deg[0];
+    let periods_in_range = if against_prediction {
+        1.0
+    } else {
+        MIN_PERIODS_IN_CURVE
+    };
+    // 1e-9: a full turn of 360° holds order 1 exactly once.
+    let lowest = (periods_in_range * FULL_TURN_DEG / span - 1e-9)
+        .ceil()
+        .max(1.0) as u32;
+    let highest = (FULL_TURN_DEG / (2.0 * median) + 1e-9).floor() as u32;
+    (lowest <= highest).then_some((lowest, highest))
 }

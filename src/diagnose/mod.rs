@@ -17,12 +17,14 @@
 //!    re-test shares and which would otherwise pose as structure).
 //! 5. A candidate is accepted only if it lowers the Bayesian information
 //!    criterion by at least [`MIN_DELTA_BIC`] (strong evidence, Kass & Raftery
-//!    1995), plus 2·ln(trials) when its shape was chosen among many (periods,
-//!    runs: the look-elsewhere effect), and predicts the runs it was not
-//!    fitted on better (leave-one-run-out). Several can be accepted.
+//!    1995), plus 2·ln(trials) when its shape was chosen among many (runs, or
+//!    the independent periods of a least-squares periodogram, `periodogram`:
+//!    the look-elsewhere effect), and predicts the runs it was not fitted on
+//!    better (leave-one-run-out). Several can be accepted.
 //! 6. **Never the nearest kind.** A position-dependent effect must be the same
-//!    along the whole axis (its parameters on the two halves of the span agree,
-//!    p ≥ [`LACK_OF_FIT_P`]), and after selection the per-target levels must be
+//!    along the whole axis (its parameters on the two halves of the span agree
+//!    within their uncertainties and, for a period, the period's, p ≥
+//!    [`LACK_OF_FIT_P`]), and after selection the per-target levels must be
 //!    explained (χ² lack of fit p ≥ [`LACK_OF_FIT_P`]); otherwise the
 //!    position-dependent effects are moved to `rejected` and the structure is
 //!    reported as unexplained, with where and how large.
@@ -34,8 +36,10 @@ mod angular_profile;
 mod between_runs;
 mod findings;
 pub mod fit;
+pub mod friction;
 mod gates;
 mod levels;
+mod periodogram;
 mod problem;
 mod selection;
 mod stats;
@@ -46,11 +50,11 @@ pub use angular_profile::AngularProfile;
 use crate::compensate::CompensateError;
 use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
-use crate::effects::{Effect, FileEntry, Kind, Reading, Reversal, Shape};
+use crate::effects::{Effect, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape};
 use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
 use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::together::NotTogether;
-use along_axis::{Background, select_along_axis};
+use along_axis::{AlongAxisSelection, Background, select_along_axis};
 use between_runs::{select_between_runs, select_reversal};
 use findings::{accepted_effect, context, figures, stats};
 use gates::applicable_kinds;
@@ -65,6 +69,11 @@ pub const MIN_DELTA_BIC: f64 = 6.0;
 pub const LACK_OF_FIT_P: f64 = 0.001;
 /// A periodic error must fit at least this many periods in the measured span.
 pub const MIN_PERIODS_IN_SPAN: f64 = 2.0;
+/// On irregular targets, periods down to this are looked for (unless twice
+/// the median spacing is shorter): the short screw leads of machine-tool feed
+/// drives (5 mm and up); a shorter lead or scale period is looked for when the
+/// machine profile gives it ([`KnownPeriod`]).
+pub const SHORTEST_PERIOD_MM: f64 = 5.0;
 /// Without a prediction, a periodic error is told from the smooth curve of the
 /// test itself (a regression spline with knots every span / 6), so it must be
 /// short next to it: at least this many periods in the span.
@@ -84,11 +93,58 @@ pub struct DiagnoseInput<'a> {
     pub backlash_set: bool,
     /// The axis' angular error (pitch or yaw) along the stroke, for Abbe.
     pub angular: Option<&'a AngularProfile>,
+    /// Periods the axis is known to have (its screw lead, its scale period:
+    /// the machine profile's), looked for before the scan of every period.
+    pub known_periods: &'a [KnownPeriod],
     /// Cycle timing to assume when the file records no duration.
     pub timing: CycleTiming,
     /// The standard whose figures the diagnosis reports
     /// ([`Diagnosis::standard_figures`]); the statistics do not depend on it.
     pub standard: &'a dyn Standard,
+}
+
+/// A period the machine's axis is known to have, from its drive or its scale.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KnownPeriod {
+    /// mm.
+    pub period_mm: f64,
+    /// What has this period.
+    pub source: PeriodSource,
+}
+
+/// What a known period belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PeriodSource {
+    /// The ball screw's lead (one revolution).
+    ScrewLead,
+    /// The linear scale's or rotary encoder's period on the axis.
+    ScalePeriod,
+}
+
+impl KnownPeriod {
+    /// The screw lead, mm.
+    pub fn screw_lead(period_mm: f64) -> KnownPeriod {
+        KnownPeriod {
+            period_mm,
+            source: PeriodSource::ScrewLead,
+        }
+    }
+
+    /// The scale's (or encoder's) period along the axis, mm.
+    pub fn scale_period(period_mm: f64) -> KnownPeriod {
+        KnownPeriod {
+            period_mm,
+            source: PeriodSource::ScalePeriod,
+        }
+    }
+
+    /// Its name in a sentence.
+    pub fn name(self) -> &'static str {
+        match self.source {
+            PeriodSource::ScrewLead => "the screw lead",
+            PeriodSource::ScalePeriod => "the scale period",
+        }
+    }
 }
 
 /// RMS and largest |value| of a residual, µm.
@@ -105,9 +161,10 @@ pub struct ResidualStats {
 pub struct Evidence {
     /// Change of the BIC when it was added (negative is better).
     pub delta_bic: f64,
-    /// How many shapes were tried (periods, runs), 1 otherwise.
+    /// How many independent shapes were tried (runs, periods searched), 1 otherwise.
     pub trials: usize,
-    /// p-value of the partial F-test of adding it.
+    /// p-value of adding it (partial F-test, or χ² with known variances), as
+    /// the chance that the best of `trials` shapes of noise fits as well.
     pub p_value: f64,
     /// Leave-one-run-out prediction error without it, µm.
     pub cv_rmse_without_um: f64,
@@ -297,12 +354,17 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     } else {
         Background::Smooth
     };
-    let (along, along_fit) = select_along_axis(
+    let AlongAxisSelection {
+        chosen: along,
+        fit: along_fit,
+        aliases_mm,
+    } = select_along_axis(
         &problem,
         &levels,
         &folds,
         reversal_b,
         &kinds,
+        input.known_periods,
         background,
         &mut rejected,
     );
@@ -330,14 +392,23 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         ));
     }
     for c in &along {
-        accepted.push(accepted_effect(
+        let mut effect = accepted_effect(
             *c,
             &along_fit.coefficients,
             &along_fit.standard_errors,
             &problem,
             &context,
             levels.len(),
-        ));
+        );
+        if let Shape::Period(period, tests) = c.shape {
+            effect.warnings.extend(period_notes(
+                period,
+                tests,
+                &aliases_mm,
+                input.known_periods,
+            ));
+        }
+        accepted.push(effect);
     }
 
     // The model: per target, the level along the axis (with a prediction: the constant and the
@@ -433,4 +504,39 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             })
             .collect(),
     })
+}
+
+/// What a user should know of a periodic error's period: that it is a known
+/// period of the axis, and which periods the targets cannot tell from it.
+fn period_notes(
+    period_mm: f64,
+    tests: PeriodicIn,
+    aliases_mm: &[f64],
+    known: &[KnownPeriod],
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    if tests == PeriodicIn::BothTests {
+        notes.push("it is in both tests: the first test's targets sampled it without resolving it, and the prediction and the table carry those samples; the amplitude is the axis' whole periodic error".to_string());
+    }
+    let known_here = known.iter().find(|k| k.period_mm == period_mm);
+    if let Some(k) = known_here {
+        notes.push(format!(
+            "the period is {} the machine profile gives ({} mm), looked for first",
+            k.name(),
+            k.period_mm
+        ));
+    }
+    if !aliases_mm.is_empty() {
+        let list: Vec<String> = aliases_mm.iter().map(|p| format!("{p:.2} mm")).collect();
+        let advice = if known_here.is_some() {
+            "the profile's period was taken; re-measure at other irregular targets to confirm it"
+        } else {
+            "re-measure at other irregular targets, or give the axis' screw lead in the machine profile, to tell them apart"
+        };
+        notes.push(format!(
+            "these targets cannot tell a period of {period_mm:.2} mm from {} (the fits differ by less than a BIC of {MIN_DELTA_BIC}); {advice}",
+            list.join(", ")
+        ));
+    }
+    notes
 }

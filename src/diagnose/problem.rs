@@ -9,7 +9,7 @@ use crate::compensate::retest::{
     Applied, BacklashRefusal, KnownError, predicted_deviation_mm, with_scatter,
 };
 use crate::compensate::{CompensateError, interpolate_hold};
-use crate::cycle::{self, CycleTiming};
+use crate::cycle;
 use crate::effects::{Line, Reading, Shape};
 use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::{AxisKind, Direction, Measurement};
@@ -27,6 +27,8 @@ pub(super) struct Problem {
     /// The predicted re-test as `predict` gives it on the measured line: the
     /// first test's readings with the predicted systematic error.
     pub(super) first_test_prediction: Option<Measurement>,
+    /// The first test's targets that `prediction_weights` index, mm (none without one).
+    pub(super) first_test_positions_mm: Vec<f64>,
     /// Variance of the first test's bidirectional mean at each of its targets, µm².
     pub(super) first_test_variance_um2: Vec<f64>,
     /// Variance of the first test's reversal x̄↑ − x̄↓ at each of its targets
@@ -99,7 +101,7 @@ impl Problem {
 /// Builds the readings, their prediction and its covariance, and the cells.
 pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), DiagnoseError> {
     let after = input.after;
-    let (times, time_assumed) = times_h(after, input.timing);
+    let (times, time_assumed) = cycle::reading_times_h(after, input.timing);
     let first = match input.before {
         Some(before) => {
             // The doubts (machine names, units, ranges) are the caller's to
@@ -165,23 +167,29 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     if readings.len() < 4 || after.runs().len() < 2 {
         return Err(DiagnoseError::TooFewReadings(readings.len()));
     }
-    let (prediction_weights, first_test_variance_um2, first_test_reversal_variance_um2) =
-        match &first {
-            Some((_, variances)) => (
-                after
-                    .targets_mm()
-                    .iter()
-                    .map(|&x| interpolation_weights(&variances.positions_mm, x))
-                    .collect(),
-                variances.mean_um2.clone(),
-                variances.reversal_um2.clone(),
-            ),
-            None => (
-                vec![Vec::new(); after.targets_mm().len()],
-                Vec::new(),
-                Vec::new(),
-            ),
-        };
+    let (
+        prediction_weights,
+        first_test_positions_mm,
+        first_test_variance_um2,
+        first_test_reversal_variance_um2,
+    ) = match &first {
+        Some((_, variances)) => (
+            after
+                .targets_mm()
+                .iter()
+                .map(|&x| interpolation_weights(&variances.positions_mm, x))
+                .collect(),
+            variances.positions_mm.clone(),
+            variances.mean_um2.clone(),
+            variances.reversal_um2.clone(),
+        ),
+        None => (
+            vec![Vec::new(); after.targets_mm().len()],
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        ),
+    };
     let mut cells: Vec<(usize, Direction)> = Vec::new();
     for t in 0..after.targets_mm().len() {
         for direction in Direction::BOTH {
@@ -217,6 +225,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         predicted_um,
         prediction_weights,
         first_test_prediction,
+        first_test_positions_mm,
         first_test_variance_um2,
         first_test_reversal_variance_um2,
         run_count: after.runs().len(),
@@ -287,24 +296,4 @@ pub(super) fn interpolation_weights(positions: &[f64], x: f64) -> Vec<(usize, f6
         .enumerate()
         .filter(|(_, w)| *w != 0.0)
         .collect()
-}
-
-/// Reading times in hours from the cycle model, scaled to the recorded
-/// duration when the file records one that differs from the model's by more
-/// than its one-minute resolution.
-pub(super) fn times_h(measurement: &Measurement, timing: CycleTiming) -> (Vec<Vec<f64>>, bool) {
-    let seconds = cycle::reading_times(measurement, timing);
-    let model = cycle::duration_s(&seconds);
-    let (scale, assumed) = match measurement.metadata.duration_s() {
-        Some(recorded) if (recorded - model).abs() > 60.0 && model > 0.0 => {
-            (recorded / model, false)
-        }
-        Some(_) => (1.0, false),
-        None => (1.0, true),
-    };
-    let hours = seconds
-        .iter()
-        .map(|run| run.iter().map(|t| t * scale / 3600.0).collect())
-        .collect();
-    (hours, assumed)
 }

@@ -3,10 +3,9 @@
 //! (used between runs and along the axis).
 
 use super::fit::Design;
-use super::gates::{Periods, predicts_better, set_rejection, strong_evidence};
+use super::gates::{predicts_better, set_rejection, strong_evidence};
 use super::{Evidence, RejectedEffect};
 use crate::effects::{Kind, Shape};
-use crate::evaluate::conformance::FULL_TURN_DEG;
 use crate::measurement::{AxisKind, Direction, Run};
 
 /// An accepted shape, where its columns start in its model, and why.
@@ -17,36 +16,38 @@ pub(super) struct Chosen {
     pub(super) evidence: Evidence,
 }
 
-/// The shapes of a kind to try.
-pub(super) fn shapes(
-    kind: Kind,
-    after_targets: &[f64],
-    periods: Option<Periods>,
-    runs: &[Run],
-    chosen: &[Chosen],
-) -> Vec<Shape> {
-    match kind {
-        Kind::Periodic => {
-            let (shortest, longest) = match periods {
-                None => return Vec::new(),
-                Some(Periods::Orders(lowest, highest)) => {
-                    return (lowest..=highest)
-                        .map(|k| Shape::Period(FULL_TURN_DEG / f64::from(k)))
-                        .collect();
-                }
-                Some(Periods::Range(shortest, longest)) => (shortest, longest),
-            };
-            let span = after_targets[after_targets.len() - 1] - after_targets[0];
-            // Frequencies 5 times finer than 1/span; the best is refined afterwards.
-            let step = 1.0 / (5.0 * span);
-            let mut frequency = 1.0 / longest;
-            let mut list = Vec::new();
-            while frequency <= 1.0 / shortest {
-                list.push(Shape::Period(1.0 / frequency));
-                frequency += step;
-            }
-            list
+/// Shapes of one kind tried together: the best of them is the candidate,
+/// judged with 2·ln(`trials`) added to its ΔBIC for having been chosen among
+/// them (the look-elsewhere effect) and its p-value the chance that the best
+/// of `trials` independent shapes of pure noise fits as well (Šidák).
+#[derive(Clone, Debug)]
+pub(super) struct ShapeSet {
+    pub(super) shapes: Vec<Shape>,
+    /// How many independent shapes the set holds (for a scan of periods
+    /// fewer than the frequencies tried, which overlap).
+    pub(super) trials: f64,
+    /// For a scan of periods: the range (shortest, longest), mm, within
+    /// which the best is refined.
+    pub(super) refine: Option<(f64, f64)>,
+}
+
+impl ShapeSet {
+    /// Shapes each tried on its own.
+    pub(super) fn each(shapes: Vec<Shape>) -> ShapeSet {
+        let trials = shapes.len() as f64;
+        ShapeSet {
+            shapes,
+            trials,
+            refine: None,
         }
+    }
+}
+
+/// The shapes of a kind between runs or of a fixed shape (a periodic error
+/// has its own sets, `periodogram::period_sets`).
+pub(super) fn shapes(kind: Kind, runs: &[Run], chosen: &[Chosen]) -> Vec<Shape> {
+    match kind {
+        Kind::Periodic => Vec::new(),
         Kind::OutlierRun => {
             let count = |d: Direction| runs.iter().filter(|r| r.direction == d).count();
             runs.iter()
@@ -59,34 +60,33 @@ pub(super) fn shapes(
     }
 }
 
-/// Tries every shape and returns the one with the lowest score; a period is
-/// refined around the best, within the period range.
+/// Tries every shape of the set and returns the one with the lowest score; a
+/// period of a scan is refined around the best, within its range.
 pub(super) fn best_of<T>(
-    shapes: &[Shape],
-    range: Option<(f64, f64)>,
+    set: &ShapeSet,
     mut score: impl FnMut(Shape) -> (f64, T),
 ) -> Option<(Shape, f64, T)> {
     let mut best: Option<(Shape, f64, T)> = None;
-    for shape in shapes {
+    for shape in &set.shapes {
         let (value, extra) = score(*shape);
         if best.as_ref().is_none_or(|b| value < b.1) {
             best = Some((*shape, value, extra));
         }
     }
     if let (
-        Some((Shape::Period(period), _, _)),
+        Some((Shape::Period(period, tests), _, _)),
         Some((shortest, longest)),
-        [Shape::Period(a), Shape::Period(b), ..],
-    ) = (&best, range, shapes)
+        [Shape::Period(a, _), Shape::Period(b, _), ..],
+    ) = (&best, set.refine, set.shapes.as_slice())
     {
         let step = (1.0 / b - 1.0 / a).abs();
-        let centre = 1.0 / period;
+        let (centre, tests) = (1.0 / period, *tests);
         for k in -10..=10 {
             let frequency = centre + f64::from(k) * step / 10.0;
             if frequency < 1.0 / longest || frequency > 1.0 / shortest {
                 continue;
             }
-            let shape = Shape::Period(1.0 / frequency);
+            let shape = Shape::Period(1.0 / frequency, tests);
             let (value, extra) = score(shape);
             if best.as_ref().is_none_or(|b| value < b.1) {
                 best = Some((shape, value, extra));
@@ -108,14 +108,11 @@ pub(super) trait Search {
     /// Whether to try `kind` now, given what is chosen.
     fn tries(&self, kind: Kind, chosen: &[Chosen]) -> bool;
 
-    /// The shapes of `kind` to try.
-    fn shapes(&self, kind: Kind, chosen: &[Chosen]) -> Vec<Shape>;
-
-    /// The range a best period is refined within (shortest, longest), mm, if any.
-    fn periods(&self) -> Option<(f64, f64)>;
-
     /// Linear or rotary (the unit of the sentences).
     fn kind(&self) -> AxisKind;
+
+    /// The shapes of `kind` to try, in sets each judged on its own.
+    fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet>;
 
     /// A shape's columns.
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>>;
@@ -156,25 +153,32 @@ pub(super) fn forward_selection<S: Search>(
     let mut model_fit = search.fit(&base);
     let mut model = base;
     loop {
-        let mut candidates: Vec<(Shape, usize, f64, S::Fit)> = Vec::new();
+        let mut candidates: Vec<(Shape, f64, f64, S::Fit)> = Vec::new();
         for &kind in kinds {
             if !search.tries(kind, &chosen) {
                 continue;
             }
-            let shapes = search.shapes(kind, &chosen);
-            let Some((shape, _, trial_fit)) = best_of(&shapes, search.periods(), |shape| {
-                let f = search.fit(&model.with(&search.columns(shape)));
-                (S::statistic(&f), f)
-            }) else {
-                continue;
-            };
-            let look_elsewhere = if shapes.len() > 1 {
-                2.0 * (shapes.len() as f64).ln()
-            } else {
-                0.0
-            };
-            let delta = search.delta_bic(&model_fit, &trial_fit, shape) + look_elsewhere;
-            candidates.push((shape, shapes.len(), delta, trial_fit));
+            for set in search.shape_sets(kind, &chosen) {
+                let Some((shape, _, trial_fit)) = best_of(&set, |shape| {
+                    let f = search.fit(&model.with(&search.columns(shape)));
+                    (S::statistic(&f), f)
+                }) else {
+                    continue;
+                };
+                // A scan over a continuous period: its peaks are not independent
+                // trials but the upcrossings of a random field, e^(−z)·√z per
+                // independent period for a χ² drop of 2z with known variances
+                // (Davies 1987; Baluev 2008, eq. 14): the trials grow by √z.
+                let trials = if set.refine.is_some() {
+                    let z = (S::statistic(&model_fit) - S::statistic(&trial_fit)) / 2.0;
+                    set.trials * z.max(1.0).sqrt()
+                } else {
+                    set.trials
+                };
+                let look_elsewhere = 2.0 * trials.max(1.0).ln();
+                let delta = search.delta_bic(&model_fit, &trial_fit, shape) + look_elsewhere;
+                candidates.push((shape, trials, delta, trial_fit));
+            }
         }
         candidates.sort_by(|a, b| a.2.total_cmp(&b.2));
         let cv_without = search.cross_validated_rmse(&model);
@@ -192,14 +196,17 @@ pub(super) fn forward_selection<S: Search>(
             if !predicts_better(rejected, shape.kind(), search.kind(), cv_with, cv_without) {
                 continue;
             }
+            let p_one = search.p_value(
+                &model_fit,
+                &trial_fit,
+                with.parameters() - model.parameters(),
+            );
             let evidence = Evidence {
                 delta_bic: delta,
-                trials,
-                p_value: search.p_value(
-                    &model_fit,
-                    &trial_fit,
-                    with.parameters() - model.parameters(),
-                ),
+                trials: trials.max(1.0).round() as usize,
+                // The chance that the best of `trials` independent shapes of noise fits
+                // as well: 1 − (1 − p)^trials (Šidák 1967), without the cancellation.
+                p_value: -(trials.max(1.0) * (-p_one).ln_1p()).exp_m1(),
                 cv_rmse_without_um: cv_without,
                 cv_rmse_with_um: cv_with,
             };

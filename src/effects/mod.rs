@@ -33,7 +33,8 @@ pub mod scale;
 
 use serde::Deserialize;
 
-use crate::measurement::{AxisKind, Direction};
+use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError};
+use crate::units::um_to_mm;
 
 pub use abbe::Abbe;
 pub use drift::Drift;
@@ -70,13 +71,25 @@ pub struct Line<'a> {
     pub angle_urad: Option<&'a [f64]>,
 }
 
+/// Which tests a periodic error is in, as a diagnosis fits it: its columns
+/// at the readings are the same; against a prediction from a first test they
+/// differ by what that prediction carries of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PeriodicIn {
+    /// The re-test only: a change since the first test (or no first test).
+    ReTest,
+    /// Both tests: the prediction carries the first test's samples of it,
+    /// interpolated between its targets (too far apart to resolve it).
+    BothTests,
+}
+
 /// The nonlinear part of an effect's shape, fixed before the linear fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shape {
     /// No free shape.
     Fixed(Kind),
-    /// A periodic error of this period, mm.
-    Period(f64),
+    /// A periodic error of this period, mm, in these tests.
+    Period(f64, PeriodicIn),
     /// One run: (direction, number).
     Run(Direction, u32),
 }
@@ -86,7 +99,7 @@ impl Shape {
     pub fn kind(self) -> Kind {
         match self {
             Shape::Fixed(kind) => kind,
-            Shape::Period(_) => Kind::Periodic,
+            Shape::Period(..) => Kind::Periodic,
             Shape::Run(..) => Kind::OutlierRun,
         }
     }
@@ -419,6 +432,43 @@ impl Effect {
         first_target_mm: f64,
     ) -> Option<f64> {
         self.model().systematic_um(x_mm, direction, first_target_mm)
+    }
+
+    /// The measurement with this effect added to every reading, at the
+    /// times `times_h` (`[run][target]`, hours, as `cycle::reading_times_h`
+    /// gives them): a known effect put into a measured test, defined by the
+    /// same [`Model::value_um`] the diagnosis fits (tests on real files).
+    pub fn added_to(
+        &self,
+        measurement: &Measurement,
+        times_h: &[Vec<f64>],
+    ) -> Result<Measurement, MeasurementError> {
+        let targets_mm = measurement.targets_mm();
+        let line = Line {
+            first_target_mm: targets_mm.first().copied().unwrap_or(0.0),
+            angle_urad: None,
+        };
+        let runs = measurement.runs();
+        measurement.map_readings(|run, target_index, value_mm| {
+            // Runs are unique by direction and number (`Measurement`'s invariant).
+            let run_index = runs
+                .iter()
+                .position(|r| r.direction == run.direction && r.number == run.number)
+                .unwrap_or(0);
+            let reading = Reading {
+                target_index,
+                target_mm: targets_mm[target_index],
+                direction: run.direction,
+                run: run.number,
+                run_index,
+                time_h: times_h
+                    .get(run_index)
+                    .and_then(|run_times| run_times.get(target_index))
+                    .copied()
+                    .unwrap_or(0.0),
+            };
+            value_mm + um_to_mm(self.value_um(&reading, &line))
+        })
     }
 
     /// What it does to a compensation table.

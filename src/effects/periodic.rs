@@ -130,7 +130,7 @@ impl Fit for Periodic {
     const POSITIONAL: bool = true;
 
     fn columns(shape: Shape, readings: &[Reading], _: &Line<'_>) -> Vec<Vec<f64>> {
-        let Shape::Period(period) = shape else {
+        let Shape::Period(period, _) = shape else {
             return Vec::new();
         };
         vec![
@@ -146,7 +146,7 @@ impl Fit for Periodic {
     }
 
     fn from_fit(shape: Shape, coefficients: &[f64], _: &Line<'_>) -> Periodic {
-        let Shape::Period(period_mm) = shape else {
+        let Shape::Period(period_mm, _) = shape else {
             unreachable!("a periodic effect's shape is its period")
         };
         // a·sin θ + b·cos θ = A·sin(θ + φ) with A cos φ = a, A sin φ = b.

@@ -62,7 +62,7 @@ fn columns_and_values_agree() {
         (Shape::Fixed(Kind::Reversal), vec![4.0]),
         (Shape::Fixed(Kind::Scale), vec![10.0]),
         (Shape::Fixed(Kind::Drift), vec![2.0]),
-        (Shape::Period(160.0), vec![1.0, -0.5]),
+        (Shape::Period(160.0, PeriodicIn::ReTest), vec![1.0, -0.5]),
         (Shape::Run(Direction::Down, 2), vec![3.0]),
         (Shape::Fixed(Kind::Abbe), vec![50.0]),
     ];

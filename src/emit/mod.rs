@@ -35,7 +35,7 @@ use crate::evaluate::conformance::FULL_TURN_DEG;
 use crate::measurement::{AxisKind, Direction};
 use crate::units::LengthUnit;
 pub use fagor::{TextEncoding, decode as decode_table, encode as encode_table};
-pub use profile::{AxisProfile, CecValues, MachineProfile};
+pub use profile::{AxisPeriods, AxisProfile, CecValues, MachineProfile};
 
 /// The controllers axcomp writes tables for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

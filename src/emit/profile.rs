@@ -18,7 +18,12 @@
 //! sinumerik_axis = "X1"     # Sinumerik machine axis name (or AX1)
 //! sinumerik_encoder = 0     # 0 = first measuring system
 //! linuxcnc_joint = 0        # LinuxCNC [JOINT_n]
+//! screw_lead_mm = 15.0      # ball-screw lead (Sinumerik MD31030 LEADSCREW_PITCH)
+//! scale_period_mm = 0.02    # period of the linear scale or encoder along the axis
 //! ```
+//!
+//! The two periods are what a periodic positioning error of the axis is
+//! likely to repeat at; `diagnose --machine` looks for them first.
 //!
 //! Axes missing from the profile get defaults from their letter (X, Y, Z, A,
 //! B, C, U, V, W → iTNC columns 1–9, TNC 640 column = the letter, Sinumerik
@@ -111,6 +116,33 @@ pub struct AxisProfileToml {
     pub sinumerik_encoder: Option<u32>,
     /// LinuxCNC joint number.
     pub linuxcnc_joint: Option<u32>,
+    /// Lead of the axis' ball screw, mm (Sinumerik MD31030 `LEADSCREW_PITCH`).
+    #[serde(default, deserialize_with = "period_mm")]
+    pub screw_lead_mm: Option<f64>,
+    /// Period of the axis' linear scale or encoder along the axis, mm.
+    #[serde(default, deserialize_with = "period_mm")]
+    pub scale_period_mm: Option<f64>,
+}
+
+/// A period, mm: positive and finite, with the message the user reads otherwise.
+fn period_mm<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<Option<f64>, D::Error> {
+    let value = f64::deserialize(deserializer)?;
+    if value > 0.0 && value.is_finite() {
+        Ok(Some(value))
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "a period must be a length in mm > 0, found {value}"
+        )))
+    }
+}
+
+/// The periods an axis' drive and scale repeat at, mm, as the profile gives them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AxisPeriods {
+    /// The ball screw's lead.
+    pub screw_lead_mm: Option<f64>,
+    /// The scale's or encoder's period.
+    pub scale_period_mm: Option<f64>,
 }
 
 /// One axis with every name resolved.
@@ -157,6 +189,17 @@ impl MachineProfile {
             (None, super::Controller::Fagor8055) => test_unit,
             (None, _) => LengthUnit::Millimetre,
         }
+    }
+
+    /// The periods of an axis the profile gives (none for an axis it does not list).
+    pub fn axis_periods(&self, axis: &str) -> AxisPeriods {
+        self.controller
+            .axes
+            .get(axis)
+            .map_or(AxisPeriods::default(), |entry| AxisPeriods {
+                screw_lead_mm: entry.screw_lead_mm,
+                scale_period_mm: entry.scale_period_mm,
+            })
     }
 
     /// The resolved names of an axis: profile entries first, defaults from the letter.
@@ -228,6 +271,26 @@ mod tests {
         let x = profile.axis("X").unwrap();
         assert_eq!((x.sinumerik_axis.as_str(), x.linuxcnc_joint), ("AX1", 3));
         assert!(MachineProfile::from_toml_str("[controller]\nmax_pionts = 3\n").is_err());
+        assert_eq!(profile.axis_periods("X"), AxisPeriods::default());
         assert!(MachineProfile::from_toml_str("[controller]\nunits = \"furlong\"\n").is_err());
+    }
+
+    #[test]
+    fn an_axis_gives_its_screw_lead_and_scale_period() {
+        // Seed 001, Tab. 7: the VC1810's axes have a 15 mm lead.
+        let text = "[controller.axes.X]\nscrew_lead_mm = 15.0\nscale_period_mm = 0.02\n";
+        let profile = MachineProfile::from_toml_str(text).unwrap();
+        assert_eq!(
+            profile.axis_periods("X"),
+            AxisPeriods {
+                screw_lead_mm: Some(15.0),
+                scale_period_mm: Some(0.02)
+            }
+        );
+        assert_eq!(profile.axis_periods("Y"), AxisPeriods::default());
+        let error = MachineProfile::from_toml_str("[controller.axes.X]\nscrew_lead_mm = -5.0\n")
+            .unwrap_err();
+        assert!(error.to_string().contains("> 0"), "{error}");
+        assert!(error.to_string().starts_with("2:"), "{error}");
     }
 }

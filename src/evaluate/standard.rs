@@ -335,37 +335,60 @@ fn span(intervals: impl IntoIterator<Item = (f64, f64)>) -> Option<f64> {
     bounds.map(|(lo, hi)| hi - lo)
 }
 
-fn max_of(values: Option<Vec<f64>>) -> Option<f64> {
-    values?.into_iter().reduce(f64::max)
-}
-
 fn axis_figures(k: f64, per_target: &[TargetStats]) -> AxisFigures {
     let points =
-        |d: Direction| every_target(per_target, |t| t.direction(d).mean_mm.map(|m| (m, m)));
-    let bands = |d: Direction| every_target(per_target, |t| t.direction(d).band(k));
-    let pooled = |a: Option<Vec<(f64, f64)>>, b: Option<Vec<(f64, f64)>>| {
-        let (a, b) = (a?, b?);
-        span(a.into_iter().chain(b))
+        |d: Direction| bounds_every(per_target, |t| t.direction(d).mean_mm.map(|m| (m, m)));
+    let bands = |d: Direction| bounds_every(per_target, |t| t.direction(d).band(k));
+    let max_every = |value: fn(&TargetStats) -> Option<f64>| {
+        bounds_every(per_target, |t| value(t).map(|v| (v, v))).map(|(_, high)| high)
     };
-    let reversals = every_target(per_target, |t| t.reversal_mm);
     AxisFigures {
-        a_mm: pooled(bands(Direction::Up), bands(Direction::Down)),
-        a_up_mm: bands(Direction::Up).and_then(span),
-        a_down_mm: bands(Direction::Down).and_then(span),
-        e_mm: pooled(points(Direction::Up), points(Direction::Down)),
-        e_up_mm: points(Direction::Up).and_then(span),
-        e_down_mm: points(Direction::Down).and_then(span),
-        m_mm: every_target(per_target, |t| t.mean_mm.map(|m| (m, m))).and_then(span),
-        r_mm: max_of(every_target(per_target, |t| t.repeatability_mm)),
-        r_up_mm: max_of(every_target(per_target, |t| t.repeatability_up_mm)),
-        r_down_mm: max_of(every_target(per_target, |t| t.repeatability_down_mm)),
-        b_mm: max_of(
-            reversals
-                .clone()
-                .map(|b| b.into_iter().map(f64::abs).collect()),
-        ),
-        b_mean_mm: reversals.map(|b| b.iter().sum::<f64>() / b.len() as f64),
+        a_mm: union(bands(Direction::Up), bands(Direction::Down)).map(width),
+        a_up_mm: bands(Direction::Up).map(width),
+        a_down_mm: bands(Direction::Down).map(width),
+        e_mm: union(points(Direction::Up), points(Direction::Down)).map(width),
+        e_up_mm: points(Direction::Up).map(width),
+        e_down_mm: points(Direction::Down).map(width),
+        m_mm: bounds_every(per_target, |t| t.mean_mm.map(|m| (m, m))).map(width),
+        r_mm: max_every(|t| t.repeatability_mm),
+        r_up_mm: max_every(|t| t.repeatability_up_mm),
+        r_down_mm: max_every(|t| t.repeatability_down_mm),
+        b_mm: max_every(|t| t.reversal_mm.map(f64::abs)),
+        b_mean_mm: per_target
+            .iter()
+            .map(|t| t.reversal_mm)
+            .sum::<Option<f64>>()
+            .map(|sum| sum / per_target.len() as f64),
     }
+}
+
+/// The lowest low and the highest high of one (low, high) interval per
+/// target, or `None` if any target lacks it (or there is none). It folds
+/// rather than collects: thirteen vectors of 10 000 targets each were a
+/// measurable part of evaluating a large test.
+fn bounds_every(
+    per_target: &[TargetStats],
+    interval: impl Fn(&TargetStats) -> Option<(f64, f64)>,
+) -> Option<(f64, f64)> {
+    let mut bounds: Option<(f64, f64)> = None;
+    for target in per_target {
+        let (low, high) = interval(target)?;
+        bounds = Some(match bounds {
+            None => (low, high),
+            Some((lo, hi)) => (lo.min(low), hi.max(high)),
+        });
+    }
+    bounds
+}
+
+/// The bounds of both, when both are evaluated.
+fn union(a: Option<(f64, f64)>, b: Option<(f64, f64)>) -> Option<(f64, f64)> {
+    let ((a_low, a_high), (b_low, b_high)) = (a?, b?);
+    Some((a_low.min(b_low), a_high.max(b_high)))
+}
+
+fn width((low, high): (f64, f64)) -> f64 {
+    high - low
 }
 
 #[cfg(test)]

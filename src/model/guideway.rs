@@ -32,6 +32,42 @@
 //! deviations (the notes' closed forms, §3.5), which the tests check.
 //!
 //! Tilting stiffness of the carriages is neglected, as in the thesis.
+//!
+//! # The carriage side: the saddle's mounting faces
+//!
+//! Seed 000's assignment asks for errors "on the rail side and on the
+//! carriage side"; the thesis models only the rails (notes §3.6). Seed 002
+//! (the paper of the same work, §4) names the carriage-side input, "the
+//! prescribed parallelism tolerance of the faces for the carriages on the
+//! saddle", and draws it in Obr. 8, which the text lacks. [`SaddleFaces`]
+//! models it: the four pads on the saddle that the carriages are bolted to
+//! are not exactly in the plane of the saddle's datum face (the face that
+//! carries the next member of the chain). Pad i sits e_i further from the
+//! rails than it should, so the datum face above carriage i moves by
+//! d_zi + e_i + Δ_zi: a pad error adds to the rail deviation under its
+//! carriage, and the equilibrium above applies unchanged. What differs from
+//! a rail error is that the pads travel with the saddle: e_i is the same at
+//! every position of the stroke. Split into the three shapes four points can
+//! have about a plane (ISO 1101 terms):
+//!
+//! - **parallelism** of the pads' plane to the datum face: a tilt across the
+//!   rails (height difference between the rail-2 and the rail-1 pads, Δ_a)
+//!   and along them (ahead minus behind, Δ_b). With equal stiffness it gives a
+//!   constant roll Δ_a/a (eq. 18 with z4 − z1 = Δ_a) and a constant pitch
+//!   Δ_b/b (eq. 19), for the whole stroke. A constant angle is not removed by
+//!   the reference position: it acts through the Abbe arms, which change
+//!   with the other axes' positions, as a squareness error does.
+//! - **flatness** of the four pads: their twist c·(+1, −1, +1, −1), which
+//!   no plane takes out (the sum of the signed residuals is 4c for any
+//!   plane, so the minimum zone is 2|c|). The coplanarity condition (12)
+//!   makes the carriages take it up: with equal stiffness z_i = e_i ∓ τ/4 =
+//!   0 (notes §3.5, τ = 4c), so the saddle does not move and each carriage
+//!   is loaded by ∓k·c. With unequal stiffness part of the twist turns into
+//!   roll and pitch, which [`GuidewayMap`] computes.
+//!
+//! A lateral counterpart (the carriages' locating edges on the saddle) would
+//! enter the lateral system the same way; seed 002 names only the mounting
+//! faces, and it is not modelled.
 
 use nalgebra::{Matrix4, Vector4};
 
@@ -213,6 +249,49 @@ pub struct CarriageDeviations {
     pub normal_mm: [f64; 4],
     /// Across the rail ("horizontal"), carriages 1–4.
     pub lateral_mm: [f64; 4],
+}
+
+impl CarriageDeviations {
+    /// The deviations under the carriages with the saddle's pad errors added
+    /// to the normal ones (a pad error adds to the rail deviation under its
+    /// carriage; see the module's "carriage side").
+    pub fn with_saddle_faces(mut self, faces: &SaddleFaces) -> CarriageDeviations {
+        for (deviation, pad) in self.normal_mm.iter_mut().zip(faces.pad_heights_mm()) {
+            *deviation += pad;
+        }
+        self
+    }
+}
+
+/// The errors of the saddle's four carriage mounting faces (pads), normal to
+/// them, relative to the saddle's datum face, mm (the carriage side; seed 002
+/// Obr. 8). Constant along the stroke: the pads travel with the saddle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SaddleFaces {
+    /// Δ_a: pads on rail 2 (carriages 3, 4) minus pads on rail 1 (1, 2), mm.
+    /// Its largest value is the parallelism tolerance across the rails.
+    pub tilt_across_mm: f64,
+    /// Δ_b: pads ahead (2, 3) minus pads behind (1, 4), mm.
+    pub tilt_along_mm: f64,
+    /// c: the twist, pads 1 and 3 up by c and 2 and 4 down by c, mm;
+    /// the flatness of the four pads is 2|c|.
+    pub twist_mm: f64,
+}
+
+impl SaddleFaces {
+    /// e_1 … e_4: how much further from the rails the datum face sits above
+    /// each carriage (carriage 1 rail 1 behind, 2 rail 1 ahead, 3 rail 2
+    /// ahead, 4 rail 2 behind), mm. The plane part has zero mean, so the
+    /// pads' mean height (a constant offset, removed by the reference
+    /// position) is not part of the description.
+    pub fn pad_heights_mm(&self) -> [f64; 4] {
+        let (a, b, c) = (
+            self.tilt_across_mm / 2.0,
+            self.tilt_along_mm / 2.0,
+            self.twist_mm,
+        );
+        [-a - b + c, -a + b - c, a + b + c, a - b - c]
+    }
 }
 
 /// What the saddle does on given rail deviations.
@@ -585,6 +664,78 @@ mod tests {
             close(response.lateral_mm, -k * x, 1e-15);
             close(response.yaw_rad, k, 1e-15);
         }
+    }
+
+    #[test]
+    fn saddle_pads_alone_tilt_the_saddle_for_the_whole_stroke() {
+        // By hand, equal stiffness (a = 350, b = 640, the MCV 754 Quick's X):
+        // a parallelism of 0.02 mm across the rails (rail-2 pads higher) and
+        // 0.01 mm along them (pads ahead higher), on straight rails, give
+        // roll = 0.02/350 rad and pitch = 0.01/640 rad at every position, no
+        // straightness (the pads' mean is zero) and no carriage forces.
+        let faces = SaddleFaces {
+            tilt_across_mm: 0.02,
+            tilt_along_mm: 0.01,
+            twist_mm: 0.0,
+        };
+        assert_eq!(
+            faces.pad_heights_mm(),
+            [-0.015, -0.005, 0.015, 0.005],
+            "e_i of carriages 1–4"
+        );
+        let map = Guideway::unloaded(350.0, 640.0).linear_map().unwrap();
+        for rail in [0.0, 0.003] {
+            let on_rails = CarriageDeviations {
+                normal_mm: [rail; 4],
+                lateral_mm: [0.0; 4],
+            };
+            let response = map.response(&on_rails.with_saddle_faces(&faces));
+            close(response.roll_rad, 0.02 / 350.0, 1e-18);
+            close(response.pitch_rad, 0.01 / 640.0, 1e-18);
+            close(response.normal_mm, rail, 1e-17);
+            for force in response.force_normal_n {
+                close(force, 0.0, 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn a_twisted_saddle_loads_equal_carriages_and_does_not_move() {
+        // Notes §3.5 with d = c·(1, −1, 1, −1): τ = 4c, z_i = d_i ∓ τ/4 = 0,
+        // F_i = k·Δ_i = ∓k·c. Flatness 0.02 mm (c = 0.01) on 100 000 N/mm
+        // carriages: ∓1000 N each, and the saddle stays where it was.
+        let faces = SaddleFaces {
+            twist_mm: 0.01,
+            ..SaddleFaces::default()
+        };
+        let guideway = Guideway::unloaded(350.0, 640.0);
+        let response = guideway
+            .solve(&CarriageDeviations::default().with_saddle_faces(&faces))
+            .unwrap();
+        for (corner, force) in response
+            .corner_normal_mm
+            .iter()
+            .zip(response.force_normal_n)
+        {
+            close(*corner, 0.0, 1e-17);
+            close(force.abs(), 1000.0, 1e-9);
+        }
+        close(response.force_normal_n[0], -1000.0, 1e-9);
+        close(response.force_normal_n[1], 1000.0, 1e-9);
+        // Unequal carriages turn part of the twist into motion. Carriage 1 at
+        // k/2, the others k: eq. 12 with Δ_i = F_i/k_i and the balances
+        // (9)–(11) give F = (f, −f, f, −f) with f(2 + 1 + 1 + 1)/k = −4c, so
+        // f = −4kc/5 and corner 1 keeps e_1 + 2f/k = c − 8c/5 = −3c/5.
+        let mut soft = guideway;
+        soft.stiffness_normal_n_per_mm[0] /= 2.0;
+        let response = soft
+            .solve(&CarriageDeviations::default().with_saddle_faces(&faces))
+            .unwrap();
+        let c = 0.01;
+        close(response.force_normal_n[0], -4.0 * 1e5 * c / 5.0, 1e-9);
+        close(response.corner_normal_mm[0], -3.0 * c / 5.0, 1e-15);
+        close(response.corner_normal_mm[1], -c + 4.0 * c / 5.0, 1e-15);
+        assert!(response.pitch_rad.abs() > 1e-7);
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The geometric model of a three-axis machine: 21 errors → volumetric error
-//! (seed 000), rail mounting surfaces → axis errors (guideway model), and the
-//! Monte Carlo tolerance study built on both.
+//! (seed 000), rail mounting surfaces and the saddle's carriage mounting
+//! faces → axis errors (guideway model), and the Monte Carlo tolerance study
+//! built on both.
 //!
 //! The source is Valášek (2021), extracted with every equation, typo and
 //! check value in `../shared/notes/seed000-volumetric-model.md`; equation
@@ -15,10 +16,13 @@
 //!   kinematic chain as data (ZFYX, FXYZ, YFXZ, …).
 //! - [`volumetric`]: the chain evaluated with full homogeneous transforms or
 //!   to first order ([`Method`]), at a point or over a [`Grid`].
-//! - [`guideway`]: one axis on two rails and four carriages ([`Guideway`]).
+//! - [`guideway`]: one axis on two rails and four carriages ([`Guideway`]),
+//!   and the carriage side: the saddle's carriage mounting faces
+//!   ([`SaddleFaces`], seed 002 Obr. 8).
 //! - [`profile`]: the random profile generator ([`ProfileShape`]).
-//! - [`monte_carlo`]: the tolerance study, its sensitivity sweep and the
-//!   single-axis study; seeded, parallel and bit-identical at any thread count.
+//! - [`monte_carlo`]: the tolerance study (rail and carriage-side
+//!   tolerances), its sensitivity sweep and ranking, and the single-axis
+//!   study; seeded, parallel and bit-identical at any thread count.
 //!
 //! Pure: no I/O, no printing, no clock, no unseeded randomness. Lengths are
 //! mm, angles rad, forces N.
@@ -78,6 +82,7 @@ pub use description::{AxisDescription, BranchDeviations, ChainCode, ErrorFrame, 
 pub use error_description::read_error_description;
 pub use guideway::{
     CarriageDeviations, Guideway, GuidewayMap, GuidewayResponse, OutputWeights, RailProfiles,
+    SaddleFaces,
 };
 pub use machine::Machine;
 pub use profile::ProfileShape;

@@ -16,6 +16,15 @@
 //! machine's measure is the largest ‖E‖ over the grid (eq. 71), with E from
 //! the first-order chain and zeroed at the reference position.
 //!
+//! The carriage side (seed 002 Obr. 8; [`super::guideway::SaddleFaces`]):
+//! each saddle's four pads get a tilt across and along the rails, Δ_a and
+//! Δ_b each uniform in ±half the axis's parallelism tolerance t (so the
+//! pads' plane stays in a zone of width t: |Δ_a| + |Δ_b| ≤ t), and a twist c
+//! uniform in ±half its flatness tolerance (flatness 2|c| ≤ t). They
+//! add to the rail deviations under the carriages through the same guideway
+//! weights, the same at every position: constant roll, pitch and
+//! straightness offsets of the moving body.
+//!
 //! Every number is drawn even when its tolerance is zero, and profiles are
 //! drawn in units of their tolerance, so studies that differ only in
 //! tolerances see the same random shapes (common random numbers): the
@@ -36,7 +45,11 @@
 //! of the thread count. Batch `i` draws from `ChaCha8Rng::seed_from_u64(seed)`
 //! with `set_stream(i)`; results are written by sample index and reduced in
 //! index order, so a seed gives bit-identical results on any number of
-//! threads (the rand book's "deterministic multi-threaded" recipe).
+//! threads (the rand book's "deterministic multi-threaded" recipe). The
+//! carriage-side numbers come from a second stream of the same seed,
+//! `set_stream(CARRIAGE_STREAM + i)`, so the rail, positioning and
+//! squareness draws are those of a study without carriage-side tolerances:
+//! with them zero a seed gives the results it gave before they existed.
 
 use nalgebra::Vector3;
 use rand_chacha::ChaCha8Rng;
@@ -44,7 +57,7 @@ use rand_chacha::rand_core::SeedableRng;
 use rayon::prelude::*;
 
 use super::components::{Axis, SquarenessPair};
-use super::guideway::{Guideway, GuidewayMap, OutputWeights};
+use super::guideway::{Guideway, GuidewayMap, OutputWeights, SaddleFaces};
 use super::machine::Machine;
 use super::profile::{ProfileShape, uniform};
 use super::stats::{Summary, linear_slope};
@@ -55,6 +68,10 @@ use crate::spline::basis_matrix;
 /// Samples per batch: each batch has its own random stream. Changing it
 /// changes every result for a given seed (the value-stability tests pin it).
 pub const BATCH_SIZE: usize = 256;
+
+/// The first stream number of the carriage-side draws (batch `i` uses
+/// `CARRIAGE_STREAM + i`); far above any batch number of the rail streams.
+const CARRIAGE_STREAM: u64 = 1 << 62;
 
 /// The tolerance values of seed 000's sensitivity study (Tab. 4.4), mm.
 pub const THESIS_SWEEP_MM: [f64; 5] = [0.005, 0.015, 0.03, 0.045, 0.06];
@@ -88,6 +105,37 @@ impl RailDirection {
     }
 }
 
+/// A tolerance of the saddle's carriage mounting faces (the carriage side,
+/// seed 002 Obr. 8; see [`super::guideway::SaddleFaces`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CarriageFace {
+    /// The pads' plane against the saddle's datum face: constant roll and pitch.
+    Parallelism,
+    /// The four pads about their plane (their twist): carriage loads, and
+    /// motion only where the carriages' stiffnesses differ.
+    Flatness,
+}
+
+impl CarriageFace {
+    /// Parallelism, then flatness.
+    pub const BOTH: [CarriageFace; 2] = [CarriageFace::Parallelism, CarriageFace::Flatness];
+
+    /// `parallelism` or `flatness`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CarriageFace::Parallelism => "parallelism",
+            CarriageFace::Flatness => "flatness",
+        }
+    }
+
+    fn index(self) -> usize {
+        match self {
+            CarriageFace::Parallelism => 0,
+            CarriageFace::Flatness => 1,
+        }
+    }
+}
+
 /// The tolerances that make a random machine.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerances {
@@ -97,6 +145,8 @@ pub struct Tolerances {
     pub positioning_mm: [f64; 3],
     /// Largest squareness error XY, XZ, YZ (uniform in ±), rad.
     pub squareness_rad: [f64; 3],
+    /// The carriage side: each axis's saddle pads, `[axis][parallelism, flatness]`, mm.
+    pub carriage_mm: [[f64; 2]; 3],
 }
 
 impl Tolerances {
@@ -108,7 +158,18 @@ impl Tolerances {
             straightness_mm: [[straightness_mm; 2]; 3],
             positioning_mm: [positioning_mm; 3],
             squareness_rad: [squareness_rad; 3],
+            carriage_mm: [[0.0; 2]; 3],
         }
+    }
+
+    /// One carriage-side tolerance.
+    pub fn carriage(&self, axis: Axis, face: CarriageFace) -> f64 {
+        self.carriage_mm[axis.index()][face.index()]
+    }
+
+    /// Sets one carriage-side tolerance.
+    pub fn set_carriage(&mut self, axis: Axis, face: CarriageFace, value_mm: f64) {
+        self.carriage_mm[axis.index()][face.index()] = value_mm;
     }
 
     /// One straightness tolerance.
@@ -127,7 +188,8 @@ impl Tolerances {
             .iter()
             .flatten()
             .chain(&self.positioning_mm)
-            .chain(&self.squareness_rad);
+            .chain(&self.squareness_rad)
+            .chain(self.carriage_mm.iter().flatten());
         if let Some(bad) = all.into_iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
             return Err(ModelError::invalid(
                 "tolerance",
@@ -202,8 +264,10 @@ pub fn tolerance_study(
             |workspace, (batch, out)| {
                 let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
                 rng.set_stream(batch as u64);
+                let mut carriage_rng = ChaCha8Rng::seed_from_u64(options.seed);
+                carriage_rng.set_stream(CARRIAGE_STREAM + batch as u64);
                 for max in out.iter_mut() {
-                    *max = plan.sample(&mut rng, workspace);
+                    *max = plan.sample(&mut rng, &mut carriage_rng, workspace);
                 }
                 progress(out.len() as u64);
             },
@@ -223,10 +287,36 @@ pub enum SweptTolerance {
     Straightness(Axis, RailDirection),
     /// All six straightness tolerances together (Tab. 4.12).
     AllStraightness,
+    /// One of the six carriage-side tolerances; the others stay at the base value.
+    Carriage(Axis, CarriageFace),
+}
+
+/// Which side of a guideway a swept tolerance is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// The rail mounting surfaces (the thesis's six).
+    Rail,
+    /// The saddle's carriage mounting faces.
+    Carriage,
+    /// All six rail surfaces together.
+    All,
+}
+
+impl Side {
+    /// `rail`, `carriage` or `all`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Side::Rail => "rail",
+            Side::Carriage => "carriage",
+            Side::All => "all",
+        }
+    }
 }
 
 impl SweptTolerance {
-    /// The six single tolerances in the thesis's order (X↑, X→, Y↑, Y→, Z↑, Z→), then all six.
+    /// The six rail tolerances in the thesis's order (X↑, X→, Y↑, Y→, Z↑, Z→),
+    /// all six together, then the six carriage-side tolerances (X
+    /// parallelism, X flatness, Y …, Z …).
     pub fn all() -> Vec<SweptTolerance> {
         let mut list: Vec<SweptTolerance> = Axis::ALL
             .into_iter()
@@ -235,16 +325,31 @@ impl SweptTolerance {
             })
             .collect();
         list.push(SweptTolerance::AllStraightness);
+        list.extend(
+            Axis::ALL.into_iter().flat_map(|axis| {
+                CarriageFace::BOTH.map(|face| SweptTolerance::Carriage(axis, face))
+            }),
+        );
         list
     }
 
-    /// `X.normal`, …, `Z.lateral`, or `all`.
+    /// `X.normal`, …, `Z.lateral`, `all`, or `X.carriage_parallelism`, …, `Z.carriage_flatness`.
     pub fn name(self) -> String {
         match self {
             SweptTolerance::Straightness(axis, direction) => {
                 format!("{axis}.{}", direction.as_str())
             }
             SweptTolerance::AllStraightness => "all".to_string(),
+            SweptTolerance::Carriage(axis, face) => format!("{axis}.carriage_{}", face.as_str()),
+        }
+    }
+
+    /// The side of the guideway it is on.
+    pub fn side(self) -> Side {
+        match self {
+            SweptTolerance::Straightness(..) => Side::Rail,
+            SweptTolerance::AllStraightness => Side::All,
+            SweptTolerance::Carriage(..) => Side::Carriage,
         }
     }
 
@@ -254,6 +359,7 @@ impl SweptTolerance {
                 tolerances.set_straightness(axis, direction, value_mm);
             }
             SweptTolerance::AllStraightness => tolerances.straightness_mm = [[value_mm; 2]; 3],
+            SweptTolerance::Carriage(axis, face) => tolerances.set_carriage(axis, face, value_mm),
         }
     }
 }
@@ -577,6 +683,8 @@ struct AxisPlan {
     tolerance_normal_mm: f64,
     tolerance_lateral_mm: f64,
     tolerance_positioning_mm: f64,
+    tolerance_parallelism_mm: f64,
+    tolerance_flatness_mm: f64,
 }
 
 impl Plan {
@@ -614,7 +722,12 @@ impl Plan {
     /// g_k = s_k [δ_k + ε_k × c_k + q_k ε_k × M_k e_k] + q_k Σ_p s_p ψ_p × M_p e_k
     /// (plus the constant Σ_p s_p ψ_p × c_p, put into g_X) and
     /// m_kj = s_k ε_k × M_k e_j, all tabulated over each axis's coordinates.
-    fn sample(&self, rng: &mut ChaCha8Rng, workspace: &mut Workspace) -> f64 {
+    fn sample(
+        &self,
+        rng: &mut ChaCha8Rng,
+        carriage_rng: &mut ChaCha8Rng,
+        workspace: &mut Workspace,
+    ) -> f64 {
         for (axis_plan, walks) in self.axes.iter().zip(workspace.walks.iter_mut()) {
             axis_plan.draw_walks(rng, &self.shape, walks);
         }
@@ -622,11 +735,21 @@ impl Plan {
         for (value, tolerance) in squareness.iter_mut().zip(self.squareness_rad) {
             *value = tolerance * uniform(rng, -1.0, 1.0);
         }
-        self.evaluate(&squareness, workspace)
+        let faces = self
+            .axes
+            .each_ref()
+            .map(|axis_plan| axis_plan.draw_faces(carriage_rng));
+        self.evaluate(&squareness, &faces, workspace)
     }
 
-    /// The largest ‖E‖ of the machine whose walks are in `workspace`.
-    fn evaluate(&self, squareness_rad: &[f64; 3], workspace: &mut Workspace) -> f64 {
+    /// The largest ‖E‖ of the machine whose walks are in `workspace`, with
+    /// the given squareness errors and saddle faces.
+    fn evaluate(
+        &self,
+        squareness_rad: &[f64; 3],
+        faces: &[SaddleFaces; 3],
+        workspace: &mut Workspace,
+    ) -> f64 {
         let Workspace {
             walks,
             errors,
@@ -636,7 +759,14 @@ impl Plan {
             ..
         } = workspace;
         for (k, axis_plan) in self.axes.iter().enumerate() {
-            axis_plan.fill(&walks[k], behind, ahead, positioning, &mut errors[k]);
+            axis_plan.fill(
+                &walks[k],
+                &faces[k],
+                behind,
+                ahead,
+                positioning,
+                &mut errors[k],
+            );
         }
         self.tabulate(squareness_rad, workspace);
         workspace.max_norm(&self.axes)
@@ -753,6 +883,20 @@ impl AxisPlan {
             tolerance_normal_mm: tolerances.straightness(axis, RailDirection::Normal),
             tolerance_lateral_mm: tolerances.straightness(axis, RailDirection::Lateral),
             tolerance_positioning_mm: tolerances.positioning_mm[axis.index()],
+            tolerance_parallelism_mm: tolerances.carriage(axis, CarriageFace::Parallelism),
+            tolerance_flatness_mm: tolerances.carriage(axis, CarriageFace::Flatness),
+        }
+    }
+
+    /// This axis's saddle faces: the tilts across and along the rails each
+    /// uniform in ±t_parallelism/2, the twist in ±t_flatness/2 (see the
+    /// module's notes). Three numbers are drawn whatever the tolerances.
+    fn draw_faces(&self, rng: &mut ChaCha8Rng) -> SaddleFaces {
+        let mut draw = |tolerance: f64| tolerance * uniform(rng, -0.5, 0.5);
+        SaddleFaces {
+            tilt_across_mm: draw(self.tolerance_parallelism_mm),
+            tilt_along_mm: draw(self.tolerance_parallelism_mm),
+            twist_mm: draw(self.tolerance_flatness_mm),
         }
     }
 
@@ -770,6 +914,7 @@ impl AxisPlan {
     fn fill(
         &self,
         walks: &[Vec<f64>; 5],
+        faces: &SaddleFaces,
         behind: &mut [Vec<f64>; 4],
         ahead: &mut [Vec<f64>; 4],
         positioning: &mut [f64],
@@ -787,16 +932,21 @@ impl AxisPlan {
         let [y5, yaw] = &self.lateral;
         let (t_n, t_l) = (self.tolerance_normal_mm, self.tolerance_lateral_mm);
         let apply = |w: &OutputWeights, d: &[f64; 4]| w.constant + dot(&w.weights, d);
+        // The saddle's pads add to the deviations under the carriages, the
+        // same at every position: their share of z5, roll and pitch is a
+        // constant (the weights are linear; the load's constant is counted once).
+        let pads = faces.pad_heights_mm();
+        let [z5_pads, roll_pads, pitch_pads] = [z5, roll, pitch].map(|w| dot(&w.weights, &pads));
         for p in 0..count {
             // Carriages 1, 2 on rail 1 behind and ahead; 3, 4 on rail 2 ahead
             // and behind (eqs 40–47). Rails: 0, 2 normal; 1, 3 lateral.
             let d_z = [behind[0][p], ahead[0][p], ahead[2][p], behind[2][p]].map(|d| t_n * d);
             let d_y = [behind[1][p], ahead[1][p], ahead[3][p], behind[3][p]].map(|d| t_l * d);
             out.translation[own][p] = self.tolerance_positioning_mm * positioning[p];
-            out.translation[self.normal_direction][p] = s_normal * apply(z5, &d_z);
+            out.translation[self.normal_direction][p] = s_normal * (apply(z5, &d_z) + z5_pads);
             out.translation[self.lateral_direction][p] = s_lateral * apply(y5, &d_y);
-            out.rotation[own][p] = s_roll * apply(roll, &d_z);
-            out.rotation[self.lateral_direction][p] = s_pitch * apply(pitch, &d_z);
+            out.rotation[own][p] = s_roll * (apply(roll, &d_z) + roll_pads);
+            out.rotation[self.lateral_direction][p] = s_pitch * (apply(pitch, &d_z) + pitch_pads);
             out.rotation[self.normal_direction][p] = s_yaw * apply(yaw, &d_y);
         }
     }
@@ -1010,7 +1160,11 @@ mod tests {
         let plan = Plan::new(machine, &options(1, 0, tolerances)).unwrap();
         let mut workspace = Workspace::new(&plan);
         formula_walks(&mut workspace);
-        let max = plan.evaluate(&FORMULA_SQUARENESS_RAD, &mut workspace);
+        let max = plan.evaluate(
+            &FORMULA_SQUARENESS_RAD,
+            &[SaddleFaces::default(); 3],
+            &mut workspace,
+        );
         (plan, workspace, max)
     }
 
@@ -1107,10 +1261,106 @@ mod tests {
         )
     }
 
+    /// The bundled machine's largest ‖E‖ with no errors but the given saddle faces.
+    fn only_faces(machine: &Machine, faces: [SaddleFaces; 3]) -> f64 {
+        let plan = Plan::new(machine, &options(1, 0, Tolerances::uniform(0.0, 0.0, 0.0))).unwrap();
+        let mut workspace = Workspace::new(&plan);
+        plan.evaluate(&[0.0; 3], &faces, &mut workspace)
+    }
+
+    /// max ‖(β·Z, −α·Z, −α·Y)‖ over Y ∈ [0, 500], Z ∈ [−550, 0], mm: the
+    /// bundled machine with a constant X roll α and pitch β (rad) and nothing else.
+    fn x_roll_and_pitch_error(alpha: f64, beta: f64) -> f64 {
+        ((beta * 550.0).powi(2) + (alpha * 550.0).powi(2) + (alpha * 500.0).powi(2)).sqrt()
+    }
+
+    #[test]
+    fn a_tilted_saddle_alone_gives_the_hand_computed_error() {
+        // The X saddle's pads tilted by Δ_a = 0.02 mm across its rails and
+        // Δ_b = 0.01 mm along them (a = 350, b = 640 mm): roll EAX = α =
+        // 0.02/350, pitch EBX = β = 0.01/640 at every X. By the peer's §2.5
+        // formulas (mc_peer.py, the thesis's eqs 63–68 for ZFYX with z4 = 80,
+        // zeroed at the origin): Ex = β·Z, Ey = −α·Z, Ez = −α·Y, whatever X.
+        // The largest norm is at Y = 500, Z = −550.
+        let expected = x_roll_and_pitch_error(0.02 / 350.0, 0.01 / 640.0);
+        let x_saddle = SaddleFaces {
+            tilt_across_mm: 0.02,
+            tilt_along_mm: 0.01,
+            twist_mm: 0.0,
+        };
+        let max = only_faces(
+            &Machine::bundled(),
+            [x_saddle, SaddleFaces::default(), SaddleFaces::default()],
+        );
+        assert!((max - expected).abs() < 1e-15, "{max} vs {expected}");
+        // By hand: 550/640 · 0.01 = 0.0085938, 550/350 · 0.02 = 0.0314286,
+        // 500/350 · 0.02 = 0.0285714; the root of their squares 0.043335 mm.
+        assert!((expected - 0.043335).abs() < 1e-6, "{expected}");
+    }
+
+    #[test]
+    fn a_twisted_saddle_on_equal_carriages_leaves_no_error() {
+        // Equal stiffness (the bundled machine): the carriages take the twist
+        // up (guideway tests), so the flatness of the pads moves nothing.
+        let twisted = SaddleFaces {
+            twist_mm: 0.01,
+            ..SaddleFaces::default()
+        };
+        let max = only_faces(&Machine::bundled(), [twisted; 3]);
+        assert!(max < 1e-15, "{max}");
+        // One soft carriage under X turns part of it into roll and pitch.
+        let soft = Machine::from_toml_str(&Machine::bundled_toml().replace(
+            "rail_spacing_mm = 350.0",
+            "rail_spacing_mm = 350.0\nstiffness_normal_n_per_mm = [50000.0, 1e5, 1e5, 1e5]",
+        ))
+        .unwrap();
+        assert!(only_faces(&soft, [twisted; 3]) > 1e-3);
+    }
+
+    #[test]
+    fn carriage_tolerances_scale_with_the_saddle_and_leave_the_rail_draws() {
+        // Only the X parallelism: doubling a and b of the X saddle halves its
+        // roll and pitch (Δ/a, Δ/b), so every machine's largest error halves.
+        let machine = Machine::bundled();
+        let wide = Machine::from_toml_str(
+            &Machine::bundled_toml()
+                .replace("rail_spacing_mm = 350.0", "rail_spacing_mm = 700.0")
+                .replace("carriage_pitch_mm = 640.0", "carriage_pitch_mm = 1280.0"),
+        )
+        .unwrap();
+        let mut tolerances = Tolerances::uniform(0.0, 0.0, 0.0);
+        tolerances.set_carriage(Axis::X, CarriageFace::Parallelism, 0.03);
+        let study = |machine: &Machine| {
+            tolerance_study(machine, &options(300, 4, tolerances), &|_| {}).unwrap()
+        };
+        let (narrow, wide) = (study(&machine), study(&wide));
+        for (n, w) in narrow.max_volumetric_mm.iter().zip(&wide.max_volumetric_mm) {
+            assert!((n - 2.0 * w).abs() < 1e-16, "{n} vs 2 × {w}");
+        }
+        // Each machine stays inside its bound: |roll| ≤ t/(2a), |pitch| ≤ t/(2b)
+        // over the arms of the test above.
+        let bound = x_roll_and_pitch_error(0.03 / 700.0, 0.03 / 1280.0);
+        assert!(narrow.summary.max <= bound + 1e-15);
+        assert!(narrow.summary.max > 0.5 * bound);
+        // The carriage side draws from its own stream: adding it to a rail
+        // study changes no rail draw, so with flatness only (which moves
+        // nothing here) every sample is the rail study's, bit for bit.
+        let rails = Tolerances::uniform(0.03, 0.01, 30e-6);
+        let mut flat = rails;
+        flat.carriage_mm = [[0.0, 0.05]; 3];
+        let base = tolerance_study(&machine, &options(300, 4, rails), &|_| {}).unwrap();
+        let with = tolerance_study(&machine, &options(300, 4, flat), &|_| {}).unwrap();
+        for (b, w) in base.max_volumetric_mm.iter().zip(&with.max_volumetric_mm) {
+            assert!((b - w).abs() < 1e-15, "{b} vs {w}");
+        }
+    }
+
     #[test]
     fn identical_at_one_and_two_threads() {
         let machine = Machine::bundled();
-        let options = options(1100, 9, Tolerances::uniform(0.03, 0.01, 30e-6));
+        let mut tolerances = Tolerances::uniform(0.03, 0.01, 30e-6);
+        tolerances.carriage_mm = [[0.02, 0.01]; 3];
+        let options = options(1100, 9, tolerances);
         let run = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -1163,15 +1413,20 @@ mod tests {
         // gives every sample's maximum doubled (the model is linear in the
         // errors and the walks scale with the tolerance).
         let machine = Machine::bundled();
+        let with_carriages = |straightness: f64, positioning: f64, squareness: f64| {
+            let mut tolerances = Tolerances::uniform(straightness, positioning, squareness);
+            tolerances.carriage_mm = [[straightness, straightness / 2.0]; 3];
+            tolerances
+        };
         let small = tolerance_study(
             &machine,
-            &options(300, 5, Tolerances::uniform(0.015, 0.005, 15e-6)),
+            &options(300, 5, with_carriages(0.015, 0.005, 15e-6)),
             &|_| {},
         )
         .unwrap();
         let large = tolerance_study(
             &machine,
-            &options(300, 5, Tolerances::uniform(0.03, 0.01, 30e-6)),
+            &options(300, 5, with_carriages(0.03, 0.01, 30e-6)),
             &|_| {},
         )
         .unwrap();
@@ -1204,8 +1459,9 @@ mod tests {
         let base = options(400, 3, Tolerances::uniform(0.03, 0.0, 0.0));
         let swept = SweptTolerance::all();
         let values = [0.015, 0.03, 0.045];
-        // 7 tolerances × 3 values, of which the 7 at 0.03 are the base run.
-        assert_eq!(sweep_runs(&base.tolerances, &swept, &values), 14);
+        // 7 rail tolerances × 3 values, of which the 7 at 0.03 are the base
+        // run, and 6 carriage-side tolerances (0 in the base) × 3 values.
+        assert_eq!(sweep_runs(&base.tolerances, &swept, &values), 14 + 18);
         let baseline = tolerance_study(&machine, &base, &|_| {})
             .unwrap()
             .summary
@@ -1215,8 +1471,12 @@ mod tests {
             counter.fetch_add(done, std::sync::atomic::Ordering::Relaxed);
         })
         .unwrap();
-        assert_eq!(counter.into_inner(), 14 * 400);
-        assert!(rows.iter().all(|row| row.p90_mm[1] == baseline));
+        assert_eq!(counter.into_inner(), 32 * 400);
+        let rail_rows = rows
+            .iter()
+            .filter(|row| row.tolerance.side() != Side::Carriage);
+        assert!(rail_rows.clone().all(|row| row.p90_mm[1] == baseline));
+        assert_eq!(rail_rows.count(), 7);
         // A repeated run gives the same P90 as the reused one (same seed).
         let mut changed = base;
         changed
@@ -1245,9 +1505,34 @@ mod tests {
             );
         }
         // All six together: P90 proportional to the tolerance.
-        let all = rows.last().unwrap();
+        let all = rows[6].clone();
         assert_eq!(all.tolerance, SweptTolerance::AllStraightness);
         assert!((all.p90_mm[2] / all.p90_mm[0] - 3.0).abs() < 1e-12);
+        // The carriage side: a tilted X or Y saddle adds error; a twisted
+        // one on equal carriages none (its rows repeat the base run's P90 to
+        // rounding). Nor does a tilted Z saddle: Z carries the tool, whose tip
+        // is fixed to the Z carriage, so a constant Z roll or pitch moves the
+        // tip by the same amount everywhere (ε × tool offset) and the
+        // reference takes it out. These four rank below every other single
+        // tolerance, rail or carriage side.
+        let zero = [
+            "X.carriage_flatness",
+            "Y.carriage_flatness",
+            "Z.carriage_flatness",
+        ]
+        .into_iter()
+        .chain(["Z.carriage_parallelism"]);
+        for name in zero.clone() {
+            assert!(slope(name).abs() < 1e-9, "{name}: {}", slope(name));
+        }
+        let smallest_other = rows
+            .iter()
+            .filter(|r| {
+                r.tolerance.side() != Side::All && !zero.clone().any(|z| z == r.tolerance.name())
+            })
+            .map(|r| r.slope.unwrap())
+            .fold(f64::INFINITY, f64::min);
+        assert!(smallest_other > 0.01, "{smallest_other}");
     }
 
     #[test]

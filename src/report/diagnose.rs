@@ -21,8 +21,19 @@
 //!   "figures_um": {"measured": {"A": …, …}, "predicted": {…}, "predicted_with_effects": {…}},
 //!                                            (each under the standard's keys, as in evaluate)
 //!   "unexplained": {"significant": false, "where_mm": [], "rms_um": …, "p_value": …},
-//!   "noise_um": …, "time_assumed": false }
+//!   "noise_um": …, "time_assumed": false,
+//!   "friction": {"servo_axis": "mcfv5050-x", "B_um": -3.3, "B_uncertainty_um": 0.1,
+//!                "change_since_first_test": false, "friction_n": 165.0,
+//!                "friction_uncertainty_n": 5.0, "scale_part_n": 50.0,
+//!                "compliance_n_per_um": 100.0, "axis_coulomb_n": 90.0, "expected_reversal_um": -1.8,
+//!                "start_coulomb_n": 165.0, "servo_sim": "axcomp servo-sim …"} }
+//!                                            (only with --servo-axis and a reversal found)
 //! ```
+//!
+//! `friction` is the force held against friction that the reversal means
+//! through B̄ = B̄_scale − 2·F_res/k_c (`diagnose::friction`), with
+//! B̄_scale = 0 and `scale_part_n` what one position increment of B̄_scale
+//! would be worth (±); with a first test both are changes since then.
 //!
 //! `params` of an `outlier-run` are `run` (a number), `direction` (`up` or
 //! `down`) and `offset_um`. `residual_before_um` is the model's error before
@@ -41,6 +52,7 @@ use std::fmt::Write;
 use serde::Serialize;
 use serde_json::{Map, Value};
 
+use crate::diagnose::friction::ReversalFriction;
 use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
 use crate::effects::{Effect, ParameterValue};
 use crate::measurement::AxisKind;
@@ -306,6 +318,90 @@ struct DiagnoseFields {
     pub noise_um: f64,
     /// Whether the reading times were assumed from a typical cycle.
     pub time_assumed: bool,
+    /// The friction behind the reversal found (with a servo description).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionJson>,
+}
+
+/// The friction force a found reversal means (module doc).
+#[derive(Clone, Debug, Serialize)]
+pub struct FrictionJson {
+    /// The servo description (`--servo-axis`) as given.
+    pub servo_axis: String,
+    /// The reversal found, µm.
+    #[serde(rename = "B_um")]
+    pub b_um: f64,
+    /// Its standard uncertainty, µm.
+    #[serde(rename = "B_uncertainty_um")]
+    pub b_uncertainty_um: f64,
+    /// Whether B and the force are changes since the first test.
+    pub change_since_first_test: bool,
+    /// F_res, N.
+    pub friction_n: f64,
+    /// Its standard uncertainty, N.
+    pub friction_uncertainty_n: f64,
+    /// ± N that one position increment of the scale's own reversal is worth.
+    pub scale_part_n: f64,
+    /// k_c, N/µm.
+    pub compliance_n_per_um: f64,
+    /// The description's F_C, N.
+    pub axis_coulomb_n: f64,
+    /// −2·F_C/k_c with the description's F_C, µm.
+    pub expected_reversal_um: f64,
+    /// The F_C servo-sim starts from, N.
+    pub start_coulomb_n: f64,
+    /// The command that simulates the ISO test with it.
+    pub servo_sim: String,
+}
+
+impl FrictionJson {
+    /// Builds the wire object for the servo description `servo_axis`.
+    pub fn new(servo_axis: &str, f: &ReversalFriction) -> FrictionJson {
+        FrictionJson {
+            servo_axis: servo_axis.to_string(),
+            b_um: f.reversal_um,
+            b_uncertainty_um: f.reversal_uncertainty_um,
+            change_since_first_test: f.change_since_first_test,
+            friction_n: f.friction_n,
+            friction_uncertainty_n: f.friction_uncertainty_n,
+            scale_part_n: f.scale_part_n,
+            compliance_n_per_um: f.compliance_n_per_um,
+            axis_coulomb_n: f.axis_coulomb_n,
+            expected_reversal_um: f.expected_reversal_um,
+            start_coulomb_n: f.start_coulomb_n,
+            servo_sim: format!(
+                "axcomp servo-sim --axis {servo_axis} --friction lugre --test iso230-2 --coulomb-n {:.1} --compliance-n-um {}",
+                f.start_coulomb_n, f.compliance_n_per_um
+            ),
+        }
+    }
+
+    /// The terminal lines under the reversal.
+    fn lines(&self) -> Vec<String> {
+        let what = if self.change_since_first_test {
+            format!(
+                "the friction force held after each approach changed by {:.1} ± {:.1} N since the first test",
+                self.friction_n, self.friction_uncertainty_n
+            )
+        } else {
+            format!(
+                "F_res = {:.1} ± {:.1} N held against friction after each approach",
+                self.friction_n, self.friction_uncertainty_n
+            )
+        };
+        vec![
+            format!(
+                "friction: B̄ = B̄_scale − 2·F_res/k_c with k_c = {} N/µm ({}): {what}, ±{:.1} N more from the scale's own part (one position increment); the F_C of {} ({:.1} N) would give B = {:.2} µm",
+                self.compliance_n_per_um,
+                self.servo_axis,
+                self.scale_part_n,
+                self.servo_axis,
+                self.axis_coulomb_n,
+                self.expected_reversal_um
+            ),
+            format!("servo-sim starts from it: {}", self.servo_sim),
+        ]
+    }
 }
 
 impl DiagnoseJson {
@@ -357,8 +453,16 @@ impl DiagnoseJson {
             },
             noise_um: units.deviation(diagnosis.noise_um),
             time_assumed: diagnosis.time_assumed,
+            friction: None,
         };
         DiagnoseJson { fields, units }
+    }
+
+    /// The friction behind the reversal found (`--servo-axis`; a linear
+    /// axis' only: its keys are µm and N).
+    pub fn set_friction(&mut self, friction: Option<FrictionJson>) {
+        debug_assert!(friction.is_none() || self.units.0 == AxisKind::Linear);
+        self.fields.friction = friction;
     }
 }
 
@@ -414,6 +518,13 @@ pub fn render(report: &DiagnoseJson) -> String {
             effect.evidence.cv_rmse_with_um,
         );
         let _ = writeln!(out, "  {:<12} {}", "", effect.explanation);
+        if effect.kind == "reversal"
+            && let Some(friction) = &report.friction
+        {
+            for line in friction.lines() {
+                let _ = writeln!(out, "  {:<12} {line}", "");
+            }
+        }
         for warning in &effect.warnings {
             let _ = writeln!(out, "  {:<12} warning: {warning}", "");
         }

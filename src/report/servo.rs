@@ -34,10 +34,24 @@
 //! the laser reads (scale minus F_T/k_c), `scale_deviation_um` the scale.
 //! `reversal_from_friction_um` is 2·F_res/k_c with F_res the mean |friction|
 //! held at the readings (the closed form of `servo::reversal`).
+//!
+//! `servo-sim --identify` prints another object (`IdentifyJson`):
+//!
+//! ```text
+//! { "axis_source": "mcfv5050-x", "coulomb_n": 109.7, "viscous_n_s_per_m": 430.3,
+//!   "force_rms_residual_n": 0.7, "rows": 14,
+//!   "lugre_stiffness_n_per_m": 2.8e7 | null, "following_error_rms_residual_um": 0.11 | null,
+//!   "samples": 21000 | null, "simulations": 37 | null,
+//!   "circle_feed_m_min": 3.2 | null, "circle_radius_mm": 90 | null,
+//!   "servo_sim": "--coulomb-n 109.7 --viscous-n-s-m 430.3 --lugre-stiffness-n-m 2.8e7" }
+//! ```
 
 use std::fmt::Write as _;
 
 use serde::Serialize;
+
+use crate::servo::friction_fit::Identified;
+use crate::servo::trajectory::Circle;
 
 use crate::report::json::FiguresJson;
 use crate::servo::circle::CircleResult;
@@ -451,4 +465,117 @@ pub fn iso_csv(axis: &str, iso: &IsoJson) -> Vec<u8> {
         );
     }
     out.into_bytes()
+}
+
+/// What `servo-sim --identify` found (wire format in the module doc).
+#[derive(Clone, Debug, Serialize)]
+pub struct IdentifyJson {
+    /// `--axis` as given.
+    pub axis_source: String,
+    /// F_C, N.
+    pub coulomb_n: f64,
+    /// μ_v, N·s/m.
+    pub viscous_n_s_per_m: f64,
+    /// RMS of the record's forces about the line, N.
+    pub force_rms_residual_n: f64,
+    /// Rows of the constant-velocity record.
+    pub rows: usize,
+    /// k_s, N/m (with `--reversal`).
+    pub lugre_stiffness_n_per_m: Option<f64>,
+    /// RMS of the reversal record about the fitted simulation, µm.
+    pub following_error_rms_residual_um: Option<f64>,
+    /// Samples of the reversal record compared.
+    pub samples: Option<usize>,
+    /// Circle simulations run.
+    pub simulations: Option<usize>,
+    /// The circle's feed, m/min.
+    pub circle_feed_m_min: Option<f64>,
+    /// The circle's radius, mm.
+    pub circle_radius_mm: Option<f64>,
+    /// The servo-sim flags that start a simulation from these values.
+    pub servo_sim: String,
+}
+
+impl IdentifyJson {
+    /// Builds the wire object; `circle` is the reversal record's circle and feed (m/min).
+    pub fn new(
+        axis_source: &str,
+        found: Identified,
+        circle: Option<(&Circle, f64)>,
+    ) -> IdentifyJson {
+        let stiffness = found.stiffness;
+        let mut servo_sim = format!(
+            "--coulomb-n {:.1} --viscous-n-s-m {:.1}",
+            found.coulomb_n, found.viscous_n_s_per_m
+        );
+        if let Some(k) = stiffness {
+            let _ = write!(
+                servo_sim,
+                " --lugre-stiffness-n-m {:.3e}",
+                k.stiffness_n_per_m
+            );
+        }
+        IdentifyJson {
+            axis_source: axis_source.to_string(),
+            coulomb_n: found.coulomb_n,
+            viscous_n_s_per_m: found.viscous_n_s_per_m,
+            force_rms_residual_n: found.force_rms_residual_n,
+            rows: found.rows,
+            lugre_stiffness_n_per_m: stiffness.map(|k| k.stiffness_n_per_m),
+            following_error_rms_residual_um: stiffness.map(|k| m_to_um(k.rms_residual_m)),
+            samples: stiffness.map(|k| k.samples),
+            simulations: stiffness.map(|k| k.simulations),
+            circle_feed_m_min: circle.map(|(_, feed)| feed),
+            circle_radius_mm: circle.map(|(c, _)| m_to_mm(c.radius_m)),
+            servo_sim,
+        }
+    }
+}
+
+/// The terminal text of `servo-sim --identify`.
+pub fn identify_text(json: &IdentifyJson) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "Friction of {} identified (seed 004 ch. 5)",
+        json.axis_source
+    );
+    let _ = writeln!(
+        out,
+        "  F_C  Coulomb friction     {:.1} N      (constant-velocity record, {} rows; F = F_C + μ_v·|v| rms {:.2} N)",
+        json.coulomb_n, json.rows, json.force_rms_residual_n
+    );
+    let _ = writeln!(
+        out,
+        "  μ_v  viscous coefficient  {:.1} N·s/m",
+        json.viscous_n_s_per_m
+    );
+    match (
+        json.lugre_stiffness_n_per_m,
+        json.following_error_rms_residual_um,
+    ) {
+        (Some(k), Some(rms)) => {
+            let _ = writeln!(
+                out,
+                "  k_s  LuGre stiffness      {k:.3e} N/m  (circle R {} mm at {} m/min, {} samples, rms {:.3} µm after {} simulations)",
+                json.circle_radius_mm.unwrap_or(f64::NAN),
+                json.circle_feed_m_min.unwrap_or(f64::NAN),
+                json.samples.unwrap_or(0),
+                rms,
+                json.simulations.unwrap_or(0)
+            );
+        }
+        _ => {
+            let _ = writeln!(
+                out,
+                "  k_s  not identified (give the circle's following error with --reversal)"
+            );
+        }
+    }
+    let _ = writeln!(
+        out,
+        "Start a simulation from them: axcomp servo-sim --axis {} {} --friction lugre --test …",
+        json.axis_source, json.servo_sim
+    );
+    out
 }

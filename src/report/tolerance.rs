@@ -12,16 +12,24 @@
 //!   "batch_size": 256, "grid_step_mm": 50.0, "grid_points": [16, 11, 12],
 //!   "tolerances": {"straightness_mm": {"X.lateral": 0.03, "X.normal": 0.03, …},
 //!                  "positioning_mm": {"X": 0.0, "Y": 0.0, "Z": 0.0},
-//!                  "squareness_um_per_m": {"XY": 0.0, "XZ": 0.0, "YZ": 0.0}},
+//!                  "squareness_um_per_m": {"XY": 0.0, "XZ": 0.0, "YZ": 0.0},
+//!                  "carriage_mm": {"X.flatness": 0.0, "X.parallelism": 0.0, …}},
 //!   "profile": {"period_mm": 100.0, "step_factor": 0.5, "band_width_factor": 1.0},
 //!   "max_volumetric_um": {"mean": …, "median": …, "min": …, "max": …, "p90": …},
 //!   "histogram": {"edges_um": [...], "counts": [...]},
-//!   "sensitivity": [{"tolerance": "X.normal", "values_mm": [0.005, …],
-//!                    "p90_um": [...], "slope_um_per_mm": 1171.6}, …] }
+//!   "sensitivity": [{"tolerance": "X.normal", "side": "rail", "values_mm": [0.005, …],
+//!                    "p90_um": [...], "slope_um_per_mm": 1171.6, "rank": 2}, …] }
 //! ```
 //!
-//! `sensitivity` is present only with `--sweep`; its last entry, `"all"`,
-//! scales all six straightness tolerances together (seed 000 Tab. 4.12).
+//! `carriage_mm` are the carriage-side tolerances of each axis's saddle
+//! (`model::guideway::SaddleFaces`): `parallelism` of its carriage mounting
+//! faces to its datum face, `flatness` of the four faces.
+//! `sensitivity` is present only with `--sweep`: the six rail tolerances,
+//! `"all"` (all six straightness tolerances scaled together, seed 000 Tab.
+//! 4.12), then the six carriage-side tolerances (`X.carriage_parallelism`,
+//! `X.carriage_flatness`, …). `side` is `rail`, `carriage` or `all`; `rank`
+//! orders the single tolerances of both sides by slope, 1 the largest
+//! (`null` for `all` and for a row without a slope).
 //! `normal` is the thesis's "vertical" straightness (normal to the rail
 //! mounting face), `lateral` its "horizontal". `p90` is the 90th percentile
 //! (linear interpolation, as NumPy's default). `slope_um_per_mm` is the
@@ -50,8 +58,8 @@ use tabled::settings::object::Columns;
 use tabled::settings::{Alignment, Style};
 
 use crate::model::monte_carlo::{
-    AxisStudyOptions, AxisStudyResult, BATCH_SIZE, RailDirection, Sensitivity, StudyOptions,
-    StudyResult,
+    AxisStudyOptions, AxisStudyResult, BATCH_SIZE, CarriageFace, RailDirection, Sensitivity, Side,
+    StudyOptions, StudyResult,
 };
 use crate::model::stats::{Histogram, Summary};
 use crate::model::{Axis, Grid, Machine, ProfileShape, SquarenessPair};
@@ -99,6 +107,8 @@ pub struct TolerancesJson {
     pub positioning_mm: BTreeMap<String, f64>,
     /// Largest squareness error per pair, µm/m.
     pub squareness_um_per_m: BTreeMap<String, f64>,
+    /// Carriage-side tolerances per saddle (`X.parallelism`, `X.flatness`), mm.
+    pub carriage_mm: BTreeMap<String, f64>,
 }
 
 /// The generator's shape.
@@ -139,14 +149,18 @@ pub struct HistogramJson {
 /// One row of the sensitivity table.
 #[derive(Clone, Debug, Serialize)]
 pub struct SensitivityJson {
-    /// `X.normal` … `Z.lateral`, or `all`.
+    /// `X.normal` … `Z.lateral`, `all`, or `X.carriage_parallelism` … `Z.carriage_flatness`.
     pub tolerance: String,
+    /// `rail`, `carriage` or `all`.
+    pub side: &'static str,
     /// The values it took, mm.
     pub values_mm: Vec<f64>,
     /// P90 of the largest volumetric error at each value, µm.
     pub p90_um: Vec<f64>,
     /// Least-squares slope, µm of P90 per mm of tolerance.
     pub slope_um_per_mm: Option<f64>,
+    /// Place by slope among the single tolerances of both sides (1 = largest).
+    pub rank: Option<usize>,
 }
 
 impl ToleranceJson {
@@ -167,7 +181,12 @@ impl ToleranceJson {
         let tolerances = &options.tolerances;
         let mut straightness_mm = BTreeMap::new();
         let mut positioning_mm = BTreeMap::new();
+        let mut carriage_mm = BTreeMap::new();
         for axis in Axis::ALL {
+            for face in CarriageFace::BOTH {
+                let key = format!("{axis}.{}", face.as_str());
+                carriage_mm.insert(key, tolerances.carriage(axis, face));
+            }
             for direction in RailDirection::BOTH {
                 let key = format!("{axis}.{}", direction.as_str());
                 straightness_mm.insert(key, tolerances.straightness(axis, direction));
@@ -191,6 +210,7 @@ impl ToleranceJson {
                 straightness_mm,
                 positioning_mm,
                 squareness_um_per_m,
+                carriage_mm,
             },
             profile: ProfileJson::from_shape(&options.shape),
             max_volumetric_um: MaxVolumetricJson {
@@ -201,8 +221,7 @@ impl ToleranceJson {
                 p90: mm_to_um(summary.p90),
             },
             histogram: HistogramJson::of(&in_um),
-            sensitivity: sensitivity
-                .map(|rows| rows.iter().map(SensitivityJson::from_row).collect()),
+            sensitivity: sensitivity.map(SensitivityJson::ranked),
         }
     }
 }
@@ -232,13 +251,25 @@ impl HistogramJson {
 }
 
 impl SensitivityJson {
-    fn from_row(row: &Sensitivity) -> SensitivityJson {
-        SensitivityJson {
-            tolerance: row.tolerance.name(),
-            values_mm: row.values_mm.clone(),
-            p90_um: row.p90_mm.iter().map(|v| mm_to_um(*v)).collect(),
-            slope_um_per_mm: row.slope.map(mm_to_um),
-        }
+    /// The rows in sweep order, each single tolerance ranked by its slope
+    /// as the report shows it (to 0.1 µm/mm): 1 the largest, equal slopes
+    /// one rank (several tolerances that change nothing share the last).
+    fn ranked(rows: &[Sensitivity]) -> Vec<SensitivityJson> {
+        let shown = |row: &Sensitivity| -> Option<i64> {
+            let slope = row.slope?;
+            (row.tolerance.side() != Side::All).then(|| (mm_to_um(slope) * 10.0).round() as i64)
+        };
+        let ranked: Vec<i64> = rows.iter().filter_map(shown).collect();
+        rows.iter()
+            .map(|row| SensitivityJson {
+                tolerance: row.tolerance.name(),
+                side: row.tolerance.side().as_str(),
+                values_mm: row.values_mm.clone(),
+                p90_um: row.p90_mm.iter().map(|v| mm_to_um(*v)).collect(),
+                slope_um_per_mm: row.slope.map(mm_to_um),
+                rank: shown(row).map(|own| 1 + ranked.iter().filter(|s| **s > own).count()),
+            })
+            .collect()
     }
 }
 
@@ -357,6 +388,29 @@ pub fn tolerance_report(report: &ToleranceJson) -> String {
         "Squareness   {}",
         describe(&t.squareness_um_per_m, "µm/m", "XY, XZ and YZ")
     );
+    let faces = |face: CarriageFace| -> BTreeMap<String, f64> {
+        t.carriage_mm
+            .iter()
+            .filter_map(|(key, value)| {
+                let (axis, name) = key.split_once('.')?;
+                (name == face.as_str()).then(|| (axis.to_string(), *value))
+            })
+            .collect()
+    };
+    let _ = writeln!(
+        out,
+        "Saddle faces parallelism {}; flatness {}",
+        describe(
+            &faces(CarriageFace::Parallelism),
+            "mm",
+            "the X, Y and Z saddles"
+        ),
+        describe(
+            &faces(CarriageFace::Flatness),
+            "mm",
+            "the X, Y and Z saddles"
+        )
+    );
     let p = &report.profile;
     let band = if p.band_width_factor == 1.0 {
         "±tol/2".to_string()
@@ -384,7 +438,8 @@ pub fn tolerance_report(report: &ToleranceJson) -> String {
     out.push_str(&text_histogram(&report.histogram, 40));
     if let Some(rows) = &report.sensitivity {
         out.push_str(
-            "\nSensitivity of P90 [µm] to one straightness tolerance (the others at their value)\n",
+            "\nSensitivity of P90 [µm] to one tolerance (the others at their value); \
+             rank by slope, rail and carriage side together\n",
         );
         out.push_str(&sensitivity_table(rows));
         out.push('\n');
@@ -425,25 +480,34 @@ fn text_histogram(histogram: &HistogramJson, width: usize) -> String {
 
 fn sensitivity_table(rows: &[SensitivityJson]) -> String {
     let mut builder = Builder::default();
-    let mut header = vec!["tolerance".to_string()];
+    let mut header = vec![
+        "rank".to_string(),
+        "tolerance".to_string(),
+        "side".to_string(),
+    ];
     if let Some(first) = rows.first() {
         header.extend(first.values_mm.iter().map(|v| format!("{v} mm")));
     }
     header.push("slope [µm/mm]".to_string());
     builder.push_record(header);
     for row in rows {
-        let mut record = vec![row.tolerance.clone()];
+        let mut record = vec![
+            row.rank.map_or(String::new(), |rank| rank.to_string()),
+            row.tolerance.clone(),
+            row.side.to_string(),
+        ];
         record.extend(row.p90_um.iter().map(|v| format!("{v:.1}")));
-        record.push(
-            row.slope_um_per_mm
-                .map_or("—".to_string(), |s| format!("{s:.1}")),
-        );
+        // A slope that rounds to zero is 0.0, not −0.0 (a rounding of 1e-13).
+        record.push(row.slope_um_per_mm.map_or("—".to_string(), |s| {
+            format!("{s:.1}").replace("-0.0", "0.0")
+        }));
         builder.push_record(record);
     }
     let mut table = builder.build();
     table
         .with(Style::markdown())
-        .modify(Columns::new(1..), Alignment::right());
+        .modify(Columns::new(3..), Alignment::right())
+        .modify(Columns::first(), Alignment::right());
     table.to_string()
 }
 
@@ -500,6 +564,59 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[0], "     0.0 –    1.0 │████████ 4");
         assert_eq!(lines[1], "     1.0 –    2.0 │██       1");
+    }
+
+    #[test]
+    fn ranks_both_sides_by_slope_and_ties_share_a_rank() {
+        use crate::model::monte_carlo::{CarriageFace, SweptTolerance};
+        let row = |tolerance, slope: f64| Sensitivity {
+            tolerance,
+            values_mm: vec![0.01, 0.02],
+            p90_mm: vec![0.08, 0.08 + 0.01 * slope],
+            slope: Some(slope),
+        };
+        let rows = [
+            row(
+                SweptTolerance::Straightness(Axis::X, RailDirection::Normal),
+                1.0,
+            ),
+            row(
+                SweptTolerance::Straightness(Axis::X, RailDirection::Lateral),
+                0.1,
+            ),
+            row(SweptTolerance::AllStraightness, 3.0),
+            row(
+                SweptTolerance::Carriage(Axis::X, CarriageFace::Parallelism),
+                0.25,
+            ),
+            row(
+                SweptTolerance::Carriage(Axis::X, CarriageFace::Flatness),
+                -4e-16,
+            ),
+            row(
+                SweptTolerance::Carriage(Axis::Z, CarriageFace::Flatness),
+                0.0,
+            ),
+        ];
+        let json = SensitivityJson::ranked(&rows);
+        let ranks: Vec<Option<usize>> = json.iter().map(|r| r.rank).collect();
+        // 1000 > 250 > 100 > 0 = 0 µm/mm; `all` is not ranked.
+        assert_eq!(ranks, [Some(1), Some(3), None, Some(2), Some(4), Some(4)]);
+        let sides: Vec<&str> = json.iter().map(|r| r.side).collect();
+        assert_eq!(
+            sides,
+            ["rail", "rail", "all", "carriage", "carriage", "carriage"]
+        );
+        let table = sensitivity_table(&json);
+        let flatness = table
+            .lines()
+            .find(|line| line.contains("X.carriage_flatness"))
+            .unwrap();
+        assert!(flatness.ends_with("|           0.0 |"), "{flatness}");
+        assert!(
+            table.contains("|    2 | X.carriage_parallelism | carriage |"),
+            "{table}"
+        );
     }
 
     #[test]

@@ -16,13 +16,15 @@
 //! - [`iso_cycle`]: a simulated ISO 230-2 linear test (a `Measurement`,
 //!   evaluated), with a structural compliance between drive and laser.
 //! - [`reversal`]: B ≈ 2·F_res/k_c (the simulated ISO cycle's report uses
-//!   it) and its inverse (no caller yet: a later issue reads a measured B
-//!   as a friction force with it).
+//!   it) and its inverse (`diagnose::friction` reads a measured B as the
+//!   friction force held through the structure with it).
 //! - [`force_step`]: the force-step (impact compliance) test; and a
 //!   constant-velocity run.
-//! - [`identify`]: the thesis's identification arithmetic (the bundled
-//!   axes use the LuGre damping; the rest is checked against the thesis but
-//!   has no caller yet).
+//! - [`identify`]: the thesis's identification arithmetic (every axis
+//!   file uses the LuGre damping; [`friction_fit`] the linear fit of the
+//!   constant-velocity currents).
+//! - [`friction_fit`]: `servo-sim --identify`, F_C and μ_v from a
+//!   constant-velocity record and k_s from a measured circle reversal.
 //!
 //! Lengths are metres inside this module (the model is SI throughout);
 //! results that leave it for a `Measurement` are converted to mm through
@@ -35,6 +37,7 @@ pub mod axis;
 pub mod circle;
 pub mod force_step;
 pub mod friction;
+pub mod friction_fit;
 pub mod identify;
 pub mod iso_cycle;
 pub mod linear;

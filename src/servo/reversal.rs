@@ -21,8 +21,9 @@
 //! increment from where the quantised loop comes to rest). `iso_cycle`
 //! simulates this in full; these two functions are the closed form. The
 //! first turns a simulated cycle's residual friction into a reversal
-//! ([`super::iso_cycle::ResidualFriction`]); the inverse has no caller yet
-//! (nothing reads a measured B as a friction force or a compliance so far). Both work with magnitudes: B ≥ 0, F ≥ 0, k_c > 0.
+//! ([`super::iso_cycle::ResidualFriction`]); the inverse reads the reversal
+//! `diagnose` finds as the friction force behind it (`diagnose::friction`,
+//! given the axis's servo description and k_c). Both work with magnitudes: B ≥ 0, F ≥ 0, k_c > 0.
 
 /// B ≈ 2·F_res/k_c, µm, for a residual friction force in N and a structural
 /// stiffness in N/µm.

@@ -25,33 +25,7 @@ fn diagnose_finds_the_reversal_and_the_next_table_and_prediction_use_it() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     std::fs::write(path("truth.toml"), TRUTH).unwrap();
-    run_ok(&[
-        "synth",
-        "--truth",
-        &path("truth.toml"),
-        "-o",
-        &path("before.rtl"),
-    ]);
-    run_ok(&[
-        "convert",
-        &path("before.rtl"),
-        "--controller",
-        "tnc640",
-        "-o",
-        &path("X.COM"),
-        "-q",
-    ]);
-    run_ok(&[
-        "synth",
-        "--truth",
-        &path("truth.toml"),
-        "-o",
-        &path("before2.rtl"),
-        "--table",
-        &path("X.COM"),
-        "--o2",
-        &path("after.rtl"),
-    ]);
+    crate::util::synth_loop_files(dir.path(), &dir.path().join("truth.toml"), None);
     // The same seed writes the same first test.
     assert_eq!(
         std::fs::read(path("before.rtl")).unwrap(),

@@ -217,41 +217,7 @@ fn the_bundled_demo_files_are_what_the_truth_gives() {
     let demo = root().join("fixtures/demo");
     let path = |name: &str| directory.path().join(name).to_str().unwrap().to_string();
     let fixture = |name: &str| demo.join(name).to_str().unwrap().to_string();
-    let ok = |args: &[&str]| {
-        let run = axcomp(args);
-        assert_eq!(run.code, 0, "{}", run.stderr);
-    };
-    ok(&[
-        "synth",
-        "--truth",
-        &fixture("truth.toml"),
-        "-o",
-        &path("before.rtl"),
-        "--seed",
-        "2026",
-    ]);
-    ok(&[
-        "convert",
-        &path("before.rtl"),
-        "--controller",
-        "tnc640",
-        "-o",
-        &path("X.COM"),
-        "-q",
-    ]);
-    ok(&[
-        "synth",
-        "--truth",
-        &fixture("truth.toml"),
-        "-o",
-        &path("before2.rtl"),
-        "--seed",
-        "2026",
-        "--table",
-        &path("X.COM"),
-        "--o2",
-        &path("after.rtl"),
-    ]);
+    crate::util::synth_loop_files(directory.path(), &demo.join("truth.toml"), Some("2026"));
     for name in ["before.rtl", "X.COM", "after.rtl"] {
         let made = std::fs::read(path(name)).unwrap();
         let bundled = std::fs::read(fixture(name)).unwrap();

@@ -100,6 +100,56 @@ fn p90_agrees_with_the_numpy_peer_and_the_thesis() {
 }
 
 #[test]
+fn carriage_side_agrees_with_the_numpy_peer_extended_to_it() {
+    // benches/reference/mc_peer_carriage.py 50000 1 --carriage-parallelism
+    // 0.03 --carriage-flatness 0.03 (the peer with the saddles' pads added
+    // under the carriages): mean 66.66, P90 88.08 µm; 2,000 samples give P90
+    // to about ±1 %.
+    let json = tolerance_json(&[
+        "--samples",
+        "2000",
+        "--carriage-parallelism",
+        "0.03",
+        "--carriage-flatness",
+        "0.03",
+    ]);
+    let p90 = number(&json["max_volumetric_um"]["p90"]);
+    let mean = number(&json["max_volumetric_um"]["mean"]);
+    assert!((p90 - 88.08).abs() < 0.03 * 88.08, "P90 {p90} µm");
+    assert!((mean - 66.66).abs() < 0.03 * 66.66, "mean {mean} µm");
+    let carriage = &json["tolerances"]["carriage_mm"];
+    assert_eq!(carriage["X.parallelism"], 0.03);
+    assert_eq!(carriage["Z.flatness"], 0.03);
+    // One saddle on its own, the others none.
+    let json = tolerance_json(&["--samples", "10", "--carriage", "y.parallelism=0.02"]);
+    let carriage = &json["tolerances"]["carriage_mm"];
+    assert_eq!(carriage["Y.parallelism"], 0.02);
+    assert_eq!(carriage["X.parallelism"], 0.0);
+    let text = axcomp([
+        "tolerance",
+        "--samples",
+        "10",
+        "--carriage",
+        "y.parallelism=0.02",
+    ]);
+    assert!(
+        text.stdout
+            .contains("Saddle faces parallelism X 0, Y 0.02, Z 0 mm; flatness none\n"),
+        "{}",
+        text.stdout
+    );
+    let refused = axcomp(["tolerance", "--single-axis", "--carriage-flatness", "0.01"]);
+    assert_eq!(refused.code, 2);
+    assert!(
+        refused
+            .stderr
+            .contains("--carriage-flatness applies to the machine study"),
+        "{}",
+        refused.stderr
+    );
+}
+
+#[test]
 fn sweep_reports_slopes_and_ranks_normal_above_lateral() {
     let json = tolerance_json(&[
         "--samples",
@@ -122,15 +172,39 @@ fn sweep_reports_slopes_and_ranks_normal_above_lateral() {
             "Y.lateral",
             "Z.normal",
             "Z.lateral",
-            "all"
+            "all",
+            "X.carriage_parallelism",
+            "X.carriage_flatness",
+            "Y.carriage_parallelism",
+            "Y.carriage_flatness",
+            "Z.carriage_parallelism",
+            "Z.carriage_flatness",
         ]
     );
     let baseline = number(&json["max_volumetric_um"]["p90"]);
     for row in rows {
         assert_eq!(row["values_mm"], serde_json::json!([0.015, 0.03, 0.045]));
-        // The middle value is the base tolerance: the base run's P90.
-        assert_eq!(number(&row["p90_um"][1]), baseline);
+        // The middle value is the base rail tolerance: the base run's P90.
+        if row["side"] != "carriage" {
+            assert_eq!(number(&row["p90_um"][1]), baseline);
+        }
     }
+    // One ranking over both sides: ranks 1 … n, `all` unranked; the
+    // flatness of the saddles (equal carriages) and the tilt of the Z saddle
+    // (fixed to the tool) change nothing and share the last rank.
+    let rank = |name: &str| rows.iter().find(|r| r["tolerance"] == name).unwrap()["rank"].clone();
+    assert_eq!(rank("all"), Value::Null);
+    // The thesis's two leading tolerances (Tab. 4.14) lead here too.
+    assert!(rank("X.normal") == 1 || rank("Y.normal") == 1);
+    let last = rank("X.carriage_flatness");
+    for name in [
+        "Y.carriage_flatness",
+        "Z.carriage_flatness",
+        "Z.carriage_parallelism",
+    ] {
+        assert_eq!(rank(name), last, "{name}");
+    }
+    assert_eq!(last, 9);
     let slope = |name: &str| {
         let row = rows.iter().find(|r| r["tolerance"] == name).unwrap();
         number(&row["slope_um_per_mm"])

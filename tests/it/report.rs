@@ -247,6 +247,7 @@ impl RetestCase {
             table: Some(&table),
             backlash_set: false,
             angular: None,
+            known_periods: &[],
             timing: CycleTiming::ASSUMED,
             standard: &ISO_230_2,
         })

@@ -89,3 +89,59 @@ pub fn assert_golden(actual: &str, golden: &Path) {
         );
     }
 }
+
+/// The loop's files from a truth through the binary, into `dir`: the first
+/// test `before.rtl` (`synth`), its TNC 640 table `X.COM` (`convert`), and
+/// the re-test `after.rtl` with the table applied (`synth --table`, which
+/// writes the first test again as `before2.rtl`); `seed` as `synth --seed`.
+pub fn synth_loop_files(dir: &Path, truth: &Path, seed: Option<&str>) {
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let truth = truth.to_str().unwrap();
+    let ok = |args: Vec<&str>| {
+        let run = axcomp(&args);
+        assert_eq!(run.code, 0, "axcomp {}: {}", args.join(" "), run.stderr);
+    };
+    let seed: Vec<&str> = seed.map_or(Vec::new(), |s| vec!["--seed", s]);
+    let before = path("before.rtl");
+    ok([vec!["synth", "--truth", truth, "-o", &before], seed.clone()].concat());
+    let table = path("X.COM");
+    ok(vec![
+        "convert",
+        &before,
+        "--controller",
+        "tnc640",
+        "-o",
+        &table,
+        "-q",
+    ]);
+    let (before2, after) = (path("before2.rtl"), path("after.rtl"));
+    ok([
+        vec!["synth", "--truth", truth, "-o", &before2],
+        seed,
+        vec!["--table", &table, "--o2", &after],
+    ]
+    .concat());
+}
+
+/// The first test of a truth, a mean table at its targets, and the re-test
+/// with that table applied (the library's `synth`, as `synth_loop_files`).
+pub fn synth_loop(
+    truth: &axcomp::synth::Truth,
+    seed: u64,
+) -> (
+    axcomp::measurement::Measurement,
+    axcomp::compensate::CompensationTable,
+    axcomp::measurement::Measurement,
+) {
+    use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
+    let before = axcomp::synth::before(truth, seed).unwrap();
+    let options = TableOptions {
+        mode: TableMode::Mean,
+        grid: GridSpec::Targets,
+        reference_mm: None,
+        extrapolate: Extrapolate::Hold,
+    };
+    let table = build_table(&before, &axcomp::evaluate::evaluate(&before), &options).unwrap();
+    let after = axcomp::synth::after(truth, &table, seed).unwrap();
+    (before, table, after)
+}
