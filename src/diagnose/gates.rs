@@ -131,13 +131,7 @@ pub(super) fn set_rejection(rejected: &mut Vec<RejectedEffect>, kind: Kind, why:
 /// 230-2's reason to recommend them; Eyer & Bartholdi 1999), from
 /// [`SHORTEST_PERIOD_MM`] or twice the median spacing if that is shorter.
 pub(super) fn period_range(targets_mm: &[f64], min_periods: f64) -> Option<(f64, f64)> {
-    if targets_mm.len() < 8 {
-        return None;
-    }
-    let mut gaps: Vec<f64> = targets_mm.windows(2).map(|p| p[1] - p[0]).collect();
-    gaps.sort_by(f64::total_cmp);
-    let median = gaps[gaps.len() / 2];
-    let span = targets_mm[targets_mm.len() - 1] - targets_mm[0];
+    let (median, span) = median_gap_and_span(targets_mm)?;
     let shortest = match crate::compensate::regular_step(targets_mm) {
         Some(step) => 2.0 * step,
         None => (2.0 * median).min(SHORTEST_PERIOD_MM),
@@ -146,19 +140,26 @@ pub(super) fn period_range(targets_mm: &[f64], min_periods: f64) -> Option<(f64,
     (shortest < longest).then_some((shortest, longest))
 }
 
+/// The median spacing and the span of at least 8 targets (fewer resolve no period).
+fn median_gap_and_span(targets: &[f64]) -> Option<(f64, f64)> {
+    if targets.len() < 8 {
+        return None;
+    }
+    let mut gaps: Vec<f64> = targets.windows(2).map(|p| p[1] - p[0]).collect();
+    gaps.sort_by(f64::total_cmp);
+    Some((
+        gaps[gaps.len() / 2],
+        targets[targets.len() - 1] - targets[0],
+    ))
+}
+
 /// A rotary axis' periods: the whole orders per revolution (lowest,
 /// highest), the period 360°/order, from one period within the range
 /// against a prediction (over a full turn a once-per-revolution term is
 /// periodic by the geometry, not a slope; [`MIN_PERIODS_IN_CURVE`] in a
 /// test's own curve) up to twice the median spacing (Nyquist).
 pub(super) fn rotary_orders(targets_deg: &[f64], against_prediction: bool) -> Option<(u32, u32)> {
-    if targets_deg.len() < 8 {
-        return None;
-    }
-    let mut gaps: Vec<f64> = targets_deg.windows(2).map(|p| p[1] - p[0]).collect();
-    gaps.sort_by(f64::total_cmp);
-    let median = gaps[gaps.len() / 2];
-    let span = targets_deg[targets_deg.len() - 1] - targets_deg[0];
+    let (median, span) = median_gap_and_span(targets_deg)?;
     let periods_in_range = if against_prediction {
         1.0
     } else {
