@@ -373,14 +373,14 @@ pub fn load_equipment(args: &UncertaintyArgs) -> Result<Equipment> {
     Ok(equipment.with_drift_test(&read.measurement, &drift_path.display().to_string()))
 }
 
-/// Refuses a rotary axis where a command handles linear axes only (the
-/// acceptance report, prediction and diagnosis are µm and mm throughout;
-/// rotary axes there are issue 14's later part).
+/// Refuses a rotary axis where a command handles linear axes only
+/// (prediction is µm and mm throughout, on the volumetric model; rotary axes
+/// there are issue 14's later part).
 pub fn linear_only(measurement: &Measurement, command: &str) -> Result<()> {
     if measurement.kind() == AxisKind::Rotary {
         anyhow::bail!(
             "axis {} is a rotary axis: {command} handles linear axes only so far; \
-             `axcomp evaluate` and `axcomp convert` take rotary axes",
+             `axcomp evaluate`, `convert`, `report` and `diagnose` take rotary axes",
             measurement.axis()
         );
     }
