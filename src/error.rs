@@ -238,6 +238,8 @@ pub enum Doubt {
     },
     /// The ranges overlap only in part.
     PartialOverlap {
+        /// After a position: ` mm`, or `°` on a rotary axis.
+        unit: &'static str,
         /// The first input.
         first: String,
         /// Its range, mm.
@@ -275,6 +277,7 @@ impl fmt::Display for Doubt {
                 second_unit.as_str()
             ),
             Doubt::PartialOverlap {
+                unit,
                 first,
                 first_mm,
                 second,
@@ -282,7 +285,7 @@ impl fmt::Display for Doubt {
                 consequence,
             } => write!(
                 f,
-                "{first} covers {} … {} mm, {second} {} … {} mm: they overlap only in part; {consequence}",
+                "{first} covers {} … {}{unit}, {second} {} … {}{unit}: they overlap only in part; {consequence}",
                 first_mm.0, first_mm.1, second_mm.0, second_mm.1
             ),
         }

@@ -178,6 +178,7 @@ fn stage(path: &Path, contents: &[u8]) -> Result<tempfile::NamedTempFile, Output
             folder: directory.to_path_buf(),
         });
     }
+    #[cfg_attr(not(unix), allow(unused_mut))]
     let mut builder = tempfile::Builder::new();
     // tempfile creates its files 0600, right for a secret but wrong for a
     // table or a report that others must read: ask for 0666 and let the

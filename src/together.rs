@@ -15,7 +15,7 @@
 use std::path::Path;
 
 use crate::error::{Doubt, Warning};
-use crate::measurement::Measurement;
+use crate::measurement::{AxisKind, Measurement};
 use crate::units::LengthUnit;
 
 /// What the two inputs are to each other: it decides what is refused and
@@ -44,8 +44,11 @@ pub struct Input<'a> {
     pub machine: Option<&'a str>,
     /// The length unit of the original file, when it is a measurement file.
     pub length_unit: Option<LengthUnit>,
-    /// First and last target (or compensation point), mm.
+    /// First and last target (or compensation point), mm (° on a rotary axis).
     pub range_mm: (f64, f64),
+    /// Linear or rotary, when a measurement says (a table's points are in
+    /// the unit of the test it is paired with): the unit the messages say.
+    pub kind: Option<AxisKind>,
     /// The file it was read from, if known.
     pub file: Option<&'a Path>,
     /// The readings, to recognise the same test given twice (tables have none).
@@ -62,6 +65,7 @@ impl<'a> Input<'a> {
             machine: measurement.metadata.machine.as_deref(),
             length_unit: Some(measurement.metadata.length_unit),
             range_mm: (targets[0], targets[targets.len() - 1]),
+            kind: Some(measurement.kind()),
             file: measurement.metadata.source_file.as_deref(),
             readings: Some(measurement),
         }
@@ -78,6 +82,7 @@ impl<'a> Input<'a> {
             machine: None,
             length_unit: None,
             range_mm: (first, last),
+            kind: None,
             file: None,
             readings: None,
         }
@@ -121,9 +126,11 @@ pub enum NotTogether {
     },
     /// The target ranges have nothing in common.
     #[error(
-        "{first} covers {first_from} … {first_to} mm, {second} {second_from} … {second_to} mm: the ranges do not overlap, so they are not {what}"
+        "{first} covers {first_from} … {first_to}{unit}, {second} {second_from} … {second_to}{unit}: the ranges do not overlap, so they are not {what}"
     )]
     DisjointRanges {
+        /// After a position: ` mm`, or `°` on a rotary axis.
+        unit: &'static str,
         /// The first input.
         first: String,
         /// Its first target, mm.
@@ -200,11 +207,17 @@ pub fn check_together(
     }
     let (a_from, a_to) = first.range_mm;
     let (b_from, b_to) = second.range_mm;
+    let unit = if [first.kind, second.kind].contains(&Some(AxisKind::Rotary)) {
+        "°"
+    } else {
+        " mm"
+    };
     let common_mm = a_to.min(b_to) - a_from.max(b_from);
     // A single common point is no common stretch (a table's end point on a test's start).
     let tolerance_mm = 1e-6;
     if common_mm.is_nan() || common_mm <= tolerance_mm {
         return Err(NotTogether::DisjointRanges {
+            unit,
             first: first.label.clone(),
             first_from: a_from,
             first_to: a_to,
@@ -251,6 +264,7 @@ pub fn check_together(
     };
     if partial {
         warnings.push(Warning::Doubtful(Doubt::PartialOverlap {
+            unit,
             first: first.label.clone(),
             first_mm: first.range_mm,
             second: second.label.clone(),
@@ -316,6 +330,44 @@ mod tests {
             &Input::measurement(a, "a.rtl"),
             &Input::measurement(b, "b.rtl"),
         )
+    }
+
+    /// Issue 14: a rotary axis' ranges are said in degrees, not mm.
+    #[test]
+    fn a_rotary_axis_ranges_are_in_degrees() {
+        let rotary =
+            |targets: Vec<f64>| test("C", targets, 0.0001, "M1").with_kind(AxisKind::Rotary);
+        let (full, upper, part) = (
+            rotary(vec![0.0, 90.0, 180.0, 270.0, 360.0]),
+            rotary(vec![400.0, 450.0, 500.0]),
+            rotary(vec![0.0, 90.0, 180.0]),
+        );
+        let refused = check(Pairing::BeforeAfter, &full, &upper).unwrap_err();
+        assert_eq!(
+            refused.to_string(),
+            "a.rtl covers 0 … 360°, b.rtl 400 … 500°: the ranges do not overlap, so they are not a test and its re-test"
+        );
+        let doubts = check(Pairing::BeforeAfter, &full, &part).unwrap();
+        assert!(
+            doubts[0]
+                .to_string()
+                .starts_with("a.rtl covers 0 … 360°, b.rtl 0 … 180°: they overlap only in part"),
+            "{}",
+            doubts[0]
+        );
+        // A table (its kind unknown) takes the unit of the rotary test.
+        let table = Input::table("C", &[400.0, 500.0], "C.comp");
+        let refused = check_together(
+            Pairing::TableOnTest,
+            &table,
+            &Input::measurement(&full, "c.csv"),
+        )
+        .unwrap_err();
+        assert!(
+            refused
+                .to_string()
+                .starts_with("C.comp covers 400 … 500°, c.csv 0 … 360°")
+        );
     }
 
     #[test]

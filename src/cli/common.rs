@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use axcomp::compensate::CompensationTable;
 use axcomp::effects::{Effect, read_effects};
-use axcomp::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
+use axcomp::emit::{Controller, EmitError, EmitOptions, MachineProfile};
 use axcomp::error::{ParseError, Warning};
 use axcomp::evaluate::Standard;
 use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
@@ -19,6 +19,7 @@ use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::LengthUnit;
+use axcomp::workflow;
 
 /// `--format NAME`: one of the input formats.
 pub fn parse_format(name: &str) -> Result<SourceFormat, String> {
@@ -195,15 +196,7 @@ pub fn read_table_of(
     options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
     options.kind = kind;
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
-    let (text, _) = emit::decode_table(&bytes).map_err(|error| in_file(path, error))?;
-    if emit::fagor8055::looks_like(&text) {
-        options.machine_unit = profile.table_unit(Controller::Fagor8055, test_unit);
-    }
-    emit::read_any(&text, &options, None)
-        .or_else(|error| match linuxcnc_type {
-            Some(kind) => emit::read_any(&text, &options, Some(kind)),
-            None => Err(error),
-        })
+    workflow::read_table(&bytes, options, profile, test_unit, linuxcnc_type)
         .map_err(|error| in_file(path, error))
 }
 
@@ -380,14 +373,14 @@ pub fn load_equipment(args: &UncertaintyArgs) -> Result<Equipment> {
     Ok(equipment.with_drift_test(&read.measurement, &drift_path.display().to_string()))
 }
 
-/// Refuses a rotary axis where a command handles linear axes only (the
-/// acceptance report, prediction and diagnosis are µm and mm throughout;
-/// rotary axes there are issue 14's later part).
+/// Refuses a rotary axis where a command handles linear axes only
+/// (prediction is µm and mm throughout, on the volumetric model; rotary axes
+/// there are issue 14's later part).
 pub fn linear_only(measurement: &Measurement, command: &str) -> Result<()> {
     if measurement.kind() == AxisKind::Rotary {
         anyhow::bail!(
             "axis {} is a rotary axis: {command} handles linear axes only so far; \
-             `axcomp evaluate` and `axcomp convert` take rotary axes",
+             `axcomp evaluate`, `convert`, `report` and `diagnose` take rotary axes",
             measurement.axis()
         );
     }

@@ -4,15 +4,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use axcomp::compensate::plan::{Request, plan};
+use axcomp::compensate::plan::Request;
 use axcomp::compensate::{self, Extrapolate, TableMode};
-use axcomp::emit::{self, Controller, EmitOptions};
-use axcomp::evaluate::evaluate;
+use axcomp::emit::{Controller, EmitOptions};
 use axcomp::evaluate::straightness::ReferenceLine;
-use axcomp::measurement::{AxisKind, RunSelector};
+use axcomp::measurement::RunSelector;
 use axcomp::output::write_new;
 use axcomp::read;
-use axcomp::report::convert::ConvertJson;
+use axcomp::workflow::{self, Converted, TableRequest};
 
 use super::common::{
     InputFormat, JsonOutput, MachineFile, Overwrite, Verbosity, load_effects, load_profile,
@@ -64,7 +63,7 @@ pub struct ConvertArgs {
     ///
     /// Default: mean, or bidirectional when --effects has a reversal and the
     /// controller takes bidirectional tables.
-    #[arg(long, value_name = "MODE", value_parser = parse_mode, help_heading = "Table")]
+    #[arg(long, value_name = "MODE", value_parser = TableMode::from_name, help_heading = "Table")]
     pub mode: Option<TableMode>,
 
     /// First compensation point, mm (default: the first target).
@@ -101,7 +100,7 @@ pub struct ConvertArgs {
 
     /// Points outside the measured range: hold the end value, or zero.
     /// Without it such points are refused.
-    #[arg(long, value_name = "RULE", value_parser = parse_extrapolate, help_heading = "Grid")]
+    #[arg(long, value_name = "RULE", value_parser = Extrapolate::from_name, help_heading = "Grid")]
     pub extrapolate: Option<Extrapolate>,
 
     /// The table that was active during the measurement (any format convert writes).
@@ -187,22 +186,6 @@ fn parse_reference_line(name: &str) -> Result<ReferenceLine, String> {
         .ok_or_else(|| format!("expected least-squares or end-points, found {name:?}"))
 }
 
-fn parse_mode(name: &str) -> Result<TableMode, String> {
-    match name {
-        "mean" => Ok(TableMode::Mean),
-        "bidirectional" => Ok(TableMode::Bidirectional),
-        _ => Err(format!("expected mean or bidirectional, found {name:?}")),
-    }
-}
-
-fn parse_extrapolate(name: &str) -> Result<Extrapolate, String> {
-    match name {
-        "hold" => Ok(Extrapolate::Hold),
-        "zero" => Ok(Extrapolate::Zero),
-        _ => Err(format!("expected hold or zero, found {name:?}")),
-    }
-}
-
 /// Runs `axcomp convert`.
 pub fn run(args: &ConvertArgs) -> Result<()> {
     // A straightness test gives a cross-axis table (`cross_axis`), not the axis's own.
@@ -264,60 +247,41 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         warnings.extend(doubts);
         measurement = compensate::add_existing_table(&measurement, &active)?;
     }
-    let evaluation = evaluate(&measurement);
-    warnings.extend(evaluation.warnings.iter().cloned());
     let effects = match &args.effects {
         Some(path) => load_effects(path)?,
         None => Vec::new(),
     };
-    let plan = plan(
-        measurement.targets_mm(),
-        &effects,
-        &args.controller.capabilities(profile.machine_unit()),
-        &Request {
-            mode: args.mode,
-            step_mm: args.step,
-            start_mm: args.start,
-            count: args.count,
-            reference_mm: args.reference,
-            extrapolate: args.extrapolate,
-        },
-    )?;
-    let table = compensate::effects::build_table_with_effects(
-        &measurement,
-        &evaluation,
-        &plan.options,
-        &effects,
-    )?;
     // A Fagor 8065 table goes back into the .mp file that was active.
     let existing_bytes = match &args.existing {
         Some(path) => Some(std::fs::read(path).with_context(|| path.display().to_string())?),
         None => None,
     };
-    let bytes = emit::write_bytes(args.controller, &table, &options, existing_bytes.as_deref())?;
-    write_new(&args.output, &bytes, args.overwrite.force)?;
     let file_name = args.output.file_name().map_or_else(
         || args.output.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let activation = emit::activation(args.controller, &table, &file_name, &options);
-    let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
-    let mut report = ConvertJson::new(
-        measurement.kind(),
-        args.controller.name(),
-        args.output.display().to_string(),
-        &table,
-        args.also.clone(),
-        activation,
-        warning_texts,
-    );
-    report.effects = plan.notes;
-    if measurement.kind() == AxisKind::Linear {
-        report.file_unit = options.machine_unit.as_str();
-    }
-    if let Some(backlash_mm) = table.suggested_backlash_mm {
-        report.set_backlash(args.controller.backlash_parameter(backlash_mm, &options));
-    }
+    let Converted { bytes, report, .. } = workflow::convert(
+        &measurement,
+        &mut warnings,
+        &TableRequest {
+            controller: args.controller,
+            options: &options,
+            request: &Request {
+                mode: args.mode,
+                step_mm: args.step,
+                start_mm: args.start,
+                count: args.count,
+                reference_mm: args.reference,
+                extrapolate: args.extrapolate,
+            },
+            effects: &effects,
+            existing: existing_bytes.as_deref(),
+            output: args.output.display().to_string(),
+            file_name,
+            also: args.also.clone(),
+        },
+    )?;
+    write_new(&args.output, &bytes, args.overwrite.force)?;
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

@@ -255,14 +255,11 @@ fn emit_options(axis: &str) -> Result<EmitOptions> {
 
 /// Where a controller's table goes: one folder per controller, its usual extension.
 fn table_path(controller: Controller, axis: &str) -> String {
-    let file = match controller {
-        Controller::Itnc530 | Controller::Tnc640 => format!("{axis}.COM"),
-        Controller::Sinumerik840d => format!("{axis}.MPF"),
-        Controller::LinuxCnc => format!("{}.comp", axis.to_ascii_lowercase()),
-        Controller::Fagor8055 => format!("AL{axis}"),
-        Controller::Fagor8065 => format!("{axis}.mp"),
-    };
-    format!("tables/{}/{file}", controller.name())
+    format!(
+        "tables/{}/{}",
+        controller.name(),
+        controller.file_name(axis)
+    )
 }
 
 /// The table after the re-test: the active table plus the residual the re-test

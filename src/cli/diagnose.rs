@@ -9,6 +9,7 @@ use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::friction::friction_behind_reversal;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, KnownPeriod, diagnose};
 use axcomp::emit::AxisPeriods;
+use axcomp::measurement::AxisKind;
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, FrictionJson, render};
@@ -103,7 +104,23 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let mut after = read::read_path(&args.after, None)?;
     print_warnings(&after.warnings, args.verbosity.quiet);
     name_axis(&mut after.measurement, args.axis.as_ref());
-    super::common::linear_only(&after.measurement, "diagnose")?;
+    if after.measurement.kind() == AxisKind::Rotary {
+        // Issue 14: a rotary re-test is diagnosed in ″ (per-revolution
+        // harmonics, reversal, outlier runs); its effects file and an Abbe
+        // profile are lengths, for linear axes only so far.
+        for (given, flag) in [
+            (args.write_effects.is_some(), "--write-effects"),
+            (args.angular.is_some(), "--angular"),
+            (args.servo_axis.is_some(), "--servo-axis"),
+        ] {
+            if given {
+                anyhow::bail!(
+                    "axis {} is a rotary axis: {flag} is for linear axes only so far (an effects file, an angular profile and a servo description are in mm, µm and N)",
+                    after.measurement.axis()
+                );
+            }
+        }
+    }
     let before = match &args.before {
         Some(path) => {
             let mut result = read::read_path(path, None)?;
@@ -176,8 +193,10 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
             bail!("--compliance-n-um: expected a number > 0, found {compliance}");
         }
         let axis = load_axis(servo_axis)?;
-        report.friction = friction_behind_reversal(&diagnosis, &axis, compliance)
-            .map(|f| FrictionJson::new(servo_axis, &f));
+        report.set_friction(
+            friction_behind_reversal(&diagnosis, &axis, compliance)
+                .map(|f| FrictionJson::new(servo_axis, &f)),
+        );
     }
     if args.json_output.json {
         print_json(&report)

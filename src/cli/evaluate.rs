@@ -5,15 +5,15 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 
 use axcomp::evaluate::evaluate_with;
-use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector};
+use axcomp::measurement::{Direction, Measurement, RunSelector};
 use axcomp::read;
-use axcomp::report::uncertainty::UncertaintyJson;
-use axcomp::report::{json::EvaluationJson, terminal, verdict};
+use axcomp::report::terminal;
+use axcomp::workflow::evaluation_report;
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     InputFormat, JsonOutput, MachineFile, StandardArg, UncertaintyArgs, Verbosity, load_equipment,
-    name_axis, parse_run_selector, print_json, print_text, print_warnings, uncertainty_budget,
+    name_axis, parse_run_selector, print_json, print_text, print_warnings,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -90,29 +90,15 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         &args.acceptance,
     )?;
     let equipment = load_equipment(&args.uncertainty)?;
-    warnings.extend(evaluation.warnings.iter().cloned());
-    // The budget is the laser's, for lengths, and limits are µm: a rotary
-    // axis has neither yet (issue 14's later part).
-    let budget = match measurement.kind() {
-        AxisKind::Rotary if !limits.is_empty() => bail!(
-            "axis {} is a rotary axis: acceptance limits (--limit, a profile's [acceptance]) are µm, for linear axes only so far",
-            measurement.axis()
-        ),
-        AxisKind::Rotary => None,
-        AxisKind::Linear => Some(uncertainty_budget(&measurement, &equipment)?),
-    };
-    let verdict = budget.as_ref().and_then(|budget| {
-        verdict::judge(
-            &evaluation,
-            &limits,
-            args.uncertainty.decision,
-            Some(budget),
-        )
-    });
-    let mut report =
-        EvaluationJson::from_evaluation(&measurement, evaluation, &args.exclude_runs, &warnings);
-    report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
-    report.verdict = verdict;
+    let report = evaluation_report(
+        &measurement,
+        evaluation,
+        &args.exclude_runs,
+        &mut warnings,
+        &limits,
+        &equipment,
+        args.uncertainty.decision,
+    )?;
     // The report holds all it prints. The readings go first, so that the
     // text rendered from a large test (megabytes) takes memory already in
     // use rather than new pages.

@@ -15,6 +15,7 @@ mod evaluate;
 mod predict;
 mod progress;
 mod report;
+mod serve;
 mod servo_sim;
 mod synth;
 mod tolerance;
@@ -101,6 +102,13 @@ pub enum Command {
     /// the before/after comparison, with --table the table and the predicted
     /// re-test, with --diagnose the diagnosis. --png writes the plots as PNG.
     Report(Box<report::ReportArgs>),
+    /// Start the local web app: evaluate, convert and report in the browser.
+    ///
+    /// Serves one page on http://127.0.0.1:8230/ (this machine only, unless
+    /// --listen) and opens it: drop a measurement file, pick the controller
+    /// and grid, download the table and the acceptance report. The same
+    /// numbers and files as the commands; everything stays in memory.
+    Serve(serve::ServeArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -195,6 +203,7 @@ fn run(args: Args) -> Result<()> {
         Command::Tolerance(tolerance_args) => tolerance::run(&tolerance_args),
         Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
         Command::Report(report_args) => report::run(&report_args),
+        Command::Serve(serve_args) => serve::run(&serve_args),
     }
 }
 

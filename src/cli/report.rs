@@ -7,24 +7,23 @@ use anyhow::{Context, Result};
 
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, diagnose};
-use axcomp::error::Warning;
-use axcomp::evaluate::uncertainty::{Budget, Equipment};
+use axcomp::evaluate::Standard;
+use axcomp::evaluate::uncertainty::Equipment;
 use axcomp::evaluate::verdict::Decision;
-use axcomp::evaluate::{Evaluation, Standard, evaluate_with};
 use axcomp::measurement::{AxisKind, Measurement, SourceFormat};
 use axcomp::output::write_all_new;
 use axcomp::read;
-use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
+use axcomp::report::acceptance::{ReportInput, TableRecord, charts};
 use axcomp::report::chart::chart;
 use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
 use axcomp::together::{Input, Pairing, check_together};
+use axcomp::workflow::Test;
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
     load_equipment, load_profile, name_axis, print_text, print_warnings, read_active_table,
-    uncertainty_budget,
 };
 
 /// Flags of `axcomp report`.
@@ -115,50 +114,20 @@ pub struct ReportArgs {
     pub verbosity: Verbosity,
 }
 
-/// A measurement read and evaluated, with every warning (as `evaluate` has them).
-struct Test {
-    measurement: Measurement,
-    evaluation: Evaluation,
-    warnings: Vec<Warning>,
-    /// `None` on a rotary axis: the budget is the laser's, for lengths.
-    budget: Option<Budget>,
-}
-
-impl Test {
-    fn read(
-        path: &Path,
-        format: Option<SourceFormat>,
-        axis: Option<&String>,
-        standard: &dyn Standard,
-        equipment: &Equipment,
-    ) -> Result<Test> {
-        let read::ReadResult {
-            mut measurement,
-            mut warnings,
-        } = read::read_paths(&[path.to_path_buf()], format)?;
-        name_axis(&mut measurement, axis);
-        let evaluation = evaluate_with(&measurement, standard);
-        warnings.extend(evaluation.warnings.iter().cloned());
-        let budget = match measurement.kind() {
-            AxisKind::Linear => Some(uncertainty_budget(&measurement, equipment)?),
-            AxisKind::Rotary => None,
-        };
-        Ok(Test {
-            measurement,
-            evaluation,
-            warnings,
-            budget,
-        })
-    }
-
-    fn record(&self) -> TestRecord<'_> {
-        TestRecord {
-            measurement: &self.measurement,
-            evaluation: &self.evaluation,
-            warnings: &self.warnings,
-            budget: self.budget.as_ref(),
-        }
-    }
+/// Reads `path` (named with `--axis`) and evaluates it as a test of the report.
+fn read_test(
+    path: &Path,
+    format: Option<SourceFormat>,
+    axis: Option<&String>,
+    standard: &dyn Standard,
+    equipment: &Equipment,
+) -> Result<Test> {
+    let read::ReadResult {
+        mut measurement,
+        warnings,
+    } = read::read_paths(&[path.to_path_buf()], format)?;
+    name_axis(&mut measurement, axis);
+    Ok(Test::new(measurement, warnings, standard, equipment)?)
 }
 
 /// What `report` does not do for a rotary axis yet, refused with the reason
@@ -197,7 +166,7 @@ fn refuse_for_rotary(args: &ReportArgs, measurement: &Measurement) -> Result<()>
 pub fn run(args: &ReportArgs) -> Result<()> {
     let standard = args.standard.standard;
     let equipment = load_equipment(&args.uncertainty)?;
-    let mut before = Test::read(
+    let mut before = read_test(
         &args.file,
         args.input_format.format,
         args.axis.as_ref(),
@@ -220,7 +189,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         );
     }
     let mut after = match &args.after {
-        Some(path) => Some(Test::read(
+        Some(path) => Some(read_test(
             path,
             args.input_format.format,
             args.axis.as_ref(),

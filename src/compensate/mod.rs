@@ -81,6 +81,15 @@ pub enum TableMode {
 }
 
 impl TableMode {
+    /// The mode named `mean` or `bidirectional` (`--mode`), or why not.
+    pub fn from_name(name: &str) -> Result<TableMode, String> {
+        match name {
+            "mean" => Ok(TableMode::Mean),
+            "bidirectional" => Ok(TableMode::Bidirectional),
+            _ => Err(format!("expected mean or bidirectional, found {name:?}")),
+        }
+    }
+
     /// `mean` or `bidirectional`.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -99,6 +108,18 @@ pub enum Extrapolate {
     Hold,
     /// Write zero (no compensation there).
     Zero,
+}
+
+impl Extrapolate {
+    /// The rule named `hold` or `zero` (`--extrapolate`; refusing is the
+    /// default, not named), or why not.
+    pub fn from_name(name: &str) -> Result<Extrapolate, String> {
+        match name {
+            "hold" => Ok(Extrapolate::Hold),
+            "zero" => Ok(Extrapolate::Zero),
+            _ => Err(format!("expected hold or zero, found {name:?}")),
+        }
+    }
 }
 
 /// Where the compensation points go.

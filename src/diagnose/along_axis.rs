@@ -13,7 +13,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::fit::{Design, WeightedFit, fit_gls};
-use super::gates::{period_range, set_rejection};
+use super::gates::{period_range, rotary_orders, set_rejection};
 use super::levels::{Fold, Level};
 use super::periodogram::{aliases, frequency_uncertainty, period_sets};
 use super::problem::Problem;
@@ -21,7 +21,8 @@ use super::selection::{Chosen, Search, ShapeSet, forward_selection, shapes};
 use super::stats::chi2_p;
 use super::{Kind, KnownPeriod, LACK_OF_FIT_P, RejectedEffect, Shape};
 use crate::effects::{PeriodicIn, Reading};
-use crate::measurement::Direction;
+use crate::evaluate::conformance::FULL_TURN_DEG;
+use crate::measurement::{AxisKind, Direction};
 
 /// Covariance of the per-target levels, µm²: each level's own scatter on the
 /// diagonal, plus the prediction's, which targets share when they interpolate
@@ -174,7 +175,10 @@ pub(super) fn select_along_axis(
         background,
         values: &values,
         covariance: &covariance,
-        periods: period_range(&problem.targets_mm, min_periods),
+        // A rotary axis' orders are its own (`shape_sets`): no scan, no aliases in mm.
+        periods: (problem.kind == AxisKind::Linear)
+            .then(|| period_range(&problem.targets_mm, min_periods))
+            .flatten(),
         min_periods,
         known,
     };
@@ -253,8 +257,28 @@ impl Search for AlongAxis<'_> {
         kind.is_positional() && !chosen.iter().any(|c| c.shape.kind() == kind)
     }
 
+    fn kind(&self) -> AxisKind {
+        self.problem.kind
+    }
+
     fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet> {
         match kind {
+            // A rotary axis' error repeats every turn: whole orders k per
+            // revolution, the period 360°/k, each tried on its own.
+            Kind::Periodic if self.problem.kind == AxisKind::Rotary => {
+                let against_prediction = self.background == Background::Constant;
+                let orders = rotary_orders(&self.problem.targets_mm, against_prediction);
+                vec![ShapeSet::each(orders.map_or_else(
+                    Vec::new,
+                    |(lowest, highest)| {
+                        (lowest..=highest)
+                            .map(|k| {
+                                Shape::Period(FULL_TURN_DEG / f64::from(k), PeriodicIn::ReTest)
+                            })
+                            .collect()
+                    },
+                ))]
+            }
             Kind::Periodic => {
                 // Against a prediction, the error may be in both tests (see `periodogram`).
                 let first = &self.problem.first_test_positions_mm;

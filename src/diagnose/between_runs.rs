@@ -12,7 +12,8 @@ use super::stats::{chi2_p, partial_f_p};
 use super::{Evidence, Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
 use nalgebra::{DMatrix, DVector};
 
-use crate::measurement::Run;
+use crate::effects::deviation_text;
+use crate::measurement::{AxisKind, Run};
 
 /// The reversal found between the directions, from the cell levels.
 #[derive(Clone, Copy, Debug)]
@@ -59,6 +60,10 @@ impl Search for BetweenRuns<'_> {
 
     fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet> {
         vec![ShapeSet::each(shapes(kind, &self.runs, chosen))]
+    }
+
+    fn kind(&self) -> AxisKind {
+        self.problem.kind
     }
 
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
@@ -202,7 +207,9 @@ pub(super) fn select_reversal(
             rejected,
             Kind::Reversal,
             format!(
-                "the directions differ, but not by one B: the reversal changes along the axis from {lowest:.2} to {highest:.2} µm (p = {p_with:.1e}); it is reported as unexplained structure"
+                "the directions differ, but not by one B: the reversal changes along the axis from {} to {} (p = {p_with:.1e}); it is reported as unexplained structure",
+                deviation_text(problem.kind, lowest, 2),
+                deviation_text(problem.kind, highest, 2)
             ),
         );
         return (None, p_without);
@@ -231,7 +238,7 @@ pub(super) fn select_reversal(
         }
     };
     let (cv_without, cv_with) = (cv(false), cv(true));
-    if !predicts_better(rejected, Kind::Reversal, cv_with, cv_without) {
+    if !predicts_better(rejected, Kind::Reversal, problem.kind, cv_with, cv_without) {
         return (None, p_without);
     }
     let evidence = Evidence {

@@ -28,6 +28,7 @@ pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context 
         _ => None,
     };
     Context {
+        kind: input.after.kind(),
         table_step_mm: input.table.and_then(CompensationTable::regular_step_mm),
         target_spacing_mm: crate::compensate::regular_step(input.after.targets_mm()),
         expansion_coefficient_ppm_per_k: input.after.environment.expansion_coefficient_ppm_per_k,
@@ -58,6 +59,7 @@ pub(super) fn accepted_effect(
         span_mm: problem.targets_mm[problem.targets_mm.len() - 1] - problem.targets_mm[0],
         n,
         target_spacing_mm: context.target_spacing_mm,
+        kind: context.kind,
     });
     if context.time_assumed && effect.kind() == Kind::Drift {
         warnings.push("the file records no test duration: times assume a typical cycle (3 s dwell, 2000 mm/min)".to_string());

@@ -6,8 +6,9 @@ use super::{
     DiagnoseInput, MIN_DELTA_BIC, MIN_PERIODS_IN_CURVE, MIN_PERIODS_IN_SPAN, RejectedEffect,
     SHORTEST_PERIOD_MM,
 };
-use crate::effects::Kind;
-use crate::measurement::Direction;
+use crate::effects::{Kind, deviation_text};
+use crate::evaluate::conformance::FULL_TURN_DEG;
+use crate::measurement::{AxisKind, Direction};
 
 /// The kinds that can be looked for here; the others go to `rejected` with the reason.
 pub(super) fn applicable_kinds(
@@ -15,9 +16,19 @@ pub(super) fn applicable_kinds(
     rejected: &mut Vec<RejectedEffect>,
 ) -> Vec<Kind> {
     let after = input.after;
+    let rotary = after.kind() == AxisKind::Rotary;
     let mut kinds = Vec::new();
     for &kind in Kind::ALL {
         let reason = match kind {
+            // A rotary axis' errors are per-revolution harmonics and the
+            // reversal (issue 14); these kinds are lengths and times.
+            Kind::Scale | Kind::Drift | Kind::Abbe if rotary => Some(
+                "not looked for on a rotary axis: modelled for linear axes only so far".to_string(),
+            ),
+            Kind::Periodic if rotary && rotary_orders(after.targets_mm(), input.before.is_some()).is_none() => Some(
+                "the targets are too coarse, or the range too short, to hold a whole order per revolution".to_string(),
+            ),
+            Kind::Periodic if rotary => None,
             Kind::Reversal if after.run_count(Direction::Up) == 0 || after.run_count(Direction::Down) == 0 => {
                 Some("needs runs in both directions".to_string())
             }
@@ -86,6 +97,7 @@ pub(super) fn strong_evidence(rejected: &mut Vec<RejectedEffect>, kind: Kind, de
 pub(super) fn predicts_better(
     rejected: &mut Vec<RejectedEffect>,
     kind: Kind,
+    axis: AxisKind,
     cv_with: f64,
     cv_without: f64,
 ) -> bool {
@@ -95,7 +107,9 @@ pub(super) fn predicts_better(
             rejected,
             kind,
             format!(
-                "improves the fit but not the prediction of runs it was not fitted on ({cv_with:.3} µm vs {cv_without:.3} µm)"
+                "improves the fit but not the prediction of runs it was not fitted on ({} vs {})",
+                deviation_text(axis, cv_with, 3),
+                deviation_text(axis, cv_without, 3)
             ),
         );
     }
@@ -117,17 +131,44 @@ pub(super) fn set_rejection(rejected: &mut Vec<RejectedEffect>, kind: Kind, why:
 /// 230-2's reason to recommend them; Eyer & Bartholdi 1999), from
 /// [`SHORTEST_PERIOD_MM`] or twice the median spacing if that is shorter.
 pub(super) fn period_range(targets_mm: &[f64], min_periods: f64) -> Option<(f64, f64)> {
-    if targets_mm.len() < 8 {
-        return None;
-    }
-    let mut gaps: Vec<f64> = targets_mm.windows(2).map(|p| p[1] - p[0]).collect();
-    gaps.sort_by(f64::total_cmp);
-    let median = gaps[gaps.len() / 2];
-    let span = targets_mm[targets_mm.len() - 1] - targets_mm[0];
+    let (median, span) = median_gap_and_span(targets_mm)?;
     let shortest = match crate::compensate::regular_step(targets_mm) {
         Some(step) => 2.0 * step,
         None => (2.0 * median).min(SHORTEST_PERIOD_MM),
     };
     let longest = span / min_periods;
     (shortest < longest).then_some((shortest, longest))
+}
+
+/// The median spacing and the span of at least 8 targets (fewer resolve no period).
+fn median_gap_and_span(targets: &[f64]) -> Option<(f64, f64)> {
+    if targets.len() < 8 {
+        return None;
+    }
+    let mut gaps: Vec<f64> = targets.windows(2).map(|p| p[1] - p[0]).collect();
+    gaps.sort_by(f64::total_cmp);
+    Some((
+        gaps[gaps.len() / 2],
+        targets[targets.len() - 1] - targets[0],
+    ))
+}
+
+/// A rotary axis' periods: the whole orders per revolution (lowest,
+/// highest), the period 360°/order, from one period within the range
+/// against a prediction (over a full turn a once-per-revolution term is
+/// periodic by the geometry, not a slope; [`MIN_PERIODS_IN_CURVE`] in a
+/// test's own curve) up to twice the median spacing (Nyquist).
+pub(super) fn rotary_orders(targets_deg: &[f64], against_prediction: bool) -> Option<(u32, u32)> {
+    let (median, span) = median_gap_and_span(targets_deg)?;
+    let periods_in_range = if against_prediction {
+        1.0
+    } else {
+        MIN_PERIODS_IN_CURVE
+    };
+    // 1e-9: a full turn of 360° holds order 1 exactly once.
+    let lowest = (periods_in_range * FULL_TURN_DEG / span - 1e-9)
+        .ceil()
+        .max(1.0) as u32;
+    let highest = (FULL_TURN_DEG / (2.0 * median) + 1e-9).floor() as u32;
+    (lowest <= highest).then_some((lowest, highest))
 }

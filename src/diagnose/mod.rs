@@ -52,7 +52,7 @@ use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
 use crate::effects::{Effect, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape};
 use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
-use crate::measurement::{Direction, Measurement};
+use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::together::NotTogether;
 use along_axis::{AlongAxisSelection, Background, select_along_axis};
 use between_runs::{select_between_runs, select_reversal};
@@ -229,6 +229,9 @@ pub struct FigureSet<F = AxisFigures> {
 /// The diagnosis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Diagnosis {
+    /// Linear or rotary: on a rotary axis every `_um` value is m° (1/1000 °)
+    /// and every `_mm` value °, which the report shows in ″ and °.
+    pub kind: AxisKind,
     /// Whether a prediction from a first test was used.
     pub predicted_from_first_test: bool,
     /// The model's error before adding effects.
@@ -337,7 +340,8 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
     {
         entry.why = format!(
-            "no change since the first test, whose B̄ = {before_um:.2} µm the prediction carries ({})",
+            "no change since the first test, whose B̄ = {} the prediction carries ({})",
+            context.deviation(before_um),
             entry.why
         );
     }
@@ -477,6 +481,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // after the first was accepted records a rejection of the same kind.
     rejected.retain(|r| !accepted.iter().any(|a| a.effect.kind() == r.kind));
     Ok(Diagnosis {
+        kind: input.after.kind(),
         predicted_from_first_test: with_prediction,
         residual_before: stats(&residual_before),
         accepted,

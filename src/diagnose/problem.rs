@@ -12,7 +12,7 @@ use crate::compensate::{CompensateError, interpolate_hold};
 use crate::cycle;
 use crate::effects::{Line, Reading, Shape};
 use crate::evaluate::{Evaluation, evaluate};
-use crate::measurement::{Direction, Measurement};
+use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::together::{Input, Pairing, check_together};
 use crate::units::mm_to_um;
 
@@ -36,6 +36,8 @@ pub(super) struct Problem {
     pub(super) first_test_reversal_variance_um2: Vec<f64>,
     pub(super) run_count: usize,
     pub(super) targets_mm: Vec<f64>,
+    /// Linear or rotary: on a rotary axis `_mm` holds ° and `_um` m° (1/1000 °).
+    pub(super) kind: AxisKind,
     pub(super) angle_urad: Option<Vec<f64>>,
     /// The cells (target, direction) that have readings, in column order.
     pub(super) cells: Vec<(usize, Direction)>,
@@ -228,6 +230,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         first_test_reversal_variance_um2,
         run_count: after.runs().len(),
         targets_mm: after.targets_mm().to_vec(),
+        kind: after.kind(),
         angle_urad,
         cells,
         cell_design,

@@ -6,7 +6,7 @@ use super::fit::Design;
 use super::gates::{predicts_better, set_rejection, strong_evidence};
 use super::{Evidence, RejectedEffect};
 use crate::effects::{Kind, Shape};
-use crate::measurement::{Direction, Run};
+use crate::measurement::{AxisKind, Direction, Run};
 
 /// An accepted shape, where its columns start in its model, and why.
 #[derive(Clone, Copy, Debug)]
@@ -108,6 +108,9 @@ pub(super) trait Search {
     /// Whether to try `kind` now, given what is chosen.
     fn tries(&self, kind: Kind, chosen: &[Chosen]) -> bool;
 
+    /// Linear or rotary (the unit of the sentences).
+    fn kind(&self) -> AxisKind;
+
     /// The shapes of `kind` to try, in sets each judged on its own.
     fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet>;
 
@@ -190,7 +193,7 @@ pub(super) fn forward_selection<S: Search>(
             }
             let with = model.with(&search.columns(shape));
             let cv_with = search.cross_validated_rmse(&with);
-            if !predicts_better(rejected, shape.kind(), cv_with, cv_without) {
+            if !predicts_better(rejected, shape.kind(), search.kind(), cv_with, cv_without) {
                 continue;
             }
             let p_one = search.p_value(

@@ -2,7 +2,8 @@
 //! geometric model (issue 6), each in its own file, below every stage that
 //! closes the loop. `diagnose` fits them, `compensate` and `predict` account
 //! for them, `report` shows them, `synth` plants them; all through this
-//! module, which depends only on `measurement` and `units`.
+//! module, which depends only on `measurement` and `units` (and the full
+//! turn of `evaluate::conformance`, for a rotary axis' orders).
 //!
 //! | kind          | column(s) over the readings                  | parameter                |
 //! |---------------|----------------------------------------------|--------------------------|
@@ -32,7 +33,7 @@ pub mod scale;
 
 use serde::Deserialize;
 
-use crate::measurement::{Direction, Measurement, MeasurementError};
+use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError};
 use crate::units::um_to_mm;
 
 pub use abbe::Abbe;
@@ -107,6 +108,9 @@ impl Shape {
 /// Context for the sentence a user reads.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Context {
+    /// Linear or rotary: on a rotary axis the values held as mm and µm are °
+    /// and m° (1/1000 °), and the sentences say ° and ″ ([`Context::deviation`]).
+    pub kind: AxisKind,
     /// The table's step, mm, if a regular table was applied.
     pub table_step_mm: Option<f64>,
     /// Spacing of the targets, when regular, mm.
@@ -122,6 +126,33 @@ pub struct Context {
     pub first_test_reversal_um: Option<f64>,
 }
 
+/// A deviation held in µm (m°, 1/1000 °, on a rotary axis) as a sentence
+/// writes it with `decimals`: `2.40 µm`, or in arc-seconds `8.64″`.
+pub fn deviation_text(kind: AxisKind, value_um: f64, decimals: usize) -> String {
+    match kind {
+        AxisKind::Linear => format!("{value_um:.decimals$} µm"),
+        AxisKind::Rotary => format!(
+            "{:.decimals$}″",
+            crate::units::deg_to_arcsec(crate::units::um_to_mm(value_um))
+        ),
+    }
+}
+
+impl Context {
+    /// A deviation as a sentence writes it ([`deviation_text`], 2 decimals).
+    pub fn deviation(&self, value_um: f64) -> String {
+        deviation_text(self.kind, value_um, 2)
+    }
+
+    /// A position or a length held in mm (° on a rotary axis): `18 mm`, `18°`.
+    pub fn position(&self, value_mm: f64, decimals: usize) -> String {
+        match self.kind {
+            AxisKind::Linear => format!("{value_mm:.decimals$} mm"),
+            AxisKind::Rotary => format!("{value_mm:.decimals$}°"),
+        }
+    }
+}
+
 /// What the fit knows that a parameter's uncertainty needs.
 #[derive(Clone, Copy, Debug)]
 pub struct FitSummary<'a> {
@@ -135,6 +166,8 @@ pub struct FitSummary<'a> {
     pub n: usize,
     /// Spacing of the targets, when regular, mm.
     pub target_spacing_mm: Option<f64>,
+    /// Linear or rotary (the spacing then in °).
+    pub kind: AxisKind,
 }
 
 /// One parameter as it is shown and saved.

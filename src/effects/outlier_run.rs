@@ -58,11 +58,16 @@ impl Model for OutlierRun {
         }
     }
 
-    fn explanation(&self, _: &Context) -> String {
+    fn explanation(&self, context: &Context) -> String {
         let (run, direction) = (self.run, self.direction);
+        let sign = if self.offset_um.is_sign_negative() {
+            ""
+        } else {
+            "+"
+        };
         format!(
-            "Run {run}{direction} sits {:+.2} µm off the others (typically the first run after start-up, before the axis is warm); leave it out with --exclude-run {run}:{} if that is why, or warm the axis up before the test.",
-            self.offset_um,
+            "Run {run}{direction} sits {sign}{} off the others (typically the first run after start-up, before the axis is warm); leave it out with --exclude-run {run}:{} if that is why, or warm the axis up before the test.",
+            context.deviation(self.offset_um),
             direction.as_str()
         )
     }

@@ -1,5 +1,8 @@
 //! Periodic error in position: `amplitude · sin(2πx/period + phase)` (a screw
-//! lead, a scale period).
+//! lead, a scale period). On a rotary axis (issue 14) the period is 360°/k,
+//! a whole order k per revolution (once from eccentricity, twice from the
+//! encoder's mounting, a worm gear's tooth count), and the sentences say so
+//! in ° and ″ ([`Periodic::per_revolution`]).
 
 use std::f64::consts::{PI, TAU};
 
@@ -8,7 +11,8 @@ use serde::Deserialize;
 use super::{
     Context, Fit, FitSummary, Line, Model, Parameter, Reading, Shape, TableRole, Uncertainty,
 };
-use crate::measurement::Direction;
+use crate::evaluate::conformance::FULL_TURN_DEG;
+use crate::measurement::{AxisKind, Direction};
 
 /// Periodic error `amplitude · sin(2πx/period + phase)`.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
@@ -24,6 +28,13 @@ pub struct Periodic {
 }
 
 impl Periodic {
+    /// On a rotary axis, the whole number of periods per revolution
+    /// (360°/period), when the period is one.
+    pub fn per_revolution(&self) -> Option<u32> {
+        let order = FULL_TURN_DEG / self.period_mm;
+        ((order - order.round()).abs() < 1e-9 && order >= 0.5).then(|| order.round() as u32)
+    }
+
     fn at_um(&self, x_mm: f64) -> f64 {
         self.amplitude_um * (TAU * x_mm / self.period_mm + self.phase_rad).sin()
     }
@@ -47,6 +58,9 @@ impl Model for Periodic {
     }
 
     fn explanation(&self, context: &Context) -> String {
+        if context.kind == AxisKind::Rotary {
+            return self.rotary_explanation(context);
+        }
         let table = context
             .table_step_mm
             .map(|s| format!("; the table's step of {s} mm cannot follow it"))
@@ -81,6 +95,33 @@ impl Model for Periodic {
         } else {
             Err(format!("period_mm must be > 0, found {}", self.period_mm))
         }
+    }
+}
+
+impl Periodic {
+    /// The sentence on a rotary axis: the order per revolution and what
+    /// commonly causes it (seed 001 and `../shared/spec/standards.md` §6:
+    /// eccentricity once, encoder mounting twice per revolution).
+    fn rotary_explanation(&self, context: &Context) -> String {
+        let order = match self.per_revolution() {
+            Some(1) => "Once-per-revolution error (1 per revolution: eccentricity of the encoder or the table)".to_string(),
+            Some(2) => "Twice-per-revolution error (2 per revolution: the encoder's mounting, an elliptic scale)".to_string(),
+            Some(k) => format!("{k}-per-revolution error ({k} per revolution: a worm gear's or a scale's period)"),
+            None => "Periodic error".to_string(),
+        };
+        // Linear interpolation follows the order within 5 % at a step of
+        // period/10 (`in_table`); a coarser table cannot.
+        let table = context
+            .table_step_mm
+            .filter(|s| *s > self.period_mm / 10.0)
+            .map(|s| format!("; the table's step of {s}° cannot follow it"))
+            .unwrap_or_default();
+        format!(
+            "{order} of {} amplitude and {:.2}° period{table}; the re-test's own table takes it out at a step of at most {:.2}° (convert the re-test with --existing and the active table), or check the encoder's mounting and the table's run-out.",
+            context.deviation(self.amplitude_um),
+            self.period_mm,
+            self.period_mm / 10.0
+        )
     }
 }
 
@@ -130,24 +171,43 @@ impl Fit for Periodic {
         let sigma_frequency = 6f64.sqrt() * noise
             / (PI * self.amplitude_um.max(1e-12) * fit.span_mm * (n as f64).sqrt());
         let mut warnings = Vec::new();
-        if let Some(spacing) = fit.target_spacing_mm {
-            let aliases: Vec<String> = (1..=2)
-                .map(|k| 1.0 / (f64::from(k) / spacing - 1.0 / self.period_mm).abs())
-                .filter(|p| p.is_finite())
-                .map(|p| format!("{p:.2} mm"))
-                .collect();
-            warnings.push(format!(
-                "the targets are evenly spaced ({spacing} mm): periods {} give the same readings (aliasing); measure with irregular spacing to tell them apart",
-                aliases.join(", ")
-            ));
+        match (fit.target_spacing_mm, fit.kind, self.per_revolution()) {
+            // Samples N = 360°/spacing per revolution: orders N − k and N + k
+            // give the same readings as k.
+            (Some(spacing), AxisKind::Rotary, Some(k)) => {
+                let samples = (FULL_TURN_DEG / spacing).round() as i64;
+                let k = i64::from(k);
+                warnings.push(format!(
+                    "the targets are evenly spaced ({spacing}°): orders {} and {} per revolution give the same readings (aliasing); measure with irregular spacing to tell them apart",
+                    (samples - k).abs(),
+                    samples + k
+                ));
+            }
+            (Some(spacing), _, _) => {
+                let aliases: Vec<String> = (1..=2)
+                    .map(|k| 1.0 / (f64::from(k) / spacing - 1.0 / self.period_mm).abs())
+                    .filter(|p| p.is_finite())
+                    .map(|p| format!("{p:.2} mm"))
+                    .collect();
+                warnings.push(format!(
+                    "the targets are evenly spaced ({spacing} mm): periods {} give the same readings (aliasing); measure with irregular spacing to tell them apart",
+                    aliases.join(", ")
+                ));
+            }
+            (None, _, _) => {}
         }
-        let uncertainty = vec![
-            (
-                "period_mm",
-                self.period_mm * self.period_mm * sigma_frequency,
-            ),
-            ("amplitude_um", sigma_amplitude),
-        ];
+        // A rotary order is chosen among whole numbers, not estimated: its
+        // period has no uncertainty to give.
+        let uncertainty = match (fit.kind, self.per_revolution()) {
+            (AxisKind::Rotary, Some(_)) => vec![("amplitude_um", sigma_amplitude)],
+            _ => vec![
+                (
+                    "period_mm",
+                    self.period_mm * self.period_mm * sigma_frequency,
+                ),
+                ("amplitude_um", sigma_amplitude),
+            ],
+        };
         (uncertainty, warnings)
     }
 }

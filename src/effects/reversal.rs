@@ -37,15 +37,17 @@ impl Model for Reversal {
         };
         // Controllers take the backlash parameter in mm (or inch), not µm:
         // `convert` prints each one's own line (`Controller::backlash_parameter`).
+        // On a rotary axis the parameter is in degrees (`emit`'s rotary tables).
+        let parameter = context.position(um_to_mm(-b_um), 4);
+        let b = context.deviation(b_um);
         match context.first_test_reversal_um {
             Some(before_um) => format!(
-                "The reversal changed since the first test by B = {b_um:.2} µm (B̄ {before_um:.2} µm then, about {:.2} µm now; {how}); a bidirectional table from the re-test (convert --existing --effects) takes the new value out, or change the backlash parameter by {:.4} mm (convert prints it in the controller's own terms).",
-                before_um + b_um,
-                um_to_mm(-b_um)
+                "The reversal changed since the first test by B = {b} (B̄ {} then, about {} now; {how}); a bidirectional table from the re-test (convert --existing --effects) takes the new value out, or change the backlash parameter by {parameter} (convert prints it in the controller's own terms).",
+                context.deviation(before_um),
+                context.deviation(before_um + b_um),
             ),
             None => format!(
-                "Direction-dependent offset of B = {b_um:.2} µm ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or change the backlash parameter by {:.4} mm (convert prints it in the controller's own terms).",
-                um_to_mm(-b_um)
+                "Direction-dependent offset of B = {b} ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or change the backlash parameter by {parameter} (convert prints it in the controller's own terms)."
             ),
         }
     }

@@ -77,6 +77,19 @@ impl Controller {
         }
     }
 
+    /// The name a table for `axis` usually has on this controller: what the
+    /// demo writes and `axcomp serve` downloads (`X.COM`, `X.MPF`, `x.comp`,
+    /// `ALX`, `X.mp`; see `formats/<controller>/`).
+    pub fn file_name(self, axis: &str) -> String {
+        match self {
+            Controller::Itnc530 | Controller::Tnc640 => format!("{axis}.COM"),
+            Controller::Sinumerik840d => format!("{axis}.MPF"),
+            Controller::LinuxCnc => format!("{}.comp", axis.to_ascii_lowercase()),
+            Controller::Fagor8055 => format!("AL{axis}"),
+            Controller::Fagor8065 => format!("{axis}.mp"),
+        }
+    }
+
     /// Looks a controller up by name.
     pub fn from_name(name: &str) -> Option<Controller> {
         Controller::ALL

@@ -40,11 +40,26 @@ pub struct ReadResult {
 
 /// Reads one measurement file. `format` overrides detection.
 pub fn read_path(path: &Path, format: Option<SourceFormat>) -> Result<ReadResult, ReadError> {
+    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    read_bytes(path, &bytes, format)
+}
+
+/// Reads a measurement file's content that is already in memory (an upload
+/// to `axcomp serve`), named `path` in messages and in the measurement, as
+/// [`read_path`] reads the file.
+pub fn read_bytes(
+    path: &Path,
+    bytes: &[u8],
+    format: Option<SourceFormat>,
+) -> Result<ReadResult, ReadError> {
     let located = |error: ParseError| ReadError::Parse {
         path: path.to_path_buf(),
         error,
     };
-    let text = read_text(path)?;
+    let text = decode(bytes).map_err(located)?;
     let format = match format {
         Some(format) => format,
         None => detect(&text).ok_or_else(|| located(not_a_positioning_test(&text)))?,
@@ -165,19 +180,43 @@ pub fn read_paths(
     paths: &[PathBuf],
     format: Option<SourceFormat>,
 ) -> Result<ReadResult, ReadError> {
+    join(
+        paths,
+        |index| read_path(&paths[index], format),
+        |path| std::fs::canonicalize(path).ok(),
+    )
+}
+
+/// Reads files whose contents are in memory, each `(name, bytes)`, as
+/// [`read_paths`] reads files: one, or two of one axis joined.
+pub fn read_all_bytes(
+    files: &[(PathBuf, Vec<u8>)],
+    format: Option<SourceFormat>,
+) -> Result<ReadResult, ReadError> {
+    let names: Vec<PathBuf> = files.iter().map(|(name, _)| name.clone()).collect();
+    join(
+        &names,
+        |index| read_bytes(&files[index].0, &files[index].1, format),
+        |_| None,
+    )
+}
+
+/// Reads the first of `paths` with `read` (by index), and joins each further one to it.
+/// The files are compared by their `canonical` paths where there are such
+/// (`a.rtl` and `./a.rtl` are one file); a copy is caught by its readings.
+fn join(
+    paths: &[PathBuf],
+    read: impl Fn(usize) -> Result<ReadResult, ReadError>,
+    canonical: impl Fn(&Path) -> Option<PathBuf>,
+) -> Result<ReadResult, ReadError> {
     let Some((first, rest)) = paths.split_first() else {
         return Err(ReadError::NoInput);
     };
-    let mut result = read_path(first, format)?;
-    for path in rest {
-        let next = read_path(path, format)?;
-        // Two files of one test: one axis, two files, the same stretch. The
-        // files are compared by their canonical paths (`a.rtl` and `./a.rtl`
-        // are one file); a copy is caught by its readings.
-        let canonical = [
-            std::fs::canonicalize(first).ok(),
-            std::fs::canonicalize(path).ok(),
-        ];
+    let mut result = read(0)?;
+    for (index, path) in rest.iter().enumerate() {
+        let next = read(index + 1)?;
+        // Two files of one test: one axis, two files, the same stretch.
+        let canonical = [canonical(first), canonical(path)];
         let mut inputs = [
             Input::measurement(&result.measurement, first.display().to_string()),
             Input::measurement(&next.measurement, path.display().to_string()),

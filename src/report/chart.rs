@@ -151,34 +151,11 @@ impl Chart {
     }
 }
 
-/// Draws a chart as SVG text or PNG bytes of [`CHART_SIZE`].
-///
-/// The embedded font has no double prime: a PNG writes the arc-second sign
-/// ″ as `"` (the browser draws an SVG's ″ from the page's fonts).
+/// Draws a chart as SVG text or PNG bytes of [`CHART_SIZE`]. A PNG draws
+/// its text in the embedded font, which has every character a chart writes,
+/// the arc-second sign ″ included (`assets/fonts/LICENSE`).
 pub fn chart(chart: &Chart, format: PlotFormat) -> Result<Vec<u8>, PlotError> {
-    if format == PlotFormat::Png && chart.texts().iter().any(|t| t.contains(ARCSEC)) {
-        return render(&in_embedded_font(chart), CHART_SIZE, format);
-    }
     render(chart, CHART_SIZE, format)
-}
-
-/// The arc-second sign, which the embedded font lacks.
-const ARCSEC: char = '\u{2033}';
-
-/// The chart with every ″ written `"`, for a PNG.
-fn in_embedded_font(chart: &Chart) -> Chart {
-    let plain = |text: &str| text.replace(ARCSEC, "\"");
-    let mut chart = chart.clone();
-    chart.title = plain(&chart.title);
-    chart.x_label = plain(&chart.x_label);
-    chart.y_label = plain(&chart.y_label);
-    for series in &mut chart.series {
-        series.label = series.label.as_deref().map(plain);
-    }
-    if let Some(polar) = &mut chart.polar {
-        polar.unit = plain(&polar.unit);
-    }
-    chart
 }
 
 /// A tick label: up to three decimals, trailing zeros dropped, and the
@@ -566,7 +543,7 @@ mod tests {
     }
 
     #[test]
-    fn a_polar_chart_draws_its_circles_and_angles_and_a_png_writes_arcseconds_plainly() {
+    fn a_polar_chart_draws_its_circles_and_angles_in_svg_and_png() {
         let mut polar = sample();
         polar.series.truncate(0);
         polar.series.push(Series {
@@ -580,8 +557,6 @@ mod tests {
         for text in ["0°", "90°", "330°", "0″", "+5″", "−5″", "mean ↑"] {
             assert!(svg.contains(text), "{text} missing");
         }
-        let plain = in_embedded_font(&polar);
-        assert!(plain.texts().iter().all(|t| !t.contains(ARCSEC)));
         assert!(chart(&polar, PlotFormat::Png).is_ok());
     }
 

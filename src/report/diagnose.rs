@@ -38,6 +38,14 @@
 //! `params` of an `outlier-run` are `run` (a number), `direction` (`up` or
 //! `down`) and `offset_um`. `residual_before_um` is the model's error before
 //! the effects are added, `residual_after_um` with them.
+//!
+//! A rotary axis (issue 14) adds `"axis_kind": "rotary"` and carries its
+//! units in the same keys: every `_um` key is `_arcsec` (″), every `_mm` key
+//! `_deg` (`residual_before_arcsec`, `figures_arcsec`, `noise_arcsec`,
+//! `unexplained.where_deg`, `evidence.cv_rmse_with_arcsec`, a periodic
+//! effect's `period_deg` and `amplitude_arcsec`, a reversal's `B_arcsec`),
+//! and a periodic effect's `params` add `per_revolution`, its whole order
+//! (2: twice per revolution, period 180°). The terminal says ″ and °.
 
 use std::fmt::Write;
 
@@ -47,8 +55,82 @@ use serde_json::{Map, Value};
 use crate::diagnose::friction::ReversalFriction;
 use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
 use crate::effects::{Effect, ParameterValue};
+use crate::measurement::AxisKind;
 use crate::report::format::{pad_name, um};
 use crate::report::json::FiguresJson;
+use crate::units::{deg_to_arcsec, um_to_mm};
+
+/// How a diagnosis' values are reported: µm and mm on a linear axis, ″ and °
+/// on a rotary one (held inside as m°, 1/1000 °, and °).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Units(AxisKind);
+
+impl Units {
+    /// A deviation held in µm (m° on a rotary axis) in its reported unit.
+    fn deviation(self, value_um: f64) -> f64 {
+        match self.0 {
+            AxisKind::Linear => value_um,
+            AxisKind::Rotary => deg_to_arcsec(um_to_mm(value_um)),
+        }
+    }
+
+    /// A parameter by the unit its key carries: `_um` (and `_um_per_h`) a
+    /// deviation, anything else (mm: ° on a rotary axis, rad, a run) as it is.
+    fn parameter(self, key: &str, value: f64) -> f64 {
+        if key.ends_with("_um") || key.ends_with("_um_per_h") {
+            self.deviation(value)
+        } else {
+            value
+        }
+    }
+
+    /// A key with the unit it reports: `_um` → `_arcsec`, `_mm` → `_deg` on
+    /// a rotary axis; unchanged on a linear one.
+    fn key(self, key: &str) -> String {
+        if self.0 == AxisKind::Linear {
+            return key.to_string();
+        }
+        for (linear, rotary) in [
+            ("_um", "_arcsec"),
+            ("_um_per_h", "_arcsec_per_h"),
+            ("_mm", "_deg"),
+        ] {
+            if let Some(stem) = key.strip_suffix(linear) {
+                return format!("{stem}{rotary}");
+            }
+        }
+        key.to_string()
+    }
+
+    /// The keys of a serialised object, renamed by [`Units::key`] at every depth.
+    fn keys(self, value: Value) -> Value {
+        match value {
+            Value::Object(map) => Value::Object(
+                map.into_iter()
+                    .map(|(k, v)| (self.key(&k), self.keys(v)))
+                    .collect(),
+            ),
+            Value::Array(items) => Value::Array(items.into_iter().map(|v| self.keys(v)).collect()),
+            other => other,
+        }
+    }
+
+    /// After a deviation in the terminal: ` µm` or `″`.
+    fn deviation_suffix(self) -> &'static str {
+        match self.0 {
+            AxisKind::Linear => " µm",
+            AxisKind::Rotary => "″",
+        }
+    }
+
+    /// After a position in the terminal: ` mm` or `°`.
+    fn position_suffix(self) -> &'static str {
+        match self.0 {
+            AxisKind::Linear => " mm",
+            AxisKind::Rotary => "°",
+        }
+    }
+}
 
 /// RMS and largest |value|, µm.
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -59,11 +141,11 @@ pub struct ResidualJson {
     pub max_abs: f64,
 }
 
-impl From<ResidualStats> for ResidualJson {
-    fn from(s: ResidualStats) -> ResidualJson {
+impl ResidualJson {
+    fn new(s: ResidualStats, units: Units) -> ResidualJson {
         ResidualJson {
-            rms: s.rms_um,
-            max_abs: s.max_abs_um,
+            rms: units.deviation(s.rms_um),
+            max_abs: units.deviation(s.max_abs_um),
         }
     }
 }
@@ -101,23 +183,31 @@ pub struct EffectJson {
 }
 
 impl EffectJson {
-    /// From an accepted effect.
-    pub fn new(a: &AcceptedEffect) -> EffectJson {
+    /// From an accepted effect, in `units`.
+    fn new(a: &AcceptedEffect, units: Units) -> EffectJson {
         let mut params = Map::new();
         for parameter in a.effect.parameters() {
             let value = match parameter.value {
                 ParameterValue::Run(run) => Value::from(run),
-                ParameterValue::Number(value) => Value::from(value),
+                ParameterValue::Number(value) => Value::from(units.parameter(parameter.key, value)),
             };
             params.insert(parameter.key.to_string(), value);
         }
-        if let Effect::OutlierRun(run) = &a.effect {
-            params.insert("direction".into(), Value::from(run.direction.as_str()));
+        match &a.effect {
+            Effect::OutlierRun(run) => {
+                params.insert("direction".into(), Value::from(run.direction.as_str()));
+            }
+            Effect::Periodic(periodic) if units.0 == AxisKind::Rotary => {
+                if let Some(order) = periodic.per_revolution() {
+                    params.insert("per_revolution".into(), Value::from(order));
+                }
+            }
+            _ => {}
         }
         let uncertainty = a
             .uncertainty
             .iter()
-            .map(|(k, v)| (k.to_string(), Value::from(*v)))
+            .map(|(k, v)| (k.to_string(), Value::from(units.parameter(k, *v))))
             .collect();
         EffectJson {
             kind: a.effect.kind().name(),
@@ -127,8 +217,8 @@ impl EffectJson {
                 delta_bic: a.evidence.delta_bic,
                 trials: a.evidence.trials,
                 p_value: a.evidence.p_value,
-                cv_rmse_without_um: a.evidence.cv_rmse_without_um,
-                cv_rmse_with_um: a.evidence.cv_rmse_with_um,
+                cv_rmse_without_um: units.deviation(a.evidence.cv_rmse_without_um),
+                cv_rmse_with_um: units.deviation(a.evidence.cv_rmse_with_um),
             },
             explanation: a.explanation.clone(),
             warnings: a.warnings.clone(),
@@ -169,9 +259,35 @@ pub struct UnexplainedJson {
     pub p_value: f64,
 }
 
-/// The whole `diagnose --json` object.
-#[derive(Clone, Debug, Serialize)]
+/// The whole `diagnose --json` object: the fields as a linear axis' keys
+/// name them, with a rotary axis' values already in ″ and ° (module doc),
+/// serialised under the keys of its unit.
+#[derive(Clone, Debug)]
 pub struct DiagnoseJson {
+    fields: DiagnoseFields,
+    units: Units,
+}
+
+impl Serialize for DiagnoseJson {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        if self.units.0 == AxisKind::Linear {
+            return self.fields.serialize(serializer);
+        }
+        let Value::Object(fields) =
+            serde_json::to_value(&self.fields).map_err(serde::ser::Error::custom)?
+        else {
+            unreachable!("a struct serialises as an object")
+        };
+        let mut object = Map::new();
+        object.insert("axis_kind".into(), Value::from(AxisKind::Rotary.as_str()));
+        object.extend(fields);
+        self.units.keys(Value::Object(object)).serialize(serializer)
+    }
+}
+
+/// [`DiagnoseJson`]'s fields.
+#[derive(Clone, Debug, Serialize)]
+struct DiagnoseFields {
     /// The re-test file.
     pub after: String,
     /// The first test file, if given.
@@ -296,7 +412,12 @@ impl DiagnoseJson {
         before: Option<String>,
         table: Option<String>,
     ) -> DiagnoseJson {
-        DiagnoseJson {
+        let units = Units(diagnosis.kind);
+        let figures = |figures: &[crate::evaluate::StandardFigure]| match units.0 {
+            AxisKind::Linear => FiguresJson::from_standard(figures),
+            AxisKind::Rotary => FiguresJson::from_standard_deg(figures),
+        };
+        let fields = DiagnoseFields {
             after,
             before,
             table,
@@ -304,8 +425,12 @@ impl DiagnoseJson {
             standard_name: diagnosis.standard.name,
             definitions_reconstructed: diagnosis.standard.reconstructed,
             predicted_from_first_test: diagnosis.predicted_from_first_test,
-            residual_before_um: diagnosis.residual_before.into(),
-            effects: diagnosis.accepted.iter().map(EffectJson::new).collect(),
+            residual_before_um: ResidualJson::new(diagnosis.residual_before, units),
+            effects: diagnosis
+                .accepted
+                .iter()
+                .map(|a| EffectJson::new(a, units))
+                .collect(),
             rejected: diagnosis
                 .rejected
                 .iter()
@@ -314,29 +439,38 @@ impl DiagnoseJson {
                     why: r.why.clone(),
                 })
                 .collect(),
-            residual_after_um: diagnosis.residual_after.into(),
+            residual_after_um: ResidualJson::new(diagnosis.residual_after, units),
             figures_um: FigureSetJson {
-                measured: FiguresJson::from_standard(&diagnosis.standard_figures.measured),
-                predicted: FiguresJson::from_standard(&diagnosis.standard_figures.predicted),
-                predicted_with_effects: FiguresJson::from_standard(
-                    &diagnosis.standard_figures.predicted_with_effects,
-                ),
+                measured: figures(&diagnosis.standard_figures.measured),
+                predicted: figures(&diagnosis.standard_figures.predicted),
+                predicted_with_effects: figures(&diagnosis.standard_figures.predicted_with_effects),
             },
             unexplained: UnexplainedJson {
                 significant: diagnosis.unexplained.significant,
                 where_mm: diagnosis.unexplained.where_mm.clone(),
-                rms_um: diagnosis.unexplained.rms_um,
+                rms_um: units.deviation(diagnosis.unexplained.rms_um),
                 p_value: diagnosis.unexplained.p_value,
             },
-            noise_um: diagnosis.noise_um,
+            noise_um: units.deviation(diagnosis.noise_um),
             time_assumed: diagnosis.time_assumed,
             friction: None,
-        }
+        };
+        DiagnoseJson { fields, units }
+    }
+
+    /// The friction behind the reversal found (`--servo-axis`; a linear
+    /// axis' only: its keys are µm and N).
+    pub fn set_friction(&mut self, friction: Option<FrictionJson>) {
+        debug_assert!(friction.is_none() || self.units.0 == AxisKind::Linear);
+        self.fields.friction = friction;
     }
 }
 
 /// The terminal report.
 pub fn render(report: &DiagnoseJson) -> String {
+    let units = report.units;
+    let (dev, pos) = (units.deviation_suffix(), units.position_suffix());
+    let report = &report.fields;
     let mut out = String::new();
     let source = match (&report.before, &report.table) {
         (Some(before), Some(table)) => format!("predicted from {before} with {table}"),
@@ -347,7 +481,7 @@ pub fn render(report: &DiagnoseJson) -> String {
     let (b, a) = (&report.residual_before_um, &report.residual_after_um);
     let _ = writeln!(
         out,
-        "Residual     rms {} µm, max {} µm; with the effects rms {} µm, max {} µm; noise {} µm",
+        "Residual     rms {}{dev}, max {}{dev}; with the effects rms {}{dev}, max {}{dev}; noise {}{dev}",
         um(Some(b.rms)),
         um(Some(b.max_abs)),
         um(Some(a.rms)),
@@ -365,16 +499,18 @@ pub fn render(report: &DiagnoseJson) -> String {
             .map(
                 |(key, value)| match (value.as_f64(), effect.uncertainty.get(key)) {
                     // A run has no uncertainty: it is shown as it is.
-                    (Some(v), Some(u)) => {
-                        format!("{key} = {v:.2} ± {:.2}", u.as_f64().unwrap_or(f64::NAN))
-                    }
-                    _ => format!("{key} = {value}"),
+                    (Some(v), Some(u)) => format!(
+                        "{} = {v:.2} ± {:.2}",
+                        units.key(key),
+                        u.as_f64().unwrap_or(f64::NAN)
+                    ),
+                    _ => format!("{} = {value}", units.key(key)),
                 },
             )
             .collect();
         let _ = writeln!(
             out,
-            "  {:<12} {}   (ΔBIC {:.1}; runs left out predicted {:.2} → {:.2} µm)",
+            "  {:<12} {}   (ΔBIC {:.1}; runs left out predicted {:.2} → {:.2}{dev})",
             effect.kind,
             params.join(", "),
             effect.evidence.delta_bic,
@@ -403,7 +539,7 @@ pub fn render(report: &DiagnoseJson) -> String {
         let places: Vec<String> = u.where_mm.iter().map(|x| format!("{x}")).collect();
         let _ = writeln!(
             out,
-            "Unexplained  significant structure (p = {:.1e}), rms {} µm, largest at {} mm: no known effect describes it",
+            "Unexplained  significant structure (p = {:.1e}), rms {}{dev}, largest at {}{pos}: no known effect describes it",
             u.p_value,
             um(Some(u.rms_um)),
             places.join(", ")
@@ -411,14 +547,15 @@ pub fn render(report: &DiagnoseJson) -> String {
     } else {
         let _ = writeln!(
             out,
-            "Unexplained  nothing significant (p = {:.2}), rms {} µm",
+            "Unexplained  nothing significant (p = {:.2}), rms {}{dev}",
             u.p_value,
             um(Some(u.rms_um))
         );
     }
     let _ = writeln!(
         out,
-        "\nFigures [µm] |  measured | predicted | predicted with effects   ({}{})",
+        "\n{:<12} |  measured | predicted | predicted with effects   ({}{})",
+        format!("Figures [{}]", dev.trim()),
         report.standard_name,
         if report.definitions_reconstructed {
             "; definitions reconstructed from public sources (README, Standards)"

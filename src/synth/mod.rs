@@ -43,7 +43,7 @@ use crate::measurement::{
     Direction, Environment, Measurement, MeasurementError, Metadata, Run, StartEnd, TestDate,
 };
 use crate::units::{mm_to_m, mm_to_um, per_m_over_mm, um_to_mm};
-pub use rotary::{RotaryTruth, rotary_test};
+pub use rotary::{RotaryTruth, rotary_retest, rotary_test};
 pub use truth::{EffectSpec, TargetSpec, TestKind, Truth};
 
 /// Why a truth cannot be turned into measurements.

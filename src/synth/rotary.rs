@@ -33,9 +33,10 @@ use serde::Deserialize;
 
 use super::SynthError;
 use super::truth::AxisInfo;
+use crate::compensate::CompensationTable;
 use crate::error::ParseError;
 use crate::measurement::{AxisKind, AxisSource, Direction, Measurement, Metadata, Run};
-use crate::units::arcsec_to_deg;
+use crate::units::{arcsec_to_deg, deg_to_arcsec};
 
 /// A rotary truth file (module doc).
 #[derive(Clone, Debug, Deserialize)]
@@ -137,6 +138,26 @@ impl RotaryTruth {
 
 /// The synthetic test of a rotary truth, seeded.
 pub fn rotary_test(truth: &RotaryTruth, seed: u64) -> Result<Measurement, SynthError> {
+    simulate(truth, None, seed)
+}
+
+/// The re-test of the compensated rotary axis, seeded: the controller
+/// applies `table` (°, actual − target, interpolated with its ends held as
+/// [`CompensationTable::value_at`]): it commands θ − v, where the axis errs
+/// by the truth's error at θ − v, and the reading is that error − v.
+pub fn rotary_retest(
+    truth: &RotaryTruth,
+    table: &CompensationTable,
+    seed: u64,
+) -> Result<Measurement, SynthError> {
+    simulate(truth, Some(table), seed)
+}
+
+fn simulate(
+    truth: &RotaryTruth,
+    table: Option<&CompensationTable>,
+    seed: u64,
+) -> Result<Measurement, SynthError> {
     let spec = &truth.rotary;
     let targets = truth.targets_deg();
     let datum_arcsec = truth.harmonics_arcsec(targets[0]);
@@ -148,7 +169,10 @@ pub fn rotary_test(truth: &RotaryTruth, seed: u64) -> Result<Measurement, SynthE
             let deviations_mm = targets
                 .iter()
                 .map(|&angle| {
-                    let arcsec = truth.harmonics_arcsec(angle) - datum_arcsec
+                    let applied_deg = table.map_or(0.0, |t| t.value_at(angle, direction));
+                    let arcsec = truth.harmonics_arcsec(angle - applied_deg)
+                        - datum_arcsec
+                        - deg_to_arcsec(applied_deg)
                         + direction.reversal_share(spec.reversal_arcsec)
                         + noise.sample(&mut rng);
                     // An encoder's resolution, 0.001″; converted as a reader converts it.

@@ -7,6 +7,22 @@ use axcomp::emit::{EmitOptions, MachineProfile, sinumerik840d, tnc640};
 
 use crate::util::{assert_golden, root};
 
+/// The golden files these tests write (controller folder, file name);
+/// `convert::every_golden_file_has_a_case` counts them as produced here.
+pub const GOLDENS: [(&str, &str); 2] = [
+    ("tnc640", "cross-Y-of-X.COM"),
+    ("sinumerik840d", "cross-Y-of-X-cec.MPF"),
+];
+
+fn golden(index: usize) -> std::path::PathBuf {
+    let (controller, name) = GOLDENS[index];
+    root()
+        .join("formats")
+        .join(controller)
+        .join("golden")
+        .join(name)
+}
+
 /// EYX by hand: X's straightness in Y, a 3 µm bow over 0 … 750 mm at 150 mm.
 fn eyx() -> CrossAxisTable {
     CrossAxisTable::new(
@@ -29,10 +45,7 @@ fn tnc640_dependent_column_round_trips() {
         text.contains("2    +300                        +0.0028\r\n"),
         "{text}"
     );
-    assert_golden(
-        &text,
-        &root().join("formats/tnc640/golden/cross-Y-of-X.COM"),
-    );
+    assert_golden(&text, &golden(0));
     let back = tnc640::read_cross_axis(&text, "X", "Y").unwrap();
     assert_eq!(back, eyx());
     // A direction in BACKLASH is refused: a straightness has none.
@@ -61,10 +74,7 @@ fn sinumerik_cec_with_another_output_axis_round_trips() {
     );
     // Corrections (the profile's default): −error.
     assert!(text.contains("$AN_CEC[0,2]=-0.0028\n"), "{text}");
-    assert_golden(
-        &text,
-        &root().join("formats/sinumerik840d/golden/cross-Y-of-X-cec.MPF"),
-    );
+    assert_golden(&text, &golden(1));
     let back = sinumerik840d::read_cross_axis(&text, (&input, &output), ("X", "Y"), true).unwrap();
     assert_eq!(back, eyx());
     // The cross table is not Y's own table.

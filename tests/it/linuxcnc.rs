@@ -1,21 +1,29 @@
 //! The LinuxCNC table on a real controller: LinuxCNC 2.9 (Debian package
-//! `linuxcnc-uspace`), simulated mill, headless.
+//! `linuxcnc-uspace`), simulated machine, headless.
 //!
 //! `axcomp convert` writes the COMP_FILE; the test writes a LinuxCNC config
 //! around it (`tests/data/linuxcnc/`), starts LinuxCNC as an unprivileged
-//! user (it refuses root) with a Python "display" that homes, moves X to
-//! 21 positions going up and 21 going down (inside, between, on and beyond
-//! the compensation points) and reads with halcmd the correction LinuxCNC
-//! applies (`joint.0.motor-pos-cmd − joint.0.pos-cmd`, formed in HAL). Every
-//! correction must equal axcomp's own prediction, −(table value at that
-//! position in that direction) as the module reads the file back, within
-//! 1e-6 mm.
+//! user (it refuses root) with a Python "display" that homes, moves the joint
+//! under test (joint 0) to positions going up and going down (inside,
+//! between, on and beyond the compensation points) and reads with halcmd the
+//! correction LinuxCNC applies (`joint.0.motor-pos-cmd − joint.0.pos-cmd`,
+//! formed in HAL). Every correction must equal axcomp's own prediction,
+//! −(table value at that position in that direction) as the module reads the
+//! file back, within 1e-6 of the joint's unit.
+//!
+//! Two joints: a linear X (the bundled `.rtl` sample, 21 positions up and 21
+//! down, in mm) and, for issue 14, an angular C (the synthetic rotary
+//! fixture, 0–360° every 15°): `[JOINT_0]TYPE = ANGULAR` without
+//! `WRAPPED_ROTARY`, so LinuxCNC does not wrap the table and holds its end
+//! values beyond 0° and 360° (`formats/linuxcnc/README.md`, "Rotary joints");
+//! seeded random angles over −20…380°, each approached going up and going
+//! down, within 1e-6°.
 //!
 //! Observed on LinuxCNC 2.9 (Debian 2.9.0~pre1): right after homing the
 //! correction is computed at once (`joint.0.backlash-corr`) but not applied
 //! (`joint.0.backlash-filt` stays 0) until a longer move; a long warm-up move
-//! (to 400 mm and back below the table) comes first, and every measured
-//! point must show the applied correction settled on the computed one.
+//! (to 400 and back below the table) comes first, and every measured point
+//! must show the applied correction settled on the computed one.
 //!
 //! The test installs nothing: `scripts/test` installs LinuxCNC and creates the
 //! user `axcomp-ci`. If LinuxCNC cannot start, the test fails.
@@ -25,20 +33,53 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use axcomp::emit::linuxcnc;
-use axcomp::measurement::Direction;
+use axcomp::emit::{self, EmitOptions, MachineProfile, linuxcnc};
+use axcomp::measurement::{AxisKind, Direction};
 use axcomp::units::LengthUnit;
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::SeedableRng;
+use rand_distr::{Distribution, Uniform};
 
 use crate::util::{axcomp, test_data};
 
 /// The user LinuxCNC runs as when the tests run as root (created by `scripts/test`).
 const USER: &str = "axcomp-ci";
-const TOLERANCE_MM: f64 = 1e-6;
-/// Moves before the measured ones (see the module doc).
-const WARM_UP: [(&str, Direction); 2] = [
-    ("400.000000", Direction::Up),
-    ("-50.000000", Direction::Down),
-];
+/// In the joint's unit: mm for the linear joint, ° for the angular one.
+const TOLERANCE: f64 = 1e-6;
+
+/// Joint 0 of the simulated machine, the one under test, and the
+/// measurement whose table it gets.
+struct Joint {
+    /// The axis LinuxCNC moves (`[AXIS_…]`, `G1 …`) and the table is for.
+    axis: &'static str,
+    /// `[JOINT_0]TYPE`.
+    joint_type: &'static str,
+    kind: AxisKind,
+    /// The unit of its positions and corrections, for the messages.
+    unit: &'static str,
+    /// The measurement `axcomp convert` turns into the table.
+    measurement: &'static str,
+}
+
+const LINEAR: Joint = Joint {
+    axis: "X",
+    joint_type: "LINEAR",
+    kind: AxisKind::Linear,
+    unit: "mm",
+    measurement: "fixtures/sample-x.rtl",
+};
+
+const ANGULAR: Joint = Joint {
+    axis: "C",
+    joint_type: "ANGULAR",
+    kind: AxisKind::Rotary,
+    unit: "°",
+    measurement: "fixtures/rotary/c.csv",
+};
+
+/// Moves before the measured ones (see the module doc): both tables lie
+/// within 0…750, so 400 and −50 are long moves ending below the table.
+const WARM_UP: [(f64, Direction); 2] = [(400.0, Direction::Up), (-50.0, Direction::Down)];
 
 fn is_root() -> bool {
     Command::new("id")
@@ -47,39 +88,75 @@ fn is_root() -> bool {
         .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
 }
 
-/// The moves: start below the table, 21 positions up, 21 down (the sample's
-/// table spans 0…750 mm; −20 and 780 lie beyond it, 302.304 is a point).
-fn positions() -> Vec<(String, Direction)> {
-    let up: Vec<f64> = vec![
-        -20.0, 0.0, 12.5, 58.557, 75.0, 100.089, 130.0, 203.029, 222.2, 302.304, 333.3, 394.083,
-        420.0, 499.86, 525.0, 596.385, 620.0, 707.927, 730.0, 750.0, 780.0,
-    ];
-    let down: Vec<f64> = vec![
-        765.0, 750.0, 740.0, 707.927, 680.0, 650.51, 600.0, 552.366, 510.0, 449.962, 400.0,
-        355.475, 320.0, 241.652, 210.0, 152.276, 110.0, 58.557, 30.0, 0.0, -25.0,
-    ];
-    let mut moves: Vec<(String, Direction)> =
-        WARM_UP.iter().map(|(p, d)| (p.to_string(), *d)).collect();
-    moves.extend(up.iter().map(|p| (format!("{p:.6}"), Direction::Up)));
-    moves.extend(down.iter().map(|p| (format!("{p:.6}"), Direction::Down)));
-    moves
+/// The warm-up, then `up` going up and `down` going down, as the driver
+/// types them (6 decimals) and with the direction of their approach.
+fn moves(up: &[f64], down: &[f64]) -> Vec<(String, Direction)> {
+    WARM_UP
+        .iter()
+        .copied()
+        .chain(up.iter().map(|p| (*p, Direction::Up)))
+        .chain(down.iter().map(|p| (*p, Direction::Down)))
+        .map(|(p, d)| (format!("{p:.6}"), d))
+        .collect()
 }
 
-/// Writes the config into `dir` and runs LinuxCNC there; returns result.json.
-fn run_linuxcnc(dir: &Path, comp_file: &str, comp_type: u8) -> serde_json::Value {
+/// The linear moves: start below the table, 21 positions up, 21 down (the
+/// sample's table spans 0…750 mm; −20 and 780 lie beyond it, 302.304 is a
+/// point).
+fn linear_moves() -> Vec<(String, Direction)> {
+    moves(
+        &[
+            -20.0, 0.0, 12.5, 58.557, 75.0, 100.089, 130.0, 203.029, 222.2, 302.304, 333.3,
+            394.083, 420.0, 499.86, 525.0, 596.385, 620.0, 707.927, 730.0, 750.0, 780.0,
+        ],
+        &[
+            765.0, 750.0, 740.0, 707.927, 680.0, 650.51, 600.0, 552.366, 510.0, 449.962, 400.0,
+            355.475, 320.0, 241.652, 210.0, 152.276, 110.0, 58.557, 30.0, 0.0, -25.0,
+        ],
+    )
+}
+
+/// The angular moves: 20 angles drawn uniformly over −20…380° (ChaCha8,
+/// seed `seed`), beyond both ends of the 0…360° table included, with 0° and
+/// 360° themselves; each visited going up (ascending, then on to 390°) and
+/// going down (descending from there, then on to −30°).
+fn angular_moves(seed: u64) -> Vec<(String, Direction)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let uniform = Uniform::new(-20.0, 380.0).unwrap();
+    let mut angles: Vec<f64> = (0..20).map(|_| uniform.sample(&mut rng)).collect();
+    angles.extend([0.0, 360.0]);
+    angles.sort_by(f64::total_cmp);
+    let mut up = angles.clone();
+    up.push(390.0);
+    let mut down: Vec<f64> = angles.into_iter().rev().collect();
+    down.push(-30.0);
+    moves(&up, &down)
+}
+
+/// Writes the config for `joint` into `dir` and runs LinuxCNC there, making
+/// `moves`; returns result.json.
+fn run_linuxcnc(
+    dir: &Path,
+    joint: &Joint,
+    moves: &[(String, Direction)],
+    comp_file: &str,
+    comp_type: u8,
+) -> serde_json::Value {
     let template = std::fs::read_to_string(test_data("linuxcnc/sim.ini")).unwrap();
     let ini = template
         .replace("@DRIVER@", &dir.join("driver.py").display().to_string())
+        .replace("@AXIS@", joint.axis)
+        .replace("@JOINT_TYPE@", joint.joint_type)
         .replace("@COMP_FILE@", comp_file)
         .replace("@COMP_FILE_TYPE@", &comp_type.to_string());
     std::fs::write(dir.join("sim.ini"), ini).unwrap();
     for file in ["sim.hal", "driver.py"] {
         std::fs::copy(test_data(&format!("linuxcnc/{file}")), dir.join(file)).unwrap();
     }
-    let moves: Vec<String> = positions().into_iter().map(|(p, _)| p).collect();
+    let positions: Vec<&str> = moves.iter().map(|(p, _)| p.as_str()).collect();
     std::fs::write(
         dir.join("positions.json"),
-        serde_json::to_string(&moves).unwrap(),
+        serde_json::json!({"axis": joint.axis, "positions": positions}).to_string(),
     )
     .unwrap();
     let _ = std::fs::remove_file(dir.join("result.json"));
@@ -151,12 +228,13 @@ fn run_linuxcnc(dir: &Path, comp_file: &str, comp_type: u8) -> serde_json::Value
     json
 }
 
-/// Converts the bundled sample, runs it on LinuxCNC and compares every point.
-fn check_type(dir: &Path, mode: &str, comp_type: u8) {
-    let comp = dir.join(format!("comp-{mode}-{comp_type}.txt"));
+/// Converts the joint's measurement, runs it on LinuxCNC making `moves` and
+/// compares every point with the table as axcomp reads it back.
+fn check_type(dir: &Path, joint: &Joint, moves: &[(String, Direction)], mode: &str, comp_type: u8) {
+    let comp = dir.join(format!("comp-{}-{mode}-{comp_type}.txt", joint.axis));
     let run = axcomp([
         "convert",
-        "fixtures/sample-x.rtl",
+        joint.measurement,
         "--controller",
         "linuxcnc",
         "--mode",
@@ -169,37 +247,46 @@ fn check_type(dir: &Path, mode: &str, comp_type: u8) {
     ]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     let text = std::fs::read_to_string(&comp).unwrap();
-    let table = linuxcnc::read(&text, "X", Some(comp_type), LengthUnit::Millimetre).unwrap();
-    let json = run_linuxcnc(dir, comp.file_name().unwrap().to_str().unwrap(), comp_type);
+    let mut options = EmitOptions::for_axis(&MachineProfile::default(), joint.axis, "").unwrap();
+    options.kind = joint.kind;
+    let (_, table) = emit::read_any(&text, &options, Some(comp_type)).unwrap();
+    let json = run_linuxcnc(
+        dir,
+        joint,
+        moves,
+        comp.file_name().unwrap().to_str().unwrap(),
+        comp_type,
+    );
+    let (axis, unit) = (joint.axis, joint.unit);
     let points = json["points"].as_array().unwrap();
-    let moves = positions();
     assert_eq!(points.len(), moves.len());
     let mut checked = [0usize; 2];
-    for (point, (x_text, direction)) in points.iter().zip(&moves).skip(WARM_UP.len()) {
+    for (point, (x_text, direction)) in points.iter().zip(moves).skip(WARM_UP.len()) {
         let x: f64 = x_text.parse().unwrap();
         let (computed, applied) = (
             point["computed"].as_f64().unwrap(),
             point["applied"].as_f64().unwrap(),
         );
         assert!(
-            (computed - applied).abs() <= TOLERANCE_MM,
-            "X{x}: LinuxCNC computed {computed} mm but applies {applied} mm"
+            (computed - applied).abs() <= TOLERANCE,
+            "{axis}{x}: LinuxCNC computed {computed} {unit} but applies {applied} {unit}"
         );
         let applied =
             point["correction"].as_f64().unwrap() - point["motor_offset"].as_f64().unwrap();
         let predicted = -table.value_at(x, *direction);
         assert!(
-            (applied - predicted).abs() <= TOLERANCE_MM,
-            "{mode} type {comp_type}: X{x} {direction}: LinuxCNC applied {applied} mm, axcomp predicts {predicted} mm"
+            (applied - predicted).abs() <= TOLERANCE,
+            "{mode} type {comp_type}: {axis}{x} {direction}: LinuxCNC applied {applied} {unit}, axcomp predicts {predicted} {unit}"
         );
         assert!(
             (point["pos_cmd"].as_f64().unwrap() - x).abs() < 1e-3,
-            "the move reached X{x}"
+            "the move reached {axis}{x}"
         );
         checked[usize::from(*direction == Direction::Down)] += 1;
     }
     assert!(checked[0] >= 20 && checked[1] >= 20, "{checked:?}");
-    // The table is not trivially zero where it was checked.
+    // The table is not trivially zero where it was checked: the linear
+    // sample's table reaches 1e-3 mm, the rotary fixture's 1.18e-3° (4.3″) at 90°.
     assert!(
         points
             .iter()
@@ -213,8 +300,20 @@ fn linuxcnc_applies_the_table_as_axcomp_predicts() {
         .prefix("axcomp-linuxcnc")
         .tempdir()
         .unwrap();
-    check_type(dir.path(), "bidirectional", 0);
-    check_type(dir.path(), "mean", 1);
+    check_type(dir.path(), &LINEAR, &linear_moves(), "bidirectional", 0);
+    check_type(dir.path(), &LINEAR, &linear_moves(), "mean", 1);
+}
+
+/// Issue 14: the rotary table on an angular joint, at random angles
+/// approached in both directions, ends held beyond 0° and 360°.
+#[test]
+fn linuxcnc_applies_the_rotary_table_as_axcomp_predicts() {
+    let dir = tempfile::Builder::new()
+        .prefix("axcomp-linuxcnc-rotary")
+        .tempdir()
+        .unwrap();
+    check_type(dir.path(), &ANGULAR, &angular_moves(14), "bidirectional", 0);
+    check_type(dir.path(), &ANGULAR, &angular_moves(15), "mean", 1);
 }
 
 #[test]

@@ -428,6 +428,10 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
             );
         }
     }
+    // A rotary axis' charts write the arc-second sign (the polar plot's
+    // rings, the deviation axis in ″): the PNG draws it as ″, not as `"`.
+    assert_ne!(font.glyph_id('\u{2033}').0, 0);
+    assert_ne!(font.glyph_id('\u{2033}'), font.glyph_id('"'));
     // And the check can fail: a character the subset lacks.
     assert_eq!(font.glyph_id('č').0, 0);
 }

@@ -583,3 +583,194 @@ fn an_active_rotary_table_is_read_in_degrees_on_an_inch_machine() {
     let ratio = at_90(&written) / at_90(&golden);
     assert!((ratio - 2.0).abs() < 0.01, "{ratio}");
 }
+
+/// A rotary truth over a full turn every 15°, 5 runs each way, with the
+/// harmonics `(order, amplitude ″, phase rad)`.
+fn rotary_truth(harmonics: &[(u32, f64, f64)]) -> axcomp::synth::RotaryTruth {
+    let harmonics: Vec<String> = harmonics
+        .iter()
+        .map(|(order, amplitude, phase)| {
+            format!("{{ per_revolution = {order}, amplitude_arcsec = {amplitude}, phase_rad = {phase} }}")
+        })
+        .collect();
+    let text = format!(
+        "[axis]\nname = \"C\"\n[rotary]\nstart_deg = 0.0\nend_deg = 360.0\ncount = 25\nruns = 5\n\
+         reversal_arcsec = 2.4\nsigma_arcsec = 0.3\nharmonics = [{}]\n",
+        harmonics.join(", ")
+    );
+    axcomp::synth::RotaryTruth::from_toml_str(&text).unwrap()
+}
+
+/// The first test of the fixture's truth (once per revolution 4″), a mean
+/// LinuxCNC table from it written by `convert`, and the re-test with that
+/// table of a truth with one more harmonic (`extra`: order, ″, phase), as
+/// files in `directory`; returns (before, table, after).
+fn rotary_retest_files(
+    directory: &Path,
+    extra: (u32, f64, f64),
+    seed: u64,
+) -> (PathBuf, PathBuf, PathBuf) {
+    use axcomp::emit::{EmitOptions, MachineProfile, read_any};
+    let first = (1, 4.0, 0.5);
+    let before_truth = rotary_truth(&[first]);
+    let after_truth = rotary_truth(&[first, extra]);
+    let before = axcomp::synth::rotary_test(&before_truth, seed).unwrap();
+    let before_path = directory.join(format!("before-{seed}.csv"));
+    std::fs::write(&before_path, axcomp::read::csv::write(&before)).unwrap();
+    let table_path = directory.join(format!("C-{seed}.comp"));
+    let run = axcomp([
+        "convert".as_ref(),
+        before_path.as_os_str(),
+        "--controller".as_ref(),
+        "linuxcnc".as_ref(),
+        "-o".as_ref(),
+        table_path.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let mut options = EmitOptions::for_axis(&MachineProfile::default(), "C", "").unwrap();
+    options.kind = axcomp::measurement::AxisKind::Rotary;
+    let text = std::fs::read_to_string(&table_path).unwrap();
+    let (_, table) = read_any(&text, &options, Some(0)).unwrap();
+    let after = axcomp::synth::rotary_retest(&after_truth, &table, seed + 1000).unwrap();
+    let after_path = directory.join(format!("after-{seed}.csv"));
+    std::fs::write(&after_path, axcomp::read::csv::write(&after)).unwrap();
+    (before_path, table_path, after_path)
+}
+
+/// Every key of a JSON value, at every depth.
+fn keys_of(value: &serde_json::Value, keys: &mut Vec<String>) {
+    match value {
+        serde_json::Value::Object(map) => {
+            for (key, item) in map {
+                keys.push(key.clone());
+                keys_of(item, keys);
+            }
+        }
+        serde_json::Value::Array(items) => items.iter().for_each(|v| keys_of(v, keys)),
+        _ => {}
+    }
+}
+
+/// Issue 14: a rotary re-test with a once- or twice-per-revolution term the
+/// first test did not have (the encoder remounted, the table's eccentricity
+/// changed) is diagnosed as a periodic effect of that order, period
+/// 360°/order, amplitude within 10 % of the truth's, in ″ in the terminal
+/// and the JSON (keys `_arcsec`, `_deg`, no `_um` or `_mm`). The expected
+/// order and amplitude are the planted truth's.
+#[test]
+fn diagnose_finds_a_per_revolution_harmonic_with_its_order() {
+    let directory = tempfile::tempdir().unwrap();
+    for (seed, extra) in [
+        (21, (2, 3.0, 0.3)),
+        (22, (2, 3.0, -2.0)),
+        (23, (1, 2.5, 1.2)),
+        (24, (3, 2.0, 0.0)),
+    ] {
+        let (order, amplitude_arcsec, _) = extra;
+        let (before, table, after) = rotary_retest_files(directory.path(), extra, seed);
+        let args = |json: bool| {
+            let mut args = vec![
+                "diagnose".as_ref(),
+                "--after".as_ref(),
+                after.as_os_str(),
+                "--before".as_ref(),
+                before.as_os_str(),
+                "--table".as_ref(),
+                table.as_os_str(),
+                "--quiet".as_ref(),
+            ];
+            if json {
+                args.push("--json".as_ref());
+            }
+            args
+        };
+        let run = axcomp(args(true));
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+        assert_eq!(json["axis_kind"], "rotary");
+        let periodic: Vec<&serde_json::Value> = json["effects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|e| e["kind"] == "periodic")
+            .collect();
+        assert_eq!(periodic.len(), 1, "seed {seed}: {}", run.stdout);
+        let params = &periodic[0]["params"];
+        assert_eq!(params["per_revolution"], order, "seed {seed}: {params}");
+        let period = params["period_deg"].as_f64().unwrap();
+        assert!((period - 360.0 / f64::from(order)).abs() < 1e-9, "{period}");
+        let found = params["amplitude_arcsec"].as_f64().unwrap();
+        assert!(
+            (found - amplitude_arcsec).abs() <= 0.1 * amplitude_arcsec,
+            "seed {seed}: order {order}: found {found}″, planted {amplitude_arcsec}″"
+        );
+        assert!(
+            periodic[0]["uncertainty"]["amplitude_arcsec"]
+                .as_f64()
+                .unwrap()
+                < 0.1 * amplitude_arcsec
+        );
+        // Nothing else was planted: the reversal is the first test's, which
+        // the prediction carries.
+        assert_eq!(
+            json["effects"].as_array().unwrap().len(),
+            1,
+            "{}",
+            run.stdout
+        );
+        let mut keys = Vec::new();
+        keys_of(&json, &mut keys);
+        assert!(
+            keys.iter()
+                .all(|k| !k.ends_with("_um") && !k.ends_with("_mm")),
+            "{keys:?}"
+        );
+        for key in ["residual_before_arcsec", "figures_arcsec", "noise_arcsec"] {
+            assert!(json.get(key).is_some(), "{key}");
+        }
+        // The residual before the effects holds the planted harmonic: its
+        // rms over a full turn is about amplitude/√2 (with 0.3″ noise).
+        let rms = json["residual_before_arcsec"]["rms"].as_f64().unwrap();
+        let expected = amplitude_arcsec / 2f64.sqrt();
+        assert!(
+            (rms - expected).abs() < 0.2 * expected,
+            "{rms} vs {expected}"
+        );
+
+        let run = axcomp(args(false));
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        assert!(
+            run.stdout.contains(&format!("{order} per revolution")),
+            "{}",
+            run.stdout
+        );
+        assert!(run.stdout.contains("Figures [″]"), "{}", run.stdout);
+        assert!(!run.stdout.contains("µm"), "{}", run.stdout);
+        assert!(!run.stdout.contains(" mm"), "{}", run.stdout);
+    }
+}
+
+/// A rotary diagnosis refuses what is still lengths only: the effects file
+/// and an angular (Abbe) profile.
+#[test]
+fn diagnose_of_a_rotary_axis_refuses_length_only_flags() {
+    let directory = tempfile::tempdir().unwrap();
+    for flag in ["--write-effects", "--angular"] {
+        let other = directory.path().join("x");
+        let run = axcomp([
+            "diagnose".as_ref(),
+            "--after".as_ref(),
+            "fixtures/rotary/c.csv".as_ref(),
+            flag.as_ref(),
+            other.as_os_str(),
+        ]);
+        assert_eq!(run.code, 2, "{}", run.stdout);
+        assert!(
+            run.stderr.contains("is a rotary axis") && run.stderr.contains(flag),
+            "{}",
+            run.stderr
+        );
+        assert!(!other.exists());
+    }
+}

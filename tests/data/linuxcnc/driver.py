@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """The "display" of the LinuxCNC test: reset E-stop, switch on, home, then
-move X to each position of positions.json (MDI G1) and record, after each
+move the axis of positions.json ({"axis": "X", "positions": [...]}; joint 0)
+to each of its positions (MDI G1) and record, after each
 move, the correction LinuxCNC applies (sum2.0.out = motor-pos-cmd − pos-cmd),
 pos-cmd, motor-offset and the screw-comp pins backlash-corr (the correction
 computed) and backlash-filt (the correction applied), read with halcmd.
@@ -21,7 +22,8 @@ def getp(pin):
 
 
 try:
-    positions = json.load(open(os.path.join(HERE, "positions.json")))
+    moves = json.load(open(os.path.join(HERE, "positions.json")))
+    axis, positions = moves["axis"], moves["positions"]
     s = linuxcnc.stat()
     c = linuxcnc.command()
     c.state(linuxcnc.STATE_ESTOP_RESET)
@@ -42,9 +44,9 @@ try:
     c.mode(linuxcnc.MODE_MDI)
     c.wait_complete(20)
     for x in positions:
-        c.mdi("G1 X%s F30000" % x)
+        c.mdi("G1 %s%s F30000" % (axis, x))
         if c.wait_complete(60) == -1:
-            raise RuntimeError("move to X%s timed out" % x)
+            raise RuntimeError("move to %s%s timed out" % (axis, x))
         time.sleep(0.05)  # let the backlash filter settle on the new correction
         result["points"].append({
             "x": x,

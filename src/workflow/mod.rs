@@ -1,0 +1,226 @@
+//! One command's work on inputs already in memory: `evaluate`, `convert`
+//! and the acceptance report's tests. The CLI (`src/cli/`) and the local web
+//! app (`serve`) both call these, so the page shows the very JSON that
+//! `--json` prints and downloads the very bytes `convert` writes.
+//!
+//! Reading files, the flags and printing stay with the caller; what is here
+//! takes a measurement that is read and named (and runs left out) and the
+//! settings already parsed.
+
+use crate::compensate::effects::build_table_with_effects;
+use crate::compensate::plan::{Request, plan};
+use crate::compensate::{CompensateError, CompensationTable};
+use crate::effects::Effect;
+use crate::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
+use crate::error::{ParseError, Warning};
+use crate::evaluate::uncertainty::{Budget, Equipment, UncertaintyError, budget};
+use crate::evaluate::verdict::{Decision, Limit};
+use crate::evaluate::{Evaluation, Standard, evaluate, evaluate_with};
+use crate::measurement::{AxisKind, Measurement, RunSelector};
+use crate::report::acceptance::TestRecord;
+use crate::report::convert::ConvertJson;
+use crate::report::json::EvaluationJson;
+use crate::report::uncertainty::UncertaintyJson;
+use crate::report::verdict;
+use crate::units::LengthUnit;
+
+/// Why a command's work stopped. Each wraps its stage's error, so it reads
+/// as that error does.
+#[derive(Debug, thiserror::Error)]
+pub enum WorkflowError {
+    /// Acceptance limits on a rotary axis (they are µm).
+    #[error(
+        "axis {axis} is a rotary axis: acceptance limits (--limit, a profile's [acceptance]) are µm, for linear axes only so far"
+    )]
+    RotaryLimits {
+        /// The axis.
+        axis: String,
+    },
+    /// The uncertainty budget.
+    #[error(transparent)]
+    Uncertainty(#[from] UncertaintyError),
+    /// The grid, the mode or the table.
+    #[error(transparent)]
+    Compensate(#[from] CompensateError),
+    /// The controller's file.
+    #[error(transparent)]
+    Emit(#[from] EmitError),
+}
+
+/// `evaluate --json`'s object for `measurement` (named, runs left out) and
+/// its `evaluation`: the uncertainty budget (linear axes), the verdict when
+/// there are `limits`, and every warning. The evaluation's warnings are
+/// added to `warnings`, for the caller to print.
+pub fn evaluation_report(
+    measurement: &Measurement,
+    evaluation: Evaluation,
+    exclude_runs: &[RunSelector],
+    warnings: &mut Vec<Warning>,
+    limits: &[Limit],
+    equipment: &Equipment,
+    decision: Decision,
+) -> Result<EvaluationJson, WorkflowError> {
+    warnings.extend(evaluation.warnings.iter().cloned());
+    // The budget is the laser's, for lengths, and limits are µm: a rotary
+    // axis has neither yet (issue 14's later part).
+    let budget = match measurement.kind() {
+        AxisKind::Rotary if !limits.is_empty() => {
+            return Err(WorkflowError::RotaryLimits {
+                axis: measurement.axis().to_string(),
+            });
+        }
+        AxisKind::Rotary => None,
+        AxisKind::Linear => Some(budget(measurement, equipment)?),
+    };
+    let verdict = budget
+        .as_ref()
+        .and_then(|budget| verdict::judge(&evaluation, limits, decision, Some(budget)));
+    let mut report =
+        EvaluationJson::from_evaluation(measurement, evaluation, exclude_runs, warnings);
+    report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
+    report.verdict = verdict;
+    Ok(report)
+}
+
+/// What a table is made for and written as (`convert`'s flags, parsed).
+pub struct TableRequest<'a> {
+    /// The controller.
+    pub controller: Controller,
+    /// Axis names, units, limits of the controller's file.
+    pub options: &'a EmitOptions,
+    /// Mode, grid, reference, extrapolation.
+    pub request: &'a Request,
+    /// Effects a diagnosis found (`--effects`).
+    pub effects: &'a [Effect],
+    /// The file that was active, when the new table goes back into it (a Fagor 8065 `.mp`).
+    pub existing: Option<&'a [u8]>,
+    /// The output as the user named it (`-o`), shown in the JSON.
+    pub output: String,
+    /// Its file name, which the activation text names.
+    pub file_name: String,
+    /// Coupled axes written the same table (`--also`).
+    pub also: Vec<String>,
+}
+
+/// A table: the file's bytes and `convert --json`'s object.
+pub struct Converted {
+    /// What the controller loads, byte for byte.
+    pub bytes: Vec<u8>,
+    /// What `convert --json` prints.
+    pub report: ConvertJson,
+    /// The table, for its chart.
+    pub table: CompensationTable,
+}
+
+/// `convert`: the table of `measurement` (named, runs left out, an active
+/// table already added) for `table.controller`. The evaluation's warnings
+/// are added to `warnings`, which the JSON lists.
+pub fn convert(
+    measurement: &Measurement,
+    warnings: &mut Vec<Warning>,
+    table: &TableRequest<'_>,
+) -> Result<Converted, WorkflowError> {
+    let evaluation = evaluate(measurement);
+    warnings.extend(evaluation.warnings.iter().cloned());
+    let options = table.options;
+    let plan = plan(
+        measurement.targets_mm(),
+        table.effects,
+        &table.controller.capabilities(options.machine_unit),
+        table.request,
+    )?;
+    let compensation =
+        build_table_with_effects(measurement, &evaluation, &plan.options, table.effects)?;
+    let bytes = emit::write_bytes(table.controller, &compensation, options, table.existing)?;
+    let activation = emit::activation(table.controller, &compensation, &table.file_name, options);
+    let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    let mut report = ConvertJson::new(
+        measurement.kind(),
+        table.controller.name(),
+        table.output.clone(),
+        &compensation,
+        table.also.clone(),
+        activation,
+        warning_texts,
+    );
+    report.effects = plan.notes;
+    if measurement.kind() == AxisKind::Linear {
+        report.file_unit = options.machine_unit.as_str();
+    }
+    if let Some(backlash_mm) = compensation.suggested_backlash_mm {
+        report.set_backlash(table.controller.backlash_parameter(backlash_mm, options));
+    }
+    Ok(Converted {
+        bytes,
+        report,
+        table: compensation,
+    })
+}
+
+/// A test of the acceptance report: read, named, evaluated, with every
+/// warning (as `evaluate` has them) and its uncertainty budget.
+pub struct Test {
+    /// The measurement.
+    pub measurement: Measurement,
+    /// Its figures.
+    pub evaluation: Evaluation,
+    /// The reader's and the evaluation's warnings.
+    pub warnings: Vec<Warning>,
+    /// `None` on a rotary axis: the budget is the laser's, for lengths.
+    pub budget: Option<Budget>,
+}
+
+impl Test {
+    /// Evaluates `measurement` (read with `warnings`) to `standard`.
+    pub fn new(
+        measurement: Measurement,
+        mut warnings: Vec<Warning>,
+        standard: &dyn Standard,
+        equipment: &Equipment,
+    ) -> Result<Test, WorkflowError> {
+        let evaluation = evaluate_with(&measurement, standard);
+        warnings.extend(evaluation.warnings.iter().cloned());
+        let budget = match measurement.kind() {
+            AxisKind::Linear => Some(budget(&measurement, equipment)?),
+            AxisKind::Rotary => None,
+        };
+        Ok(Test {
+            measurement,
+            evaluation,
+            warnings,
+            budget,
+        })
+    }
+
+    /// What the report is made from.
+    pub fn record(&self) -> TestRecord<'_> {
+        TestRecord {
+            measurement: &self.measurement,
+            evaluation: &self.evaluation,
+            warnings: &self.warnings,
+            budget: self.budget.as_ref(),
+        }
+    }
+}
+
+/// A compensation table's file `bytes` (UTF-8, Latin-1 or UTF-16 with a
+/// byte-order mark), in any format `convert` writes, for
+/// the axis of `options`. A Fagor 8055 table is read in the profile's unit,
+/// else in `test_unit` (`MachineProfile::table_unit`); a LinuxCNC table's
+/// type is told from its numbers, `linuxcnc_type` deciding when they do not.
+pub fn read_table(
+    bytes: &[u8],
+    mut options: EmitOptions,
+    profile: &MachineProfile,
+    test_unit: LengthUnit,
+    linuxcnc_type: Option<u8>,
+) -> Result<(Controller, CompensationTable), ParseError> {
+    let (text, _) = emit::decode_table(bytes)?;
+    if emit::fagor8055::looks_like(&text) {
+        options.machine_unit = profile.table_unit(Controller::Fagor8055, test_unit);
+    }
+    emit::read_any(&text, &options, None).or_else(|error| match linuxcnc_type {
+        Some(kind) => emit::read_any(&text, &options, Some(kind)),
+        None => Err(error),
+    })
+}
