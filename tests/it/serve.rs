@@ -544,3 +544,208 @@ fn the_page_works_in_a_real_browser() {
     let red = Pixels::read(&shot).fraction(|r, g, b| r > 150 && g < 60 && b < 60);
     assert!(red > 0.0005, "{red:.4} red");
 }
+
+/// A machine profile with acceptance limits and a screw lead for X.
+const PROFILE: &str = "[controller]\nunits = \"mm\"\n\n[controller.axes.X]\nscrew_lead_mm = 10\n\n\
+[acceptance]\nA = { per_1000_mm_um = 10, min_um = 5 }\nR = 4\n";
+
+/// Limits from the page and from the profile, under either decision rule:
+/// the verdict is `evaluate --json --machine P --limit …`'s, key for key.
+#[test]
+fn the_verdict_is_what_evaluate_prints_with_the_same_limits() {
+    let server = Server::start();
+    let work = tempfile::tempdir().unwrap();
+    std::fs::copy(sample(), work.path().join("sample-x.rtl")).unwrap();
+    std::fs::write(work.path().join("p.toml"), PROFILE).unwrap();
+    let cases: [(&[&str], &str, &str, bool); 3] = [
+        (
+            &["--limit", "A=14", "--limit", "R=3"],
+            "A=14, R=3",
+            "simple",
+            false,
+        ),
+        (
+            &["--machine", "p.toml", "--limit", "E=8"],
+            "E=8",
+            "iso14253-1",
+            true,
+        ),
+        (
+            &["--limit", "A=20", "--limit", "B_mean=5"],
+            "A=20;B_mean=5",
+            "simple",
+            false,
+        ),
+    ];
+    let mut outcomes = Vec::new();
+    for (flags, limits, decision, with_profile) in cases {
+        let mut form = Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .text("limits", limits)
+            .text("decision", decision);
+        if with_profile {
+            form = form.file("machine", "p.toml", PROFILE.as_bytes());
+        }
+        let answer = server.post("/api/evaluate", form, &[]);
+        assert_eq!(answer.status, 200, "{limits}: {}", answer.text());
+        let mut args = vec!["evaluate", "--json", "sample-x.rtl", "--decision", decision];
+        args.extend_from_slice(flags);
+        let cli: serde_json::Value = serde_json::from_slice(&cli_in(work.path(), &args)).unwrap();
+        let verdict = &answer.json()["evaluation"]["verdict"];
+        assert!(verdict.is_object(), "{limits}: no verdict");
+        assert_eq!(*verdict, cli["verdict"], "{limits}");
+        assert_eq!(answer.json()["evaluation"], cli, "{limits}");
+        outcomes.push(verdict["pass"].as_bool().unwrap());
+    }
+    // A of the sample is 13.19 µm (README): 14 passes it, R=3 fails R.
+    assert_eq!(outcomes[0], false);
+    assert_eq!(outcomes[2], true);
+    let checks = |answer: &Response| answer.json()["evaluation"]["verdict"]["checks"].clone();
+    let answer = server.post(
+        "/api/evaluate",
+        Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .file("machine", "p.toml", PROFILE.as_bytes()),
+        &[],
+    );
+    // The profile alone: its two limits, named by the file.
+    let checks = checks(&answer);
+    assert_eq!(checks.as_array().unwrap().len(), 2, "{checks}");
+    assert_eq!(checks[0]["limit_source"], "p.toml [acceptance]");
+    // A bad limit is refused with what is valid.
+    let answer = server.post(
+        "/api/evaluate",
+        Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .text("limits", "Q=3"),
+        &[],
+    );
+    assert_eq!(answer.status, 400);
+    assert!(
+        answer.text().contains("unknown figure"),
+        "{}",
+        answer.text()
+    );
+}
+
+/// The table with a machine profile (inch, as `--machine`) is byte for
+/// byte `convert --machine P.toml`'s.
+#[test]
+fn the_table_with_a_profile_is_what_convert_writes_with_it() {
+    let server = Server::start();
+    let work = tempfile::tempdir().unwrap();
+    let profile = root().join("fixtures/machines/gantry-inch.toml");
+    for (controller, name) in [
+        ("tnc640", "X.COM"),
+        ("linuxcnc", "x.comp"),
+        ("sinumerik840d", "X.MPF"),
+    ] {
+        let answer = server.post(
+            "/api/table",
+            Form::new()
+                .file("file", "sample-x.rtl", &read(&sample()))
+                .file("machine", "gantry-inch.toml", &read(&profile))
+                .text("controller", controller)
+                .text("step", "50"),
+            &[],
+        );
+        assert_eq!(answer.status, 200, "{controller}: {}", answer.text());
+        let output = work.path().join(controller).join(name);
+        std::fs::create_dir_all(output.parent().unwrap()).unwrap();
+        let (sample_arg, output_arg) =
+            (sample().display().to_string(), output.display().to_string());
+        let profile_arg = profile.display().to_string();
+        cli_in(
+            &root(),
+            &[
+                "convert",
+                &sample_arg,
+                "--controller",
+                controller,
+                "--step",
+                "50",
+                "--machine",
+                &profile_arg,
+                "-o",
+                &output_arg,
+            ],
+        );
+        assert_eq!(answer.body, read(&output), "{controller}: {name} differs");
+        // Without the profile the file is another (mm, not inch): the profile was used.
+        let plain = server.post(
+            "/api/table",
+            Form::new()
+                .file("file", "sample-x.rtl", &read(&sample()))
+                .text("controller", controller)
+                .text("step", "50"),
+            &[],
+        );
+        assert_ne!(
+            plain.body, answer.body,
+            "{controller}: the profile changed nothing"
+        );
+    }
+    let convert = server.post(
+        "/api/convert",
+        Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .file("machine", "gantry-inch.toml", &read(&profile))
+            .text("controller", "tnc640"),
+        &[],
+    );
+    assert_eq!(convert.json()["convert"]["file_unit"], "inch");
+}
+
+/// A bad profile is a 400 naming the upload, line and column, as the CLI
+/// says it; the Edlén check is in the evaluation, as `evaluate --json` has it.
+#[test]
+fn a_bad_profile_is_refused_with_its_position() {
+    let server = Server::start();
+    let bad = "[controller]\nunits = \"mm\"\nfrobnicate = 3\n";
+    let work = tempfile::tempdir().unwrap();
+    std::fs::write(work.path().join("bad.toml"), bad).unwrap();
+    std::fs::copy(sample(), work.path().join("sample-x.rtl")).unwrap();
+    for path in ["/api/evaluate", "/api/convert", "/api/table"] {
+        let answer = server.post(
+            path,
+            Form::new()
+                .file("file", "sample-x.rtl", &read(&sample()))
+                .file("machine", "bad.toml", bad.as_bytes()),
+            &[],
+        );
+        assert_eq!(answer.status, 400, "{path}");
+        let message = answer.json()["error"].as_str().unwrap().to_string();
+        assert!(message.starts_with("bad.toml:3:1: "), "{path}: {message}");
+        let cli = Command::new(env!("CARGO_BIN_EXE_axcomp"))
+            .args([
+                "convert",
+                "sample-x.rtl",
+                "--controller",
+                "tnc640",
+                "--machine",
+                "bad.toml",
+                "-o",
+                "out.com",
+            ])
+            .current_dir(work.path())
+            .output()
+            .unwrap();
+        assert_eq!(cli.status.code(), Some(2));
+        let stderr = String::from_utf8_lossy(&cli.stderr);
+        assert_eq!(
+            message,
+            stderr.trim().trim_start_matches("axcomp: error: "),
+            "{path}"
+        );
+    }
+    let answer = server.post(
+        "/api/evaluate",
+        Form::new().file("file", "sample-x.rtl", &read(&sample())),
+        &[],
+    );
+    let check = &answer.json()["evaluation"]["refractive_index"];
+    // The sample at the start: the factor implies an index 0.01 ppm below Edlén's, which the report prints as −0.01.
+    assert_eq!(check["start"]["agrees"], true);
+    let difference = check["start"]["difference_ppm"].as_f64().unwrap();
+    assert!((difference + 0.00999).abs() < 1e-4, "{difference}");
+}
