@@ -489,7 +489,36 @@ fn the_page_works_in_a_real_browser() {
     );
     let figures = browser.execute("return document.getElementById('figures').innerText");
     assert!(figures.as_str().unwrap().contains("13.19"), "{figures}");
+    // The plot at the bottom of the window, the figures above it.
+    browser.execute("document.getElementById('deviation').scrollIntoView(false); return true");
     check_screenshot(&browser, "2-evaluated", 0.05, true);
+    // The Edlén check as evaluate --json has it: −0.01 ppm at the start.
+    let edlen = browser.execute("return document.getElementById('edlen').innerText");
+    assert!(edlen.as_str().unwrap().contains("-0.01 ✓"), "{edlen}");
+
+    // A limit of 12 µm on A (the sample's A is 13.19 µm): FAIL, as
+    // `evaluate --limit A=12` says.
+    browser.click(&browser.find("#limit-A"));
+    browser.send_keys(&browser.find("#limit-A"), "12\u{E007}");
+    browser.wait_for(
+        "return document.body.dataset.verdict === 'fail' && document.body.dataset.busy === '0'",
+        "the verdict on A = 12 µm",
+    );
+    let verdict = browser.execute("return document.getElementById('verdict').innerText");
+    assert_eq!(
+        verdict.as_str().unwrap(),
+        "FAIL (simple acceptance): A not within the limits"
+    );
+    let checks = browser.execute("return document.getElementById('checks').innerText");
+    assert!(
+        checks
+            .as_str()
+            .unwrap()
+            .starts_with("A 13.19 µm against 12.00 µm"),
+        "{checks}"
+    );
+    browser.execute("document.getElementById('figures').scrollIntoView(); return true");
+    check_screenshot(&browser, "2b-verdict", 0.02, false);
 
     browser.click(&browser.find("#controller option[value='linuxcnc']"));
     browser.click(&browser.find("#step"));
