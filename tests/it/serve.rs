@@ -778,3 +778,60 @@ fn a_bad_profile_is_refused_with_its_position() {
     let difference = check["start"]["difference_ppm"].as_f64().unwrap();
     assert!((difference + 0.00999).abs() < 1e-4, "{difference}");
 }
+
+/// The re-test's diagnosis with a machine profile searches its screw lead
+/// first, as `diagnose --machine` does: the same JSON, the lead found at
+/// exactly 15 mm (seed 001's VC1810, Tab. 7) in a re-test with a planted
+/// 15 mm lead error (seed 3 of `diagnose_periodic`).
+#[test]
+fn the_retest_with_a_profile_is_what_diagnose_prints_with_it() {
+    let server = Server::start();
+    let work = tempfile::tempdir().unwrap();
+    let case = crate::diagnose_periodic::case(15.0, 3, true);
+    let truth = work.path().join("truth.toml");
+    std::fs::write(&truth, &case.truth).unwrap();
+    crate::util::synth_loop_files(work.path(), &truth, Some("3"));
+    let profile = root().join("fixtures/machines/vc1810.toml");
+    std::fs::copy(&profile, work.path().join("vc1810.toml")).unwrap();
+    let file = |name: &str| read(&work.path().join(name));
+    let answer = server.post(
+        "/api/retest",
+        Form::new()
+            .file("file", "before.rtl", &file("before.rtl"))
+            .file("after", "after.rtl", &file("after.rtl"))
+            .file("table", "X.COM", &file("X.COM"))
+            .file("machine", "vc1810.toml", &read(&profile)),
+        &[],
+    );
+    assert_eq!(answer.status, 200, "{}", answer.text());
+    let cli: serde_json::Value = serde_json::from_slice(&cli_in(
+        work.path(),
+        &[
+            "diagnose",
+            "--after",
+            "after.rtl",
+            "--before",
+            "before.rtl",
+            "--table",
+            "X.COM",
+            "--machine",
+            "vc1810.toml",
+            "--json",
+        ],
+    ))
+    .unwrap();
+    let diagnosis = &answer.json()["diagnosis"];
+    assert_eq!(*diagnosis, cli);
+    let periodic = diagnosis["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["kind"] == "periodic")
+        .unwrap_or_else(|| panic!("{diagnosis:#}"));
+    assert_eq!(periodic["params"]["period_mm"], 15.0);
+    assert!(
+        periodic["warnings"]
+            .to_string()
+            .contains("the screw lead the machine profile gives (15 mm)")
+    );
+}
