@@ -5,7 +5,9 @@
 //! the binary; no CDN, so it works offline) and a small JSON API over the
 //! library, on axum and tokio:
 //!
-//! - `POST /api/evaluate`: `evaluate --json`'s object and the deviation plot;
+//! - `POST /api/evaluate`: `evaluate --json`'s object (with the form's
+//!   `limits`, `decision` and machine profile, as `--limit`, `--decision`,
+//!   `--machine`) and the deviation plot;
 //! - `POST /api/convert`: `convert --json`'s object, the file's text and the
 //!   table's plot; `POST /api/table` the file itself, byte for byte what
 //!   `convert -o NAME` writes, under the controller's usual name
@@ -13,6 +15,10 @@
 //! - `POST /api/retest`: the diagnosis of a re-test (`diagnose --json`) and
 //!   the next table;
 //! - `POST /api/report`: the acceptance report, the HTML `axcomp report` writes.
+//!
+//! Every route takes the machine profile (`machine`, the `--machine` TOML):
+//! its axis settings for the tables, its `[acceptance]` for the verdict, its
+//! screw lead and scale period for the diagnosis.
 //!
 //! The work is the CLI's own ([`crate::workflow`]); this module only reads
 //! the form and answers. Its limits: uploads of at most [`UPLOAD_LIMIT`]
