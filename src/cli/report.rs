@@ -22,7 +22,7 @@ use axcomp::workflow::Test;
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
+    AngleUnitArg, InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
     load_equipment, load_profile, name_axis, print_text, print_warnings, read_active_table,
 };
 
@@ -105,6 +105,10 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub overwrite: Overwrite,
 
+    /// `--angle-unit` (the same in `evaluate` and `diagnose`).
+    #[command(flatten)]
+    pub angle_unit: AngleUnitArg,
+
     /// `--standard` (the same in every command).
     #[command(flatten)]
     pub standard: StandardArg,
@@ -173,6 +177,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         standard,
         &equipment,
     )?;
+    let angle = args.angle_unit.for_axis(&before.measurement)?;
     if before.measurement.kind() == AxisKind::Rotary {
         refuse_for_rotary(args, &before.measurement)?;
     }
@@ -255,6 +260,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         limits: &limits,
         decision: args.uncertainty.decision,
         standard,
+        angle,
         generator: &generator,
     };
     // Render everything before writing anything: a failure leaves no half report.

@@ -52,6 +52,7 @@ use crate::read;
 use crate::report::acceptance::{ReportInput, TableRecord, charts};
 use crate::report::chart::chart;
 use crate::report::convert::ConvertJson;
+use crate::units::AngleUnit;
 use crate::report::diagnose::DiagnoseJson;
 use crate::report::html;
 use crate::report::json::EvaluationJson;
@@ -330,6 +331,7 @@ fn report_input<'a>(
         limits: &[],
         decision: Decision::default(),
         standard,
+        angle: AngleUnit::default(),
         generator,
     }
 }
@@ -352,11 +354,14 @@ async fn api_evaluate(multipart: Multipart) -> Result<axum::Json<EvaluateAnswer>
         let evaluation = workflow::evaluation_report(
             &measurement,
             evaluation,
-            &[],
             &mut warnings,
-            &[],
-            &equipment,
-            Decision::default(),
+            workflow::EvaluationReportOptions {
+                exclude_runs: &[],
+                limits: &[],
+                equipment: &equipment,
+                decision: Decision::default(),
+                angle: AngleUnit::default(),
+            },
         )?;
         let input = report_input(&test, None, None, None, standard, "");
         Ok(EvaluateAnswer {
@@ -669,6 +674,7 @@ fn retest(form: &Form) -> Result<Retest, ApiError> {
         table
             .as_ref()
             .map(|((name, _), ..)| name.display().to_string()),
+        AngleUnit::default(),
     );
     Ok(Retest {
         effects_toml: diagnosis.effects_file(&after_label),

@@ -409,6 +409,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
         limits: &[],
         decision: Default::default(),
         standard: &ISO_230_2,
+        angle: Default::default(),
         generator: "test",
     };
     let charts = charts(&input);
