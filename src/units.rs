@@ -405,10 +405,12 @@ mod tests {
     #[test]
     fn deviation_units_by_hand() {
         // 1° = 3600″ = 17 453.292 5 µrad (π/180 · 10⁶); 0.001 mm = 1 µm.
-        assert_eq!(DeviationUnit::Angle(AngleUnit::Arcsec).from_internal(1.0), 3600.0);
+        assert_eq!(
+            DeviationUnit::Angle(AngleUnit::Arcsec).from_internal(1.0),
+            3600.0
+        );
         assert!(
-            (DeviationUnit::Angle(AngleUnit::Urad).from_internal(1.0) - 17_453.292_519_943_3)
-                .abs()
+            (DeviationUnit::Angle(AngleUnit::Urad).from_internal(1.0) - 17_453.292_519_943_3).abs()
                 < 1e-9
         );
         assert_eq!(DeviationUnit::Micrometre.from_internal(0.5), 500.0);

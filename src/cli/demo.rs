@@ -148,6 +148,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
 
     // 4. The re-test, diagnosed against the prediction.
     let diagnosis = diagnose(&DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: Some(&before),
         table: Some(&active),

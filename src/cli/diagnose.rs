@@ -16,8 +16,8 @@ use axcomp::report::diagnose::{DiagnoseJson, FrictionJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 
 use super::common::{
-    AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load, load_profile,
-    name_axis, print_json, print_text, print_warnings, read_active_table,
+    AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load,
+    load_profile, name_axis, print_json, print_text, print_warnings, read_active_table,
 };
 use super::servo_sim::load_axis;
 
@@ -172,6 +172,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     };
     let angular = args.angular.as_deref().map(load_angular).transpose()?;
     let input = DiagnoseInput {
+        angle,
         after: &after.measurement,
         before: before.as_ref(),
         table: table.as_ref(),

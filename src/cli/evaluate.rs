@@ -12,8 +12,8 @@ use axcomp::workflow::{EvaluationReportOptions, evaluation_report};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    AngleUnitArg, InputFormat, JsonOutput, MachineFile, StandardArg, UncertaintyArgs, Verbosity, load_equipment,
-    name_axis, parse_run_selector, print_json, print_text, print_warnings,
+    AngleUnitArg, InputFormat, JsonOutput, MachineFile, StandardArg, UncertaintyArgs, Verbosity,
+    load_equipment, name_axis, parse_run_selector, print_json, print_text, print_warnings,
 };
 
 /// Flags of `axcomp evaluate`.

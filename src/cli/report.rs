@@ -22,8 +22,9 @@ use axcomp::workflow::Test;
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    AngleUnitArg, InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
-    load_equipment, load_profile, name_axis, print_text, print_warnings, read_active_table,
+    AngleUnitArg, InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs,
+    Verbosity, load_equipment, load_profile, name_axis, print_text, print_warnings,
+    read_active_table,
 };
 
 /// Flags of `axcomp report`.
@@ -230,6 +231,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let diagnosis = match (&after, args.diagnose) {
         (Some(after), true) => {
             let input = DiagnoseInput {
+                angle,
                 after: &after.measurement,
                 before: Some(&before.measurement),
                 table: table.as_ref().map(|(_, _, t)| t),

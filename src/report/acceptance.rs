@@ -433,7 +433,11 @@ fn means_in(
 /// (target, x̄ − 2s, x̄ + 2s) converted by `shown`, where both are defined.
 fn band(target_mm: f64, stats: &DirectionStats, shown: DeviationUnit) -> Option<(f64, f64, f64)> {
     let (low, high) = stats.band(crate::evaluate::ISO_230_2.k)?;
-    Some((target_mm, shown.from_internal(low), shown.from_internal(high)))
+    Some((
+        target_mm,
+        shown.from_internal(low),
+        shown.from_internal(high),
+    ))
 }
 
 /// The largest |x̄↑|, |x̄↓|, |x̄| of a rotary test, in `angle`; `None` for a linear one.

@@ -560,10 +560,12 @@ pub fn render(report: &DiagnoseJson) -> String {
             um(Some(u.rms_um))
         );
     }
+    // The first column fits its heading: `Figures [µrad]` is wider than `Figures [µm]`.
+    let heading = format!("Figures [{}]", dev.trim());
+    let width = heading.chars().count().max(12);
     let _ = writeln!(
         out,
-        "\n{:<12} |  measured | predicted | predicted with effects   ({}{})",
-        format!("Figures [{}]", dev.trim()),
+        "\n{heading:<width$} |  measured | predicted | predicted with effects   ({}{})",
         report.standard_name,
         if report.definitions_reconstructed {
             "; definitions reconstructed from public sources (README, Standards)"
@@ -573,14 +575,15 @@ pub fn render(report: &DiagnoseJson) -> String {
     );
     let _ = writeln!(
         out,
-        "-------------+-----------+-----------+-----------------------"
+        "{}+-----------+-----------+-----------------------",
+        "-".repeat(width + 1)
     );
     let f = &report.figures_um;
     for (name, key) in f.measured.terminal_rows() {
         let _ = writeln!(
             out,
             " {} | {:>9} | {:>9} | {:>22}",
-            pad_name(name, 11),
+            pad_name(name, width - 1),
             um(f.measured.get(key)),
             um(f.predicted.get(key)),
             um(f.predicted_with_effects.get(key))

@@ -52,12 +52,12 @@ use crate::read;
 use crate::report::acceptance::{ReportInput, TableRecord, charts};
 use crate::report::chart::chart;
 use crate::report::convert::ConvertJson;
-use crate::units::AngleUnit;
 use crate::report::diagnose::DiagnoseJson;
 use crate::report::html;
 use crate::report::json::EvaluationJson;
 use crate::report::plot::PlotFormat;
 use crate::together::{Input, Pairing, check_together};
+use crate::units::AngleUnit;
 use crate::workflow::{self, Converted, TableRequest, Test};
 
 use form::{Form, Upload};
@@ -656,6 +656,7 @@ fn retest(form: &Form) -> Result<Retest, ApiError> {
         after_warnings.extend(doubts.iter().cloned());
     }
     let diagnosis = diagnose(&DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: Some(&before),
         table: table.as_ref().map(|(_, _, t, _)| t),
@@ -754,6 +755,7 @@ async fn api_report(multipart: Multipart) -> Result<Response, ApiError> {
         }
         let diagnosis = match (&after, form.text("diagnose")) {
             (Some(after), Some(_)) => Some(diagnose(&DiagnoseInput {
+                angle: Default::default(),
                 after: &after.measurement,
                 before: Some(&before.measurement),
                 table: table.as_ref().map(|(_, _, t, _)| t),

@@ -242,6 +242,7 @@ impl RetestCase {
         let text = std::fs::read_to_string(&self.table).unwrap();
         let (_, table) = emit::read_any(&text, &table_options(), None).unwrap();
         diagnose(&DiagnoseInput {
+            angle: Default::default(),
             after: &after,
             before: Some(&before),
             table: Some(&table),

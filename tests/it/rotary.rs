@@ -774,3 +774,230 @@ fn diagnose_of_a_rotary_axis_refuses_length_only_flags() {
         assert!(!other.exists());
     }
 }
+
+/// µrad in one arc-second, from the definition (1″ = π/648000 rad), not
+/// from `axcomp::units`.
+const URAD_PER_ARCSEC: f64 = std::f64::consts::PI / 648_000.0 * 1e6;
+
+/// Walks the ″ object `arcsec` beside the µrad object `urad`: every key
+/// ending in `_arcsec` is there as `_urad` with every number in it (at any
+/// depth) the ″ number × [`URAD_PER_ARCSEC`] (within rounding), every
+/// other value the same. Returns how many numbers were compared scaled.
+fn assert_urad_beside_arcsec(
+    arcsec: &serde_json::Value,
+    urad: &serde_json::Value,
+    scaled: bool,
+    at: &str,
+) -> usize {
+    use serde_json::Value;
+    match (arcsec, urad) {
+        (Value::Object(a), Value::Object(u)) => {
+            assert_eq!(a.len(), u.len(), "{at}: {:?} vs {:?}", a.keys(), u.keys());
+            let mut count = 0;
+            for (key, value) in a {
+                let (key_urad, scaled) = match key.strip_suffix("_arcsec") {
+                    Some(stem) => (format!("{stem}_urad"), true),
+                    None => (key.clone(), scaled),
+                };
+                let other = u
+                    .get(&key_urad)
+                    .unwrap_or_else(|| panic!("{at}.{key_urad} missing"));
+                count += assert_urad_beside_arcsec(value, other, scaled, &format!("{at}.{key}"));
+            }
+            count
+        }
+        (Value::Array(a), Value::Array(u)) => {
+            assert_eq!(a.len(), u.len(), "{at}");
+            a.iter()
+                .zip(u)
+                .enumerate()
+                .map(|(i, (a, u))| assert_urad_beside_arcsec(a, u, scaled, &format!("{at}.{i}")))
+                .sum()
+        }
+        (Value::Number(a), Value::Number(u)) if scaled => {
+            let (a, u) = (a.as_f64().unwrap(), u.as_f64().unwrap());
+            let expected = a * URAD_PER_ARCSEC;
+            assert!(
+                (u - expected).abs() <= 1e-12 * expected.abs().max(1.0),
+                "{at}: {u} µrad ≠ {a}″ × {URAD_PER_ARCSEC} = {expected}"
+            );
+            1
+        }
+        // A sentence that says a deviation says it in the unit asked for.
+        (Value::String(a), Value::String(u)) if a != u => {
+            assert!(
+                a.contains('″') && !u.contains('″') && u.contains("µrad"),
+                "{at}: {a:?} vs {u:?}"
+            );
+            0
+        }
+        (a, u) => {
+            assert_eq!(a, u, "{at}");
+            0
+        }
+    }
+}
+
+/// `--angle-unit urad`: the rotary fixture's every deviation figure is the
+/// arc-second figure × π/648000·10⁶ (computed here, not by axcomp), every
+/// key that ends in `_arcsec` ends in `_urad` (and none in `_arcsec`), and
+/// the terminal says µrad. The default is still ″.
+#[test]
+fn evaluate_in_microradians_is_the_arcsec_report_times_the_factor() {
+    let file = "fixtures/rotary/c.csv";
+    let run = axcomp(["evaluate", "--json", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let arcsec: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let run = axcomp(["evaluate", "--json", "--angle-unit", "arcsec", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert_eq!(
+        serde_json::from_str::<serde_json::Value>(&run.stdout).unwrap(),
+        arcsec
+    );
+    let run = axcomp(["evaluate", "--json", "--angle-unit", "urad", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let urad: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let compared = assert_urad_beside_arcsec(&arcsec, &urad, false, "");
+    // 25 targets × 9 statistics, and the 12 ISO 230-2 figures at least.
+    assert!(compared >= 25 * 9 + 12, "{compared}");
+    let mut keys = Vec::new();
+    keys_of(&urad, &mut keys);
+    assert!(keys.iter().all(|k| !k.ends_with("_arcsec")), "{keys:?}");
+    assert!(keys.iter().any(|k| k == "figures_urad"), "{keys:?}");
+    assert!(keys.iter().any(|k| k == "mean_up_urad"), "{keys:?}");
+    // One figure by hand: E = 17.33″ in the golden file → µrad.
+    let e_arcsec = arcsec["figures_arcsec"]["E"].as_f64().unwrap();
+    let e_urad = urad["figures_urad"]["E"].as_f64().unwrap();
+    assert!((e_urad / e_arcsec - 4.848_136_811).abs() < 1e-8);
+
+    let run = axcomp(["evaluate", "--angle-unit", "urad", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains("Per target [µrad]"), "{}", run.stdout);
+    assert!(run.stdout.contains("Axis figures [µrad]"), "{}", run.stdout);
+    assert!(!run.stdout.contains('″'), "{}", run.stdout);
+}
+
+/// `report --angle-unit urad`: the tables, the rotary note and the plots'
+/// labels say µrad, the figures are the µrad JSON's, and no ″ is left in
+/// the deviation units.
+#[test]
+fn report_in_microradians() {
+    let directory = tempfile::tempdir().unwrap();
+    let html_path = directory.path().join("r.html");
+    let png = directory.path().join("png");
+    let run = axcomp([
+        "report".as_ref(),
+        "fixtures/rotary/c.csv".as_ref(),
+        "--angle-unit".as_ref(),
+        "urad".as_ref(),
+        "-o".as_ref(),
+        html_path.as_os_str(),
+        "--png".as_ref(),
+        png.as_os_str(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&html_path).unwrap();
+    for text in [
+        "ISO 230-2 figures [µrad]",
+        "Per target [µrad]",
+        "data-key=\"before.figures_urad.A\"",
+        "data-key=\"before.per_target.0.mean_up_urad\"",
+        "positional deviation [µrad]",
+        "in microradians",
+    ] {
+        assert!(html.contains(text), "{text}");
+    }
+    for text in ["figures_arcsec", "_arcsec\"", "[″]", "labelled with in ″"] {
+        assert!(!html.contains(text), "{text}");
+    }
+    // The figure A shown is the µrad figure of evaluate, to two decimals.
+    let run = axcomp([
+        "evaluate",
+        "--json",
+        "--angle-unit",
+        "urad",
+        "fixtures/rotary/c.csv",
+    ]);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let a_urad = json["figures_urad"]["A"].as_f64().unwrap();
+    assert!(
+        html.contains(&format!(
+            "data-key=\"before.figures_urad.A\" data-um=\"{a_urad}\">{a_urad:.2}<"
+        )),
+        "A = {a_urad}"
+    );
+    assert!(png.join("polar.png").exists());
+}
+
+/// `--angle-unit` cannot apply to a linear axis (its deviations are µm):
+/// `evaluate`, `report` and `diagnose` refuse it, exit 2, saying why.
+#[test]
+fn angle_unit_on_a_linear_axis_is_refused() {
+    let directory = tempfile::tempdir().unwrap();
+    let html = directory.path().join("r.html");
+    let linear = "fixtures/sample-x.rtl";
+    for args in [
+        vec!["evaluate", "--angle-unit", "urad", linear],
+        vec!["evaluate", "--json", "--angle-unit", "arcsec", linear],
+        vec![
+            "report",
+            linear,
+            "--angle-unit",
+            "urad",
+            "-o",
+            html.to_str().unwrap(),
+        ],
+        vec!["diagnose", "--after", linear, "--angle-unit", "urad"],
+    ] {
+        let run = axcomp(&args);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stdout);
+        assert!(
+            run.stderr.contains("--angle-unit") && run.stderr.contains("linear axis"),
+            "{args:?}: {}",
+            run.stderr
+        );
+        assert!(run.stdout.is_empty(), "{args:?}");
+    }
+    assert!(!html.exists());
+    let run = axcomp(["evaluate", "--angle-unit", "mrad", "fixtures/rotary/c.csv"]);
+    assert_eq!(run.code, 2);
+    assert!(run.stderr.contains("arcsec, urad"), "{}", run.stderr);
+}
+
+/// `diagnose --angle-unit urad` on a rotary re-test: the same diagnosis,
+/// every `_arcsec` key `_urad` with its value × π/648000·10⁶, µrad in the terminal.
+#[test]
+fn diagnose_in_microradians() {
+    let directory = tempfile::tempdir().unwrap();
+    let (before, table, after) = rotary_retest_files(directory.path(), (2, 3.0, 0.3), 31);
+    let run_in = |unit: &str, json: bool| {
+        let mut args = vec![
+            "diagnose".as_ref(),
+            "--after".as_ref(),
+            after.as_os_str(),
+            "--before".as_ref(),
+            before.as_os_str(),
+            "--table".as_ref(),
+            table.as_os_str(),
+            "--quiet".as_ref(),
+            "--angle-unit".as_ref(),
+            unit.as_ref(),
+        ];
+        if json {
+            args.push("--json".as_ref());
+        }
+        let run = axcomp(args);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        run.stdout
+    };
+    let arcsec: serde_json::Value = serde_json::from_str(&run_in("arcsec", true)).unwrap();
+    let urad: serde_json::Value = serde_json::from_str(&run_in("urad", true)).unwrap();
+    let compared = assert_urad_beside_arcsec(&arcsec, &urad, false, "");
+    assert!(compared > 10, "{compared}");
+    let mut keys = Vec::new();
+    keys_of(&urad, &mut keys);
+    assert!(keys.iter().all(|k| !k.contains("arcsec")), "{keys:?}");
+    let text = run_in("urad", false);
+    assert!(text.contains("Figures [µrad]"), "{text}");
+    assert!(!text.contains('″'), "{text}");
+}
