@@ -638,6 +638,26 @@ fn rotary_retest_files(
     (before_path, table_path, after_path)
 }
 
+/// `diagnose --quiet` of the re-test `files` (before, table, after) with
+/// `extra` flags; it must succeed.
+fn diagnose_retest(files: &(PathBuf, PathBuf, PathBuf), extra: &[&str]) -> crate::util::Run {
+    let (before, table, after) = files;
+    let mut args = vec![
+        "diagnose".as_ref(),
+        "--after".as_ref(),
+        after.as_os_str(),
+        "--before".as_ref(),
+        before.as_os_str(),
+        "--table".as_ref(),
+        table.as_os_str(),
+        "--quiet".as_ref(),
+    ];
+    args.extend(extra.iter().map(|flag| std::ffi::OsStr::new(flag)));
+    let run = axcomp(args);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    run
+}
+
 /// Every key of a JSON value, at every depth.
 fn keys_of(value: &serde_json::Value, keys: &mut Vec<String>) {
     match value {
@@ -668,25 +688,8 @@ fn diagnose_finds_a_per_revolution_harmonic_with_its_order() {
         (24, (3, 2.0, 0.0)),
     ] {
         let (order, amplitude_arcsec, _) = extra;
-        let (before, table, after) = rotary_retest_files(directory.path(), extra, seed);
-        let args = |json: bool| {
-            let mut args = vec![
-                "diagnose".as_ref(),
-                "--after".as_ref(),
-                after.as_os_str(),
-                "--before".as_ref(),
-                before.as_os_str(),
-                "--table".as_ref(),
-                table.as_os_str(),
-                "--quiet".as_ref(),
-            ];
-            if json {
-                args.push("--json".as_ref());
-            }
-            args
-        };
-        let run = axcomp(args(true));
-        assert_eq!(run.code, 0, "{}", run.stderr);
+        let files = rotary_retest_files(directory.path(), extra, seed);
+        let run = diagnose_retest(&files, &["--json"]);
         let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
         assert_eq!(json["axis_kind"], "rotary");
         let periodic: Vec<&serde_json::Value> = json["effects"]
@@ -738,8 +741,7 @@ fn diagnose_finds_a_per_revolution_harmonic_with_its_order() {
             "{rms} vs {expected}"
         );
 
-        let run = axcomp(args(false));
-        assert_eq!(run.code, 0, "{}", run.stderr);
+        let run = diagnose_retest(&files, &[]);
         assert!(
             run.stdout.contains(&format!("{order} per revolution")),
             "{}",
@@ -969,35 +971,18 @@ fn angle_unit_on_a_linear_axis_is_refused() {
 #[test]
 fn diagnose_in_microradians() {
     let directory = tempfile::tempdir().unwrap();
-    let (before, table, after) = rotary_retest_files(directory.path(), (2, 3.0, 0.3), 31);
-    let run_in = |unit: &str, json: bool| {
-        let mut args = vec![
-            "diagnose".as_ref(),
-            "--after".as_ref(),
-            after.as_os_str(),
-            "--before".as_ref(),
-            before.as_os_str(),
-            "--table".as_ref(),
-            table.as_os_str(),
-            "--quiet".as_ref(),
-            "--angle-unit".as_ref(),
-            unit.as_ref(),
-        ];
-        if json {
-            args.push("--json".as_ref());
-        }
-        let run = axcomp(args);
-        assert_eq!(run.code, 0, "{}", run.stderr);
-        run.stdout
+    let files = rotary_retest_files(directory.path(), (2, 3.0, 0.3), 31);
+    let json_in = |unit: &str| -> serde_json::Value {
+        let run = diagnose_retest(&files, &["--json", "--angle-unit", unit]);
+        serde_json::from_str(&run.stdout).unwrap()
     };
-    let arcsec: serde_json::Value = serde_json::from_str(&run_in("arcsec", true)).unwrap();
-    let urad: serde_json::Value = serde_json::from_str(&run_in("urad", true)).unwrap();
+    let (arcsec, urad) = (json_in("arcsec"), json_in("urad"));
     let compared = assert_urad_beside_arcsec(&arcsec, &urad, false, "");
     assert!(compared > 10, "{compared}");
     let mut keys = Vec::new();
     keys_of(&urad, &mut keys);
     assert!(keys.iter().all(|k| !k.contains("arcsec")), "{keys:?}");
-    let text = run_in("urad", false);
+    let text = diagnose_retest(&files, &["--angle-unit", "urad"]).stdout;
     assert!(text.contains("Figures [µrad]"), "{text}");
     assert!(!text.contains('″'), "{text}");
 }
