@@ -652,7 +652,7 @@ fn diagnose_retest(files: &(PathBuf, PathBuf, PathBuf), extra: &[&str]) -> crate
         table.as_os_str(),
         "--quiet".as_ref(),
     ];
-    args.extend(extra.iter().map(|flag| std::ffi::OsStr::new(flag)));
+    args.extend(extra.iter().map(std::ffi::OsStr::new));
     let run = axcomp(args);
     assert_eq!(run.code, 0, "{}", run.stderr);
     run
