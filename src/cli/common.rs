@@ -445,11 +445,16 @@ pub struct LinuxCncType {
 
 /// Prints warnings to stderr unless `quiet`.
 pub fn print_warnings(warnings: &[Warning], quiet: bool) {
+    print_warnings_in(warnings, quiet, AngleUnit::default());
+}
+
+/// [`print_warnings`], a rotary axis' deviations in `angle` (`--angle-unit`).
+pub fn print_warnings_in(warnings: &[Warning], quiet: bool, angle: AngleUnit) {
     if quiet {
         return;
     }
     for warning in warnings {
-        eprintln!("axcomp: warning: {warning}");
+        eprintln!("axcomp: warning: {}", warning.text_in(angle));
     }
 }
 

@@ -13,7 +13,7 @@ use axcomp::workflow::{EvaluationReportOptions, evaluation_report};
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     AngleUnitArg, InputFormat, JsonOutput, MachineFile, StandardArg, UncertaintyArgs, Verbosity,
-    load_equipment, name_axis, parse_run_selector, print_json, print_text, print_warnings,
+    load_equipment, name_axis, parse_run_selector, print_json, print_text, print_warnings_in,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -111,7 +111,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     // text rendered from a large test (megabytes) takes memory already in
     // use rather than new pages.
     drop(measurement);
-    print_warnings(&warnings, args.verbosity.quiet);
+    print_warnings_in(&warnings, args.verbosity.quiet, angle);
     if args.json_output.json {
         print_json(&report)
     } else {

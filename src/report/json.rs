@@ -783,7 +783,7 @@ impl EvaluationJson {
                 location: metadata.location.clone(),
                 description: metadata.description.clone(),
             },
-            warnings: warnings.iter().map(ToString::to_string).collect(),
+            warnings: warnings.iter().map(|w| w.text_in(angle)).collect(),
             uncertainty_um: None,
             verdict: None,
             test_conformance: ConformanceJson::from_conformance(&evaluation.conformance),

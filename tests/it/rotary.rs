@@ -194,6 +194,20 @@ fn missing_principal_angles_and_disagreeing_ends_are_said() {
         warnings.contains("0° and 360° are one physical position, but their mean deviations differ by 10.50″ (+0.50″ and +11.00″), more than the repeatability there (5.83″)"),
         "{warnings}"
     );
+    // The same with --angle-unit urad, × π/648000·10⁶ by hand: 10.5″ =
+    // 50.905 µrad, 0.5″ = 2.424, 11″ = 53.330, (2√2 + 3)″ = 28.257 µrad;
+    // on stderr and in the JSON alike.
+    let run = axcomp([
+        "evaluate".as_ref(),
+        "--json".as_ref(),
+        "--angle-unit".as_ref(),
+        "urad".as_ref(),
+        path.as_os_str(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let said = "differ by 50.91 µrad (+2.42 µrad and +53.33 µrad), more than the repeatability there (28.26 µrad)";
+    assert!(run.stderr.contains(said), "{}", run.stderr);
+    assert!(run.stdout.contains(said), "{}", run.stdout);
 }
 
 #[test]
