@@ -23,7 +23,7 @@ use axcomp::workflow::Test;
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     AngleUnitArg, InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs,
-    Verbosity, load_equipment, load_profile, name_axis, print_text, print_warnings,
+    Verbosity, load_equipment, load_profile, name_axis, print_text, print_warnings_in,
     read_active_table,
 };
 
@@ -291,7 +291,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         return Err(error.into());
     }
     for test in std::iter::once(&before).chain(&after) {
-        print_warnings(&test.warnings, args.verbosity.quiet);
+        print_warnings_in(&test.warnings, args.verbosity.quiet, angle);
     }
     let mut summary = format!("Wrote {}\n", args.output.display());
     for (path, _) in files.iter().skip(1) {

@@ -1378,7 +1378,7 @@ fn notes(input: &ReportInput<'_>) -> Vec<Note> {
         for warning in record.warnings {
             notes.push(Note {
                 test,
-                what: NoteText::Warning(warning.to_string()),
+                what: NoteText::Warning(warning.text_in(input.angle)),
             });
         }
         for outlier in &record.evaluation.outliers {

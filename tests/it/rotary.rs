@@ -208,6 +208,19 @@ fn missing_principal_angles_and_disagreeing_ends_are_said() {
     let said = "differ by 50.91 µrad (+2.42 µrad and +53.33 µrad), more than the repeatability there (28.26 µrad)";
     assert!(run.stderr.contains(said), "{}", run.stderr);
     assert!(run.stdout.contains(said), "{}", run.stdout);
+    // And in the report's notes.
+    let html = directory.path().join("ends.html");
+    let run = axcomp([
+        "report".as_ref(),
+        path.as_os_str(),
+        "--angle-unit".as_ref(),
+        "urad".as_ref(),
+        "-o".as_ref(),
+        html.as_os_str(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains(said), "{}", run.stderr);
+    assert!(std::fs::read_to_string(&html).unwrap().contains(said));
 }
 
 #[test]
