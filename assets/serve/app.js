@@ -4,7 +4,9 @@
 "use strict";
 
 const $ = (id) => document.getElementById(id);
-const files = { file: [], after: [], table: [] };
+const files = { file: [], after: [], table: [], machine: [] };
+// The limits typed next to the figures, µm, by figure key (`A`, `R_up`).
+const limits = {};
 let busy = 0;
 let lastConvert = null;
 
@@ -43,12 +45,14 @@ function showError(id, message) {
 // The page's settings and files as a form for the API.
 function form(fields) {
   const data = new FormData();
-  for (const field of fields) {
+  for (const field of fields.concat(["machine"])) {
     for (const file of files[field]) data.append(field, file, file.name);
   }
-  for (const id of ["axis", "standard"]) {
+  for (const id of ["axis", "standard", "decision"]) {
     if ($(id).value.trim()) data.append(id, $(id).value.trim());
   }
+  const given = Object.entries(limits).filter(([, v]) => v !== "").map(([k, v]) => k + "=" + v);
+  if (given.length) data.append("limits", given.join(","));
   return data;
 }
 
@@ -121,12 +125,24 @@ function showEvaluation(answer) {
   const unit = e.figures_um ? "um" : "arcsec";
   const values = e.figures_um || e.figures_arcsec || {};
   const uncertainty = e.uncertainty_um || {};
-  row(figures, ["figure", unit === "um" ? "µm" : "″", "U"], true);
+  row(figures, unit === "um" ? ["figure", "µm", "U", "limit [µm]"] : ["figure", "″", "U"], true);
   for (const [key, value] of Object.entries(values)) {
     row(figures, [key.replace("_up", " ↑").replace("_down", " ↓").replace("B_mean", "B̄"), text(value),
       uncertainty[key] ? "± " + text(uncertainty[key]) : ""]);
+    if (unit !== "um") continue;
+    // Limits are µm, for linear axes only (as --limit).
+    const input = element("input");
+    input.id = "limit-" + key;
+    input.size = 5;
+    input.inputMode = "decimal";
+    input.value = limits[key] || "";
+    const check = e.verdict && e.verdict.checks.find((c) => c.figure === key);
+    if (check && !input.value) input.placeholder = text(check.limit_um);
+    input.addEventListener("change", () => { limits[key] = input.value.trim(); evaluate(); });
+    figures.rows[figures.rows.length - 1].insertCell().appendChild(input);
   }
-  $("verdict").textContent = e.verdict ? (e.verdict.pass ? "PASS" : "FAIL: " + e.verdict.failed.join(", ")) : "";
+  showVerdict(e.verdict);
+  showEdlen(e.refractive_index);
   const environment = $("environment");
   environment.replaceChildren();
   const env = e.environment || {};
@@ -154,6 +170,49 @@ function showEvaluation(answer) {
   $("deviation").innerHTML = answer.deviation_svg || "";
   $("evaluation").hidden = false;
   for (const id of ["step-table", "step-retest", "step-report"]) $(id).hidden = false;
+}
+
+// The verdict as evaluate --json gives it: the rule, then one line per check.
+function showVerdict(verdict) {
+  const box = $("verdict");
+  const checks = $("checks");
+  checks.replaceChildren();
+  if (!verdict) {
+    box.textContent = "";
+    box.className = "";
+    delete document.body.dataset.verdict;
+    return;
+  }
+  const word = { pass: "PASS", fail: "FAIL", "not-proven": "NOT PROVEN" }[verdict.conformance] || verdict.conformance;
+  box.textContent = word + " (" + verdict.decision + ")" + (verdict.failed.length ? ": " + verdict.failed.join(", ") + " not within the limits" : "");
+  box.className = "verdict " + verdict.conformance;
+  for (const c of verdict.checks) {
+    checks.appendChild(element("li", c.figure + " " + text(c.value_um) + " µm against " + text(c.limit_um) +
+      " µm" + (c.U_um !== null && c.U_um !== undefined ? " (U ± " + text(c.U_um) + ")" : "") + ": " + c.conformance +
+      " · " + c.limit_source + (c.limit_derivation ? ", " + c.limit_derivation : "")));
+  }
+  document.body.dataset.verdict = verdict.conformance;
+}
+
+// The Edlén check as evaluate --json gives it (no physics here).
+function showEdlen(check) {
+  const table = $("edlen");
+  table.replaceChildren();
+  if (!check) return;
+  row(table, ["", "factor [µm]", "n implied", "n Edlén", "difference [ppm]"], true);
+  const notes = [];
+  for (const when of ["start", "end"]) {
+    const at = check[when];
+    if (at.missing.length) {
+      notes.push(when + ": not checked, the file lacks " + at.missing.join(", "));
+      continue;
+    }
+    row(table, [when, text(at.factor_um, 8), text(at.implied_n, 9), text(at.edlen_n, 9),
+      (at.difference_ppm >= 0 ? "+" : "") + text(at.difference_ppm, 2) + (at.agrees ? " ✓" : " ✗")]);
+  }
+  notes.push("agreement within ±" + check.agreement_ppm + " ppm; vacuum wavelength " + check.vacuum_wavelength_um +
+    " µm" + (check.wavelength_assumed ? " (assumed: the file records none)" : ""));
+  $("edlen-note").textContent = notes.join("; ");
 }
 
 async function evaluate() {
@@ -262,6 +321,8 @@ async function start() {
   $("file").addEventListener("change", (event) => pick("file", event.target.files, evaluate));
   $("after").addEventListener("change", (event) => pick("after", event.target.files, retest));
   $("table").addEventListener("change", (event) => pick("table", event.target.files, retest));
+  $("machine").addEventListener("change", (event) => pick("machine", event.target.files, () => { evaluate().then(retest); }));
+  $("decision").addEventListener("change", evaluate);
   dropZone($("drop-file"), "file", evaluate);
   for (const id of ["axis", "standard"]) $(id).addEventListener("change", evaluate);
   for (const id of ["controller", "mode", "start", "step", "count", "reference", "extrapolate", "linuxcnc_type"]) {

@@ -2,11 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::plan::Request;
 use axcomp::compensate::{self, Extrapolate, TableMode};
 use axcomp::emit::{Controller, EmitOptions};
+use axcomp::evaluate::straightness::ReferenceLine;
 use axcomp::measurement::RunSelector;
 use axcomp::output::write_new;
 use axcomp::read;
@@ -14,10 +15,12 @@ use axcomp::workflow::{self, Converted, TableRequest};
 
 use super::common::{
     InputFormat, JsonOutput, MachineFile, Overwrite, Verbosity, load_effects, load_profile,
-    name_axis, parse_run_selector, print_json, print_text, print_warnings, read_active_table,
-    recorded_axis,
+    name_axis, parse_position, parse_run_selector, print_json, print_text, print_warnings,
+    read_active_table, recorded_axis,
 };
 use super::evaluate::check_selectors;
+
+mod cross_axis;
 
 /// Flags of `axcomp convert`.
 #[derive(Debug, clap::Args)]
@@ -131,6 +134,26 @@ pub struct ConvertArgs {
     #[arg(long = "linuxcnc-type", value_name = "0|1", default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=1), help_heading = "Machine")]
     pub linuxcnc_type: u8,
 
+    /// A straightness test: the straightness to write when the file has
+    /// several (EYX: X's straightness in Y, the table Y = F(X)).
+    #[arg(long, value_name = "EYX", help_heading = "Cross-axis table")]
+    pub straightness: Option<String>,
+
+    /// A straightness test: the machine position of its line, mm, as in a
+    /// survey's `line_mm` (default: the machine's reference position).
+    #[arg(long, value_name = "y=…,z=…", value_parser = parse_position, help_heading = "Cross-axis table")]
+    pub line: Option<[Option<f64>; 3]>,
+
+    /// A straightness test: the moving optics from the tool tip, mm, as in a
+    /// survey's `optics_offset_mm` (default: at the tool tip).
+    #[arg(long = "optics-offset", value_name = "x=…,y=…,z=…", value_parser = parse_position, help_heading = "Cross-axis table")]
+    pub optics_offset: Option<[Option<f64>; 3]>,
+
+    /// A straightness test: its ISO 230-1 reference line, least-squares
+    /// (default) or end-points.
+    #[arg(long = "reference-line", value_name = "LINE", value_parser = parse_reference_line, help_heading = "Cross-axis table")]
+    pub reference_line: Option<ReferenceLine>,
+
     /// `--format` (the same in every command).
     #[command(flatten)]
     pub input_format: InputFormat,
@@ -158,8 +181,33 @@ fn parse_controller(name: &str) -> Result<Controller, String> {
     })
 }
 
+fn parse_reference_line(name: &str) -> Result<ReferenceLine, String> {
+    ReferenceLine::from_name(name)
+        .ok_or_else(|| format!("expected least-squares or end-points, found {name:?}"))
+}
+
 /// Runs `axcomp convert`.
 pub fn run(args: &ConvertArgs) -> Result<()> {
+    // A straightness test gives a cross-axis table (`cross_axis`), not the axis's own.
+    if let [file] = args.files.as_slice()
+        && read::is_geometry_path(file)?
+    {
+        return cross_axis::run(args, file);
+    }
+    if args.straightness.is_some()
+        || args.line.is_some()
+        || args.optics_offset.is_some()
+        || args.reference_line.is_some()
+    {
+        bail!(
+            "--straightness, --line, --optics-offset and --reference-line are for a straightness test (a geometry CSV with EYX_um, …); {} is a positioning test",
+            args.files
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(" + ")
+        );
+    }
     let profile = load_profile(args.machine_file.machine.as_deref())?;
     let read::ReadResult {
         mut measurement,

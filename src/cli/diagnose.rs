@@ -7,13 +7,13 @@ use anyhow::{Result, bail};
 
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::friction::friction_behind_reversal;
-use axcomp::diagnose::{AngularProfile, DiagnoseInput, KnownPeriod, diagnose};
-use axcomp::emit::AxisPeriods;
+use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
 use axcomp::measurement::AxisKind;
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, FrictionJson, render};
 use axcomp::together::{Input, Pairing, check_together};
+use axcomp::workflow;
 
 use super::common::{
     AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load,
@@ -142,19 +142,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         None => None,
     };
     let profile = load_profile(args.machine_file.machine.as_deref())?;
-    // The profile's periods of the axis the re-test states (never of a guessed axis).
-    let periods = if after.measurement.axis_recorded() {
-        profile.axis_periods(after.measurement.axis())
-    } else {
-        AxisPeriods::default()
-    };
-    let known_periods: Vec<KnownPeriod> = [
-        periods.screw_lead_mm.map(KnownPeriod::screw_lead),
-        periods.scale_period_mm.map(KnownPeriod::scale_period),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
+    let known_periods = workflow::known_periods(&profile, &after.measurement);
     let table = match &args.table {
         Some(path) => {
             // The table was active during the re-test.

@@ -300,13 +300,7 @@ fn load_survey(
     let mut files = Vec::new();
     for test in &survey.tests {
         let file = folder.join(&test.file);
-        let text = std::fs::read(&file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
-        let is_geometry = String::from_utf8_lossy(&text)
-            .lines()
-            .map(str::trim)
-            .find(|l| !l.is_empty() && !l.starts_with('#'))
-            .is_some_and(axcomp::read::geometry::is_header);
-        if is_geometry {
+        if read::is_geometry_path(&file)? {
             files.push(SurveyFile::Geometry(read::read_geometry_path(&file)?));
         } else {
             let mut result = read::read_path(&file, None)?;

@@ -2,28 +2,43 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 
 use axcomp::measurement::{AxisKind, Measurement};
 use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
+use axcomp::synth::geometry::{self, GeometryPlan};
 use axcomp::synth::{self, RotaryTruth, Truth};
-use axcomp::units::LengthUnit;
+use axcomp::units::{LengthUnit, mm_to_um, rad_to_um_per_m};
 
 use super::common::{
-    LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_profile, print_text, read_table,
+    LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_machine, load_profile, print_text,
+    read_table,
 };
 
 /// Flags of `axcomp synth`.
 #[derive(Debug, clap::Args)]
 pub struct SynthArgs {
     /// The ground truth (TOML): axis error, effects, noise, test cycle, conditions.
-    #[arg(long, value_name = "T.toml")]
-    pub truth: PathBuf,
+    #[arg(long, value_name = "T.toml", required_unless_present = "geometry")]
+    pub truth: Option<PathBuf>,
 
     /// The first test: .rtl (Renishaw) or .csv (axcomp CSV), by extension.
-    #[arg(short = 'o', long = "output", value_name = "BEFORE")]
-    pub output: PathBuf,
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "BEFORE",
+        required_unless_present = "geometry"
+    )]
+    pub output: Option<PathBuf>,
+
+    /// Instead of a positioning test: the geometry tests of a synthetic
+    /// machine with random 21 errors (`synth::geometry`, the plan of the
+    /// issue 15 tests: one 6-DOF CSV per axis on a line away from the
+    /// reference, optics off the tool), X.csv, Y.csv, Z.csv, and the
+    /// survey.toml naming them, written into the folder DIR.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["truth", "output", "table", "output2"])]
+    pub geometry: Option<PathBuf>,
 
     /// The compensation table the controller applies in the re-test (any format convert writes).
     #[arg(long, value_name = "TABLE", requires = "output2")]
@@ -56,15 +71,18 @@ pub struct SynthArgs {
 
 /// Runs `axcomp synth`.
 pub fn run(args: &SynthArgs) -> Result<()> {
-    if load(&args.truth, |text| {
+    let (Some(truth_path), Some(output)) = (&args.truth, &args.output) else {
+        return run_geometry(args);
+    };
+    if load(truth_path, |text| {
         Ok::<bool, axcomp::synth::SynthError>(RotaryTruth::is_rotary(text))
     })? {
-        return run_rotary(args);
+        return run_rotary(args, truth_path, output);
     }
-    let truth = load(&args.truth, Truth::from_toml_str)?;
+    let truth = load(truth_path, Truth::from_toml_str)?;
     // Render everything before writing anything, so a bad table leaves no half result.
     let first = synth::before(&truth, args.seed)?;
-    let first_text = render(&first, &args.output)?;
+    let first_text = render(&first, output)?;
     let second = match (&args.table, &args.output2) {
         (Some(table_path), Some(output2)) => {
             let profile = load_profile(args.machine_file.machine.as_deref())?;
@@ -83,14 +101,14 @@ pub fn run(args: &SynthArgs) -> Result<()> {
         _ => None,
     };
     // Both files or neither: an existing --o2 must not leave a new first file.
-    let mut files = vec![(args.output.as_path(), first_text.as_bytes())];
+    let mut files = vec![(output.as_path(), first_text.as_bytes())];
     if let Some((path, text)) = &second {
         files.push((path.as_path(), text.as_bytes()));
     }
     write_all_new(&files, args.overwrite.force)?;
     let mut summary = format!(
         "Wrote {} ({} targets, {} runs)\n",
-        args.output.display(),
+        output.display(),
         first.targets_mm().len(),
         first.runs().len()
     );
@@ -104,26 +122,56 @@ pub fn run(args: &SynthArgs) -> Result<()> {
 }
 
 /// A rotary truth's test (`synth::rotary`): one file, no re-test yet.
-fn run_rotary(args: &SynthArgs) -> Result<()> {
+fn run_rotary(args: &SynthArgs, truth_path: &Path, output: &Path) -> Result<()> {
     if args.table.is_some() {
         bail!(
             "{}: a rotary truth has no re-test with a table yet (issue 14); leave out --table and --o2",
-            args.truth.display()
+            truth_path.display()
         );
     }
-    let truth = load(&args.truth, RotaryTruth::from_toml_str)?;
+    let truth = load(truth_path, RotaryTruth::from_toml_str)?;
     let test = synth::rotary_test(&truth, args.seed)?;
-    let text = render(&test, &args.output)?;
-    write_all_new(
-        &[(args.output.as_path(), text.as_bytes())],
-        args.overwrite.force,
-    )?;
+    let text = render(&test, output)?;
+    write_all_new(&[(output, text.as_bytes())], args.overwrite.force)?;
     print_text(&format!(
         "Wrote {} (rotary axis, {} targets, {} runs)\n",
-        args.output.display(),
+        output.display(),
         test.targets_mm().len(),
         test.runs().len()
     ))
+}
+
+/// `--geometry DIR`: a synthetic machine's geometry tests and their survey.
+fn run_geometry(args: &SynthArgs) -> Result<()> {
+    let Some(dir) = &args.geometry else {
+        bail!("give --truth T.toml -o FILE, or --geometry DIR");
+    };
+    let machine = load_machine(args.machine_file.machine.as_deref())?;
+    let plan = GeometryPlan::example();
+    let truth = geometry::random_truth(&machine, &plan, args.seed)?;
+    let synthetic = geometry::measure(&machine, &truth, &plan, args.seed)?;
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    let mut files: Vec<(PathBuf, &[u8])> = synthetic
+        .tests
+        .iter()
+        .map(|(name, text)| (dir.join(name), text.as_bytes()))
+        .collect();
+    files.push((dir.join("survey.toml"), synthetic.survey.as_bytes()));
+    write_all_new(&files, args.overwrite.force)?;
+    let mut summary = String::new();
+    for (path, _) in &files {
+        summary.push_str(&format!("Wrote {}\n", path.display()));
+    }
+    summary.push_str(&format!(
+        "  {} with 21 random errors (seed {}); one 6-DOF test per axis ({} mm targets, {} runs each way, noise {:.1} µm and {:.1} µrad a reading), on a line away from the reference with the optics off the tool, as survey.toml states\n",
+        machine.name(),
+        args.seed,
+        plan.step_mm,
+        plan.runs,
+        mm_to_um(plan.noise_mm),
+        rad_to_um_per_m(plan.noise_rad),
+    ));
+    print_text(&summary)
 }
 
 /// The file text for an output path, by its extension.

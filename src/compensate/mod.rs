@@ -475,7 +475,7 @@ fn shift_to_reference(
 }
 
 /// The compensation points of a grid spec.
-fn grid_positions(targets_mm: &[f64], grid: GridSpec) -> Result<Vec<f64>, CompensateError> {
+pub fn grid_positions(targets_mm: &[f64], grid: GridSpec) -> Result<Vec<f64>, CompensateError> {
     match grid {
         GridSpec::Targets => {
             if targets_mm.len() < 2 {

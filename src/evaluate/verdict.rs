@@ -393,6 +393,28 @@ pub enum LimitError {
     },
 }
 
+/// `A=12`: a figure and a number of µm above 0, as `--limit` and the web
+/// app's limit fields take it.
+pub fn parse_limit(text: &str) -> Result<(Figure, f64), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected FIGURE=UM like A=12, found {text:?}"))?;
+    let name = name.trim();
+    let figure = Figure::from_name(name).ok_or_else(|| {
+        format!(
+            "unknown figure {name:?}; the figures are {}",
+            Figure::names()
+        )
+    })?;
+    let value: f64 = value
+        .trim()
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("expected a number of µm above 0 after {name}=, found {value:?}"))?;
+    Ok((figure, value))
+}
+
 /// The limits given on the command line as (figure, µm): fixed values.
 /// A figure given twice, or a value that is not above 0, is refused.
 pub fn command_line_limits(limits: &[(Figure, f64)]) -> Result<Vec<Limit>, LimitError> {
@@ -900,8 +922,24 @@ fn positive_um<E: de::Error>(value: f64) -> Result<f64, E> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
     use crate::evaluate::{AxisFigures, TargetStats};
     use crate::units::mm_to_um;
+
+    #[test]
+    fn limits_parse_and_bad_ones_say_what_is_valid() {
+        assert_eq!(parse_limit("A=12").unwrap(), (Figure::A, 12.0));
+        assert_eq!(parse_limit("B_mean = 2.5").unwrap(), (Figure::BMean, 2.5));
+        let unknown = parse_limit("Q=3").unwrap_err();
+        assert!(unknown.contains("unknown figure \"Q\""), "{unknown}");
+        assert!(
+            unknown.contains("A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B, B_mean")
+        );
+        for bad in ["A=0", "A=-3", "A=inf", "A=NaN", "A=12um", "A="] {
+            assert!(parse_limit(bad).unwrap_err().contains("above 0"), "{bad}");
+        }
+        assert!(parse_limit("A12").unwrap_err().contains("FIGURE=UM"));
+    }
 
     fn evaluation(first_mm: f64, last_mm: f64, figures: AxisFigures) -> Evaluation {
         let target = |target_mm| TargetStats {

@@ -704,10 +704,10 @@ pub fn cross_axis_table(
     name: ErrorName,
     points: usize,
 ) -> Result<CrossAxisTable, PredictError> {
-    let ErrorComponent::Translation { axis, direction } = name.component() else {
+    let ErrorComponent::Translation { axis, .. } = name.component() else {
         return Err(PredictError::Internal(format!("{name} is no straightness")));
     };
-    if axis == direction || points < 2 {
+    if points < 2 {
         return Err(PredictError::Internal(format!(
             "{name} with {points} points is no straightness table"
         )));
@@ -716,14 +716,40 @@ pub fn cross_axis_table(
     let positions: Vec<f64> = (0..points)
         .map(|i| low + (high - low) * i as f64 / (points - 1) as f64)
         .collect();
+    cross_axis_table_at(
+        errors,
+        name,
+        positions,
+        machine.reference_mm()[axis.index()],
+    )
+}
+
+/// A cross-axis table of the straightness `name` as the errors hold it, at
+/// `positions_mm` of its axis, zero at `reference_mm` (`convert` writes it
+/// on the grid the engineer chose).
+pub fn cross_axis_table_at(
+    errors: &GeometricErrors,
+    name: ErrorName,
+    positions_mm: Vec<f64>,
+    reference_mm: f64,
+) -> Result<CrossAxisTable, PredictError> {
+    let ErrorComponent::Translation { axis, direction } = name.component() else {
+        return Err(PredictError::Internal(format!("{name} is no straightness")));
+    };
+    if axis == direction || positions_mm.len() < 2 {
+        return Err(PredictError::Internal(format!(
+            "{name} with {} points is no straightness table",
+            positions_mm.len()
+        )));
+    }
     let function = errors.function(name).cloned().unwrap_or_default();
-    let values = positions.iter().map(|&x| function.value_at(x)).collect();
+    let values = positions_mm.iter().map(|&x| function.value_at(x)).collect();
     Ok(CrossAxisTable::new(
         &axis.to_string(),
         &direction.to_string(),
-        positions,
+        positions_mm,
         values,
-        machine.reference_mm()[axis.index()],
+        reference_mm,
     ))
 }
 

@@ -89,6 +89,16 @@ pub fn read_geometry_path(path: &Path) -> Result<geometry::GeometryTest, ReadErr
     })
 }
 
+/// Whether a file is a geometry test: its first line that is not blank or a
+/// `#` comment is a geometry header ([`geometry::is_header`]).
+pub fn is_geometry_path(path: &Path) -> Result<bool, ReadError> {
+    let text = read_text(path)?;
+    Ok(text::lines(&text)
+        .map(|line| line.text.trim())
+        .find(|line| !line.is_empty() && !line.starts_with('#'))
+        .is_some_and(geometry::is_header))
+}
+
 /// The decoded text of a file ([`decode`]), errors with the path.
 fn read_text(path: &Path) -> Result<Cow<'static, str>, ReadError> {
     let bytes = std::fs::read(path).map_err(|error| ReadError::Io {

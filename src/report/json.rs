@@ -23,6 +23,11 @@
 //!   "outliers": [{"run": 1, "direction": "down", "score": 48.2,
 //!                 "worst_target_mm": 15.0, "offset_um": 101.4}],
 //!   "environment": {…}, "metadata": {…}, "warnings": ["…"],
+//!   "refractive_index": {"vacuum_wavelength_um": 0.632991, "wavelength_assumed": true,
+//!                        "agreement_ppm": 1.0,
+//!                        "start": {"factor_um": …, "implied_n": …, "edlen_n": …,
+//!                                  "difference_ppm": …, "material_correction_ppm": null,
+//!                                  "agrees": true, "missing": []}, "end": {…}},
 //!   "test_conformance": {"title": "bidirectional test, 5 runs, 16 targets over 750 mm to ISO 230-2:2014",
 //!                        "meets_iso230_2": true, "length_mm": 750.0,
 //!                        "checks": [{"check": "runs", "recommendation": false, "met": true,
@@ -70,6 +75,7 @@
 use serde::Serialize;
 
 use crate::error::Warning;
+use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
 use crate::evaluate::{
     AxisFigures, Evaluation, StandardFigure, SuspectedOutlier, TargetStats, TestConformance,
 };
@@ -136,6 +142,9 @@ pub struct EvaluationJson {
     pub outliers: Vec<OutlierJson>,
     /// Test conditions.
     pub environment: EnvironmentJson,
+    /// The recorded environmental factor checked against Edlén's air index
+    /// (eq. 36), at the start and the end, as the report shows it.
+    pub refractive_index: RefractiveIndexJson,
     /// Who, what, where, when.
     pub metadata: MetadataJson,
     /// Reader and evaluator warnings, as sentences.
@@ -607,6 +616,73 @@ impl EnvironmentJson {
     }
 }
 
+/// The Edlén check (`evaluate::environment::check_refractive_index`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RefractiveIndexJson {
+    /// The vacuum wavelength used, µm.
+    pub vacuum_wavelength_um: f64,
+    /// Whether it was assumed (the file records none).
+    pub wavelength_assumed: bool,
+    /// How far the implied index may be from Edlén's and agree, ppm.
+    pub agreement_ppm: f64,
+    /// At the start of the test.
+    pub start: IndexAtJson,
+    /// At the end of the test.
+    pub end: IndexAtJson,
+}
+
+/// The check at one moment: made, or what the file lacks for it.
+#[derive(Clone, Debug, Serialize)]
+pub struct IndexAtJson {
+    /// The recorded factor, µm (`null` when the check could not be made).
+    pub factor_um: Option<f64>,
+    /// n_air implied by the factor.
+    pub implied_n: Option<f64>,
+    /// n_air by Edlén's eq. (36) from the recorded air.
+    pub edlen_n: Option<f64>,
+    /// (implied − Edlén) · 10⁶: µm per metre.
+    pub difference_ppm: Option<f64>,
+    /// The material correction taken out of the factor, ppm.
+    pub material_correction_ppm: Option<f64>,
+    /// Whether the difference is within `agreement_ppm`.
+    pub agrees: Option<bool>,
+    /// What the file lacks for the check (empty when made).
+    pub missing: Vec<&'static str>,
+}
+
+impl RefractiveIndexJson {
+    /// Copies the check.
+    pub fn from_check(check: &RefractiveIndexCheck) -> RefractiveIndexJson {
+        let at = |comparison: &IndexComparison| match comparison {
+            IndexComparison::Made(at) => IndexAtJson {
+                factor_um: Some(at.factor_um),
+                implied_n: Some(at.implied_n),
+                edlen_n: Some(at.edlen_n),
+                difference_ppm: Some(at.difference_ppm),
+                material_correction_ppm: at.material_correction_ppm,
+                agrees: Some(at.agrees()),
+                missing: Vec::new(),
+            },
+            IndexComparison::Missing(missing) => IndexAtJson {
+                factor_um: None,
+                implied_n: None,
+                edlen_n: None,
+                difference_ppm: None,
+                material_correction_ppm: None,
+                agrees: None,
+                missing: missing.clone(),
+            },
+        };
+        RefractiveIndexJson {
+            vacuum_wavelength_um: check.vacuum_wavelength_um,
+            wavelength_assumed: check.wavelength_assumed,
+            agreement_ppm: AGREEMENT_PPM,
+            start: at(&check.start),
+            end: at(&check.end),
+        }
+    }
+}
+
 /// Metadata as text.
 #[derive(Clone, Debug, Serialize)]
 pub struct MetadataJson {
@@ -770,6 +846,7 @@ impl EvaluationJson {
                 .map(|o| OutlierJson::from_outlier(o, kind, angle))
                 .collect(),
             environment: EnvironmentJson::from_environment(&measurement.environment),
+            refractive_index: RefractiveIndexJson::from_check(&evaluation.refractive_index),
             metadata: MetadataJson {
                 machine: metadata.machine.clone(),
                 serial_number: metadata.serial_number.clone(),

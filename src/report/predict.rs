@@ -165,9 +165,9 @@ pub struct PredictJson {
     pub standard_name: &'static str,
     /// Whether its definitions are reconstructed from public sources.
     pub definitions_reconstructed: bool,
-    /// The first table's re-test.
+    /// The first table's re-test; none when only cross-axis tables are given.
     #[serde(flatten)]
-    pub retest: RetestJson,
+    pub retest: Option<RetestJson>,
     /// The other tables' re-tests.
     pub also: Vec<RetestJson>,
     /// Largest volumetric error with the tables, µm.
@@ -333,7 +333,7 @@ impl SurveyJson {
 }
 
 impl PredictJson {
-    /// Builds the wire object; `prediction` has at least one re-test.
+    /// Builds the wire object (a re-test per positioning table).
     pub fn new(
         machine: &str,
         chain: &str,
@@ -343,9 +343,7 @@ impl PredictJson {
         notes: Vec<String>,
     ) -> PredictJson {
         let mut retests = prediction.retests.iter().map(RetestJson::new);
-        let first = retests
-            .next()
-            .expect("predict returns one re-test per table, and needs a table");
+        let first = retests.next();
         PredictJson {
             machine: machine.to_string(),
             chain: chain.to_string(),
@@ -399,7 +397,7 @@ pub fn render(report: &PredictJson) -> String {
             "             definitions reconstructed from public sources, not read in the standard (README, Standards)"
         );
     }
-    for retest in std::iter::once(&report.retest).chain(&report.also) {
+    for retest in report.retest.iter().chain(&report.also) {
         render_retest(&mut out, retest);
     }
     let at = |p: &PositionJson| format!("X {} Y {} Z {} mm", p.x, p.y, p.z);
@@ -413,7 +411,10 @@ pub fn render(report: &PredictJson) -> String {
         um(Some(report.volumetric_max_um)),
         at(&report.volumetric_max_at_mm),
     );
-    if report.volumetric_max_positioning_only_um != report.volumetric_max_um {
+    // Without a positioning table that line would repeat "without the tables".
+    if report.retest.is_some()
+        && report.volumetric_max_positioning_only_um != report.volumetric_max_um
+    {
         let _ = writeln!(
             out,
             "  positioning tables only {} µm at {} (the cross-axis tables take the rest)",

@@ -9,11 +9,12 @@ use axum::extract::multipart::MultipartError;
 use axum::http::StatusCode;
 
 /// The file fields: `file` (one, or two of one axis: API forward and
-/// reverse), `after` (the re-test) and `table` (the table that was active).
-const FILE_FIELDS: [&str; 3] = ["file", "after", "table"];
+/// reverse), `after` (the re-test), `table` (the table that was active)
+/// and `machine` (the machine profile, as `--machine`).
+const FILE_FIELDS: [&str; 4] = ["file", "after", "table", "machine"];
 
 /// The settings the page sends, each at most once.
-const TEXT_FIELDS: [&str; 12] = [
+const TEXT_FIELDS: [&str; 14] = [
     "format",
     "axis",
     "standard",
@@ -26,6 +27,8 @@ const TEXT_FIELDS: [&str; 12] = [
     "extrapolate",
     "linuxcnc_type",
     "diagnose",
+    "limits",
+    "decision",
 ];
 
 /// A file sent with the form: its name as the browser gives it, reduced

@@ -5,7 +5,9 @@
 //! the binary; no CDN, so it works offline) and a small JSON API over the
 //! library, on axum and tokio:
 //!
-//! - `POST /api/evaluate`: `evaluate --json`'s object and the deviation plot;
+//! - `POST /api/evaluate`: `evaluate --json`'s object (with the form's
+//!   `limits`, `decision` and machine profile, as `--limit`, `--decision`,
+//!   `--machine`) and the deviation plot;
 //! - `POST /api/convert`: `convert --json`'s object, the file's text and the
 //!   table's plot; `POST /api/table` the file itself, byte for byte what
 //!   `convert -o NAME` writes, under the controller's usual name
@@ -13,6 +15,10 @@
 //! - `POST /api/retest`: the diagnosis of a re-test (`diagnose --json`) and
 //!   the next table;
 //! - `POST /api/report`: the acceptance report, the HTML `axcomp report` writes.
+//!
+//! Every route takes the machine profile (`machine`, the `--machine` TOML):
+//! its axis settings for the tables, its `[acceptance]` for the verdict, its
+//! screw lead and scale period for the diagnosis.
 //!
 //! The work is the CLI's own ([`crate::workflow`]); this module only reads
 //! the form and answers. Its limits: uploads of at most [`UPLOAD_LIMIT`]
@@ -45,7 +51,7 @@ use crate::effects::{Effect, read_effects};
 use crate::emit::{self, Controller, EmitOptions, MachineProfile};
 use crate::error::Warning;
 use crate::evaluate::uncertainty::Equipment;
-use crate::evaluate::verdict::Decision;
+use crate::evaluate::verdict::{AcceptanceProfile, Decision, Figure, Limit, parse_limit};
 use crate::evaluate::{self, Standard, evaluate_with};
 use crate::measurement::{AxisKind, Measurement, SourceFormat};
 use crate::read;
@@ -298,6 +304,72 @@ fn standard(form: &Form) -> Result<&'static dyn Standard, ApiError> {
     )?)
 }
 
+/// The machine profile of the form's `machine` field (as `--machine`):
+/// its `[controller]` part and its `[acceptance]` part; the defaults and no
+/// limits when none is sent. A bad profile is refused as the CLI refuses
+/// it: `NAME:LINE:COL: …`.
+struct Profile {
+    /// The file's name, which the limits' source names.
+    file: String,
+    machine: MachineProfile,
+    acceptance: Option<AcceptanceProfile>,
+}
+
+fn profile(form: &Form) -> Result<Profile, ApiError> {
+    let Some((name, bytes)) = form.one_file("machine")? else {
+        return Ok(Profile {
+            file: String::new(),
+            machine: MachineProfile::default(),
+            acceptance: None,
+        });
+    };
+    let file = name.display().to_string();
+    let text = std::str::from_utf8(bytes)
+        .map_err(|_| ApiError::bad(format!("{file}: a machine profile is UTF-8 text (TOML)")))?;
+    let at = |error: crate::error::ParseError| ApiError::bad(format!("{file}:{error}"));
+    Ok(Profile {
+        machine: MachineProfile::from_toml_str(text).map_err(at)?,
+        acceptance: Some(AcceptanceProfile::from_toml_str(text).map_err(at)?),
+        file,
+    })
+}
+
+/// The form's `limits` (`A=12, E_up=6`: `--limit` each) on top of the
+/// profile's `[acceptance]`, for `evaluation`'s axis and standard.
+fn limits(
+    form: &Form,
+    profile: &Profile,
+    axis: &str,
+    evaluation: &evaluate::Evaluation,
+) -> Result<Vec<Limit>, ApiError> {
+    let given = form
+        .text("limits")
+        .unwrap_or_default()
+        .split([',', ';', '\n'])
+        .map(str::trim)
+        .filter(|item| !item.is_empty())
+        .map(|item| parse_limit(item).map_err(|error| format!("limits: {error}")))
+        .collect::<Result<Vec<(Figure, f64)>, String>>()?;
+    let acceptance = profile
+        .acceptance
+        .as_ref()
+        .map(|acceptance| (acceptance, profile.file.as_str()));
+    workflow::limits(acceptance, axis, evaluation, &given)
+        .map_err(|error| ApiError::bad(error.to_string()))
+}
+
+/// The form's decision rule (`--decision`), simple acceptance unless sent.
+fn decision(form: &Form) -> Result<Decision, ApiError> {
+    match form.text("decision") {
+        None => Ok(Decision::default()),
+        Some(name) => Decision::from_name(name).ok_or_else(|| {
+            ApiError::bad(format!(
+                "decision: expected simple or iso14253-1, found {name:?}"
+            ))
+        }),
+    }
+}
+
 fn file_label(files: &[Upload]) -> String {
     files
         .iter()
@@ -348,8 +420,10 @@ async fn api_evaluate(multipart: Multipart) -> Result<axum::Json<EvaluateAnswer>
     answer(multipart, |form| {
         let (measurement, mut warnings) = measurement(&form, "file")?;
         let standard = standard(&form)?;
+        let profile = profile(&form)?;
         let equipment = Equipment::bundled();
         let evaluation = evaluate_with(&measurement, standard);
+        let limits = limits(&form, &profile, measurement.axis(), &evaluation)?;
         let test = Test::new(measurement.clone(), warnings.clone(), standard, &equipment)?;
         let evaluation = workflow::evaluation_report(
             &measurement,
@@ -357,9 +431,9 @@ async fn api_evaluate(multipart: Multipart) -> Result<axum::Json<EvaluateAnswer>
             &mut warnings,
             workflow::EvaluationReportOptions {
                 exclude_runs: &[],
-                limits: &[],
+                limits: &limits,
                 equipment: &equipment,
-                decision: Decision::default(),
+                decision: decision(&form)?,
                 angle: AngleUnit::default(),
             },
         )?;
@@ -444,7 +518,7 @@ fn recorded_axis(measurement: &Measurement) -> Result<&str, ApiError> {
 /// `convert` for the form: the measurement of `field`, the table that was
 /// active during it (`table`), the controller and grid.
 fn table_of(form: &Form, field: &str, effects: &[Effect]) -> Result<Table, ApiError> {
-    let profile = MachineProfile::default();
+    let profile = profile(form)?.machine;
     let (measurement, mut warnings) = measurement(form, field)?;
     let before = Test::new(
         measurement.clone(),
@@ -649,7 +723,8 @@ fn retest(form: &Form) -> Result<Retest, ApiError> {
         &Input::measurement(&after, after_label.clone()),
     )?);
     let linuxcnc_type = form.number("linuxcnc_type", "0 or 1")?;
-    let profile = MachineProfile::default();
+    let profile = profile(form)?.machine;
+    let known_periods = workflow::known_periods(&profile, &after);
     // The table was active during the re-test.
     let table = active_table(form, &after, after_label.clone(), &profile, linuxcnc_type)?;
     if let Some((_, _, _, doubts)) = &table {
@@ -664,9 +739,7 @@ fn retest(form: &Form) -> Result<Retest, ApiError> {
         angular: None,
         timing: CycleTiming::ASSUMED,
         standard,
-        // The page takes no machine profile yet, so no screw lead or scale
-        // period is searched first (the CLI's --machine gives them).
-        known_periods: &[],
+        known_periods: &known_periods,
     })?;
     let report = DiagnoseJson::new(
         &diagnosis,
@@ -748,8 +821,20 @@ async fn api_report(multipart: Multipart) -> Result<Response, ApiError> {
                 Some(after)
             }
         };
-        let profile = MachineProfile::default();
-        let table = active_table(&form, &before.measurement, label, &profile, None)?;
+        let profile = self::profile(&form)?;
+        let limits = limits(
+            &form,
+            &profile,
+            before.measurement.axis(),
+            &before.evaluation,
+        )?;
+        if before.measurement.kind() == AxisKind::Rotary && !limits.is_empty() {
+            return Err(workflow::WorkflowError::RotaryLimits {
+                axis: before.measurement.axis().to_string(),
+            }
+            .into());
+        }
+        let table = active_table(&form, &before.measurement, label, &profile.machine, None)?;
         if let Some((_, _, _, doubts)) = &table {
             before.warnings.extend(doubts.iter().cloned());
         }
@@ -784,7 +869,7 @@ async fn api_report(multipart: Multipart) -> Result<Response, ApiError> {
             env!("CARGO_PKG_VERSION"),
             chrono::Local::now().format("%Y-%m-%d %H:%M")
         );
-        let input = report_input(
+        let mut input = report_input(
             &before,
             after.as_ref(),
             record,
@@ -792,6 +877,8 @@ async fn api_report(multipart: Multipart) -> Result<Response, ApiError> {
             standard,
             &generator,
         );
+        input.limits = &limits;
+        input.decision = decision(&form)?;
         let page = html::render(&input)?;
         Ok(attachment(
             "report.html",

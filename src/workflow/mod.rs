@@ -10,11 +10,15 @@
 use crate::compensate::effects::build_table_with_effects;
 use crate::compensate::plan::{Request, plan};
 use crate::compensate::{CompensateError, CompensationTable};
+use crate::diagnose::KnownPeriod;
 use crate::effects::Effect;
 use crate::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
 use crate::error::{ParseError, Warning};
 use crate::evaluate::uncertainty::{Budget, Equipment, UncertaintyError, budget};
-use crate::evaluate::verdict::{Decision, Limit};
+use crate::evaluate::verdict::{
+    AcceptanceProfile, Decision, Figure, Limit, LimitError, check_standard, command_line_limits,
+    with_overrides,
+};
 use crate::evaluate::{Evaluation, Standard, evaluate, evaluate_with};
 use crate::measurement::{AxisKind, Measurement, RunSelector};
 use crate::report::acceptance::TestRecord;
@@ -99,6 +103,39 @@ pub fn evaluation_report(
     report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
     report.verdict = verdict;
     Ok(report)
+}
+
+/// The acceptance limits for `axis`: the profile's `[acceptance]` (the
+/// profile and its file name, when one is given) with the `given` ones
+/// (`--limit`, the page's fields) on top, each on a figure of the
+/// evaluation's standard. Empty: no verdict.
+pub fn limits(
+    profile: Option<(&AcceptanceProfile, &str)>,
+    axis: &str,
+    evaluation: &Evaluation,
+    given: &[(Figure, f64)],
+) -> Result<Vec<Limit>, LimitError> {
+    let from_profile =
+        profile.map_or_else(Vec::new, |(profile, file)| profile.limits_for(axis, file));
+    let limits = with_overrides(from_profile, command_line_limits(given)?);
+    check_standard(&limits, evaluation)?;
+    Ok(limits)
+}
+
+/// The periods the diagnosis searches first: the profile's screw lead and
+/// scale period of the axis the re-test states (never of a guessed axis).
+pub fn known_periods(profile: &MachineProfile, after: &Measurement) -> Vec<KnownPeriod> {
+    if !after.axis_recorded() {
+        return Vec::new();
+    }
+    let periods = profile.axis_periods(after.axis());
+    [
+        periods.screw_lead_mm.map(KnownPeriod::screw_lead),
+        periods.scale_period_mm.map(KnownPeriod::scale_period),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// What a table is made for and written as (`convert`'s flags, parsed).

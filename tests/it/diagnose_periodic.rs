@@ -28,8 +28,8 @@ const SEEDS: u64 = 20;
 const LEADS_MM: [f64; 3] = [10.0, 15.0, 20.0];
 
 /// One drawn case: its truth file and the planted error.
-struct Case {
-    truth: String,
+pub(crate) struct Case {
+    pub(crate) truth: String,
     period_mm: f64,
     amplitude_um: f64,
 }
@@ -41,7 +41,7 @@ fn draw(rng: &mut ChaCha8Rng, low: f64, high: f64) -> f64 {
 /// The case of `seed`: a lead's periodic error (or none, `lead_mm` = 0) in
 /// the re-test of a drawn cycle. The targets move by up to ±30 % of their
 /// nominal step (irregular, as ISO 230-2 recommends).
-fn case(lead_mm: f64, seed: u64, in_both: bool) -> Case {
+pub(crate) fn case(lead_mm: f64, seed: u64, in_both: bool) -> Case {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(lead_mm.to_bits());
     let count = Uniform::new_inclusive(19usize, 25)

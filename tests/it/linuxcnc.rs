@@ -135,6 +135,11 @@ fn angular_moves(seed: u64) -> Vec<(String, Direction)> {
 
 /// Writes the config for `joint` into `dir` and runs LinuxCNC there, making
 /// `moves`; returns result.json.
+/// One LinuxCNC at a time: two instances on one machine share its HAL
+/// shared memory and NML channels and break each other ("move to … timed
+/// out"), and cargo runs the linear and the rotary test in parallel.
+static ONE_LINUXCNC: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn run_linuxcnc(
     dir: &Path,
     joint: &Joint,
@@ -142,6 +147,10 @@ fn run_linuxcnc(
     comp_file: &str,
     comp_type: u8,
 ) -> serde_json::Value {
+    // A test that failed while holding the lock has already said why.
+    let _one = ONE_LINUXCNC
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let template = std::fs::read_to_string(test_data("linuxcnc/sim.ini")).unwrap();
     let ini = template
         .replace("@DRIVER@", &dir.join("driver.py").display().to_string())

@@ -489,7 +489,36 @@ fn the_page_works_in_a_real_browser() {
     );
     let figures = browser.execute("return document.getElementById('figures').innerText");
     assert!(figures.as_str().unwrap().contains("13.19"), "{figures}");
+    // The plot at the bottom of the window, the figures above it.
+    browser.execute("document.getElementById('deviation').scrollIntoView(false); return true");
     check_screenshot(&browser, "2-evaluated", 0.05, true);
+    // The Edlén check as evaluate --json has it: −0.01 ppm at the start.
+    let edlen = browser.execute("return document.getElementById('edlen').innerText");
+    assert!(edlen.as_str().unwrap().contains("-0.01 ✓"), "{edlen}");
+
+    // A limit of 12 µm on A (the sample's A is 13.19 µm): FAIL, as
+    // `evaluate --limit A=12` says.
+    browser.click(&browser.find("#limit-A"));
+    browser.send_keys(&browser.find("#limit-A"), "12\u{E007}");
+    browser.wait_for(
+        "return document.body.dataset.verdict === 'fail' && document.body.dataset.busy === '0'",
+        "the verdict on A = 12 µm",
+    );
+    let verdict = browser.execute("return document.getElementById('verdict').innerText");
+    assert_eq!(
+        verdict.as_str().unwrap(),
+        "FAIL (simple acceptance): A not within the limits"
+    );
+    let checks = browser.execute("return document.getElementById('checks').innerText");
+    assert!(
+        checks
+            .as_str()
+            .unwrap()
+            .starts_with("A 13.19 µm against 12.00 µm"),
+        "{checks}"
+    );
+    browser.execute("document.getElementById('figures').scrollIntoView(); return true");
+    check_screenshot(&browser, "2b-verdict", 0.02, false);
 
     browser.click(&browser.find("#controller option[value='linuxcnc']"));
     browser.click(&browser.find("#step"));
@@ -543,4 +572,266 @@ fn the_page_works_in_a_real_browser() {
     // The error box's red is on the page.
     let red = Pixels::read(&shot).fraction(|r, g, b| r > 150 && g < 60 && b < 60);
     assert!(red > 0.0005, "{red:.4} red");
+}
+
+/// A machine profile with acceptance limits and a screw lead for X.
+const PROFILE: &str = "[controller]\nunits = \"mm\"\n\n[controller.axes.X]\nscrew_lead_mm = 10\n\n\
+[acceptance]\nA = { per_1000_mm_um = 10, min_um = 5 }\nR = 4\n";
+
+/// Limits from the page and from the profile, under either decision rule:
+/// the verdict is `evaluate --json --machine P --limit …`'s, key for key.
+#[test]
+fn the_verdict_is_what_evaluate_prints_with_the_same_limits() {
+    let server = Server::start();
+    let work = tempfile::tempdir().unwrap();
+    std::fs::copy(sample(), work.path().join("sample-x.rtl")).unwrap();
+    std::fs::write(work.path().join("p.toml"), PROFILE).unwrap();
+    let cases: [(&[&str], &str, &str, bool); 3] = [
+        (
+            &["--limit", "A=14", "--limit", "R=3"],
+            "A=14, R=3",
+            "simple",
+            false,
+        ),
+        (
+            &["--machine", "p.toml", "--limit", "E=8"],
+            "E=8",
+            "iso14253-1",
+            true,
+        ),
+        (
+            &["--limit", "A=20", "--limit", "B_mean=5"],
+            "A=20;B_mean=5",
+            "simple",
+            false,
+        ),
+    ];
+    let mut outcomes = Vec::new();
+    for (flags, limits, decision, with_profile) in cases {
+        let mut form = Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .text("limits", limits)
+            .text("decision", decision);
+        if with_profile {
+            form = form.file("machine", "p.toml", PROFILE.as_bytes());
+        }
+        let answer = server.post("/api/evaluate", form, &[]);
+        assert_eq!(answer.status, 200, "{limits}: {}", answer.text());
+        let mut args = vec!["evaluate", "--json", "sample-x.rtl", "--decision", decision];
+        args.extend_from_slice(flags);
+        let cli: serde_json::Value = serde_json::from_slice(&cli_in(work.path(), &args)).unwrap();
+        let verdict = &answer.json()["evaluation"]["verdict"];
+        assert!(verdict.is_object(), "{limits}: no verdict");
+        assert_eq!(*verdict, cli["verdict"], "{limits}");
+        assert_eq!(answer.json()["evaluation"], cli, "{limits}");
+        outcomes.push(verdict["pass"].as_bool().unwrap());
+    }
+    // The sample (README): A 13.19 µm passes 14 but R 6.26 µm fails 3; |B̄| 3.18 µm passes 5.
+    assert!(!outcomes[0]);
+    assert!(outcomes[2]);
+    let checks = |answer: &Response| answer.json()["evaluation"]["verdict"]["checks"].clone();
+    let answer = server.post(
+        "/api/evaluate",
+        Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .file("machine", "p.toml", PROFILE.as_bytes()),
+        &[],
+    );
+    // The profile alone: its two limits, named by the file.
+    let checks = checks(&answer);
+    assert_eq!(checks.as_array().unwrap().len(), 2, "{checks}");
+    assert_eq!(checks[0]["limit_source"], "p.toml [acceptance]");
+    // A bad limit is refused with what is valid.
+    let answer = server.post(
+        "/api/evaluate",
+        Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .text("limits", "Q=3"),
+        &[],
+    );
+    assert_eq!(answer.status, 400);
+    assert!(
+        answer.text().contains("unknown figure"),
+        "{}",
+        answer.text()
+    );
+}
+
+/// The table with a machine profile (inch, as `--machine`) is byte for
+/// byte `convert --machine P.toml`'s.
+#[test]
+fn the_table_with_a_profile_is_what_convert_writes_with_it() {
+    let server = Server::start();
+    let work = tempfile::tempdir().unwrap();
+    let profile = root().join("fixtures/machines/gantry-inch.toml");
+    for (controller, name) in [
+        ("tnc640", "X.COM"),
+        ("linuxcnc", "x.comp"),
+        ("sinumerik840d", "X.MPF"),
+    ] {
+        let answer = server.post(
+            "/api/table",
+            Form::new()
+                .file("file", "sample-x.rtl", &read(&sample()))
+                .file("machine", "gantry-inch.toml", &read(&profile))
+                .text("controller", controller)
+                .text("step", "50"),
+            &[],
+        );
+        assert_eq!(answer.status, 200, "{controller}: {}", answer.text());
+        let output = work.path().join(controller).join(name);
+        std::fs::create_dir_all(output.parent().unwrap()).unwrap();
+        let (sample_arg, output_arg) =
+            (sample().display().to_string(), output.display().to_string());
+        let profile_arg = profile.display().to_string();
+        cli_in(
+            &root(),
+            &[
+                "convert",
+                &sample_arg,
+                "--controller",
+                controller,
+                "--step",
+                "50",
+                "--machine",
+                &profile_arg,
+                "-o",
+                &output_arg,
+            ],
+        );
+        assert_eq!(answer.body, read(&output), "{controller}: {name} differs");
+        // Without the profile the file is another (mm, not inch): the profile was used.
+        let plain = server.post(
+            "/api/table",
+            Form::new()
+                .file("file", "sample-x.rtl", &read(&sample()))
+                .text("controller", controller)
+                .text("step", "50"),
+            &[],
+        );
+        assert_ne!(
+            plain.body, answer.body,
+            "{controller}: the profile changed nothing"
+        );
+    }
+    let convert = server.post(
+        "/api/convert",
+        Form::new()
+            .file("file", "sample-x.rtl", &read(&sample()))
+            .file("machine", "gantry-inch.toml", &read(&profile))
+            .text("controller", "tnc640"),
+        &[],
+    );
+    assert_eq!(convert.json()["convert"]["file_unit"], "inch");
+}
+
+/// A bad profile is a 400 naming the upload, line and column, as the CLI
+/// says it; the Edlén check is in the evaluation, as `evaluate --json` has it.
+#[test]
+fn a_bad_profile_is_refused_with_its_position() {
+    let server = Server::start();
+    let bad = "[controller]\nunits = \"mm\"\nfrobnicate = 3\n";
+    let work = tempfile::tempdir().unwrap();
+    std::fs::write(work.path().join("bad.toml"), bad).unwrap();
+    std::fs::copy(sample(), work.path().join("sample-x.rtl")).unwrap();
+    for path in ["/api/evaluate", "/api/convert", "/api/table"] {
+        let answer = server.post(
+            path,
+            Form::new()
+                .file("file", "sample-x.rtl", &read(&sample()))
+                .file("machine", "bad.toml", bad.as_bytes()),
+            &[],
+        );
+        assert_eq!(answer.status, 400, "{path}");
+        let message = answer.json()["error"].as_str().unwrap().to_string();
+        assert!(message.starts_with("bad.toml:3:1: "), "{path}: {message}");
+        let cli = Command::new(env!("CARGO_BIN_EXE_axcomp"))
+            .args([
+                "convert",
+                "sample-x.rtl",
+                "--controller",
+                "tnc640",
+                "--machine",
+                "bad.toml",
+                "-o",
+                "out.com",
+            ])
+            .current_dir(work.path())
+            .output()
+            .unwrap();
+        assert_eq!(cli.status.code(), Some(2));
+        let stderr = String::from_utf8_lossy(&cli.stderr);
+        assert_eq!(
+            message,
+            stderr.trim().trim_start_matches("axcomp: error: "),
+            "{path}"
+        );
+    }
+    let answer = server.post(
+        "/api/evaluate",
+        Form::new().file("file", "sample-x.rtl", &read(&sample())),
+        &[],
+    );
+    let check = &answer.json()["evaluation"]["refractive_index"];
+    // The sample at the start: the factor implies an index 0.01 ppm below Edlén's, which the report prints as −0.01.
+    assert_eq!(check["start"]["agrees"], true);
+    let difference = check["start"]["difference_ppm"].as_f64().unwrap();
+    assert!((difference + 0.00999).abs() < 1e-4, "{difference}");
+}
+
+/// The re-test's diagnosis with a machine profile searches its screw lead
+/// first, as `diagnose --machine` does: the same JSON, the lead found at
+/// exactly 15 mm (seed 001's VC1810, Tab. 7) in a re-test with a planted
+/// 15 mm lead error (seed 3 of `diagnose_periodic`).
+#[test]
+fn the_retest_with_a_profile_is_what_diagnose_prints_with_it() {
+    let server = Server::start();
+    let work = tempfile::tempdir().unwrap();
+    let case = crate::diagnose_periodic::case(15.0, 3, true);
+    let truth = work.path().join("truth.toml");
+    std::fs::write(&truth, &case.truth).unwrap();
+    crate::util::synth_loop_files(work.path(), &truth, Some("3"));
+    let profile = root().join("fixtures/machines/vc1810.toml");
+    std::fs::copy(&profile, work.path().join("vc1810.toml")).unwrap();
+    let file = |name: &str| read(&work.path().join(name));
+    let answer = server.post(
+        "/api/retest",
+        Form::new()
+            .file("file", "before.rtl", &file("before.rtl"))
+            .file("after", "after.rtl", &file("after.rtl"))
+            .file("table", "X.COM", &file("X.COM"))
+            .file("machine", "vc1810.toml", &read(&profile)),
+        &[],
+    );
+    assert_eq!(answer.status, 200, "{}", answer.text());
+    let cli: serde_json::Value = serde_json::from_slice(&cli_in(
+        work.path(),
+        &[
+            "diagnose",
+            "--after",
+            "after.rtl",
+            "--before",
+            "before.rtl",
+            "--table",
+            "X.COM",
+            "--machine",
+            "vc1810.toml",
+            "--json",
+        ],
+    ))
+    .unwrap();
+    let diagnosis = &answer.json()["diagnosis"];
+    assert_eq!(*diagnosis, cli);
+    let periodic = diagnosis["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["kind"] == "periodic")
+        .unwrap_or_else(|| panic!("{diagnosis:#}"));
+    assert_eq!(periodic["params"]["period_mm"], 15.0);
+    assert!(
+        periodic["warnings"]
+            .to_string()
+            .contains("the screw lead the machine profile gives (15 mm)")
+    );
 }
