@@ -12,7 +12,7 @@ use std::fmt;
 
 use crate::measurement::{AxisKind, Direction};
 use crate::units::LengthUnit;
-use crate::units::{deg_to_arcsec, mm_to_um, um_to_mm};
+use crate::units::{AngleUnit, DeviationUnit, mm_to_um, um_to_mm};
 
 /// A position in a text file. Both fields start at 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -292,6 +292,35 @@ impl fmt::Display for Doubt {
     }
 }
 
+impl Warning {
+    /// The sentence, a rotary axis' deviations in `angle` (″ or µrad,
+    /// `--angle-unit`); `Display` says them in ″.
+    pub fn text_in(&self, angle: AngleUnit) -> String {
+        let Warning::FullTurnEndsDisagree {
+            first_deg,
+            last_deg,
+            mean_first_deg,
+            mean_last_deg,
+            repeatability_deg,
+        } = self
+        else {
+            return self.to_string();
+        };
+        let unit = DeviationUnit::Angle(angle).suffix();
+        format!(
+            "{}° and {}° are one physical position, but their mean deviations differ by {:.2}{unit} \
+             ({:+.2}{unit} and {:+.2}{unit}), more than the repeatability there ({:.2}{unit}): \
+             check for drift or a reference that moved during the turn",
+            mm_text(*first_deg),
+            mm_text(*last_deg),
+            angle.from_deg((mean_last_deg - mean_first_deg).abs()),
+            angle.from_deg(*mean_first_deg),
+            angle.from_deg(*mean_last_deg),
+            angle.from_deg(*repeatability_deg),
+        )
+    }
+}
+
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -407,24 +436,9 @@ impl fmt::Display for Warning {
                     angles.join(", ")
                 )
             }
-            Warning::FullTurnEndsDisagree {
-                first_deg,
-                last_deg,
-                mean_first_deg,
-                mean_last_deg,
-                repeatability_deg,
-            } => write!(
-                f,
-                "{}° and {}° are one physical position, but their mean deviations differ by {:.2}″ \
-                 ({:+.2}″ and {:+.2}″), more than the repeatability there ({:.2}″): \
-                 check for drift or a reference that moved during the turn",
-                mm_text(*first_deg),
-                mm_text(*last_deg),
-                deg_to_arcsec((mean_last_deg - mean_first_deg).abs()),
-                deg_to_arcsec(*mean_first_deg),
-                deg_to_arcsec(*mean_last_deg),
-                deg_to_arcsec(*repeatability_deg),
-            ),
+            Warning::FullTurnEndsDisagree { .. } => {
+                f.write_str(&self.text_in(AngleUnit::default()))
+            }
             Warning::Doubtful(doubt) => write!(f, "{doubt}"),
         }
     }

@@ -22,7 +22,7 @@ use std::path::PathBuf;
 
 use chrono::NaiveDateTime;
 
-use crate::units::{LengthUnit, Mm};
+use crate::units::{AngleUnit, DeviationUnit, LengthUnit, Mm};
 
 /// Approach direction of a run: ↑ moves in the positive direction, ↓ in the negative.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -89,6 +89,15 @@ impl AxisKind {
         match self {
             AxisKind::Linear => "linear",
             AxisKind::Rotary => "rotary",
+        }
+    }
+
+    /// The unit its deviations are reported in: µm on a linear axis,
+    /// `angle` on a rotary one.
+    pub fn deviation_unit(self, angle: AngleUnit) -> DeviationUnit {
+        match self {
+            AxisKind::Linear => DeviationUnit::Micrometre,
+            AxisKind::Rotary => DeviationUnit::Angle(angle),
         }
     }
 

@@ -77,6 +77,102 @@ impl LengthUnit {
     }
 }
 
+/// The unit a rotary axis' deviations are reported in: arc-seconds (″, the
+/// default, as the rotary laser vendors and ISO 230-2's tables quote them) or
+/// microradians (µrad, on request, issue 14). Inside they stay degrees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AngleUnit {
+    /// Arc-seconds, ″.
+    #[default]
+    Arcsec,
+    /// Microradians, µrad.
+    Urad,
+}
+
+impl AngleUnit {
+    /// Every unit, in the order `--angle-unit` lists them.
+    pub const ALL: [AngleUnit; 2] = [AngleUnit::Arcsec, AngleUnit::Urad];
+
+    /// The name a user types and JSON keys end in: `arcsec` or `urad`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AngleUnit::Arcsec => "arcsec",
+            AngleUnit::Urad => "urad",
+        }
+    }
+
+    /// Looks a unit up by [`AngleUnit::name`].
+    pub fn from_name(name: &str) -> Option<AngleUnit> {
+        AngleUnit::ALL
+            .into_iter()
+            .find(|unit| unit.name().eq_ignore_ascii_case(name))
+    }
+
+    /// The sign printed after a number: `″` or `µrad`.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            AngleUnit::Arcsec => "″",
+            AngleUnit::Urad => "µrad",
+        }
+    }
+
+    /// An angle in degrees in this unit.
+    pub fn from_deg(self, value_deg: Deg) -> f64 {
+        match self {
+            AngleUnit::Arcsec => deg_to_arcsec(value_deg),
+            AngleUnit::Urad => deg_to_urad(value_deg),
+        }
+    }
+}
+
+/// The unit a deviation is reported in: µm on a linear axis, the
+/// [`AngleUnit`] on a rotary one (`AxisKind::deviation_unit` picks it). One
+/// value that every report (terminal, JSON, HTML, plots, diagnosis) converts
+/// and labels with, so that a number and its unit cannot disagree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeviationUnit {
+    /// Micrometres (held inside in mm).
+    Micrometre,
+    /// An angle unit (held inside in degrees).
+    Angle(AngleUnit),
+}
+
+impl DeviationUnit {
+    /// A deviation held inside (mm, or ° on a rotary axis) in this unit.
+    pub fn from_internal(self, value: f64) -> f64 {
+        match self {
+            DeviationUnit::Micrometre => mm_to_um(value),
+            DeviationUnit::Angle(unit) => unit.from_deg(value),
+        }
+    }
+
+    /// The suffix of a JSON key: `um`, `arcsec` or `urad`.
+    pub fn key(self) -> &'static str {
+        match self {
+            DeviationUnit::Micrometre => "um",
+            DeviationUnit::Angle(unit) => unit.name(),
+        }
+    }
+
+    /// The unit as a table heading writes it: `µm`, `″` or `µrad`.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            DeviationUnit::Micrometre => "µm",
+            DeviationUnit::Angle(unit) => unit.symbol(),
+        }
+    }
+
+    /// What follows a number in a sentence: ` µm`, `″` (set close, as in
+    /// 3.2″) or ` µrad`.
+    pub fn suffix(self) -> &'static str {
+        match self {
+            DeviationUnit::Micrometre => " µm",
+            DeviationUnit::Angle(AngleUnit::Arcsec) => "″",
+            DeviationUnit::Angle(AngleUnit::Urad) => " µrad",
+        }
+    }
+}
+
 /// Millimetres to micrometres.
 pub fn mm_to_um(value_mm: Mm) -> Um {
     value_mm * UM_PER_MM
@@ -304,5 +400,23 @@ mod tests {
             );
         }
         assert_eq!(arcsec_text(arcsec_to_deg(1.3)), "1.3");
+    }
+
+    #[test]
+    fn deviation_units_by_hand() {
+        // 1° = 3600″ = 17 453.292 5 µrad (π/180 · 10⁶); 0.001 mm = 1 µm.
+        assert_eq!(
+            DeviationUnit::Angle(AngleUnit::Arcsec).from_internal(1.0),
+            3600.0
+        );
+        assert!(
+            (DeviationUnit::Angle(AngleUnit::Urad).from_internal(1.0) - 17_453.292_519_943_3).abs()
+                < 1e-9
+        );
+        assert_eq!(DeviationUnit::Micrometre.from_internal(0.5), 500.0);
+        assert_eq!(AngleUnit::from_name("URAD"), Some(AngleUnit::Urad));
+        assert_eq!(AngleUnit::from_name("mrad"), None);
+        assert_eq!(DeviationUnit::Angle(AngleUnit::Urad).key(), "urad");
+        assert_eq!(DeviationUnit::Angle(AngleUnit::Urad).suffix(), " µrad");
     }
 }

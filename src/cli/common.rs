@@ -18,7 +18,7 @@ use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
 use axcomp::together::{Input, Pairing, check_together};
-use axcomp::units::LengthUnit;
+use axcomp::units::{AngleUnit, LengthUnit};
 use axcomp::workflow;
 
 /// `--format NAME`: one of the input formats.
@@ -296,6 +296,48 @@ fn parse_standard(name: &str) -> Result<&'static dyn Standard, String> {
     axcomp::evaluate::by_name(name).map_err(|error| error.to_string())
 }
 
+/// `--angle-unit`, the same in every command that reports a rotary axis'
+/// deviations (`evaluate`, `report`, `diagnose`).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct AngleUnitArg {
+    /// A rotary axis' deviations in arcsec (″, the default) or urad (µrad).
+    ///
+    /// Every deviation figure of a rotary axis (per target, the axis
+    /// figures, outliers, the plots, a diagnosis) is printed in this unit,
+    /// and its JSON keys end in `_arcsec` or `_urad` (never both).
+    /// 1″ = π/648000 rad ≈ 4.848 µrad. Refused on a linear axis, whose
+    /// deviations are µm.
+    #[arg(long = "angle-unit", value_name = "UNIT", value_parser = parse_angle_unit, help_heading = "Output")]
+    pub angle_unit: Option<AngleUnit>,
+}
+
+impl AngleUnitArg {
+    /// The unit for `measurement`'s deviations: refused when it is given
+    /// for a linear axis (it cannot apply to µm), the default ″ otherwise.
+    pub fn for_axis(&self, measurement: &Measurement) -> Result<AngleUnit> {
+        let Some(unit) = self.angle_unit else {
+            return Ok(AngleUnit::default());
+        };
+        if measurement.kind() == AxisKind::Linear {
+            anyhow::bail!(
+                "--angle-unit {}: axis {} is a linear axis, whose deviations are µm; \
+                 the flag is for rotary axes only",
+                unit.name(),
+                measurement.axis()
+            );
+        }
+        Ok(unit)
+    }
+}
+
+/// `arcsec` or `urad`.
+fn parse_angle_unit(name: &str) -> Result<AngleUnit, String> {
+    AngleUnit::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = AngleUnit::ALL.map(AngleUnit::name).to_vec();
+        format!("expected one of {}, found {name:?}", names.join(", "))
+    })
+}
+
 /// `--force`, the same in every command that writes files.
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub struct Overwrite {
@@ -403,11 +445,16 @@ pub struct LinuxCncType {
 
 /// Prints warnings to stderr unless `quiet`.
 pub fn print_warnings(warnings: &[Warning], quiet: bool) {
+    print_warnings_in(warnings, quiet, AngleUnit::default());
+}
+
+/// [`print_warnings`], a rotary axis' deviations in `angle` (`--angle-unit`).
+pub fn print_warnings_in(warnings: &[Warning], quiet: bool, angle: AngleUnit) {
     if quiet {
         return;
     }
     for warning in warnings {
-        eprintln!("axcomp: warning: {warning}");
+        eprintln!("axcomp: warning: {}", warning.text_in(angle));
     }
 }
 

@@ -78,7 +78,13 @@ pub fn run(args: &DemoArgs) -> Result<()> {
 
     // 1. The first test per ISO 230-2.
     let evaluation = evaluate(&before);
-    let json = EvaluationJson::new(&before, &evaluation, &[], &evaluation.warnings);
+    let json = EvaluationJson::new(
+        &before,
+        &evaluation,
+        &[],
+        &evaluation.warnings,
+        Default::default(),
+    );
     files.push(("evaluate.json".into(), serde_json::to_vec_pretty(&json)?));
     steps.inc(1);
 
@@ -142,6 +148,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
 
     // 4. The re-test, diagnosed against the prediction.
     let diagnosis = diagnose(&DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: Some(&before),
         table: Some(&active),
@@ -156,6 +163,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         "after.rtl".into(),
         Some("before.rtl".into()),
         Some(table_path(Controller::Tnc640, &table.axis)),
+        Default::default(),
     );
     files.push((
         "diagnose.json".into(),
@@ -212,6 +220,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         limits: &[],
         decision: Default::default(),
         standard: &ISO_230_2,
+        angle: Default::default(),
         generator: &generator,
     };
     files.push(("report.html".into(), html::render(&input)?.into_bytes()));

@@ -16,8 +16,8 @@ use axcomp::together::{Input, Pairing, check_together};
 use axcomp::workflow;
 
 use super::common::{
-    JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load, load_profile,
-    name_axis, print_json, print_text, print_warnings, read_active_table,
+    AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load,
+    load_profile, name_axis, print_json, print_text, print_warnings, read_active_table,
 };
 use super::servo_sim::load_axis;
 
@@ -94,6 +94,10 @@ pub struct DiagnoseArgs {
     #[command(flatten)]
     pub json_output: JsonOutput,
 
+    /// `--angle-unit` (the same in `evaluate` and `report`).
+    #[command(flatten)]
+    pub angle_unit: AngleUnitArg,
+
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
     pub verbosity: Verbosity,
@@ -104,6 +108,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let mut after = read::read_path(&args.after, None)?;
     print_warnings(&after.warnings, args.verbosity.quiet);
     name_axis(&mut after.measurement, args.axis.as_ref());
+    let angle = args.angle_unit.for_axis(&after.measurement)?;
     if after.measurement.kind() == AxisKind::Rotary {
         // Issue 14: a rotary re-test is diagnosed in ″ (per-revolution
         // harmonics, reversal, outlier runs); its effects file and an Abbe
@@ -155,6 +160,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     };
     let angular = args.angular.as_deref().map(load_angular).transpose()?;
     let input = DiagnoseInput {
+        angle,
         after: &after.measurement,
         before: before.as_ref(),
         table: table.as_ref(),
@@ -175,6 +181,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         name(&args.after),
         args.before.as_deref().map(name),
         args.table.as_deref().map(name),
+        angle,
     );
     if let (Some(servo_axis), Some(compliance)) = (&args.servo_axis, args.compliance_n_um) {
         if !(compliance.is_finite() && compliance > 0.0) {

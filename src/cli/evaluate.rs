@@ -8,12 +8,12 @@ use axcomp::evaluate::evaluate_with;
 use axcomp::measurement::{Direction, Measurement, RunSelector};
 use axcomp::read;
 use axcomp::report::terminal;
-use axcomp::workflow::evaluation_report;
+use axcomp::workflow::{EvaluationReportOptions, evaluation_report};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, JsonOutput, MachineFile, StandardArg, UncertaintyArgs, Verbosity, load_equipment,
-    name_axis, parse_run_selector, print_json, print_text, print_warnings,
+    AngleUnitArg, InputFormat, JsonOutput, MachineFile, StandardArg, UncertaintyArgs, Verbosity,
+    load_equipment, name_axis, parse_run_selector, print_json, print_text, print_warnings_in,
 };
 
 /// Flags of `axcomp evaluate`.
@@ -66,6 +66,10 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub json_output: JsonOutput,
 
+    /// `--angle-unit` (the same in `report` and `diagnose`).
+    #[command(flatten)]
+    pub angle_unit: AngleUnitArg,
+
     /// -q/--quiet (the same in every command).
     #[command(flatten)]
     pub verbosity: Verbosity,
@@ -78,6 +82,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         mut warnings,
     } = read::read_paths(&args.files, args.input_format.format)?;
     name_axis(&mut measurement, args.axis.as_ref());
+    let angle = args.angle_unit.for_axis(&measurement)?;
     check_selectors(&measurement, &args.exclude_runs)?;
     let measurement = measurement
         .without_runs(&args.exclude_runs)
@@ -93,17 +98,20 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
     let report = evaluation_report(
         &measurement,
         evaluation,
-        &args.exclude_runs,
         &mut warnings,
-        &limits,
-        &equipment,
-        args.uncertainty.decision,
+        EvaluationReportOptions {
+            exclude_runs: &args.exclude_runs,
+            limits: &limits,
+            equipment: &equipment,
+            decision: args.uncertainty.decision,
+            angle,
+        },
     )?;
     // The report holds all it prints. The readings go first, so that the
     // text rendered from a large test (megabytes) takes memory already in
     // use rather than new pages.
     drop(measurement);
-    print_warnings(&warnings, args.verbosity.quiet);
+    print_warnings_in(&warnings, args.verbosity.quiet, angle);
     if args.json_output.json {
         print_json(&report)
     } else {

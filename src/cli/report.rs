@@ -22,8 +22,9 @@ use axcomp::workflow::Test;
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
-    InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs, Verbosity,
-    load_equipment, load_profile, name_axis, print_text, print_warnings, read_active_table,
+    AngleUnitArg, InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs,
+    Verbosity, load_equipment, load_profile, name_axis, print_text, print_warnings_in,
+    read_active_table,
 };
 
 /// Flags of `axcomp report`.
@@ -105,6 +106,10 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub overwrite: Overwrite,
 
+    /// `--angle-unit` (the same in `evaluate` and `diagnose`).
+    #[command(flatten)]
+    pub angle_unit: AngleUnitArg,
+
     /// `--standard` (the same in every command).
     #[command(flatten)]
     pub standard: StandardArg,
@@ -173,6 +178,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         standard,
         &equipment,
     )?;
+    let angle = args.angle_unit.for_axis(&before.measurement)?;
     if before.measurement.kind() == AxisKind::Rotary {
         refuse_for_rotary(args, &before.measurement)?;
     }
@@ -225,6 +231,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let diagnosis = match (&after, args.diagnose) {
         (Some(after), true) => {
             let input = DiagnoseInput {
+                angle,
                 after: &after.measurement,
                 before: Some(&before.measurement),
                 table: table.as_ref().map(|(_, _, t)| t),
@@ -255,6 +262,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         limits: &limits,
         decision: args.uncertainty.decision,
         standard,
+        angle,
         generator: &generator,
     };
     // Render everything before writing anything: a failure leaves no half report.
@@ -283,7 +291,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         return Err(error.into());
     }
     for test in std::iter::once(&before).chain(&after) {
-        print_warnings(&test.warnings, args.verbosity.quiet);
+        print_warnings_in(&test.warnings, args.verbosity.quiet, angle);
     }
     let mut summary = format!("Wrote {}\n", args.output.display());
     for (path, _) in files.iter().skip(1) {

@@ -23,6 +23,7 @@ use super::{Kind, KnownPeriod, LACK_OF_FIT_P, RejectedEffect, Shape};
 use crate::effects::{PeriodicIn, Reading};
 use crate::evaluate::conformance::FULL_TURN_DEG;
 use crate::measurement::{AxisKind, Direction};
+use crate::units::DeviationUnit;
 
 /// Covariance of the per-target levels, µm²: each level's own scatter on the
 /// diagonal, plus the prediction's, which targets share when they interpolate
@@ -257,8 +258,8 @@ impl Search for AlongAxis<'_> {
         kind.is_positional() && !chosen.iter().any(|c| c.shape.kind() == kind)
     }
 
-    fn kind(&self) -> AxisKind {
-        self.problem.kind
+    fn deviation(&self) -> DeviationUnit {
+        self.problem.deviation
     }
 
     fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet> {

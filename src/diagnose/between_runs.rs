@@ -13,7 +13,8 @@ use super::{Evidence, Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
 use nalgebra::{DMatrix, DVector};
 
 use crate::effects::deviation_text;
-use crate::measurement::{AxisKind, Run};
+use crate::measurement::Run;
+use crate::units::DeviationUnit;
 
 /// The reversal found between the directions, from the cell levels.
 #[derive(Clone, Copy, Debug)]
@@ -62,8 +63,8 @@ impl Search for BetweenRuns<'_> {
         vec![ShapeSet::each(shapes(kind, &self.runs, chosen))]
     }
 
-    fn kind(&self) -> AxisKind {
-        self.problem.kind
+    fn deviation(&self) -> DeviationUnit {
+        self.problem.deviation
     }
 
     fn columns(&self, shape: Shape) -> Vec<Vec<f64>> {
@@ -208,8 +209,8 @@ pub(super) fn select_reversal(
             Kind::Reversal,
             format!(
                 "the directions differ, but not by one B: the reversal changes along the axis from {} to {} (p = {p_with:.1e}); it is reported as unexplained structure",
-                deviation_text(problem.kind, lowest, 2),
-                deviation_text(problem.kind, highest, 2)
+                deviation_text(problem.deviation, lowest, 2),
+                deviation_text(problem.deviation, highest, 2)
             ),
         );
         return (None, p_without);
@@ -238,7 +239,13 @@ pub(super) fn select_reversal(
         }
     };
     let (cv_without, cv_with) = (cv(false), cv(true));
-    if !predicts_better(rejected, Kind::Reversal, problem.kind, cv_with, cv_without) {
+    if !predicts_better(
+        rejected,
+        Kind::Reversal,
+        problem.deviation,
+        cv_with,
+        cv_without,
+    ) {
         return (None, p_without);
     }
     let evidence = Evidence {

@@ -9,6 +9,7 @@ use super::{
 use crate::effects::{Kind, deviation_text};
 use crate::evaluate::conformance::FULL_TURN_DEG;
 use crate::measurement::{AxisKind, Direction};
+use crate::units::DeviationUnit;
 
 /// The kinds that can be looked for here; the others go to `rejected` with the reason.
 pub(super) fn applicable_kinds(
@@ -97,7 +98,7 @@ pub(super) fn strong_evidence(rejected: &mut Vec<RejectedEffect>, kind: Kind, de
 pub(super) fn predicts_better(
     rejected: &mut Vec<RejectedEffect>,
     kind: Kind,
-    axis: AxisKind,
+    unit: DeviationUnit,
     cv_with: f64,
     cv_without: f64,
 ) -> bool {
@@ -108,8 +109,8 @@ pub(super) fn predicts_better(
             kind,
             format!(
                 "improves the fit but not the prediction of runs it was not fitted on ({} vs {})",
-                deviation_text(axis, cv_with, 3),
-                deviation_text(axis, cv_without, 3)
+                deviation_text(unit, cv_with, 3),
+                deviation_text(unit, cv_without, 3)
             ),
         );
     }

@@ -101,6 +101,9 @@ pub struct DiagnoseInput<'a> {
     /// The standard whose figures the diagnosis reports
     /// ([`Diagnosis::standard_figures`]); the statistics do not depend on it.
     pub standard: &'a dyn Standard,
+    /// The unit the sentences say a rotary axis' deviations in (″ or µrad;
+    /// `--angle-unit`); the numbers of the diagnosis stay in m°.
+    pub angle: crate::units::AngleUnit,
 }
 
 /// A period the machine's axis is known to have, from its drive or its scale.

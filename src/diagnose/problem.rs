@@ -14,7 +14,7 @@ use crate::effects::{Line, Reading, Shape};
 use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::together::{Input, Pairing, check_together};
-use crate::units::mm_to_um;
+use crate::units::{DeviationUnit, mm_to_um};
 
 /// The readings with their prediction, as one table.
 pub(super) struct Problem {
@@ -38,6 +38,8 @@ pub(super) struct Problem {
     pub(super) targets_mm: Vec<f64>,
     /// Linear or rotary: on a rotary axis `_mm` holds ° and `_um` m° (1/1000 °).
     pub(super) kind: AxisKind,
+    /// The unit its sentences say a deviation in (µm, ″ or µrad).
+    pub(super) deviation: DeviationUnit,
     pub(super) angle_urad: Option<Vec<f64>>,
     /// The cells (target, direction) that have readings, in column order.
     pub(super) cells: Vec<(usize, Direction)>,
@@ -231,6 +233,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         run_count: after.runs().len(),
         targets_mm: after.targets_mm().to_vec(),
         kind: after.kind(),
+        deviation: after.kind().deviation_unit(input.angle),
         angle_urad,
         cells,
         cell_design,

@@ -6,7 +6,8 @@ use super::fit::Design;
 use super::gates::{predicts_better, set_rejection, strong_evidence};
 use super::{Evidence, RejectedEffect};
 use crate::effects::{Kind, Shape};
-use crate::measurement::{AxisKind, Direction, Run};
+use crate::measurement::{Direction, Run};
+use crate::units::DeviationUnit;
 
 /// An accepted shape, where its columns start in its model, and why.
 #[derive(Clone, Copy, Debug)]
@@ -108,8 +109,8 @@ pub(super) trait Search {
     /// Whether to try `kind` now, given what is chosen.
     fn tries(&self, kind: Kind, chosen: &[Chosen]) -> bool;
 
-    /// Linear or rotary (the unit of the sentences).
-    fn kind(&self) -> AxisKind;
+    /// The unit the sentences say a deviation in.
+    fn deviation(&self) -> DeviationUnit;
 
     /// The shapes of `kind` to try, in sets each judged on its own.
     fn shape_sets(&self, kind: Kind, chosen: &[Chosen]) -> Vec<ShapeSet>;
@@ -193,7 +194,13 @@ pub(super) fn forward_selection<S: Search>(
             }
             let with = model.with(&search.columns(shape));
             let cv_with = search.cross_validated_rmse(&with);
-            if !predicts_better(rejected, shape.kind(), search.kind(), cv_with, cv_without) {
+            if !predicts_better(
+                rejected,
+                shape.kind(),
+                search.deviation(),
+                cv_with,
+                cv_without,
+            ) {
                 continue;
             }
             let p_one = search.p_value(

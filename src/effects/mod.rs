@@ -34,7 +34,7 @@ pub mod scale;
 use serde::Deserialize;
 
 use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError};
-use crate::units::um_to_mm;
+use crate::units::{AngleUnit, DeviationUnit, um_to_mm};
 
 pub use abbe::Abbe;
 pub use drift::Drift;
@@ -111,6 +111,8 @@ pub struct Context {
     /// Linear or rotary: on a rotary axis the values held as mm and µm are °
     /// and m° (1/1000 °), and the sentences say ° and ″ ([`Context::deviation`]).
     pub kind: AxisKind,
+    /// The unit a rotary axis' deviations are said in (″ or µrad).
+    pub angle: AngleUnit,
     /// The table's step, mm, if a regular table was applied.
     pub table_step_mm: Option<f64>,
     /// Spacing of the targets, when regular, mm.
@@ -127,21 +129,22 @@ pub struct Context {
 }
 
 /// A deviation held in µm (m°, 1/1000 °, on a rotary axis) as a sentence
-/// writes it with `decimals`: `2.40 µm`, or in arc-seconds `8.64″`.
-pub fn deviation_text(kind: AxisKind, value_um: f64, decimals: usize) -> String {
-    match kind {
-        AxisKind::Linear => format!("{value_um:.decimals$} µm"),
-        AxisKind::Rotary => format!(
-            "{:.decimals$}″",
-            crate::units::deg_to_arcsec(crate::units::um_to_mm(value_um))
-        ),
+/// writes it in `unit` with `decimals`: `2.40 µm`, or in arc-seconds `8.64″`
+/// (`41.89 µrad`).
+pub fn deviation_text(unit: DeviationUnit, value_um: f64, decimals: usize) -> String {
+    let suffix = unit.suffix();
+    match unit {
+        DeviationUnit::Micrometre => format!("{value_um:.decimals$}{suffix}"),
+        DeviationUnit::Angle(angle) => {
+            format!("{:.decimals$}{suffix}", angle.from_deg(um_to_mm(value_um)))
+        }
     }
 }
 
 impl Context {
     /// A deviation as a sentence writes it ([`deviation_text`], 2 decimals).
     pub fn deviation(&self, value_um: f64) -> String {
-        deviation_text(self.kind, value_um, 2)
+        deviation_text(self.kind.deviation_unit(self.angle), value_um, 2)
     }
 
     /// A position or a length held in mm (° on a rotary axis): `18 mm`, `18°`.

@@ -20,7 +20,7 @@ use crate::evaluate::{
 use crate::measurement::AxisKind;
 use crate::measurement::{Direction, Measurement};
 use crate::report::chart::{Chart, Mark, Polar, Rgb, Series};
-use crate::units::{deg_to_arcsec, mm_to_um};
+use crate::units::{AngleUnit, DeviationUnit, mm_to_um};
 
 /// One test (the first, or the re-test) as the report shows it.
 #[derive(Clone, Copy, Debug)]
@@ -65,6 +65,8 @@ pub struct ReportInput<'a> {
     /// The standard the tests were evaluated to (`--standard`), whose
     /// figures the predicted re-test reports too.
     pub standard: &'a dyn Standard,
+    /// The unit of a rotary axis' deviations (`--angle-unit`; unused on a linear axis).
+    pub angle: AngleUnit,
     /// What made the report, e.g. `axcomp 0.1.0 on 2026-11-22 15:04`
     /// (the library reads no clock: the caller says when).
     pub generator: &'a str,
@@ -185,23 +187,28 @@ const EFFECT_COLOURS: [Rgb; 6] = [
 
 const POSITION_LABEL: &str = "target position [mm]";
 const DEVIATION_LABEL: &str = "positional deviation [µm]";
-/// The same on a rotary axis, whose targets are in ° and deviations in ″.
+/// The same on a rotary axis, whose targets are in °.
 const ANGLE_LABEL: &str = "target position [°]";
-const ANGULAR_DEVIATION_LABEL: &str = "positional deviation [″]";
 
-/// How a test's deviations are drawn: in µm (the `_mm` fields), or in ″ on a
-/// rotary axis (the same fields hold °).
-fn shown(test: &TestRecord<'_>) -> fn(f64) -> f64 {
-    match test.measurement.kind() {
-        AxisKind::Linear => mm_to_um,
-        AxisKind::Rotary => deg_to_arcsec,
+/// How a test's deviations are drawn: in µm (the `_mm` fields), or in
+/// `angle` (″, µrad) on a rotary axis (the same fields hold °).
+fn shown(test: &TestRecord<'_>, angle: AngleUnit) -> DeviationUnit {
+    test.measurement.kind().deviation_unit(angle)
+}
+
+/// The deviation axis' label, in the unit drawn.
+fn deviation_label(shown: DeviationUnit) -> String {
+    match shown {
+        DeviationUnit::Micrometre => DEVIATION_LABEL.into(),
+        angle => format!("positional deviation [{}]", angle.symbol()),
     }
 }
 
 /// All charts of the report, in the order the HTML shows them.
 pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
     let mut charts = Vec::new();
-    let mut before = deviation_chart(&input.before, "first test");
+    let angle = input.angle;
+    let mut before = deviation_chart(&input.before, "first test", angle);
     match &input.after {
         None => {
             before.title = format!("Positional deviation{}", axis_suffix(&input.before));
@@ -209,7 +216,7 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
                 name: "deviation",
                 chart: before,
             });
-            if let Some(polar) = polar_chart(&input.before, "", None) {
+            if let Some(polar) = polar_chart(&input.before, "", None, angle) {
                 charts.push(NamedChart {
                     name: "polar",
                     chart: polar,
@@ -217,7 +224,7 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
             }
         }
         Some(after_record) => {
-            let mut after = deviation_chart(after_record, "re-test");
+            let mut after = deviation_chart(after_record, "re-test", angle);
             // One scale for both, so the eye compares them truly.
             let range = [before.y_extent(), after.y_extent()]
                 .into_iter()
@@ -237,13 +244,13 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
             // A rotary axis' polar plots, on one scale too.
             let largest = [&input.before, after_record]
                 .into_iter()
-                .filter_map(|test| largest_mean(test))
+                .filter_map(|test| largest_mean(test, angle))
                 .reduce(f64::max);
             for (test, name, which) in [
                 (&input.before, "polar-before", ", first test"),
                 (after_record, "polar-after", ", re-test"),
             ] {
-                if let Some(polar) = polar_chart(test, which, largest) {
+                if let Some(polar) = polar_chart(test, which, largest, angle) {
                     charts.push(NamedChart { name, chart: polar });
                 }
             }
@@ -318,11 +325,11 @@ fn series(label: Option<String>, color: Rgb, mark: Mark, points: Vec<(f64, f64)>
 /// Every run (▲ moving ↑, ▼ moving ↓, a thin line joining each run's
 /// readings), the means per direction, the bidirectional mean and the
 /// x̄ ± 2s band of each direction.
-fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
+fn deviation_chart(test: &TestRecord<'_>, which: &str, angle: AngleUnit) -> Chart {
     let measurement = test.measurement;
     let targets = measurement.targets_mm();
     let per_target = &test.evaluation.per_target;
-    let shown = shown(test);
+    let shown = shown(test, angle);
     let mut all = Vec::new();
     for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
         let (lower, upper): (Vec<(f64, f64)>, Vec<f64>) = per_target
@@ -351,7 +358,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
             let points: Vec<(f64, f64)> = targets
                 .iter()
                 .zip(&run.deviations_mm)
-                .filter_map(|(x, value)| value.map(|v| (*x, shown(v))))
+                .filter_map(|(x, value)| value.map(|v| (*x, shown.from_internal(v))))
                 .collect();
             lines.push(series(None, light, Mark::Line(1), points.clone()));
             let runs = if count == 1 { "run" } else { "runs" };
@@ -369,11 +376,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
             AxisKind::Rotary => ANGLE_LABEL,
         }
         .into(),
-        y_label: match test.measurement.kind() {
-            AxisKind::Linear => DEVIATION_LABEL,
-            AxisKind::Rotary => ANGULAR_DEVIATION_LABEL,
-        }
-        .into(),
+        y_label: deviation_label(shown),
         series: all,
         y_range: None,
         polar: None,
@@ -383,7 +386,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str) -> Chart {
 /// The mean lines of a test: x̄↑ and x̄↓ (solid, in their colours) and the
 /// bidirectional mean x̄ (dashed), converted by `shown`; the deviation plot
 /// and the polar plot draw the same three.
-fn mean_lines(per_target: &[TargetStats], shown: fn(f64) -> f64) -> Vec<Series> {
+fn mean_lines(per_target: &[TargetStats], shown: DeviationUnit) -> Vec<Series> {
     let mut lines = Vec::new();
     for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
         let means = means_in(per_target, direction, shown);
@@ -398,7 +401,7 @@ fn mean_lines(per_target: &[TargetStats], shown: fn(f64) -> f64) -> Vec<Series> 
     }
     let bidirectional: Vec<(f64, f64)> = per_target
         .iter()
-        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, shown(m))))
+        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, shown.from_internal(m))))
         .collect();
     if !bidirectional.is_empty() {
         lines.push(series(
@@ -412,29 +415,33 @@ fn mean_lines(per_target: &[TargetStats], shown: fn(f64) -> f64) -> Vec<Series> 
 }
 
 /// (target, x̄) for one direction, where the mean is defined, the mean
-/// converted by `shown` (to µm, or ″).
+/// converted by `shown` (to µm, or ″ or µrad).
 fn means_in(
     per_target: &[TargetStats],
     direction: Direction,
-    shown: fn(f64) -> f64,
+    shown: DeviationUnit,
 ) -> Vec<(f64, f64)> {
     per_target
         .iter()
         .filter_map(|t| {
             let mean = t.direction(direction).mean_mm?;
-            Some((t.target_mm, shown(mean)))
+            Some((t.target_mm, shown.from_internal(mean)))
         })
         .collect()
 }
 
 /// (target, x̄ − 2s, x̄ + 2s) converted by `shown`, where both are defined.
-fn band(target_mm: f64, stats: &DirectionStats, shown: fn(f64) -> f64) -> Option<(f64, f64, f64)> {
+fn band(target_mm: f64, stats: &DirectionStats, shown: DeviationUnit) -> Option<(f64, f64, f64)> {
     let (low, high) = stats.band(crate::evaluate::ISO_230_2.k)?;
-    Some((target_mm, shown(low), shown(high)))
+    Some((
+        target_mm,
+        shown.from_internal(low),
+        shown.from_internal(high),
+    ))
 }
 
-/// The largest |x̄↑|, |x̄↓|, |x̄| of a rotary test, ″; `None` for a linear one.
-fn largest_mean(test: &TestRecord<'_>) -> Option<f64> {
+/// The largest |x̄↑|, |x̄↓|, |x̄| of a rotary test, in `angle`; `None` for a linear one.
+fn largest_mean(test: &TestRecord<'_>, angle: AngleUnit) -> Option<f64> {
     if test.measurement.kind() != AxisKind::Rotary {
         return None;
     }
@@ -443,26 +450,32 @@ fn largest_mean(test: &TestRecord<'_>) -> Option<f64> {
         .iter()
         .flat_map(|t| [t.up.mean_mm, t.down.mean_mm, t.mean_mm])
         .flatten()
-        .map(|mean| deg_to_arcsec(mean).abs())
+        .map(|mean| angle.from_deg(mean).abs())
         .reduce(f64::max)
 }
 
 /// A rotary test's polar plot: x̄↑, x̄↓ and x̄ around the circle, each a
-/// radial offset in ″ from the reference circle ([`Polar`], scaled to
-/// `largest` ″ or the test's own largest mean); `None` for a linear axis.
-fn polar_chart(test: &TestRecord<'_>, which: &str, largest: Option<f64>) -> Option<Chart> {
-    let largest = largest.or_else(|| largest_mean(test))?;
-    let all = mean_lines(&test.evaluation.per_target, deg_to_arcsec);
+/// radial offset in `angle` (″, µrad) from the reference circle ([`Polar`],
+/// scaled to `largest` or the test's own largest mean); `None` for a linear axis.
+fn polar_chart(
+    test: &TestRecord<'_>,
+    which: &str,
+    largest: Option<f64>,
+    angle: AngleUnit,
+) -> Option<Chart> {
+    let largest = largest.or_else(|| largest_mean(test, angle))?;
+    let shown = DeviationUnit::Angle(angle);
+    let all = mean_lines(&test.evaluation.per_target, shown);
     Some(Chart {
         title: format!(
             "Mean deviation around the circle{which}{}",
             axis_suffix(test)
         ),
         x_label: ANGLE_LABEL.into(),
-        y_label: ANGULAR_DEVIATION_LABEL.into(),
+        y_label: deviation_label(shown),
         series: all,
         y_range: None,
-        polar: Some(Polar::fitting(largest, "″")),
+        polar: Some(Polar::fitting(largest, shown.suffix())),
     })
 }
 
@@ -594,7 +607,7 @@ fn prediction_chart(
     if let Some(after) = after {
         for (direction, mark) in [(Direction::Up, Mark::Up), (Direction::Down, Mark::Down)] {
             let color = if direction == Direction::Up { UP } else { DOWN };
-            let means = means_in(&after.per_target, direction, mm_to_um);
+            let means = means_in(&after.per_target, direction, DeviationUnit::Micrometre);
             if !means.is_empty() {
                 all.push(series(
                     Some(format!("re-test mean {direction}, measured")),

@@ -85,7 +85,7 @@ pub struct Polar {
     pub reference: f64,
     /// The deviation of the inner and outer rings, in deviation units.
     pub ring: f64,
-    /// The deviation's unit, after the ring labels (`″`).
+    /// The deviation's unit, after the ring labels (`″`, ` µrad`).
     pub unit: String,
 }
 

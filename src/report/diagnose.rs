@@ -46,6 +46,8 @@
 //! effect's `period_deg` and `amplitude_arcsec`, a reversal's `B_arcsec`),
 //! and a periodic effect's `params` add `per_revolution`, its whole order
 //! (2: twice per revolution, period 180°). The terminal says ″ and °.
+//! With `--angle-unit urad` the same values are µrad and every such key
+//! ends in `_urad` (`residual_before_urad`, `amplitude_urad`) instead.
 
 use std::fmt::Write;
 
@@ -58,19 +60,25 @@ use crate::effects::{Effect, ParameterValue};
 use crate::measurement::AxisKind;
 use crate::report::format::{pad_name, um};
 use crate::report::json::FiguresJson;
-use crate::units::{deg_to_arcsec, um_to_mm};
+use crate::units::{AngleUnit, DeviationUnit, um_to_mm};
 
-/// How a diagnosis' values are reported: µm and mm on a linear axis, ″ and °
-/// on a rotary one (held inside as m°, 1/1000 °, and °).
+/// How a diagnosis' values are reported: µm and mm on a linear axis, ″ (or
+/// µrad, the [`AngleUnit`]) and ° on a rotary one (held inside as m°,
+/// 1/1000 °, and °).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Units(AxisKind);
+struct Units(AxisKind, AngleUnit);
 
 impl Units {
+    /// The unit a deviation is reported in.
+    fn shown(self) -> DeviationUnit {
+        self.0.deviation_unit(self.1)
+    }
+
     /// A deviation held in µm (m° on a rotary axis) in its reported unit.
     fn deviation(self, value_um: f64) -> f64 {
-        match self.0 {
-            AxisKind::Linear => value_um,
-            AxisKind::Rotary => deg_to_arcsec(um_to_mm(value_um)),
+        match self.shown() {
+            DeviationUnit::Micrometre => value_um,
+            DeviationUnit::Angle(angle) => angle.from_deg(um_to_mm(value_um)),
         }
     }
 
@@ -84,19 +92,20 @@ impl Units {
         }
     }
 
-    /// A key with the unit it reports: `_um` → `_arcsec`, `_mm` → `_deg` on
-    /// a rotary axis; unchanged on a linear one.
+    /// A key with the unit it reports: `_um` → `_arcsec` (`_urad`), `_mm`
+    /// → `_deg` on a rotary axis; unchanged on a linear one.
     fn key(self, key: &str) -> String {
         if self.0 == AxisKind::Linear {
             return key.to_string();
         }
+        let angle = self.shown().key();
         for (linear, rotary) in [
-            ("_um", "_arcsec"),
-            ("_um_per_h", "_arcsec_per_h"),
-            ("_mm", "_deg"),
+            ("_um", angle),
+            ("_um_per_h", &format!("{angle}_per_h")),
+            ("_mm", "deg"),
         ] {
             if let Some(stem) = key.strip_suffix(linear) {
-                return format!("{stem}{rotary}");
+                return format!("{stem}_{rotary}");
             }
         }
         key.to_string()
@@ -115,12 +124,9 @@ impl Units {
         }
     }
 
-    /// After a deviation in the terminal: ` µm` or `″`.
+    /// After a deviation in the terminal: ` µm`, `″` or ` µrad`.
     fn deviation_suffix(self) -> &'static str {
-        match self.0 {
-            AxisKind::Linear => " µm",
-            AxisKind::Rotary => "″",
-        }
+        self.shown().suffix()
     }
 
     /// After a position in the terminal: ` mm` or `°`.
@@ -406,16 +412,18 @@ impl FrictionJson {
 
 impl DiagnoseJson {
     /// Builds the wire object.
+    /// A rotary axis' deviations are in `angle`.
     pub fn new(
         diagnosis: &Diagnosis,
         after: String,
         before: Option<String>,
         table: Option<String>,
+        angle: AngleUnit,
     ) -> DiagnoseJson {
-        let units = Units(diagnosis.kind);
+        let units = Units(diagnosis.kind, angle);
         let figures = |figures: &[crate::evaluate::StandardFigure]| match units.0 {
             AxisKind::Linear => FiguresJson::from_standard(figures),
-            AxisKind::Rotary => FiguresJson::from_standard_deg(figures),
+            AxisKind::Rotary => FiguresJson::from_standard_deg(figures, angle),
         };
         let fields = DiagnoseFields {
             after,
@@ -552,10 +560,12 @@ pub fn render(report: &DiagnoseJson) -> String {
             um(Some(u.rms_um))
         );
     }
+    // The first column fits its heading: `Figures [µrad]` is wider than `Figures [µm]`.
+    let heading = format!("Figures [{}]", dev.trim());
+    let width = heading.chars().count().max(12);
     let _ = writeln!(
         out,
-        "\n{:<12} |  measured | predicted | predicted with effects   ({}{})",
-        format!("Figures [{}]", dev.trim()),
+        "\n{heading:<width$} |  measured | predicted | predicted with effects   ({}{})",
         report.standard_name,
         if report.definitions_reconstructed {
             "; definitions reconstructed from public sources (README, Standards)"
@@ -565,14 +575,15 @@ pub fn render(report: &DiagnoseJson) -> String {
     );
     let _ = writeln!(
         out,
-        "-------------+-----------+-----------+-----------------------"
+        "{}+-----------+-----------+-----------------------",
+        "-".repeat(width + 1)
     );
     let f = &report.figures_um;
     for (name, key) in f.measured.terminal_rows() {
         let _ = writeln!(
             out,
             " {} | {:>9} | {:>9} | {:>22}",
-            pad_name(name, 11),
+            pad_name(name, width - 1),
             um(f.measured.get(key)),
             um(f.predicted.get(key)),
             um(f.predicted_with_effects.get(key))

@@ -57,7 +57,7 @@ use crate::evaluate::TestConformance;
 use crate::evaluate::conformance::{Check, Requirement};
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
 use crate::evaluate::standard::{Vdi3441, vdi_figure_name};
-use crate::evaluate::verdict::{Decision, Figure, Limit};
+use crate::evaluate::verdict::Figure;
 use crate::evaluate::{Standard, StandardUsed};
 use crate::measurement::{AxisKind, Direction, Measurement, StartEnd};
 use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts, prediction};
@@ -68,7 +68,7 @@ use crate::report::json::{EvaluationJson, FiguresJson, PerTargetJson, iso_keys};
 use crate::report::plot::{FONT, PlotError, PlotFormat};
 use crate::report::uncertainty::{NOT_EVALUATED_NOTE, UncertaintyJson};
 use crate::report::verdict::{Judged, verdict_box};
-use crate::units::{LengthUnit, deg_to_arcsec, mm_to_um, um_to_mm};
+use crate::units::{AngleUnit, DeviationUnit, LengthUnit, mm_to_um, um_to_mm};
 
 /// Renders the whole report.
 ///
@@ -83,7 +83,8 @@ use crate::units::{LengthUnit, deg_to_arcsec, mm_to_um, um_to_mm};
 /// let evaluation = evaluate(&measurement);
 /// let before = TestRecord { measurement: &measurement, evaluation: &evaluation, warnings: &warnings, budget: None };
 /// let input = ReportInput { before, after: None, table: None, diagnosis: None, limits: &[],
-///     decision: Default::default(), standard: &ISO_230_2, generator: "axcomp" };
+///     decision: Default::default(), standard: &ISO_230_2, angle: Default::default(),
+///     generator: "axcomp" };
 /// let html = axcomp::report::html::render(&input).unwrap();
 /// // E = max(x̄↑; x̄↓) − min(x̄↑; x̄↓) = 5 − (−1) = 6 µm, shown as the terminal shows it.
 /// assert!(html.contains(r#"data-key="before.figures_um.E" data-um="6">6.00</td>"#));
@@ -108,11 +109,8 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
     let plot = |name: &str| plots.iter().find(|plot| plot.name == name).cloned();
     let data = ReportDataJson {
         generator: input.generator,
-        before: evaluation_json(&input.before, input.limits, input.decision),
-        after: input
-            .after
-            .as_ref()
-            .map(|a| evaluation_json(a, input.limits, input.decision)),
+        before: evaluation_json(&input.before, input),
+        after: input.after.as_ref().map(|a| evaluation_json(a, input)),
     };
     let json = serde_json::to_string(&data).unwrap_or_else(|_| "null".into());
     let page = Page {
@@ -129,7 +127,7 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
             axis_shown(input.before.measurement)
         ),
         font_base64: font_base64(),
-        units: Units::of(input.before.measurement.kind()),
+        units: Units::of(input.before.measurement.kind(), input.angle),
         header: header(input),
         verdict: verdict_box(input),
         conditions: conditions(input),
@@ -186,36 +184,39 @@ struct Page<'a> {
 }
 
 /// The units a report is written in: a linear axis in mm and µm, a rotary
-/// one in ° and ″ (its `Measurement` holds ° in the `_mm` fields).
+/// one in ° and ″ or µrad (its `Measurement` holds ° in the `_mm` fields).
 struct Units {
     /// `linear` or `rotary`, as the subtitle names the axis.
     kind: &'static str,
     rotary: bool,
-    /// A deviation's unit: `µm` or `″`.
+    /// A deviation's unit: `µm`, `″` or `µrad`.
     deviation: &'static str,
+    /// The same in words, for the rotary note: `arc-seconds (1° = 3600″)`.
+    deviation_named: &'static str,
     /// A position's unit: `mm` or `°`.
     position: &'static str,
 }
 
 impl Units {
-    fn of(kind: AxisKind) -> Units {
+    fn of(kind: AxisKind, angle: AngleUnit) -> Units {
         let rotary = kind == AxisKind::Rotary;
         Units {
             kind: kind.as_str(),
             rotary,
-            deviation: if rotary { "″" } else { "µm" },
+            deviation: kind.deviation_unit(angle).symbol(),
+            deviation_named: match angle {
+                AngleUnit::Arcsec => "arc-seconds (1° = 3600″)",
+                AngleUnit::Urad => "microradians, µrad (1° = π/180 rad = 10⁶·π/180 µrad)",
+            },
             position: if rotary { "°" } else { "mm" },
         }
     }
 }
 
-/// A deviation held in the `_mm` fields (mm, or ° on a rotary axis) in the
-/// unit the report shows (µm, or ″).
-fn deviation_shown(measurement: &Measurement) -> fn(f64) -> f64 {
-    match measurement.kind() {
-        AxisKind::Linear => mm_to_um,
-        AxisKind::Rotary => deg_to_arcsec,
-    }
+/// The unit the report shows a test's deviations in (held in the `_mm`
+/// fields as mm, or ° on a rotary axis): µm, or ″ or µrad.
+fn deviation_shown(measurement: &Measurement, angle: AngleUnit) -> DeviationUnit {
+    measurement.kind().deviation_unit(angle)
 }
 
 /// `uncertainty.html`: the budget of the test being accepted, largest
@@ -535,10 +536,17 @@ fn json_in_script(json: &str) -> String {
 }
 
 /// As `evaluate --json` prints it, with the same limits, rule and budget.
-fn evaluation_json(test: &TestRecord<'_>, limits: &[Limit], decision: Decision) -> EvaluationJson {
-    let mut json = EvaluationJson::new(test.measurement, test.evaluation, &[], test.warnings);
+fn evaluation_json(test: &TestRecord<'_>, input: &ReportInput<'_>) -> EvaluationJson {
+    let mut json = EvaluationJson::new(
+        test.measurement,
+        test.evaluation,
+        &[],
+        test.warnings,
+        input.angle,
+    );
     json.uncertainty_um = test.budget.map(UncertaintyJson::from_budget);
-    json.verdict = crate::report::verdict::judge(test.evaluation, limits, decision, test.budget);
+    json.verdict =
+        crate::report::verdict::judge(test.evaluation, input.limits, input.decision, test.budget);
     json
 }
 
@@ -999,7 +1007,9 @@ fn figures(input: &ReportInput<'_>) -> Figures {
         .iter()
         .map(|(_, test)| match test.measurement.kind() {
             AxisKind::Linear => FiguresJson::from_figures(&test.evaluation.figures),
-            AxisKind::Rotary => FiguresJson::from_standard_deg(&test.evaluation.standard_figures),
+            AxisKind::Rotary => {
+                FiguresJson::from_standard_deg(&test.evaluation.standard_figures, input.angle)
+            }
         })
         .collect();
     let rows = FIGURE_ROWS
@@ -1013,11 +1023,11 @@ fn figures(input: &ReportInput<'_>) -> Figures {
                     // Where these figures are in the test's JSON: its
                     // `figures_um`, or beside another standard's.
                     let object = if test.measurement.kind() == AxisKind::Rotary {
-                        "figures_arcsec"
+                        format!("figures_{}", input.angle.name())
                     } else if iso_keys(&test.evaluation.standard_figures) {
-                        "figures_um"
+                        "figures_um".to_string()
                     } else {
-                        "figures_iso230_2_um"
+                        "figures_iso230_2_um".to_string()
                     };
                     // U beside the figures it is evaluated for (E, M, A).
                     let cell = |shown: Figure| {
@@ -1134,21 +1144,23 @@ fn per_target(input: &ReportInput<'_>) -> Vec<PerTargetTable> {
         .zip(["before", "after"])
         .map(|((name, test), prefix)| PerTargetTable {
             heading: input.after.as_ref().map(|_| name),
-            rows: per_target_rows(test, prefix),
+            rows: per_target_rows(test, prefix, input.angle),
         })
         .collect()
 }
 
-fn per_target_rows(test: &TestRecord<'_>, prefix: &str) -> Vec<PerTargetRow> {
+fn per_target_rows(test: &TestRecord<'_>, prefix: &str, angle: AngleUnit) -> Vec<PerTargetRow> {
     let length_unit = test.measurement.metadata.length_unit.as_str();
     let kind = test.measurement.kind();
     let rotary = kind == AxisKind::Rotary;
     let mut rows = Vec::new();
     for (index, stats) in test.evaluation.per_target.iter().enumerate() {
-        let t = PerTargetJson::from_stats_of(stats, kind);
-        // The JSON key: `mean_up_um`, or `mean_up_arcsec` on a rotary axis.
+        let t = PerTargetJson::from_stats_of(stats, kind, angle);
+        // The JSON key: `mean_up_um`, or `mean_up_arcsec` (`_urad`) on a rotary axis.
         let key = |name: &str| match (rotary, name.strip_suffix("_um")) {
-            (true, Some(stem)) => format!("{prefix}.per_target.{index}.{stem}_arcsec"),
+            (true, Some(stem)) => {
+                format!("{prefix}.per_target.{index}.{stem}_{}", t.deviation.key())
+            }
             _ => format!("{prefix}.per_target.{index}.{name}"),
         };
         let cells = [
@@ -1366,7 +1378,7 @@ fn notes(input: &ReportInput<'_>) -> Vec<Note> {
         for warning in record.warnings {
             notes.push(Note {
                 test,
-                what: NoteText::Warning(warning.to_string()),
+                what: NoteText::Warning(warning.text_in(input.angle)),
             });
         }
         for outlier in &record.evaluation.outliers {
@@ -1377,7 +1389,8 @@ fn notes(input: &ReportInput<'_>) -> Vec<Note> {
                     direction: outlier.direction,
                     score: format!("{:.1}", outlier.score),
                     offset_um: signed_plus(
-                        deviation_shown(record.measurement)(outlier.offset_mm),
+                        deviation_shown(record.measurement, input.angle)
+                            .from_internal(outlier.offset_mm),
                         2,
                     ),
                     worst_target_mm: outlier.worst_target_mm,

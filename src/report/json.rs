@@ -64,6 +64,10 @@
 //! `length_unit` is `deg`, and there is no `uncertainty_um` (the budget is
 //! the laser's, for lengths). A linear axis' object is unchanged.
 //!
+//! With `--angle-unit urad` every rotary deviation is in µrad instead, and
+//! every key that would end in `_arcsec` ends in `_urad` (`figures_urad`,
+//! `mean_up_urad`, `offset_urad`); no `_arcsec` key is written then.
+//!
 //! `axis_source` says where `axis` came from: `{"kind": "file", "field": …}`
 //! (the field of the file that states it), `{"kind": "given"}` (`--axis`) or
 //! `{"kind": "not_recorded"}`, when `axis` is only the placeholder `X`.
@@ -78,7 +82,7 @@ use crate::evaluate::{
 use crate::measurement::{
     AxisKind, AxisSource, Environment, Measurement, RunSelector, SourceFormat, StartEnd, TestSetup,
 };
-use crate::units::{deg_to_arcsec, mm_to_um, opt_deg_to_arcsec, opt_mm_to_um};
+use crate::units::{AngleUnit, DeviationUnit, opt_mm_to_um};
 
 /// The whole `evaluate --json` object.
 #[derive(Clone, Debug, Serialize)]
@@ -125,6 +129,13 @@ pub struct EvaluationJson {
     /// The same in ″ on a rotary axis (empty, and absent, on a linear one).
     #[serde(skip_serializing_if = "FiguresJson::is_empty")]
     pub figures_arcsec: FiguresJson,
+    /// The same in µrad on a rotary axis with `--angle-unit urad` (empty,
+    /// and absent, otherwise).
+    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
+    pub figures_urad: FiguresJson,
+    /// The unit of every deviation here (µm, ″ or µrad); the keys say it.
+    #[serde(skip)]
+    pub deviation: DeviationUnit,
     /// Per-target statistics.
     pub per_target: Vec<PerTargetJson>,
     /// Suspected outlier runs (included in the figures).
@@ -359,12 +370,12 @@ impl FiguresJson {
         }
     }
 
-    /// Converts a standard's figures (°) to ″, for a rotary axis.
-    pub fn from_standard_deg(figures: &[StandardFigure]) -> FiguresJson {
+    /// Converts a standard's figures (°) to `angle` (″ or µrad), for a rotary axis.
+    pub fn from_standard_deg(figures: &[StandardFigure], angle: AngleUnit) -> FiguresJson {
         FiguresJson {
             values: figures
                 .iter()
-                .map(|f| (f.key, opt_deg_to_arcsec(f.value_mm)))
+                .map(|f| (f.key, f.value_mm.map(|value_deg| angle.from_deg(value_deg))))
                 .collect(),
         }
     }
@@ -400,12 +411,15 @@ impl Serialize for FiguresJson {
 }
 
 /// Statistics at one target, µm; on a rotary axis (`kind`) the same fields
-/// hold ° and ″ and serialise as `target_deg`, `mean_up_arcsec`, …
+/// hold ° and ″ (or µrad, `deviation`) and serialise as `target_deg`,
+/// `mean_up_arcsec` (`mean_up_urad`), …
 #[allow(non_snake_case)]
 #[derive(Clone, Copy, Debug)]
 pub struct PerTargetJson {
-    /// Linear or rotary: the unit of every value and of the JSON keys.
+    /// Linear or rotary: the unit of the target and its JSON key.
     pub kind: AxisKind,
+    /// The unit of every deviation and of its JSON keys.
+    pub deviation: DeviationUnit,
     /// Target, mm.
     pub target_mm: f64,
     /// Readings ↑.
@@ -435,14 +449,16 @@ pub struct PerTargetJson {
 impl PerTargetJson {
     /// Converts one target's statistics of a linear axis to µm.
     pub fn from_stats(t: &TargetStats) -> PerTargetJson {
-        PerTargetJson::from_stats_of(t, AxisKind::Linear)
+        PerTargetJson::from_stats_of(t, AxisKind::Linear, AngleUnit::default())
     }
 
-    /// Converts one target's statistics to µm, or ″ on a rotary axis.
-    pub fn from_stats_of(t: &TargetStats, kind: AxisKind) -> PerTargetJson {
-        let shown = deviation_in(kind);
+    /// Converts one target's statistics to µm, or `angle` (″, µrad) on a rotary axis.
+    pub fn from_stats_of(t: &TargetStats, kind: AxisKind, angle: AngleUnit) -> PerTargetJson {
+        let deviation = kind.deviation_unit(angle);
+        let shown = |value: f64| deviation.from_internal(value);
         PerTargetJson {
             kind,
+            deviation,
             target_mm: t.target_mm,
             n_up: t.up.n,
             n_down: t.down.n,
@@ -459,26 +475,18 @@ impl PerTargetJson {
     }
 }
 
-/// A deviation held inside (mm, or ° on a rotary axis) in its reported unit (µm or ″).
-fn deviation_in(kind: AxisKind) -> fn(f64) -> f64 {
+/// The key suffix of a position: `mm`, or `deg` on a rotary axis.
+fn position_key(kind: AxisKind) -> &'static str {
     match kind {
-        AxisKind::Linear => mm_to_um,
-        AxisKind::Rotary => deg_to_arcsec,
-    }
-}
-
-/// The key suffixes of a position and a deviation: `mm`, `um` or `deg`, `arcsec`.
-fn key_units(kind: AxisKind) -> (&'static str, &'static str) {
-    match kind {
-        AxisKind::Linear => ("mm", "um"),
-        AxisKind::Rotary => ("deg", "arcsec"),
+        AxisKind::Linear => "mm",
+        AxisKind::Rotary => "deg",
     }
 }
 
 impl Serialize for PerTargetJson {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
-        let (position, deviation) = key_units(self.kind);
+        let (position, deviation) = (position_key(self.kind), self.deviation.key());
         let mut map = serializer.serialize_map(Some(13))?;
         map.serialize_entry(&format!("target_{position}"), &self.target_mm)?;
         map.serialize_entry("n_up", &self.n_up)?;
@@ -502,11 +510,14 @@ impl Serialize for PerTargetJson {
 }
 
 /// A suspected outlier run; on a rotary axis (`kind`) the position is ° and
-/// the offset ″, serialised as `worst_target_deg` and `offset_arcsec`.
+/// the offset ″ (or µrad), serialised as `worst_target_deg` and
+/// `offset_arcsec` (`offset_urad`).
 #[derive(Clone, Copy, Debug)]
 pub struct OutlierJson {
     /// Linear or rotary.
     pub kind: AxisKind,
+    /// The unit of the offset.
+    pub deviation: DeviationUnit,
     /// Run number within its direction.
     pub run: u32,
     /// `up` or `down`.
@@ -520,15 +531,17 @@ pub struct OutlierJson {
 }
 
 impl OutlierJson {
-    /// Converts a flagged run of an axis of `kind`.
-    pub fn from_outlier(o: &SuspectedOutlier, kind: AxisKind) -> OutlierJson {
+    /// Converts a flagged run of an axis of `kind`, an angle's offset to `angle`.
+    pub fn from_outlier(o: &SuspectedOutlier, kind: AxisKind, angle: AngleUnit) -> OutlierJson {
+        let deviation = kind.deviation_unit(angle);
         OutlierJson {
             kind,
+            deviation,
             run: o.run,
             direction: o.direction.as_str(),
             score: o.score,
             worst_target_mm: o.worst_target_mm,
-            offset_um: deviation_in(kind)(o.offset_mm),
+            offset_um: deviation.from_internal(o.offset_mm),
         }
     }
 }
@@ -536,7 +549,7 @@ impl OutlierJson {
 impl Serialize for OutlierJson {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
-        let (position, deviation) = key_units(self.kind);
+        let (position, deviation) = (position_key(self.kind), self.deviation.key());
         let mut map = serializer.serialize_map(Some(5))?;
         map.serialize_entry("run", &self.run)?;
         map.serialize_entry("direction", self.direction)?;
@@ -699,22 +712,18 @@ impl EvaluationJson {
         }
     }
 
-    /// The figures, in their unit (µm, or ″ on a rotary axis).
+    /// The figures, in their unit (µm, or ″ or µrad on a rotary axis).
     pub fn figures(&self) -> &FiguresJson {
-        if self.figures_arcsec.is_empty() {
-            &self.figures_um
-        } else {
-            &self.figures_arcsec
+        match self.deviation {
+            DeviationUnit::Micrometre => &self.figures_um,
+            DeviationUnit::Angle(AngleUnit::Arcsec) => &self.figures_arcsec,
+            DeviationUnit::Angle(AngleUnit::Urad) => &self.figures_urad,
         }
     }
 
-    /// How a deviation's unit is printed: `µm`, or `″` on a rotary axis.
+    /// How a deviation's unit is printed: `µm`, or `″` or `µrad` on a rotary axis.
     pub fn deviation_unit(&self) -> &'static str {
-        if self.axis_kind.is_some() {
-            "″"
-        } else {
-            "µm"
-        }
+        self.deviation.symbol()
     }
 
     /// How a target's unit is printed after a number: ` mm`, or `°` on a rotary axis.
@@ -726,19 +735,27 @@ impl EvaluationJson {
         }
     }
 
-    /// Builds the wire object from a measurement, its evaluation and all warnings.
+    /// Builds the wire object from a measurement, its evaluation and all
+    /// warnings, a rotary axis' deviations in `angle`.
     pub fn new(
         measurement: &Measurement,
         evaluation: &Evaluation,
         excluded: &[RunSelector],
         warnings: &[Warning],
+        angle: AngleUnit,
     ) -> EvaluationJson {
         let per_target = evaluation
             .per_target
             .iter()
-            .map(|stats| PerTargetJson::from_stats_of(stats, measurement.kind()))
+            .map(|stats| PerTargetJson::from_stats_of(stats, measurement.kind(), angle))
             .collect();
-        EvaluationJson::with_per_target(measurement, evaluation, per_target, excluded, warnings)
+        EvaluationJson::with_per_target(
+            measurement,
+            evaluation,
+            per_target,
+            (excluded, warnings),
+            angle,
+        )
     }
 
     /// [`EvaluationJson::new`], taking the evaluation: each target's
@@ -749,23 +766,31 @@ impl EvaluationJson {
         mut evaluation: Evaluation,
         excluded: &[RunSelector],
         warnings: &[Warning],
+        angle: AngleUnit,
     ) -> EvaluationJson {
         let per_target = std::mem::take(&mut evaluation.per_target)
             .into_iter()
-            .map(|stats| PerTargetJson::from_stats_of(&stats, measurement.kind()))
+            .map(|stats| PerTargetJson::from_stats_of(&stats, measurement.kind(), angle))
             .collect();
-        EvaluationJson::with_per_target(measurement, &evaluation, per_target, excluded, warnings)
+        EvaluationJson::with_per_target(
+            measurement,
+            &evaluation,
+            per_target,
+            (excluded, warnings),
+            angle,
+        )
     }
 
     fn with_per_target(
         measurement: &Measurement,
         evaluation: &Evaluation,
         per_target: Vec<PerTargetJson>,
-        excluded: &[RunSelector],
-        warnings: &[Warning],
+        (excluded, warnings): (&[RunSelector], &[Warning]),
+        angle: AngleUnit,
     ) -> EvaluationJson {
         let metadata = &measurement.metadata;
         let kind = measurement.kind();
+        let deviation = kind.deviation_unit(angle);
         let rotary = kind == AxisKind::Rotary;
         let targets = measurement.targets_mm().to_vec();
         let (targets_mm, targets_deg) = if rotary {
@@ -773,16 +798,16 @@ impl EvaluationJson {
         } else {
             (targets, Vec::new())
         };
-        let (figures_um, figures_arcsec) = if rotary {
-            (
-                FiguresJson::default(),
-                FiguresJson::from_standard_deg(&evaluation.standard_figures),
-            )
+        // One of the three is filled, in the unit of `deviation`.
+        let (mut figures_um, mut figures_arcsec, mut figures_urad) = Default::default();
+        *match deviation {
+            DeviationUnit::Micrometre => &mut figures_um,
+            DeviationUnit::Angle(AngleUnit::Arcsec) => &mut figures_arcsec,
+            DeviationUnit::Angle(AngleUnit::Urad) => &mut figures_urad,
+        } = if rotary {
+            FiguresJson::from_standard_deg(&evaluation.standard_figures, angle)
         } else {
-            (
-                FiguresJson::from_standard(&evaluation.standard_figures),
-                FiguresJson::default(),
-            )
+            FiguresJson::from_standard(&evaluation.standard_figures)
         };
         EvaluationJson {
             format: metadata.source_format.map(|f| f.name()),
@@ -812,11 +837,13 @@ impl EvaluationJson {
                 .then(|| FiguresJson::from_figures(&evaluation.figures)),
             figures_um,
             figures_arcsec,
+            figures_urad,
+            deviation,
             per_target,
             outliers: evaluation
                 .outliers
                 .iter()
-                .map(|o| OutlierJson::from_outlier(o, kind))
+                .map(|o| OutlierJson::from_outlier(o, kind, angle))
                 .collect(),
             environment: EnvironmentJson::from_environment(&measurement.environment),
             refractive_index: RefractiveIndexJson::from_check(&evaluation.refractive_index),
@@ -833,7 +860,7 @@ impl EvaluationJson {
                 location: metadata.location.clone(),
                 description: metadata.description.clone(),
             },
-            warnings: warnings.iter().map(ToString::to_string).collect(),
+            warnings: warnings.iter().map(|w| w.text_in(angle)).collect(),
             uncertainty_um: None,
             verdict: None,
             test_conformance: ConformanceJson::from_conformance(&evaluation.conformance),

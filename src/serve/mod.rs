@@ -63,6 +63,7 @@ use crate::report::html;
 use crate::report::json::EvaluationJson;
 use crate::report::plot::PlotFormat;
 use crate::together::{Input, Pairing, check_together};
+use crate::units::AngleUnit;
 use crate::workflow::{self, Converted, TableRequest, Test};
 
 use form::{Form, Upload};
@@ -402,6 +403,7 @@ fn report_input<'a>(
         limits: &[],
         decision: Decision::default(),
         standard,
+        angle: AngleUnit::default(),
         generator,
     }
 }
@@ -426,11 +428,14 @@ async fn api_evaluate(multipart: Multipart) -> Result<axum::Json<EvaluateAnswer>
         let evaluation = workflow::evaluation_report(
             &measurement,
             evaluation,
-            &[],
             &mut warnings,
-            &limits,
-            &equipment,
-            decision(&form)?,
+            workflow::EvaluationReportOptions {
+                exclude_runs: &[],
+                limits: &limits,
+                equipment: &equipment,
+                decision: decision(&form)?,
+                angle: AngleUnit::default(),
+            },
         )?;
         let input = report_input(&test, None, None, None, standard, "");
         Ok(EvaluateAnswer {
@@ -726,6 +731,7 @@ fn retest(form: &Form) -> Result<Retest, ApiError> {
         after_warnings.extend(doubts.iter().cloned());
     }
     let diagnosis = diagnose(&DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: Some(&before),
         table: table.as_ref().map(|(_, _, t, _)| t),
@@ -742,6 +748,7 @@ fn retest(form: &Form) -> Result<Retest, ApiError> {
         table
             .as_ref()
             .map(|((name, _), ..)| name.display().to_string()),
+        AngleUnit::default(),
     );
     Ok(Retest {
         effects_toml: diagnosis.effects_file(&after_label),
@@ -833,6 +840,7 @@ async fn api_report(multipart: Multipart) -> Result<Response, ApiError> {
         }
         let diagnosis = match (&after, form.text("diagnose")) {
             (Some(after), Some(_)) => Some(diagnose(&DiagnoseInput {
+                angle: Default::default(),
                 after: &after.measurement,
                 before: Some(&before.measurement),
                 table: table.as_ref().map(|(_, _, t, _)| t),

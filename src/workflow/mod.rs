@@ -26,7 +26,7 @@ use crate::report::convert::ConvertJson;
 use crate::report::json::EvaluationJson;
 use crate::report::uncertainty::UncertaintyJson;
 use crate::report::verdict;
-use crate::units::LengthUnit;
+use crate::units::{AngleUnit, LengthUnit};
 
 /// Why a command's work stopped. Each wraps its stage's error, so it reads
 /// as that error does.
@@ -51,19 +51,38 @@ pub enum WorkflowError {
     Emit(#[from] EmitError),
 }
 
+/// What `evaluate`'s object is judged against and shown in.
+#[derive(Clone, Copy, Debug)]
+pub struct EvaluationReportOptions<'a> {
+    /// The runs left out (`--exclude-run`), named in the object.
+    pub exclude_runs: &'a [RunSelector],
+    /// The acceptance limits; empty: no verdict.
+    pub limits: &'a [Limit],
+    /// The equipment of the uncertainty budget.
+    pub equipment: &'a Equipment,
+    /// The verdict's decision rule.
+    pub decision: Decision,
+    /// The unit of a rotary axis' deviations (`--angle-unit`).
+    pub angle: AngleUnit,
+}
+
 /// `evaluate --json`'s object for `measurement` (named, runs left out) and
 /// its `evaluation`: the uncertainty budget (linear axes), the verdict when
-/// there are `limits`, and every warning. The evaluation's warnings are
+/// there are limits, and every warning. The evaluation's warnings are
 /// added to `warnings`, for the caller to print.
 pub fn evaluation_report(
     measurement: &Measurement,
     evaluation: Evaluation,
-    exclude_runs: &[RunSelector],
     warnings: &mut Vec<Warning>,
-    limits: &[Limit],
-    equipment: &Equipment,
-    decision: Decision,
+    options: EvaluationReportOptions<'_>,
 ) -> Result<EvaluationJson, WorkflowError> {
+    let EvaluationReportOptions {
+        exclude_runs,
+        limits,
+        equipment,
+        decision,
+        angle,
+    } = options;
     warnings.extend(evaluation.warnings.iter().cloned());
     // The budget is the laser's, for lengths, and limits are µm: a rotary
     // axis has neither yet (issue 14's later part).
@@ -80,7 +99,7 @@ pub fn evaluation_report(
         .as_ref()
         .and_then(|budget| verdict::judge(&evaluation, limits, decision, Some(budget)));
     let mut report =
-        EvaluationJson::from_evaluation(measurement, evaluation, exclude_runs, warnings);
+        EvaluationJson::from_evaluation(measurement, evaluation, exclude_runs, warnings, angle);
     report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
     report.verdict = verdict;
     Ok(report)

@@ -57,6 +57,7 @@ fn run(truth_text: &str, seed: u64, angular: bool) -> Diagnosis {
         }
     });
     let input = DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: Some(&before),
         table: Some(&table),
@@ -90,6 +91,7 @@ fn run_alone(truth_text: &str, seed: u64) -> Diagnosis {
     let truth = Truth::from_toml_str(truth_text).unwrap();
     let (_, _, after) = synth_loop(&truth, seed);
     let input = DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: None,
         table: None,
@@ -528,6 +530,7 @@ fn real_ess_files_get_a_stated_diagnosis() {
     for path in &files {
         let m = read_path(path, None).unwrap().measurement;
         let input = DiagnoseInput {
+            angle: Default::default(),
             after: &m,
             before: None,
             table: None,
@@ -587,6 +590,7 @@ fn tests_of_different_axes_are_refused() {
     let after = before.clone();
     before.set_axis("Y");
     let input = DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: Some(&before),
         table: None,

@@ -78,6 +78,7 @@ fn run(case: &Case, seed: u64, known: &[KnownPeriod]) -> Diagnosis {
     let truth = Truth::from_toml_str(&case.truth).unwrap();
     let (before, table, after) = synth_loop(&truth, seed);
     let input = DiagnoseInput {
+        angle: Default::default(),
         after: &after,
         before: Some(&before),
         table: Some(&table),

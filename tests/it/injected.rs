@@ -97,6 +97,7 @@ fn name_of(path: &std::path::Path) -> String {
 
 fn try_run(after: &Measurement, before: Option<&Measurement>) -> Result<Diagnosis, DiagnoseError> {
     let input = DiagnoseInput {
+        angle: Default::default(),
         after,
         before,
         table: None,

@@ -242,6 +242,7 @@ impl RetestCase {
         let text = std::fs::read_to_string(&self.table).unwrap();
         let (_, table) = emit::read_any(&text, &table_options(), None).unwrap();
         diagnose(&DiagnoseInput {
+            angle: Default::default(),
             after: &after,
             before: Some(&before),
             table: Some(&table),
@@ -409,6 +410,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
         limits: &[],
         decision: Default::default(),
         standard: &ISO_230_2,
+        angle: Default::default(),
         generator: "test",
     };
     let charts = charts(&input);

@@ -194,6 +194,33 @@ fn missing_principal_angles_and_disagreeing_ends_are_said() {
         warnings.contains("0° and 360° are one physical position, but their mean deviations differ by 10.50″ (+0.50″ and +11.00″), more than the repeatability there (5.83″)"),
         "{warnings}"
     );
+    // The same with --angle-unit urad, × π/648000·10⁶ by hand: 10.5″ =
+    // 50.905 µrad, 0.5″ = 2.424, 11″ = 53.330, (2√2 + 3)″ = 28.257 µrad;
+    // on stderr and in the JSON alike.
+    let run = axcomp([
+        "evaluate".as_ref(),
+        "--json".as_ref(),
+        "--angle-unit".as_ref(),
+        "urad".as_ref(),
+        path.as_os_str(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let said = "differ by 50.91 µrad (+2.42 µrad and +53.33 µrad), more than the repeatability there (28.26 µrad)";
+    assert!(run.stderr.contains(said), "{}", run.stderr);
+    assert!(run.stdout.contains(said), "{}", run.stdout);
+    // And in the report's notes.
+    let html = directory.path().join("ends.html");
+    let run = axcomp([
+        "report".as_ref(),
+        path.as_os_str(),
+        "--angle-unit".as_ref(),
+        "urad".as_ref(),
+        "-o".as_ref(),
+        html.as_os_str(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains(said), "{}", run.stderr);
+    assert!(std::fs::read_to_string(&html).unwrap().contains(said));
 }
 
 #[test]
@@ -638,6 +665,26 @@ fn rotary_retest_files(
     (before_path, table_path, after_path)
 }
 
+/// `diagnose --quiet` of the re-test `files` (before, table, after) with
+/// `extra` flags; it must succeed.
+fn diagnose_retest(files: &(PathBuf, PathBuf, PathBuf), extra: &[&str]) -> crate::util::Run {
+    let (before, table, after) = files;
+    let mut args = vec![
+        "diagnose".as_ref(),
+        "--after".as_ref(),
+        after.as_os_str(),
+        "--before".as_ref(),
+        before.as_os_str(),
+        "--table".as_ref(),
+        table.as_os_str(),
+        "--quiet".as_ref(),
+    ];
+    args.extend(extra.iter().map(std::ffi::OsStr::new));
+    let run = axcomp(args);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    run
+}
+
 /// Every key of a JSON value, at every depth.
 fn keys_of(value: &serde_json::Value, keys: &mut Vec<String>) {
     match value {
@@ -668,25 +715,8 @@ fn diagnose_finds_a_per_revolution_harmonic_with_its_order() {
         (24, (3, 2.0, 0.0)),
     ] {
         let (order, amplitude_arcsec, _) = extra;
-        let (before, table, after) = rotary_retest_files(directory.path(), extra, seed);
-        let args = |json: bool| {
-            let mut args = vec![
-                "diagnose".as_ref(),
-                "--after".as_ref(),
-                after.as_os_str(),
-                "--before".as_ref(),
-                before.as_os_str(),
-                "--table".as_ref(),
-                table.as_os_str(),
-                "--quiet".as_ref(),
-            ];
-            if json {
-                args.push("--json".as_ref());
-            }
-            args
-        };
-        let run = axcomp(args(true));
-        assert_eq!(run.code, 0, "{}", run.stderr);
+        let files = rotary_retest_files(directory.path(), extra, seed);
+        let run = diagnose_retest(&files, &["--json"]);
         let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
         assert_eq!(json["axis_kind"], "rotary");
         let periodic: Vec<&serde_json::Value> = json["effects"]
@@ -738,8 +768,7 @@ fn diagnose_finds_a_per_revolution_harmonic_with_its_order() {
             "{rms} vs {expected}"
         );
 
-        let run = axcomp(args(false));
-        assert_eq!(run.code, 0, "{}", run.stderr);
+        let run = diagnose_retest(&files, &[]);
         assert!(
             run.stdout.contains(&format!("{order} per revolution")),
             "{}",
@@ -773,4 +802,214 @@ fn diagnose_of_a_rotary_axis_refuses_length_only_flags() {
         );
         assert!(!other.exists());
     }
+}
+
+/// µrad in one arc-second, from the definition (1″ = π/648000 rad), not
+/// from `axcomp::units`.
+const URAD_PER_ARCSEC: f64 = std::f64::consts::PI / 648_000.0 * 1e6;
+
+/// Walks the ″ object `arcsec` beside the µrad object `urad`: every key
+/// ending in `_arcsec` is there as `_urad` with every number in it (at any
+/// depth) the ″ number × [`URAD_PER_ARCSEC`] (within rounding), every
+/// other value the same. Returns how many numbers were compared scaled.
+fn assert_urad_beside_arcsec(
+    arcsec: &serde_json::Value,
+    urad: &serde_json::Value,
+    scaled: bool,
+    at: &str,
+) -> usize {
+    use serde_json::Value;
+    match (arcsec, urad) {
+        (Value::Object(a), Value::Object(u)) => {
+            assert_eq!(a.len(), u.len(), "{at}: {:?} vs {:?}", a.keys(), u.keys());
+            let mut count = 0;
+            for (key, value) in a {
+                let (key_urad, scaled) = match key.strip_suffix("_arcsec") {
+                    Some(stem) => (format!("{stem}_urad"), true),
+                    None => (key.clone(), scaled),
+                };
+                let other = u
+                    .get(&key_urad)
+                    .unwrap_or_else(|| panic!("{at}.{key_urad} missing"));
+                count += assert_urad_beside_arcsec(value, other, scaled, &format!("{at}.{key}"));
+            }
+            count
+        }
+        (Value::Array(a), Value::Array(u)) => {
+            assert_eq!(a.len(), u.len(), "{at}");
+            a.iter()
+                .zip(u)
+                .enumerate()
+                .map(|(i, (a, u))| assert_urad_beside_arcsec(a, u, scaled, &format!("{at}.{i}")))
+                .sum()
+        }
+        (Value::Number(a), Value::Number(u)) if scaled => {
+            let (a, u) = (a.as_f64().unwrap(), u.as_f64().unwrap());
+            let expected = a * URAD_PER_ARCSEC;
+            assert!(
+                (u - expected).abs() <= 1e-12 * expected.abs().max(1.0),
+                "{at}: {u} µrad ≠ {a}″ × {URAD_PER_ARCSEC} = {expected}"
+            );
+            1
+        }
+        // A sentence that says a deviation says it in the unit asked for.
+        (Value::String(a), Value::String(u)) if a != u => {
+            assert!(
+                a.contains('″') && !u.contains('″') && u.contains("µrad"),
+                "{at}: {a:?} vs {u:?}"
+            );
+            0
+        }
+        (a, u) => {
+            assert_eq!(a, u, "{at}");
+            0
+        }
+    }
+}
+
+/// `--angle-unit urad`: the rotary fixture's every deviation figure is the
+/// arc-second figure × π/648000·10⁶ (computed here, not by axcomp), every
+/// key that ends in `_arcsec` ends in `_urad` (and none in `_arcsec`), and
+/// the terminal says µrad. The default is still ″.
+#[test]
+fn evaluate_in_microradians_is_the_arcsec_report_times_the_factor() {
+    let file = "fixtures/rotary/c.csv";
+    let run = axcomp(["evaluate", "--json", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let arcsec: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let run = axcomp(["evaluate", "--json", "--angle-unit", "arcsec", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert_eq!(
+        serde_json::from_str::<serde_json::Value>(&run.stdout).unwrap(),
+        arcsec
+    );
+    let run = axcomp(["evaluate", "--json", "--angle-unit", "urad", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let urad: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let compared = assert_urad_beside_arcsec(&arcsec, &urad, false, "");
+    // 25 targets × 9 statistics, and the 12 ISO 230-2 figures at least.
+    assert!(compared >= 25 * 9 + 12, "{compared}");
+    let mut keys = Vec::new();
+    keys_of(&urad, &mut keys);
+    assert!(keys.iter().all(|k| !k.ends_with("_arcsec")), "{keys:?}");
+    assert!(keys.iter().any(|k| k == "figures_urad"), "{keys:?}");
+    assert!(keys.iter().any(|k| k == "mean_up_urad"), "{keys:?}");
+    // One figure by hand: E = 17.33″ in the golden file → µrad.
+    let e_arcsec = arcsec["figures_arcsec"]["E"].as_f64().unwrap();
+    let e_urad = urad["figures_urad"]["E"].as_f64().unwrap();
+    assert!((e_urad / e_arcsec - 4.848_136_811).abs() < 1e-8);
+
+    let run = axcomp(["evaluate", "--angle-unit", "urad", file]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains("Per target [µrad]"), "{}", run.stdout);
+    assert!(run.stdout.contains("Axis figures [µrad]"), "{}", run.stdout);
+    assert!(!run.stdout.contains('″'), "{}", run.stdout);
+}
+
+/// `report --angle-unit urad`: the tables, the rotary note and the plots'
+/// labels say µrad, the figures are the µrad JSON's, and no ″ is left in
+/// the deviation units.
+#[test]
+fn report_in_microradians() {
+    let directory = tempfile::tempdir().unwrap();
+    let html_path = directory.path().join("r.html");
+    let png = directory.path().join("png");
+    let run = axcomp([
+        "report".as_ref(),
+        "fixtures/rotary/c.csv".as_ref(),
+        "--angle-unit".as_ref(),
+        "urad".as_ref(),
+        "-o".as_ref(),
+        html_path.as_os_str(),
+        "--png".as_ref(),
+        png.as_os_str(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let html = std::fs::read_to_string(&html_path).unwrap();
+    for text in [
+        "ISO 230-2 figures [µrad]",
+        "Per target [µrad]",
+        "data-key=\"before.figures_urad.A\"",
+        "data-key=\"before.per_target.0.mean_up_urad\"",
+        "positional deviation [µrad]",
+        "in microradians",
+    ] {
+        assert!(html.contains(text), "{text}");
+    }
+    for text in ["figures_arcsec", "_arcsec\"", "[″]", "labelled with in ″"] {
+        assert!(!html.contains(text), "{text}");
+    }
+    // The figure A shown is the µrad figure of evaluate, to two decimals.
+    let run = axcomp([
+        "evaluate",
+        "--json",
+        "--angle-unit",
+        "urad",
+        "fixtures/rotary/c.csv",
+    ]);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let a_urad = json["figures_urad"]["A"].as_f64().unwrap();
+    assert!(
+        html.contains(&format!(
+            "data-key=\"before.figures_urad.A\" data-um=\"{a_urad}\">{a_urad:.2}<"
+        )),
+        "A = {a_urad}"
+    );
+    assert!(png.join("polar.png").exists());
+}
+
+/// `--angle-unit` cannot apply to a linear axis (its deviations are µm):
+/// `evaluate`, `report` and `diagnose` refuse it, exit 2, saying why.
+#[test]
+fn angle_unit_on_a_linear_axis_is_refused() {
+    let directory = tempfile::tempdir().unwrap();
+    let html = directory.path().join("r.html");
+    let linear = "fixtures/sample-x.rtl";
+    for args in [
+        vec!["evaluate", "--angle-unit", "urad", linear],
+        vec!["evaluate", "--json", "--angle-unit", "arcsec", linear],
+        vec![
+            "report",
+            linear,
+            "--angle-unit",
+            "urad",
+            "-o",
+            html.to_str().unwrap(),
+        ],
+        vec!["diagnose", "--after", linear, "--angle-unit", "urad"],
+    ] {
+        let run = axcomp(&args);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stdout);
+        assert!(
+            run.stderr.contains("--angle-unit") && run.stderr.contains("linear axis"),
+            "{args:?}: {}",
+            run.stderr
+        );
+        assert!(run.stdout.is_empty(), "{args:?}");
+    }
+    assert!(!html.exists());
+    let run = axcomp(["evaluate", "--angle-unit", "mrad", "fixtures/rotary/c.csv"]);
+    assert_eq!(run.code, 2);
+    assert!(run.stderr.contains("arcsec, urad"), "{}", run.stderr);
+}
+
+/// `diagnose --angle-unit urad` on a rotary re-test: the same diagnosis,
+/// every `_arcsec` key `_urad` with its value × π/648000·10⁶, µrad in the terminal.
+#[test]
+fn diagnose_in_microradians() {
+    let directory = tempfile::tempdir().unwrap();
+    let files = rotary_retest_files(directory.path(), (2, 3.0, 0.3), 31);
+    let json_in = |unit: &str| -> serde_json::Value {
+        let run = diagnose_retest(&files, &["--json", "--angle-unit", unit]);
+        serde_json::from_str(&run.stdout).unwrap()
+    };
+    let (arcsec, urad) = (json_in("arcsec"), json_in("urad"));
+    let compared = assert_urad_beside_arcsec(&arcsec, &urad, false, "");
+    assert!(compared > 10, "{compared}");
+    let mut keys = Vec::new();
+    keys_of(&urad, &mut keys);
+    assert!(keys.iter().all(|k| !k.contains("arcsec")), "{keys:?}");
+    let text = diagnose_retest(&files, &["--angle-unit", "urad"]).stdout;
+    assert!(text.contains("Figures [µrad]"), "{text}");
+    assert!(!text.contains('″'), "{text}");
 }
