@@ -9,8 +9,9 @@ mod cli;
 // 1.9 MB) spent a third of its time in the kernel faulting in fresh pages
 // for the file, the runs, the statistics and the printed table; mimalloc
 // reuses freed pages and asks for transparent huge pages, and evaluate of
-// that file takes a fifth less CPU time (README, Speed). ripgrep makes the
-// same choice (jemalloc) for the same reason.
+// that file took a fifth less CPU time on a quiet machine, less when huge
+// pages are scarce (README, Speed). ripgrep likewise replaces the allocator
+// where the system's is slow (jemalloc, in its musl builds).
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
