@@ -13,7 +13,7 @@ use unicode_width::UnicodeWidthStr;
 
 use crate::evaluate::standard::vdi_figure_name;
 use crate::report::format::{NOT_EVALUATED, inch_beside, push_integer, push_um, um};
-use crate::report::json::{EvaluationJson, StartEndJson};
+use crate::report::json::{EvaluationJson, PerTargetJson, StartEndJson};
 
 /// Renders the whole evaluation report.
 pub fn evaluation_report(report: &EvaluationJson) -> String {
@@ -149,9 +149,19 @@ fn environment_line(r: &EvaluationJson) -> String {
     }
 }
 
+/// The per-target table's columns.
+const PER_TARGET_COLUMNS: usize = 12;
+
+/// The per-target table as `tabled`'s `Style::psql()` with every column
+/// right-aligned draws it, byte for byte.
+///
+/// Drawn here rather than by `tabled::Table`, which keeps every cell as a
+/// `String` with its own layout state (for a 10 000-target test that was a
+/// third of `evaluate`'s time); `tabled::tables::IterTable`, which streams,
+/// has no header rule. The small tables keep `tabled`.
 fn per_target_table(out: &mut String, r: &EvaluationJson) {
     let target_header = format!("target [{}]", r.position_unit().trim_start());
-    let header: [&str; 12] = [
+    let header: [&str; PER_TARGET_COLUMNS] = [
         &target_header,
         "n↑",
         "n↓",
@@ -165,109 +175,119 @@ fn per_target_table(out: &mut String, r: &EvaluationJson) {
         "R_i↓",
         "R_i",
     ];
-    // Every cell's text in one buffer and each cell's length: a 10 000-target
-    // test has 120 000 cells, and a `String` each was most of the time
-    // `evaluate` took to print it. A cell is one number's text, a few hundred
-    // bytes at most, so its length fits a `u32` (half the memory of a `usize`).
-    let mut text = String::with_capacity(r.per_target.len() * 80);
-    let mut lengths: Vec<u32> = Vec::with_capacity(r.per_target.len() * header.len());
-    let mut cell_start = 0;
-    let mut end_cell = |text: &String| {
-        lengths.push((text.len() - cell_start) as u32);
-        cell_start = text.len();
-    };
-    for t in &r.per_target {
-        let _ = write!(text, "{}", t.target_mm);
-        end_cell(&text);
-        push_integer(&mut text, t.n_up as u64);
-        end_cell(&text);
-        push_integer(&mut text, t.n_down as u64);
-        end_cell(&text);
-        for value in [
-            t.mean_up_um,
-            t.mean_down_um,
-            t.mean_um,
-            t.s_up_um,
-            t.s_down_um,
-            t.B_um,
-            t.R_up_um,
-            t.R_down_um,
-            t.R_um,
-        ] {
-            push_um(&mut text, value);
-            end_cell(&text);
-        }
-    }
-    let rows = lengths
-        .chunks_exact(header.len())
-        .scan(0, |offset: &mut usize, row_lengths| {
-            Some(std::array::from_fn(|column| {
-                let start = *offset;
-                *offset += row_lengths[column] as usize;
-                &text[start..*offset]
-            }))
-        });
-    psql_right_aligned(out, header, rows);
-}
-
-/// The rows as `tabled`'s `Style::psql()` with every column right-aligned
-/// draws them, byte for byte, without a grid of owned cells.
-///
-/// `tabled::Table` keeps every cell as a `String` with its own layout
-/// state; for a 10 000-target test that was a third of `evaluate`'s time,
-/// and `tabled::tables::IterTable`, which streams, has no header rule. The
-/// small tables keep `tabled`.
-fn psql_right_aligned<'a, const N: usize>(
-    out: &mut String,
-    header: [&'a str; N],
-    rows: impl Iterator<Item = [&'a str; N]> + Clone,
-) {
-    fn width(cell: &str) -> usize {
-        if cell.is_ascii() {
-            cell.len()
-        } else {
-            UnicodeWidthStr::width(cell)
-        }
-    }
-    let mut widths = header.map(width);
-    let mut count = 0;
-    for row in rows.clone() {
-        count += 1;
-        for (column, cell) in row.iter().enumerate() {
-            widths[column] = widths[column].max(width(cell));
-        }
+    let cells = TableCells::of(&r.per_target);
+    let mut widths = header.map(cell_width);
+    for (width, widest) in widths.iter_mut().zip(cells.widths) {
+        *width = (*width).max(widest);
     }
     let line_width: usize = widths.iter().map(|w| w + 3).sum();
     // Room for the table and what follows it (the figures are a few lines).
-    out.reserve((count + 2) * (line_width + 8));
-    const SPACES: &str = "                                ";
-    let push_row = |out: &mut String, row: &[&str; N]| {
-        for (column, cell) in row.iter().enumerate() {
-            if column > 0 {
-                out.push('|');
-            }
-            out.push(' ');
-            let mut padding = widths[column] - width(cell);
-            while padding > 0 {
-                let spaces = padding.min(SPACES.len());
-                out.push_str(&SPACES[..spaces]);
-                padding -= spaces;
-            }
-            out.push_str(cell);
-            out.push(' ');
-        }
-    };
-    push_row(out, &header);
+    out.reserve((r.per_target.len() + 2) * (line_width + 8));
+    push_psql_row(out, &widths, &header);
     out.push('\n');
-    for (column, w) in widths.iter().enumerate() {
+    for (column, width) in widths.iter().enumerate() {
         if column > 0 {
             out.push('+');
         }
-        out.extend(std::iter::repeat_n('-', w + 2));
+        out.extend(std::iter::repeat_n('-', width + 2));
     }
-    for row in rows {
-        out.push('\n');
-        push_row(out, &row);
+    cells.push_rows(out, &widths);
+}
+
+/// The per-target table's rows, formatted: every cell's text in one buffer
+/// and each cell's length (a `String` per cell was most of the time a large
+/// table took; a cell is one number's text, a few hundred bytes at most, so
+/// its length fits a `u32`), and the widest cell of each column, found as
+/// the cells are made.
+struct TableCells {
+    text: String,
+    lengths: Vec<u32>,
+    widths: [usize; PER_TARGET_COLUMNS],
+}
+
+impl TableCells {
+    fn of(rows: &[PerTargetJson]) -> TableCells {
+        let mut text = String::with_capacity(rows.len() * 80);
+        let mut lengths: Vec<u32> = Vec::with_capacity(rows.len() * PER_TARGET_COLUMNS);
+        let mut widths = [0; PER_TARGET_COLUMNS];
+        let mut cell_start = 0;
+        let mut column = 0;
+        let mut end_cell = |text: &String| {
+            let cell = &text[cell_start..];
+            widths[column] = widths[column].max(cell_width(cell));
+            lengths.push(cell.len() as u32);
+            cell_start = text.len();
+            column = (column + 1) % PER_TARGET_COLUMNS;
+        };
+        for t in rows {
+            let _ = write!(text, "{}", t.target_mm);
+            end_cell(&text);
+            push_integer(&mut text, t.n_up as u64);
+            end_cell(&text);
+            push_integer(&mut text, t.n_down as u64);
+            end_cell(&text);
+            for value in [
+                t.mean_up_um,
+                t.mean_down_um,
+                t.mean_um,
+                t.s_up_um,
+                t.s_down_um,
+                t.B_um,
+                t.R_up_um,
+                t.R_down_um,
+                t.R_um,
+            ] {
+                push_um(&mut text, value);
+                end_cell(&text);
+            }
+        }
+        TableCells {
+            text,
+            lengths,
+            widths,
+        }
+    }
+
+    /// Each row after a line break.
+    fn push_rows(&self, out: &mut String, widths: &[usize; PER_TARGET_COLUMNS]) {
+        let mut offset = 0;
+        for row_lengths in self.lengths.chunks_exact(PER_TARGET_COLUMNS) {
+            let row: [&str; PER_TARGET_COLUMNS] = std::array::from_fn(|column| {
+                let start = offset;
+                offset += row_lengths[column] as usize;
+                &self.text[start..offset]
+            });
+            out.push('\n');
+            push_psql_row(out, widths, &row);
+        }
+    }
+}
+
+/// The columns a cell takes in a terminal.
+fn cell_width(cell: &str) -> usize {
+    if cell.is_ascii() {
+        cell.len()
+    } else {
+        UnicodeWidthStr::width(cell)
+    }
+}
+
+/// One row as `Style::psql()` draws it, every cell right-aligned in its column.
+fn push_psql_row<const N: usize>(out: &mut String, widths: &[usize; N], row: &[&str; N]) {
+    const SPACES: &str = "                                ";
+    for (column, cell) in row.iter().enumerate() {
+        if column > 0 {
+            out.push('|');
+        }
+        out.push(' ');
+        let mut padding = widths[column] - cell_width(cell);
+        while padding > 0 {
+            let spaces = padding.min(SPACES.len());
+            out.push_str(&SPACES[..spaces]);
+            padding -= spaces;
+        }
+        out.push_str(cell);
+        out.push(' ');
     }
 }
 
