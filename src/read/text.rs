@@ -69,28 +69,62 @@ impl<'a> Line<'a> {
 }
 
 /// Splits text into numbered lines, accepting LF and CRLF line ends.
-pub fn lines(text: &str) -> impl Iterator<Item = Line<'_>> {
-    // The pieces of `split('\n')`, found with a plain byte search: lines are
-    // short, and the string searcher's set-up costs more than the search.
-    let mut rest = Some(text);
-    std::iter::from_fn(move || {
-        let current = rest?;
-        match current.bytes().position(|b| b == b'\n') {
+pub fn lines(text: &str) -> Lines<'_> {
+    Lines {
+        rest: Some(text),
+        number: 1,
+    }
+}
+
+/// The numbered lines of a text ([`lines`]): the pieces of `split('\n')`,
+/// each without its `\r`.
+#[derive(Clone, Debug)]
+pub struct Lines<'a> {
+    /// The text from the next line on; `None` after the last line.
+    rest: Option<&'a str>,
+    /// The next line's number.
+    number: usize,
+}
+
+impl<'a> Lines<'a> {
+    /// Goes on at `rest`, which is the text from the start of line `number`
+    /// on, and ends with the text (a reader that read some lines another way).
+    pub fn resume_at(&mut self, rest: &'a str, number: usize) {
+        self.rest = Some(rest);
+        self.number = number;
+    }
+
+    /// The text of the lines not taken yet and the next line's number
+    /// (for [`Lines::resume_at`]); `None` after the last line.
+    pub fn remaining(&self) -> Option<(&'a str, usize)> {
+        Some((self.rest?, self.number))
+    }
+}
+
+impl<'a> Iterator for Lines<'a> {
+    type Item = Line<'a>;
+
+    fn next(&mut self) -> Option<Line<'a>> {
+        let current = self.rest?;
+        // A plain byte search: lines are short, and the string searcher's
+        // set-up costs more than the search.
+        let raw = match current.bytes().position(|b| b == b'\n') {
             Some(end) => {
-                rest = Some(&current[end + 1..]);
-                Some(&current[..end])
+                self.rest = Some(&current[end + 1..]);
+                &current[..end]
             }
             None => {
-                rest = None;
-                Some(current)
+                self.rest = None;
+                current
             }
-        }
-    })
-    .enumerate()
-    .map(|(index, raw)| Line {
-        number: index + 1,
-        text: raw.strip_suffix('\r').unwrap_or(raw),
-    })
+        };
+        let line = Line {
+            number: self.number,
+            text: raw.strip_suffix('\r').unwrap_or(raw),
+        };
+        self.number += 1;
+        Some(line)
+    }
 }
 
 /// The line just past the end of the text, for "expected …, found end of file".
@@ -185,7 +219,7 @@ pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseErro
 /// point) (exact up to 10^22) is one correctly rounded division of two exact
 /// values, which is the correctly rounded decimal, as the standard parser
 /// gives (Clinger's fast path). A large file has a hundred thousand readings.
-fn short_decimal(token: &str) -> Option<f64> {
+pub(crate) fn short_decimal(token: &str) -> Option<f64> {
     const MAX_DIGITS: usize = 15;
     const POWERS_OF_TEN: [f64; MAX_DIGITS + 1] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,

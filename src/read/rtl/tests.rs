@@ -418,3 +418,78 @@ proptest! {
         let _ = parse(&text);
     }
 }
+
+/// The row [`PlainRow`] and `text::number` read from the first line of
+/// `text`: what [`SimpleRow`] must give (or nothing, leaving the line to them).
+fn as_plain_row(text: &str) -> Option<(usize, u64, u64, u64)> {
+    let line = text.split('\n').next()?;
+    let line = line.strip_suffix('\r').unwrap_or(line);
+    let row = PlainRow::of(line)?;
+    let located = Line {
+        number: 1,
+        text: line,
+    };
+    let value = text::number(&located, row.value, "deviation in µm").ok()?;
+    Some((
+        row.run_offset,
+        row.file_run,
+        row.target_number,
+        value.to_bits(),
+    ))
+}
+
+fn as_simple_row(text: &str) -> Option<((usize, u64, u64, u64), usize)> {
+    let (row, length) = SimpleRow::of(text)?;
+    let fields = (
+        row.run_offset,
+        row.file_run,
+        row.target_number,
+        row.deviation_um.to_bits(),
+    );
+    Some((fields, length))
+}
+
+#[test]
+fn simple_rows_are_plain_rows_with_their_line_end() {
+    let simple = [
+        ("1   2      1.270\r\nnext", 18),
+        ("  12\t3 -0.125 \n", 15),
+        ("1 1 +.5\n", 8),
+        ("1 1 5.\r\n", 8),
+        ("1 1 123456789012345\n", 20),
+    ];
+    for (text, length) in simple {
+        let (fields, read) = as_simple_row(text).unwrap_or_else(|| panic!("{text:?}"));
+        assert_eq!(read, length, "{text:?}");
+        assert_eq!(Some(fields), as_plain_row(text), "{text:?}");
+    }
+    // Left to the line-by-line reading: no line end, an exponent, 16 digits,
+    // a field too many, a stray carriage return, a sign inside, no value.
+    for text in [
+        "1 1 1.5",
+        "1 1 1e-3\n",
+        "1 1 1234567890123456\n",
+        "1 1 1.5 2\n",
+        "1 1 1.5\r\r\n",
+        "1 1 1-5\n",
+        "1 1 .\n",
+        "1 1\n",
+        "11.5\n",
+        "1 1234567890123456789 1\n",
+    ] {
+        assert_eq!(as_simple_row(text), None, "{text:?}");
+    }
+}
+
+proptest! {
+    #[test]
+    fn a_simple_row_reads_as_the_plain_row_reading_does(
+        text in "[ \t]{0,2}[0-9]{1,3}[ \t]{0,2}[0-9]{1,20}[ \t]{0,2}[-+]?[0-9.]{0,17}[eE]?[0-9]{0,2}[ \t]{0,2}\r?\r?\n?x"
+    ) {
+        if let Some((fields, length)) = as_simple_row(&text) {
+            prop_assert_eq!(Some(fields), as_plain_row(&text));
+            prop_assert_eq!(text[..length].matches('\n').count(), 1);
+            prop_assert!(text[..length].ends_with('\n'));
+        }
+    }
+}
