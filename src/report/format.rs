@@ -51,23 +51,72 @@ pub fn push_um(out: &mut String, value: Option<f64>) {
 fn push_two_decimals(out: &mut String, value: f64) {
     use std::fmt::Write;
     let scaled = value * 100.0;
-    let rounded = scaled.round();
-    let clear_of_a_tie = 0.5 - (scaled - rounded).abs() > 1e-6;
-    if scaled.abs() < 1e9 && clear_of_a_tie && rounded != 0.0 {
-        // |rounded| < 1e9, so the cast is exact.
-        let hundredths = rounded as i64;
-        if hundredths < 0 {
-            out.push('-');
+    if scaled.abs() < 1e9 {
+        // Rounded half away from zero by truncation, not by `f64::round`,
+        // a library call: whenever the check below passes, the result is
+        // the integer nearest `scaled`, which is what `round` gives.
+        let hundredths = (scaled + 0.5f64.copysign(scaled)) as i64;
+        let clear_of_a_tie = 0.5 - (scaled - hundredths as f64).abs() > 1e-6;
+        if clear_of_a_tie && hundredths != 0 {
+            if hundredths < 0 {
+                out.push('-');
+            }
+            let hundredths = hundredths.unsigned_abs();
+            push_integer(out, hundredths / 100);
+            out.push('.');
+            push_digits(out, hundredths % 100, 2);
+            return;
         }
-        let hundredths = hundredths.unsigned_abs();
-        push_integer(out, hundredths / 100);
-        let cents = hundredths % 100;
-        out.push('.');
-        out.push(char::from(b'0' + (cents / 10) as u8));
-        out.push(char::from(b'0' + (cents % 10) as u8));
-        return;
     }
     let _ = write!(out, "{value:.2}");
+}
+
+/// Appends `format!("{value}")` to `out` (the shortest text that reads back
+/// to `value`), the same text, faster for a value with at most six decimals
+/// below 10⁹ in size, as targets are.
+///
+/// The shortest text of such a value is `units / 10^k` with the least k
+/// whose text reads back to it: below 10⁹ a float's neighbours are closer
+/// than 10⁻⁶, so at most one k-decimal text reads back to it, and one with
+/// fewer digits would have fewer decimals. `units / 10^k` in floating point
+/// is what reading that text gives (both exact below 2⁵³, one rounding).
+/// Anything else, and ±0, goes to the standard formatter.
+pub fn push_shortest(out: &mut String, value: f64) {
+    use std::fmt::Write;
+    const POWERS_OF_TEN: [f64; 7] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6];
+    if value != 0.0 && value.abs() < 1e9 {
+        for (decimals, scale) in POWERS_OF_TEN.iter().enumerate() {
+            let scaled = value * scale;
+            let units = (scaled + 0.5f64.copysign(scaled)) as i64;
+            if units as f64 / scale == value {
+                if units < 0 {
+                    out.push('-');
+                }
+                let units = units.unsigned_abs();
+                let scale = 10u64.pow(decimals as u32);
+                push_integer(out, units / scale);
+                if decimals > 0 {
+                    out.push('.');
+                    push_digits(out, units % scale, decimals);
+                }
+                return;
+            }
+        }
+    }
+    let _ = write!(out, "{value}");
+}
+
+/// Appends the last `count` decimal digits of `value`, with leading zeros.
+fn push_digits(out: &mut String, value: u64, count: usize) {
+    let mut digits = [b'0'; 20];
+    let mut rest = value;
+    for digit in digits[..count].iter_mut().rev() {
+        *digit = b'0' + (rest % 10) as u8;
+        rest /= 10;
+    }
+    for &digit in &digits[..count] {
+        out.push(char::from(digit));
+    }
 }
 
 /// A length in an inch file's own unit, ` (… in)`, beside the mm; empty for mm files.
@@ -181,6 +230,7 @@ fn escape_into<W: fmt::Write>(mut dest: W, text: &str) -> fmt::Result {
 
 /// Appends the decimal digits of `value` (what `{}` writes, without the
 /// formatting machinery: the large per-target table writes 120 000 numbers).
+#[inline]
 pub fn push_integer(out: &mut String, value: u64) {
     let mut digits = [0u8; 20];
     let mut start = digits.len();
@@ -250,6 +300,27 @@ mod tests {
         assert_eq!(um(Some(-0.004)), "0.00");
         assert_eq!(um(Some(-1.236)), "-1.24");
         assert_eq!(um(None), NOT_EVALUATED);
+        for value in [
+            0.0,
+            -0.0,
+            0.1,
+            -0.1,
+            999.9,
+            0.3,
+            1e-7,
+            123456.789012,
+            999999999.9,
+            1e9,
+            5e-324,
+            1.0,
+            -2.5,
+            0.000001,
+            0.0000015,
+        ] {
+            let mut text = String::new();
+            push_shortest(&mut text, value);
+            assert_eq!(text, format!("{value}"), "{value:e}");
+        }
         for value in [0, 7, 10, 99, 100, 12345, u64::MAX] {
             let mut text = String::new();
             push_integer(&mut text, value);
@@ -261,6 +332,16 @@ mod tests {
         #[test]
         fn two_decimals_match_the_standard_formatter(value in -1e8f64..1e8) {
             prop_assert_eq!(fast(value), standard(value));
+        }
+
+        #[test]
+        fn shortest_matches_the_standard_formatter(units in -1_000_000_000_000_000i64..1_000_000_000_000_000, decimals in 0..9u32, any in proptest::num::f64::ANY) {
+            // Decimals as targets are written, and any float at all.
+            for value in [units as f64 / 10f64.powi(decimals as i32), any] {
+                let mut text = String::new();
+                push_shortest(&mut text, value);
+                prop_assert_eq!(text, format!("{value}"));
+            }
         }
 
         #[test]

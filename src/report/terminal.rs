@@ -12,7 +12,7 @@ use tabled::settings::{Alignment, Style};
 use unicode_width::UnicodeWidthStr;
 
 use crate::evaluate::standard::vdi_figure_name;
-use crate::report::format::{NOT_EVALUATED, inch_beside, push_integer, push_um, um};
+use crate::report::format::{NOT_EVALUATED, inch_beside, push_integer, push_shortest, push_um, um};
 use crate::report::json::{EvaluationJson, PerTargetJson, StartEndJson};
 
 /// Renders the whole evaluation report.
@@ -220,7 +220,7 @@ impl TableCells {
             column = (column + 1) % PER_TARGET_COLUMNS;
         };
         for t in rows {
-            let _ = write!(text, "{}", t.target_mm);
+            push_shortest(&mut text, t.target_mm);
             end_cell(&text);
             push_integer(&mut text, t.n_up as u64);
             end_cell(&text);
