@@ -15,9 +15,16 @@ pub const NOT_EVALUATED: &str = "—";
 
 /// Formats an optional µm value with two decimals, or `—`.
 pub fn um(value: Option<f64>) -> String {
-    let mut text = String::new();
+    let mut text = Vec::new();
     push_um(&mut text, value);
-    text
+    text_of(text)
+}
+
+/// The text of bytes the `push_` functions wrote (always UTF-8: digits,
+/// signs, points and [`NOT_EVALUATED`]).
+pub fn text_of(bytes: Vec<u8>) -> String {
+    String::from_utf8(bytes)
+        .unwrap_or_else(|error| String::from_utf8_lossy(error.as_bytes()).into_owned())
 }
 
 /// `name` padded with spaces to `width` columns as a terminal shows it
@@ -31,12 +38,14 @@ pub fn pad_name(name: &str, width: usize) -> String {
 }
 
 /// Appends [`um`]'s text to `out`, without a `String` of its own (a large
-/// test's per-target table has a hundred thousand of these).
-pub fn push_um(out: &mut String, value: Option<f64>) {
+/// test's per-target table has a hundred thousand of these). The `push_`
+/// functions write bytes: a byte is pushed without the character encoding
+/// a `String` push goes through ([`text_of`] makes the text).
+pub fn push_um(out: &mut Vec<u8>, value: Option<f64>) {
     match value {
-        None => out.push_str(NOT_EVALUATED),
+        None => out.extend_from_slice(NOT_EVALUATED.as_bytes()),
         // −0.004 µm is 0.00, not "-0.00".
-        Some(v) if v.abs() < 0.005 => out.push_str("0.00"),
+        Some(v) if v.abs() < 0.005 => out.extend_from_slice(b"0.00"),
         Some(v) => push_two_decimals(out, v),
     }
 }
@@ -48,8 +57,8 @@ pub fn push_um(out: &mut String, value: Option<f64>) {
 /// integer gives the same digits whenever the product is not within its own
 /// rounding error (under 1e-7 for |value| < 1e7) of a half: there the
 /// standard formatter decides.
-fn push_two_decimals(out: &mut String, value: f64) {
-    use std::fmt::Write;
+fn push_two_decimals(out: &mut Vec<u8>, value: f64) {
+    use std::io::Write;
     let scaled = value * 100.0;
     if scaled.abs() < 1e9 {
         // Rounded half away from zero by truncation, not by `f64::round`,
@@ -59,11 +68,11 @@ fn push_two_decimals(out: &mut String, value: f64) {
         let clear_of_a_tie = 0.5 - (scaled - hundredths as f64).abs() > 1e-6;
         if clear_of_a_tie && hundredths != 0 {
             if hundredths < 0 {
-                out.push('-');
+                out.push(b'-');
             }
             let hundredths = hundredths.unsigned_abs();
             push_integer(out, hundredths / 100);
-            out.push('.');
+            out.push(b'.');
             push_digits(out, hundredths % 100, 2);
             return;
         }
@@ -81,8 +90,8 @@ fn push_two_decimals(out: &mut String, value: f64) {
 /// fewer digits would have fewer decimals. `units / 10^k` in floating point
 /// is what reading that text gives (both exact below 2⁵³, one rounding).
 /// Anything else, and ±0, goes to the standard formatter.
-pub fn push_shortest(out: &mut String, value: f64) {
-    use std::fmt::Write;
+pub fn push_shortest(out: &mut Vec<u8>, value: f64) {
+    use std::io::Write;
     const POWERS_OF_TEN: [f64; 7] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6];
     if value != 0.0 && value.abs() < 1e9 {
         for (decimals, scale) in POWERS_OF_TEN.iter().enumerate() {
@@ -90,13 +99,13 @@ pub fn push_shortest(out: &mut String, value: f64) {
             let units = (scaled + 0.5f64.copysign(scaled)) as i64;
             if units as f64 / scale == value {
                 if units < 0 {
-                    out.push('-');
+                    out.push(b'-');
                 }
                 let units = units.unsigned_abs();
                 let scale = 10u64.pow(decimals as u32);
                 push_integer(out, units / scale);
                 if decimals > 0 {
-                    out.push('.');
+                    out.push(b'.');
                     push_digits(out, units % scale, decimals);
                 }
                 return;
@@ -107,16 +116,14 @@ pub fn push_shortest(out: &mut String, value: f64) {
 }
 
 /// Appends the last `count` decimal digits of `value`, with leading zeros.
-fn push_digits(out: &mut String, value: u64, count: usize) {
+fn push_digits(out: &mut Vec<u8>, value: u64, count: usize) {
     let mut digits = [b'0'; 20];
     let mut rest = value;
     for digit in digits[..count].iter_mut().rev() {
         *digit = b'0' + (rest % 10) as u8;
         rest /= 10;
     }
-    for &digit in &digits[..count] {
-        out.push(char::from(digit));
-    }
+    out.extend_from_slice(&digits[..count]);
 }
 
 /// A length in an inch file's own unit, ` (… in)`, beside the mm; empty for mm files.
@@ -231,7 +238,7 @@ fn escape_into<W: fmt::Write>(mut dest: W, text: &str) -> fmt::Result {
 /// Appends the decimal digits of `value` (what `{}` writes, without the
 /// formatting machinery: the large per-target table writes 120 000 numbers).
 #[inline]
-pub fn push_integer(out: &mut String, value: u64) {
+pub fn push_integer(out: &mut Vec<u8>, value: u64) {
     let mut digits = [0u8; 20];
     let mut start = digits.len();
     let mut rest = value;
@@ -243,9 +250,7 @@ pub fn push_integer(out: &mut String, value: u64) {
             break;
         }
     }
-    for &digit in &digits[start..] {
-        out.push(char::from(digit));
-    }
+    out.extend_from_slice(&digits[start..]);
 }
 
 #[cfg(test)]
@@ -259,9 +264,9 @@ mod tests {
     }
 
     fn fast(value: f64) -> String {
-        let mut text = String::new();
+        let mut text = Vec::new();
         push_two_decimals(&mut text, value);
-        text
+        text_of(text)
     }
 
     #[test]
@@ -317,14 +322,14 @@ mod tests {
             0.000001,
             0.0000015,
         ] {
-            let mut text = String::new();
+            let mut text = Vec::new();
             push_shortest(&mut text, value);
-            assert_eq!(text, format!("{value}"), "{value:e}");
+            assert_eq!(text_of(text), format!("{value}"), "{value:e}");
         }
         for value in [0, 7, 10, 99, 100, 12345, u64::MAX] {
-            let mut text = String::new();
+            let mut text = Vec::new();
             push_integer(&mut text, value);
-            assert_eq!(text, value.to_string());
+            assert_eq!(text_of(text), value.to_string());
         }
     }
 
@@ -338,9 +343,9 @@ mod tests {
         fn shortest_matches_the_standard_formatter(units in -1_000_000_000_000_000i64..1_000_000_000_000_000, decimals in 0..9u32, any in proptest::num::f64::ANY) {
             // Decimals as targets are written, and any float at all.
             for value in [units as f64 / 10f64.powi(decimals as i32), any] {
-                let mut text = String::new();
+                let mut text = Vec::new();
                 push_shortest(&mut text, value);
-                prop_assert_eq!(text, format!("{value}"));
+                prop_assert_eq!(text_of(text), format!("{value}"));
             }
         }
 

@@ -12,7 +12,9 @@ use tabled::settings::{Alignment, Style};
 use unicode_width::UnicodeWidthStr;
 
 use crate::evaluate::standard::vdi_figure_name;
-use crate::report::format::{NOT_EVALUATED, inch_beside, push_integer, push_shortest, push_um, um};
+use crate::report::format::{
+    NOT_EVALUATED, inch_beside, push_integer, push_shortest, push_um, text_of, um,
+};
 use crate::report::json::{EvaluationJson, PerTargetJson, StartEndJson};
 
 /// Renders the whole evaluation report.
@@ -181,17 +183,24 @@ fn per_target_table(out: &mut String, r: &EvaluationJson) {
         *width = (*width).max(widest);
     }
     let line_width: usize = widths.iter().map(|w| w + 3).sum();
-    // Room for the table and what follows it (the figures are a few lines).
-    out.reserve((r.per_target.len() + 2) * (line_width + 8));
-    push_psql_row(out, &widths, &header);
-    out.push('\n');
+    // Written as bytes into the report's own buffer (a byte is pushed
+    // without the encoding a `String` push goes through), which is text again after.
+    let mut table = std::mem::take(out).into_bytes();
+    table.reserve((r.per_target.len() + 2) * (line_width + 8));
+    push_psql_row(
+        &mut table,
+        &widths,
+        header.map(|cell| (cell.as_bytes(), cell_width(cell))),
+    );
+    table.push(b'\n');
     for (column, width) in widths.iter().enumerate() {
         if column > 0 {
-            out.push('+');
+            table.push(b'+');
         }
-        out.extend(std::iter::repeat_n('-', width + 2));
+        table.extend(std::iter::repeat_n(b'-', width + 2));
     }
-    cells.push_rows(out, &widths);
+    cells.push_rows(&mut table, &widths);
+    *out = text_of(table);
 }
 
 /// The per-target table's rows, formatted: every cell's text in one buffer
@@ -200,21 +209,21 @@ fn per_target_table(out: &mut String, r: &EvaluationJson) {
 /// its length fits a `u32`), and the widest cell of each column, found as
 /// the cells are made.
 struct TableCells {
-    text: String,
+    text: Vec<u8>,
     lengths: Vec<u32>,
     widths: [usize; PER_TARGET_COLUMNS],
 }
 
 impl TableCells {
     fn of(rows: &[PerTargetJson]) -> TableCells {
-        let mut text = String::with_capacity(rows.len() * 80);
+        let mut text = Vec::with_capacity(rows.len() * 80);
         let mut lengths: Vec<u32> = Vec::with_capacity(rows.len() * PER_TARGET_COLUMNS);
         let mut widths = [0; PER_TARGET_COLUMNS];
         let mut cell_start = 0;
         let mut column = 0;
-        let mut end_cell = |text: &String| {
+        let mut end_cell = |text: &Vec<u8>| {
             let cell = &text[cell_start..];
-            widths[column] = widths[column].max(cell_width(cell));
+            widths[column] = widths[column].max(data_cell_width(cell));
             lengths.push(cell.len() as u32);
             cell_start = text.len();
             column = (column + 1) % PER_TARGET_COLUMNS;
@@ -249,17 +258,28 @@ impl TableCells {
     }
 
     /// Each row after a line break.
-    fn push_rows(&self, out: &mut String, widths: &[usize; PER_TARGET_COLUMNS]) {
+    fn push_rows(&self, out: &mut Vec<u8>, widths: &[usize; PER_TARGET_COLUMNS]) {
         let mut offset = 0;
-        for row_lengths in self.lengths.chunks_exact(PER_TARGET_COLUMNS) {
-            let row: [&str; PER_TARGET_COLUMNS] = std::array::from_fn(|column| {
-                let start = offset;
-                offset += row_lengths[column] as usize;
-                &self.text[start..offset]
+        let (rows, _) = self.lengths.as_chunks::<PER_TARGET_COLUMNS>();
+        for row_lengths in rows {
+            out.push(b'\n');
+            let row = row_lengths.map(|length| {
+                let cell = &self.text[offset..offset + length as usize];
+                offset += length as usize;
+                (cell, data_cell_width(cell))
             });
-            out.push('\n');
-            push_psql_row(out, widths, &row);
+            push_psql_row(out, widths, row);
         }
+    }
+}
+
+/// The columns a data cell takes: every one is ASCII (a number) but
+/// [`NOT_EVALUATED`], which takes one.
+fn data_cell_width(cell: &[u8]) -> usize {
+    if cell == NOT_EVALUATED.as_bytes() {
+        1
+    } else {
+        cell.len()
     }
 }
 
@@ -272,22 +292,17 @@ fn cell_width(cell: &str) -> usize {
     }
 }
 
-/// One row as `Style::psql()` draws it, every cell right-aligned in its column.
-fn push_psql_row<const N: usize>(out: &mut String, widths: &[usize; N], row: &[&str; N]) {
-    const SPACES: &str = "                                ";
-    for (column, cell) in row.iter().enumerate() {
+/// One row as `Style::psql()` draws it, every cell (its text and the
+/// columns it takes) right-aligned in its column.
+fn push_psql_row<const N: usize>(out: &mut Vec<u8>, widths: &[usize; N], row: [(&[u8], usize); N]) {
+    for (column, (cell, cell_width)) in row.into_iter().enumerate() {
         if column > 0 {
-            out.push('|');
+            out.push(b'|');
         }
-        out.push(' ');
-        let mut padding = widths[column] - cell_width(cell);
-        while padding > 0 {
-            let spaces = padding.min(SPACES.len());
-            out.push_str(&SPACES[..spaces]);
-            padding -= spaces;
-        }
-        out.push_str(cell);
-        out.push(' ');
+        out.push(b' ');
+        out.extend(std::iter::repeat_n(b' ', widths[column] - cell_width));
+        out.extend_from_slice(cell);
+        out.push(b' ');
     }
 }
 
