@@ -25,6 +25,7 @@
 //! Deviations in the file are µm, actual minus target; targets are mm.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 
 /// The `Owner` value taken to mark a rotary (XR20) test. No rotary `.rtl`
 /// sample is public (`../shared/spec/standards.md` §6), so this is the one
@@ -475,21 +476,25 @@ impl RtlParser {
         }
         for token in values.split_whitespace() {
             let value = text::number(line, token, "target position in mm")?;
-            check_target_mm(value, line.number, line.column_of(token))?;
             let column = line.column_of(token);
+            check_target_mm(value, line.number, column)?;
             let key = (value + 0.0).to_bits();
-            if let Some(&index) = self.target_lookup.get(&key) {
-                let first = self.targets[index];
-                return Err(ParseError::new(
-                    line.number,
-                    column,
-                    format!(
-                        "duplicate target {value} mm (first listed at line {}, column {})",
-                        first.line, first.column
-                    ),
-                ));
+            match self.target_lookup.entry(key) {
+                Entry::Occupied(first) => {
+                    let first = self.targets[*first.get()];
+                    return Err(ParseError::new(
+                        line.number,
+                        column,
+                        format!(
+                            "duplicate target {value} mm (first listed at line {}, column {})",
+                            first.line, first.column
+                        ),
+                    ));
+                }
+                Entry::Vacant(slot) => {
+                    slot.insert(self.targets.len());
+                }
             }
-            self.target_lookup.insert(key, self.targets.len());
             self.targets.push(Located {
                 value,
                 line: line.number,

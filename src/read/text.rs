@@ -268,10 +268,16 @@ pub const MAX_TARGET_MM: f64 = 100_000.0;
 
 /// Refuses a deviation (already in mm) that is not finite or beyond
 /// [`MAX_DEVIATION_MM`], at the given line and column.
+#[inline]
 pub fn check_deviation_mm(value_mm: f64, line: usize, column: usize) -> Result<f64, ParseError> {
     if value_mm.abs() <= MAX_DEVIATION_MM {
         return Ok(value_mm);
     }
+    deviation_beyond_bound(value_mm, line, column)
+}
+
+#[cold]
+fn deviation_beyond_bound(value_mm: f64, line: usize, column: usize) -> Result<f64, ParseError> {
     // In µm, as deviations are read, unless that overflows (a value near f64::MAX in mm).
     let found = if mm_to_um(value_mm).is_finite() {
         format!("{} µm", shown(mm_to_um(value_mm)))
