@@ -460,7 +460,9 @@ pub fn print_warnings_in(warnings: &[Warning], quiet: bool, angle: AngleUnit) {
 
 /// Prints one JSON object, pretty, to stdout.
 pub fn print_json(value: &impl Serialize) -> Result<()> {
-    let mut stdout = std::io::stdout().lock();
+    // Buffered: stdout flushes at every line end, and pretty JSON is a line
+    // per value (a 10 000-target test's object took 150 000 writes, 70 ms).
+    let mut stdout = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
     serde_json::to_writer_pretty(&mut stdout, value)?;
     writeln!(stdout)?;
     stdout.flush()?;
