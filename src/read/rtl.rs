@@ -998,6 +998,61 @@ fn row_fields<'a>(line: &Line<'a>) -> [Option<&'a str>; 4] {
     }
 }
 
+/// The start of a deviation row, `run target ` with blanks (spaces or
+/// tabs) before and between: where each part is, up to the value.
+struct RowStart {
+    /// Byte offset of the run number.
+    run_offset: usize,
+    file_run: u64,
+    target_number: u64,
+    /// Byte offset of the value's first byte.
+    value_at: usize,
+}
+
+impl RowStart {
+    /// The start of the row `bytes` begins with, or `None`: no blank
+    /// between the fields, a run or target number missing or too long to
+    /// be exact. Reads up to the first byte of the value (a line end ends
+    /// nothing here: it is not a digit and not a blank).
+    fn of(bytes: &[u8]) -> Option<RowStart> {
+        // Up to 18 digits: every such number fits a u64.
+        let digits = |from: usize| -> Option<(u64, usize)> {
+            let mut number = 0u64;
+            let mut at = from;
+            while let Some(&b) = bytes.get(at).filter(|b| b.is_ascii_digit()) {
+                number = number * 10 + u64::from(b - b'0');
+                at += 1;
+                if at - from > 18 {
+                    return None;
+                }
+            }
+            (at > from).then_some((number, at))
+        };
+        let run_offset = skip_blanks(bytes, 0);
+        let (file_run, after_run) = digits(run_offset)?;
+        let target_at = skip_blanks(bytes, after_run);
+        let (target_number, after_target) = digits(target_at)?;
+        let value_at = skip_blanks(bytes, after_target);
+        if target_at == after_run || value_at == after_target {
+            return None;
+        }
+        Some(RowStart {
+            run_offset,
+            file_run,
+            target_number,
+            value_at,
+        })
+    }
+}
+
+/// The first byte from `at` on that is not a blank (space or tab).
+fn skip_blanks(bytes: &[u8], mut at: usize) -> usize {
+    while bytes.get(at).is_some_and(|&b| b == b' ' || b == b'\t') {
+        at += 1;
+    }
+    at
+}
+
 /// A deviation row in its common form, `run target value` separated by
 /// spaces or tabs, read in one pass over its bytes.
 struct PlainRow<'a> {
@@ -1014,35 +1069,8 @@ impl<'a> PlainRow<'a> {
     /// run or target number too long to be exact, fewer or more fields.
     fn of(text: &'a str) -> Option<PlainRow<'a>> {
         let bytes = text.as_bytes();
-        let blank = |b: u8| b == b' ' || b == b'\t';
-        let skip_blanks = |from: usize| {
-            from + bytes[from..]
-                .iter()
-                .position(|&b| !blank(b))
-                .unwrap_or(bytes.len() - from)
-        };
-        // Up to 18 digits: every such number fits a u64.
-        let digits = |from: usize| -> Option<(u64, usize)> {
-            let count = bytes[from..]
-                .iter()
-                .position(|b| !b.is_ascii_digit())
-                .unwrap_or(bytes.len() - from);
-            if count == 0 || count > 18 {
-                return None;
-            }
-            let number = bytes[from..from + count]
-                .iter()
-                .fold(0u64, |number, &b| number * 10 + u64::from(b - b'0'));
-            Some((number, from + count))
-        };
-        let run_offset = skip_blanks(0);
-        let (file_run, after_run) = digits(run_offset)?;
-        let target_at = skip_blanks(after_run);
-        let (target_number, after_target) = digits(target_at)?;
-        let value_at = skip_blanks(after_target);
-        if target_at == after_run || value_at == after_target {
-            return None;
-        }
+        let start = RowStart::of(bytes)?;
+        let value_at = start.value_at;
         let value_end = value_at
             + bytes[value_at..]
                 .iter()
@@ -1050,13 +1078,13 @@ impl<'a> PlainRow<'a> {
                     !(b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E'))
                 })
                 .unwrap_or(bytes.len() - value_at);
-        if value_end == value_at || skip_blanks(value_end) != bytes.len() {
+        if value_end == value_at || skip_blanks(bytes, value_end) != bytes.len() {
             return None;
         }
         Some(PlainRow {
-            run_offset,
-            file_run,
-            target_number,
+            run_offset: start.run_offset,
+            file_run: start.file_run,
+            target_number: start.target_number,
             value: &text[value_at..value_end],
         })
     }
@@ -1081,51 +1109,24 @@ impl SimpleRow {
     /// `None` when the first line of `text` is not a simple row.
     fn of(text: &str) -> Option<(SimpleRow, usize)> {
         let bytes = text.as_bytes();
-        let blank = |b: u8| b == b' ' || b == b'\t';
-        let skip_blanks = |mut at: usize| {
-            while bytes.get(at).is_some_and(|&b| blank(b)) {
-                at += 1;
-            }
-            at
-        };
-        // Up to 18 digits: every such number fits a u64 (as `PlainRow`).
-        let digits = |from: usize| -> Option<(u64, usize)> {
-            let mut number = 0u64;
-            let mut at = from;
-            while let Some(&b) = bytes.get(at).filter(|b| b.is_ascii_digit()) {
-                number = number * 10 + u64::from(b - b'0');
-                at += 1;
-                if at - from > 18 {
-                    return None;
-                }
-            }
-            (at > from).then_some((number, at))
-        };
-        let run_offset = skip_blanks(0);
-        let (file_run, after_run) = digits(run_offset)?;
-        let target_at = skip_blanks(after_run);
-        let (target_number, after_target) = digits(target_at)?;
-        let value_at = skip_blanks(after_target);
-        if target_at == after_run || value_at == after_target {
-            return None;
-        }
-        let mut value_end = value_at;
+        let start = RowStart::of(bytes)?;
+        let mut value_end = start.value_at;
         while bytes
             .get(value_end)
             .is_some_and(|&b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+'))
         {
             value_end += 1;
         }
-        let deviation_um = text::short_decimal(&text[value_at..value_end])?;
-        let mut end = skip_blanks(value_end);
+        let deviation_um = text::short_decimal(&text[start.value_at..value_end])?;
+        let mut end = skip_blanks(bytes, value_end);
         if bytes.get(end) == Some(&b'\r') {
             end += 1;
         }
         (bytes.get(end) == Some(&b'\n')).then_some((
             SimpleRow {
-                run_offset,
-                file_run,
-                target_number,
+                run_offset: start.run_offset,
+                file_run: start.file_run,
+                target_number: start.target_number,
                 deviation_um,
             },
             end + 1,
