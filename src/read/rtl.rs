@@ -639,11 +639,7 @@ impl RtlParser {
         let Some(row) = PlainRow::of(line.text) else {
             return false;
         };
-        if row.file_run == 0
-            || row.file_run > u64::from(run_count.value)
-            || row.target_number == 0
-            || row.target_number > self.targets.len() as u64
-        {
+        if !self.names_a_listed_pair(run_count, row.file_run, row.target_number) {
             return false;
         }
         let Ok(deviation_um) = text::number(line, row.value, "deviation in µm") else {
@@ -662,6 +658,19 @@ impl RtlParser {
         )
     }
 
+    /// Whether a row's run and target numbers are within `Run-count` and
+    /// the targets listed (a row outside is left to `deviation_line`, which
+    /// says which number is out of range).
+    fn names_a_listed_pair(
+        &self,
+        run_count: Located<u32>,
+        file_run: u64,
+        target_number: u64,
+    ) -> bool {
+        (1..=u64::from(run_count.value)).contains(&file_run)
+            && (1..=self.targets.len() as u64).contains(&target_number)
+    }
+
     /// Reads the rows at the start of `text` (from line `number` on) that
     /// are [`SimpleRow`]s and records them, up to the first line that is not
     /// one or that `record_row` does not take; returns the text from that
@@ -675,10 +684,8 @@ impl RtlParser {
         let Some(run_count) = self.run_count else {
             return (text, number);
         };
-        let target_count = self.targets.len() as u64;
         while let Some((row, length)) = SimpleRow::of(text) {
-            let in_range = (1..=u64::from(run_count.value)).contains(&row.file_run)
-                && (1..=target_count).contains(&row.target_number);
+            let in_range = self.names_a_listed_pair(run_count, row.file_run, row.target_number);
             let Some(deviation_mm) = in_range
                 .then(|| check_deviation_mm(um_to_mm(row.deviation_um), 0, 0).ok())
                 .flatten()
