@@ -1021,24 +1021,12 @@ impl RowStart {
     /// between the fields, a run or target number missing or too long to
     /// be exact. Reads up to the first byte of the value (a line end ends
     /// nothing here: it is not a digit and not a blank).
+    #[inline]
     fn of(bytes: &[u8]) -> Option<RowStart> {
-        // Up to 18 digits: every such number fits a u64.
-        let digits = |from: usize| -> Option<(u64, usize)> {
-            let mut number = 0u64;
-            let mut at = from;
-            while let Some(&b) = bytes.get(at).filter(|b| b.is_ascii_digit()) {
-                number = number * 10 + u64::from(b - b'0');
-                at += 1;
-                if at - from > 18 {
-                    return None;
-                }
-            }
-            (at > from).then_some((number, at))
-        };
         let run_offset = skip_blanks(bytes, 0);
-        let (file_run, after_run) = digits(run_offset)?;
+        let (file_run, after_run) = digits_at(bytes, run_offset)?;
         let target_at = skip_blanks(bytes, after_run);
-        let (target_number, after_target) = digits(target_at)?;
+        let (target_number, after_target) = digits_at(bytes, target_at)?;
         let value_at = skip_blanks(bytes, after_target);
         if target_at == after_run || value_at == after_target {
             return None;
@@ -1052,7 +1040,24 @@ impl RowStart {
     }
 }
 
+/// The number of the digits at `bytes[from..]` and the offset after them,
+/// or `None`: no digit, or more than 18 (every such number fits a u64).
+#[inline]
+fn digits_at(bytes: &[u8], from: usize) -> Option<(u64, usize)> {
+    let mut number = 0u64;
+    let mut at = from;
+    while let Some(&b) = bytes.get(at).filter(|b| b.is_ascii_digit()) {
+        number = number * 10 + u64::from(b - b'0');
+        at += 1;
+        if at - from > 18 {
+            return None;
+        }
+    }
+    (at > from).then_some((number, at))
+}
+
 /// The first byte from `at` on that is not a blank (space or tab).
+#[inline]
 fn skip_blanks(bytes: &[u8], mut at: usize) -> usize {
     while bytes.get(at).is_some_and(|&b| b == b' ' || b == b'\t') {
         at += 1;
@@ -1114,17 +1119,11 @@ struct SimpleRow {
 impl SimpleRow {
     /// The row at the start of `text` and its length with its line end, or
     /// `None` when the first line of `text` is not a simple row.
+    #[inline]
     fn of(text: &str) -> Option<(SimpleRow, usize)> {
         let bytes = text.as_bytes();
         let start = RowStart::of(bytes)?;
-        let mut value_end = start.value_at;
-        while bytes
-            .get(value_end)
-            .is_some_and(|&b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+'))
-        {
-            value_end += 1;
-        }
-        let deviation_um = text::short_decimal(&text[start.value_at..value_end])?;
+        let (deviation_um, value_end) = text::short_decimal_at(bytes, start.value_at)?;
         let mut end = skip_blanks(bytes, value_end);
         if bytes.get(end) == Some(&b'\r') {
             end += 1;

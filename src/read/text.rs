@@ -220,36 +220,52 @@ pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseErro
 /// values, which is the correctly rounded decimal, as the standard parser
 /// gives (Clinger's fast path). A large file has a hundred thousand readings.
 pub(crate) fn short_decimal(token: &str) -> Option<f64> {
+    match short_decimal_at(token.as_bytes(), 0)? {
+        (value, end) if end == token.len() => Some(value),
+        _ => None,
+    }
+}
+
+/// [`short_decimal`] of the token at `bytes[at..]`, the longest run of
+/// digits, points and signs there, and the offset just after it; `None`
+/// when that token is not a short decimal. One pass over the token, for
+/// the rows of a large file (`read::rtl`'s `SimpleRow`).
+#[inline]
+pub(crate) fn short_decimal_at(bytes: &[u8], mut at: usize) -> Option<(f64, usize)> {
     const MAX_DIGITS: usize = 15;
     const POWERS_OF_TEN: [f64; MAX_DIGITS + 1] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
     ];
-    let (negative, unsigned) = match token.as_bytes() {
-        [b'-', rest @ ..] => (true, rest),
-        [b'+', rest @ ..] => (false, rest),
-        all => (false, all),
-    };
+    let negative = bytes.get(at) == Some(&b'-');
+    if matches!(bytes.get(at), Some(b'-' | b'+')) {
+        at += 1;
+    }
     let mut digits: u64 = 0;
     let mut digit_count = 0;
-    let mut after_point: Option<usize> = None;
-    for &byte in unsigned {
-        match byte {
-            b'0'..=b'9' if digit_count < MAX_DIGITS => {
+    // The number of digits before the point, once there is one.
+    let mut point: Option<usize> = None;
+    loop {
+        match bytes.get(at) {
+            Some(&byte @ b'0'..=b'9') => {
+                if digit_count == MAX_DIGITS {
+                    return None;
+                }
                 digits = digits * 10 + u64::from(byte - b'0');
                 digit_count += 1;
-                if let Some(count) = &mut after_point {
-                    *count += 1;
-                }
             }
-            b'.' if after_point.is_none() => after_point = Some(0),
-            _ => return None,
+            Some(b'.') if point.is_none() => point = Some(digit_count),
+            // A second point or a sign inside the token.
+            Some(b'.' | b'+' | b'-') => return None,
+            _ => break,
         }
+        at += 1;
     }
     if digit_count == 0 {
         return None;
     }
-    let magnitude = digits as f64 / POWERS_OF_TEN[after_point.unwrap_or(0)];
-    Some(if negative { -magnitude } else { magnitude })
+    let decimals = point.map_or(0, |before| digit_count - before);
+    let magnitude = digits as f64 / POWERS_OF_TEN[decimals];
+    Some((if negative { -magnitude } else { magnitude }, at))
 }
 
 /// Largest deviation accepted, mm, either sign: 1 m.
