@@ -67,13 +67,29 @@ fn push_two_decimals(out: &mut Vec<u8>, value: f64) {
         let hundredths = (scaled + 0.5f64.copysign(scaled)) as i64;
         let clear_of_a_tie = 0.5 - (scaled - hundredths as f64).abs() > 1e-6;
         if clear_of_a_tie && hundredths != 0 {
-            if hundredths < 0 {
-                out.push(b'-');
+            // Written backwards into a buffer and appended at once: a push
+            // per byte was most of the time a large table took. Below 10⁹
+            // hundredths: at most ten digits, the point and the sign.
+            let mut text = [0u8; 12];
+            let mut start = text.len();
+            let mut rest = hundredths.unsigned_abs();
+            // The two decimals, the point, then the units (at least one digit).
+            let mut written = 0;
+            while written < 3 || rest > 0 {
+                if written == 2 {
+                    start -= 1;
+                    text[start] = b'.';
+                }
+                start -= 1;
+                text[start] = b'0' + (rest % 10) as u8;
+                rest /= 10;
+                written += 1;
             }
-            let hundredths = hundredths.unsigned_abs();
-            push_integer(out, hundredths / 100);
-            out.push(b'.');
-            push_digits(out, hundredths % 100, 2);
+            if hundredths < 0 {
+                start -= 1;
+                text[start] = b'-';
+            }
+            out.extend_from_slice(&text[start..]);
             return;
         }
     }
