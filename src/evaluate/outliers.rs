@@ -53,49 +53,18 @@ pub fn suspected_outliers(measurement: &Measurement) -> Vec<SuspectedOutlier> {
 
 /// The score of every run in one direction (empty with fewer than 3 runs).
 pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<SuspectedOutlier> {
-    let runs: Vec<_> = measurement.runs_in(direction).collect();
+    let runs: Vec<&[Option<f64>]> = measurement
+        .runs_in(direction)
+        .map(|run| run.deviations_mm.as_slice())
+        .collect();
     if runs.len() < 3 {
         return Vec::new();
     }
     let targets = measurement.targets_mm();
-    // Per target: sum, sum of squares and count over all runs, so that the
-    // statistics without run j are a subtraction away.
-    let mut sum = vec![0.0; targets.len()];
-    let mut count = vec![0usize; targets.len()];
-    for run in &runs {
-        for (i, value) in run.deviations_mm.iter().enumerate() {
-            if let Some(v) = value {
-                sum[i] += v;
-                count[i] += 1;
-            }
-        }
-    }
+    let totals = TargetTotals::of(&runs, targets.len());
+    let pooled = pooled_squares(&runs, &totals);
     let mut scores = Vec::with_capacity(runs.len());
-    for (run_index, run) in runs.iter().enumerate() {
-        // The other runs' readings, in their order (sliced once: this loop
-        // visits every reading of every other run).
-        let other_runs: Vec<&[Option<f64>]> = runs
-            .iter()
-            .enumerate()
-            .filter(|(other_index, _)| *other_index != run_index)
-            .map(|(_, other)| other.deviations_mm.as_slice())
-            .collect();
-        // Pooled variance of the other runs, two-pass for accuracy.
-        let mut sum_sq = 0.0;
-        let mut degrees = 0usize;
-        for (i, own) in run.deviations_mm.iter().enumerate() {
-            let others = count[i] - usize::from(own.is_some());
-            if others < 2 {
-                continue;
-            }
-            let mean_others = (sum[i] - own.unwrap_or(0.0)) / others as f64;
-            for other in &other_runs {
-                if let Some(v) = other[i] {
-                    sum_sq += (v - mean_others) * (v - mean_others);
-                }
-            }
-            degrees += others - 1;
-        }
+    for ((j, run), (sum_sq, degrees)) in measurement.runs_in(direction).enumerate().zip(pooled) {
         if degrees == 0 || sum_sq <= 0.0 {
             continue;
         }
@@ -106,14 +75,14 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
             .map(|others| sigma * (1.0 + 1.0 / others as f64).sqrt())
             .collect();
         let mut worst: Option<(f64, usize, f64)> = None;
-        for (i, own) in run.deviations_mm.iter().enumerate() {
-            let (Some(own), others) = (own, count[i] - usize::from(own.is_some())) else {
+        for (i, own) in runs[j].iter().enumerate() {
+            let (Some(own), others) = (own, totals.others(i, own)) else {
                 continue;
             };
             if others < 2 {
                 continue;
             }
-            let offset = own - (sum[i] - own) / others as f64;
+            let offset = own - (totals.sum[i] - own) / others as f64;
             let z = offset.abs() / difference_sd[others];
             if worst.is_none_or(|(best, _, _)| z > best) {
                 worst = Some((z, i, offset));
@@ -130,6 +99,65 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
         }
     }
     scores
+}
+
+/// Per target, the sum and the number of the readings of all runs, so that
+/// the mean without one run is a subtraction away.
+struct TargetTotals {
+    sum: Vec<f64>,
+    count: Vec<usize>,
+}
+
+impl TargetTotals {
+    fn of(runs: &[&[Option<f64>]], targets: usize) -> TargetTotals {
+        let mut sum = vec![0.0; targets];
+        let mut count = vec![0usize; targets];
+        for run in runs {
+            for (i, value) in run.iter().enumerate() {
+                if let Some(v) = value {
+                    sum[i] += v;
+                    count[i] += 1;
+                }
+            }
+        }
+        TargetTotals { sum, count }
+    }
+
+    /// The number of readings at target `i` besides a run's `own`.
+    fn others(&self, i: usize, own: &Option<f64>) -> usize {
+        self.count[i] - usize::from(own.is_some())
+    }
+}
+
+/// Per run, the pooled squares of the other runs about their mean at each
+/// target (two-pass, for accuracy) and their degrees of freedom.
+///
+/// Every run's sums go over the targets, and at each over the other runs in
+/// order, as when one run is scored at a time (so to the bit the same
+/// figures); they are made side by side in one pass over the targets, as
+/// independent sums rather than one long chain of additions per run (a
+/// large test has ten thousand targets).
+fn pooled_squares(runs: &[&[Option<f64>]], totals: &TargetTotals) -> Vec<(f64, usize)> {
+    let mut pooled = vec![(0.0, 0usize); runs.len()];
+    for (i, sum) in totals.sum.iter().enumerate() {
+        for (j, (sum_sq, degrees)) in pooled.iter_mut().enumerate() {
+            let own = &runs[j][i];
+            let others = totals.others(i, own);
+            if others < 2 {
+                continue;
+            }
+            let mean_others = (sum - own.unwrap_or(0.0)) / others as f64;
+            for (k, other) in runs.iter().enumerate() {
+                if k != j
+                    && let Some(v) = other[i]
+                {
+                    *sum_sq += (v - mean_others) * (v - mean_others);
+                }
+            }
+            *degrees += others - 1;
+        }
+    }
+    pooled
 }
 
 #[cfg(test)]
@@ -194,6 +222,60 @@ mod tests {
         assert!(suspected_outliers(&clean).is_empty());
         let two = measurement(&[[0.0, 0.0, 0.0], [0.1, 0.1, 0.1]]);
         assert!(run_scores(&two, Direction::Up).is_empty());
+    }
+
+    /// The pooled squares as the method states them, one run at a time (as
+    /// `run_scores` first made them): what `pooled_squares` must give, to the bit.
+    fn pooled_squares_one_run_at_a_time(
+        runs: &[&[Option<f64>]],
+        totals: &TargetTotals,
+    ) -> Vec<(f64, usize)> {
+        let mut pooled = Vec::new();
+        for (j, run) in runs.iter().enumerate() {
+            let mut sum_sq = 0.0;
+            let mut degrees = 0usize;
+            for (i, own) in run.iter().enumerate() {
+                let others = totals.others(i, own);
+                if others < 2 {
+                    continue;
+                }
+                let mean_others = (totals.sum[i] - own.unwrap_or(0.0)) / others as f64;
+                let other_runs = runs.iter().enumerate().filter(|(k, _)| *k != j);
+                for v in other_runs.filter_map(|(_, other)| other[i]) {
+                    sum_sq += (v - mean_others) * (v - mean_others);
+                }
+                degrees += others - 1;
+            }
+            pooled.push((sum_sq, degrees));
+        }
+        pooled
+    }
+
+    proptest::proptest! {
+        /// Pooling every run's squares in one pass changes no bit: runs of
+        /// 3 to 6, readings missing here and there, an outlier or not.
+        #[test]
+        fn pooled_squares_are_those_of_one_run_at_a_time(
+            mut readings in proptest::collection::vec(
+                proptest::collection::vec(proptest::option::weighted(0.9, -0.01f64..0.01), 7),
+                3..7,
+            ),
+            outlier in proptest::option::of((0usize..6, 0usize..7, 0.01f64..0.1)),
+        ) {
+            if let Some((run, target, size)) = outlier {
+                let count = readings.len();
+                readings[run % count][target] = Some(size);
+            }
+            let runs: Vec<&[Option<f64>]> = readings.iter().map(Vec::as_slice).collect();
+            let totals = TargetTotals::of(&runs, 7);
+            let bits = |pooled: Vec<(f64, usize)>| -> Vec<(u64, usize)> {
+                pooled.into_iter().map(|(sum_sq, degrees)| (sum_sq.to_bits(), degrees)).collect()
+            };
+            proptest::prop_assert_eq!(
+                bits(pooled_squares(&runs, &totals)),
+                bits(pooled_squares_one_run_at_a_time(&runs, &totals))
+            );
+        }
     }
 
     #[test]
