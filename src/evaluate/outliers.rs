@@ -147,13 +147,17 @@ fn pooled_squares(runs: &[&[Option<f64>]], totals: &TargetTotals) -> Vec<(f64, u
                 continue;
             }
             let mean_others = (sum - own.unwrap_or(0.0)) / others as f64;
+            // Summed in a local: through `sum_sq` each addition waited for
+            // the store of the one before.
+            let mut squares = *sum_sq;
             for (k, other) in runs.iter().enumerate() {
                 if k != j
                     && let Some(v) = other[i]
                 {
-                    *sum_sq += (v - mean_others) * (v - mean_others);
+                    squares += (v - mean_others) * (v - mean_others);
                 }
             }
+            *sum_sq = squares;
             *degrees += others - 1;
         }
     }
