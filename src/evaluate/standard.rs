@@ -342,13 +342,16 @@ fn axis_figures(k: f64, per_target: &[TargetStats]) -> AxisFigures {
     let max_every = |value: fn(&TargetStats) -> Option<f64>| {
         bounds_every(per_target, |t| value(t).map(|v| (v, v))).map(|(_, high)| high)
     };
+    // Each found once (a pass over every target) and used twice.
+    let (bands_up, bands_down) = (bands(Direction::Up), bands(Direction::Down));
+    let (points_up, points_down) = (points(Direction::Up), points(Direction::Down));
     AxisFigures {
-        a_mm: union(bands(Direction::Up), bands(Direction::Down)).map(width),
-        a_up_mm: bands(Direction::Up).map(width),
-        a_down_mm: bands(Direction::Down).map(width),
-        e_mm: union(points(Direction::Up), points(Direction::Down)).map(width),
-        e_up_mm: points(Direction::Up).map(width),
-        e_down_mm: points(Direction::Down).map(width),
+        a_mm: union(bands_up, bands_down).map(width),
+        a_up_mm: bands_up.map(width),
+        a_down_mm: bands_down.map(width),
+        e_mm: union(points_up, points_down).map(width),
+        e_up_mm: points_up.map(width),
+        e_down_mm: points_down.map(width),
         m_mm: bounds_every(per_target, |t| t.mean_mm.map(|m| (m, m))).map(width),
         r_mm: max_every(|t| t.repeatability_mm),
         r_up_mm: max_every(|t| t.repeatability_up_mm),
