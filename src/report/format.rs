@@ -67,33 +67,44 @@ fn push_two_decimals(out: &mut Vec<u8>, value: f64) {
         let hundredths = (scaled + 0.5f64.copysign(scaled)) as i64;
         let clear_of_a_tie = 0.5 - (scaled - hundredths as f64).abs() > 1e-6;
         if clear_of_a_tie && hundredths != 0 {
-            // Written backwards into a buffer and appended at once: a push
-            // per byte was most of the time a large table took. Below 10⁹
-            // hundredths: at most ten digits, the point and the sign.
-            let mut text = [0u8; 12];
-            let mut start = text.len();
-            let mut rest = hundredths.unsigned_abs();
-            // The two decimals, the point, then the units (at least one digit).
-            let mut written = 0;
-            while written < 3 || rest > 0 {
-                if written == 2 {
-                    start -= 1;
-                    text[start] = b'.';
-                }
-                start -= 1;
-                text[start] = b'0' + (rest % 10) as u8;
+            // Made in a buffer and appended at once: a push per byte was
+            // most of the time a large table took. Below 10⁹ hundredths: at
+            // most seven digits of units, the sign, the point and two decimals.
+            let magnitude = hundredths.unsigned_abs();
+            let (units, cents) = (magnitude / 100, (magnitude % 100) as u8);
+            let mut digits = 1;
+            while units >= 10u64.pow(digits) {
+                digits += 1;
+            }
+            let sign = usize::from(hundredths < 0);
+            let point = sign + digits as usize;
+            let mut text = [b'-'; SHORT_TEXT];
+            let mut rest = units;
+            for digit in text[sign..point].iter_mut().rev() {
+                *digit = b'0' + (rest % 10) as u8;
                 rest /= 10;
-                written += 1;
             }
-            if hundredths < 0 {
-                start -= 1;
-                text[start] = b'-';
-            }
-            out.extend_from_slice(&text[start..]);
+            text[point..point + 3].copy_from_slice(&[b'.', b'0' + cents / 10, b'0' + cents % 10]);
+            push_short(out, &text, point + 3);
             return;
         }
     }
     let _ = write!(out, "{value:.2}");
+}
+
+/// The room of a short text made for [`push_short`]: a cell of the reports
+/// is at most this long in its common forms.
+pub const SHORT_TEXT: usize = 16;
+
+/// Appends the first `length` bytes of `text` (at most [`SHORT_TEXT`]) with
+/// one copy of a known size, then drops the rest: for a few bytes, the
+/// general copy of a length known only at run time cost more than the bytes.
+#[inline]
+pub fn push_short(out: &mut Vec<u8>, text: &[u8; SHORT_TEXT], length: usize) {
+    debug_assert!(length <= SHORT_TEXT);
+    let old = out.len();
+    out.extend_from_slice(text);
+    out.truncate(old + length);
 }
 
 /// Appends `format!("{value}")` to `out` (the shortest text that reads back

@@ -13,7 +13,8 @@ use unicode_width::UnicodeWidthStr;
 
 use crate::evaluate::standard::vdi_figure_name;
 use crate::report::format::{
-    NOT_EVALUATED, inch_beside, push_integer, push_shortest, push_um, text_of, um,
+    NOT_EVALUATED, SHORT_TEXT, inch_beside, push_integer, push_short, push_shortest, push_um,
+    text_of, um,
 };
 use crate::report::json::{EvaluationJson, PerTargetJson, StartEndJson};
 
@@ -190,7 +191,7 @@ fn per_target_table(out: &mut String, r: &EvaluationJson) {
     push_psql_row(
         &mut table,
         &widths,
-        header.map(|cell| (cell.as_bytes(), cell_width(cell))),
+        header.map(|cell| (cell.as_bytes(), cell.len(), cell_width(cell))),
     );
     table.push(b'\n');
     for (column, width) in widths.iter().enumerate() {
@@ -264,9 +265,13 @@ impl TableCells {
         for row_lengths in rows {
             out.push(b'\n');
             let row = row_lengths.map(|length| {
-                let cell = &self.text[offset..offset + length as usize];
-                offset += length as usize;
-                (cell, data_cell_width(cell))
+                let length = length as usize;
+                // The cell and what follows it, for one copy of a known size.
+                let end = (offset + SHORT_TEXT).min(self.text.len());
+                let window = &self.text[offset..end.max(offset + length)];
+                let cell = &window[..length];
+                offset += length;
+                (window, length, data_cell_width(cell))
             });
             push_psql_row(out, widths, row);
         }
@@ -292,16 +297,25 @@ fn cell_width(cell: &str) -> usize {
     }
 }
 
-/// One row as `Style::psql()` draws it, every cell (its text and the
-/// columns it takes) right-aligned in its column.
-fn push_psql_row<const N: usize>(out: &mut Vec<u8>, widths: &[usize; N], row: [(&[u8], usize); N]) {
-    for (column, (cell, cell_width)) in row.into_iter().enumerate() {
+/// One row as `Style::psql()` draws it, every cell right-aligned in its
+/// column. A cell is given as its text's first `length` bytes of `window`
+/// (which may go on past it, for a copy of a known size) and the columns it
+/// takes.
+fn push_psql_row<const N: usize>(
+    out: &mut Vec<u8>,
+    widths: &[usize; N],
+    row: [(&[u8], usize, usize); N],
+) {
+    for (column, (window, length, cell_width)) in row.into_iter().enumerate() {
         if column > 0 {
             out.push(b'|');
         }
         out.push(b' ');
         out.extend(std::iter::repeat_n(b' ', widths[column] - cell_width));
-        out.extend_from_slice(cell);
+        match window.first_chunk::<SHORT_TEXT>() {
+            Some(short) if length <= SHORT_TEXT => push_short(out, short, length),
+            _ => out.extend_from_slice(&window[..length]),
+        }
         out.push(b' ');
     }
 }
