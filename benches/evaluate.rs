@@ -17,8 +17,10 @@
 //!
 //! and time both commands as whole processes, paired, in turn (for example
 //! `/usr/bin/time -f '%e s %U+%S s'` on `axcomp evaluate /tmp/big.rtl -q` and
-//! on `python3 benches/reference/evaluate_rtl.py /tmp/big.rtl`, several runs
-//! each, medians). README, Speed, gives the last figures.
+//! on `/usr/bin/python3 benches/reference/evaluate_rtl.py /tmp/big.rtl`,
+//! several runs each, medians). Time the interpreter itself: a version
+//! manager's `python3` shim adds its own start (0.3 s on one machine) and
+//! flatters the ratio. README, Speed, gives the last figures.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
