@@ -136,13 +136,19 @@ impl TargetTotals {
 /// order, as when one run is scored at a time (so to the bit the same
 /// figures); they are made side by side in one pass over the targets, as
 /// independent sums rather than one long chain of additions per run (a
-/// large test has ten thousand targets).
+/// large test has ten thousand targets). Each target's readings are first
+/// copied into one small column, run by run: the sums then read it rather
+/// than a reading of every run's slice, checked against its length, for
+/// each pair of runs.
 fn pooled_squares(runs: &[&[Option<f64>]], totals: &TargetTotals) -> Vec<(f64, usize)> {
     let mut pooled = vec![(0.0, 0usize); runs.len()];
-    for (i, sum) in totals.sum.iter().enumerate() {
-        for (j, (sum_sq, degrees)) in pooled.iter_mut().enumerate() {
-            let own = &runs[j][i];
-            let others = totals.others(i, own);
+    let mut column: Vec<Option<f64>> = vec![None; runs.len()];
+    for (i, (sum, count)) in totals.sum.iter().zip(&totals.count).enumerate() {
+        for (reading, run) in column.iter_mut().zip(runs) {
+            *reading = run[i];
+        }
+        for (j, ((sum_sq, degrees), own)) in pooled.iter_mut().zip(&column).enumerate() {
+            let others = count - usize::from(own.is_some());
             if others < 2 {
                 continue;
             }
@@ -150,9 +156,9 @@ fn pooled_squares(runs: &[&[Option<f64>]], totals: &TargetTotals) -> Vec<(f64, u
             // Summed in a local: through `sum_sq` each addition waited for
             // the store of the one before.
             let mut squares = *sum_sq;
-            for (k, other) in runs.iter().enumerate() {
+            for (k, other) in column.iter().enumerate() {
                 if k != j
-                    && let Some(v) = other[i]
+                    && let Some(v) = other
                 {
                     squares += (v - mean_others) * (v - mean_others);
                 }
