@@ -143,12 +143,12 @@ impl TargetTotals {
 fn pooled_squares(runs: &[&[Option<f64>]], totals: &TargetTotals) -> Vec<(f64, usize)> {
     let mut pooled = vec![(0.0, 0usize); runs.len()];
     let mut column: Vec<Option<f64>> = vec![None; runs.len()];
-    for (i, (sum, count)) in totals.sum.iter().zip(&totals.count).enumerate() {
+    for (i, sum) in totals.sum.iter().enumerate() {
         for (reading, run) in column.iter_mut().zip(runs) {
             *reading = run[i];
         }
         for (j, ((sum_sq, degrees), own)) in pooled.iter_mut().zip(&column).enumerate() {
-            let others = count - usize::from(own.is_some());
+            let others = totals.others(i, own);
             if others < 2 {
                 continue;
             }
