@@ -71,7 +71,7 @@ fn push_two_decimals(out: &mut Vec<u8>, value: f64) {
             // most of the time a large table took. Below 10⁹ hundredths: at
             // most seven digits of units, the sign, the point and two decimals.
             let magnitude = hundredths.unsigned_abs();
-            let (units, cents) = (magnitude / 100, (magnitude % 100) as u8);
+            let (units, cents) = (magnitude / 100, magnitude % 100);
             let mut digits = 1;
             while units >= 10u64.pow(digits) {
                 digits += 1;
@@ -79,12 +79,9 @@ fn push_two_decimals(out: &mut Vec<u8>, value: f64) {
             let sign = usize::from(hundredths < 0);
             let point = sign + digits as usize;
             let mut text = [b'-'; SHORT_TEXT];
-            let mut rest = units;
-            for digit in text[sign..point].iter_mut().rev() {
-                *digit = b'0' + (rest % 10) as u8;
-                rest /= 10;
-            }
-            text[point..point + 3].copy_from_slice(&[b'.', b'0' + cents / 10, b'0' + cents % 10]);
+            write_digits(&mut text[sign..point], units);
+            text[point] = b'.';
+            write_digits(&mut text[point + 1..point + 3], cents);
             push_short(out, &text, point + 3);
             return;
         }
@@ -145,12 +142,18 @@ pub fn push_shortest(out: &mut Vec<u8>, value: f64) {
 /// Appends the last `count` decimal digits of `value`, with leading zeros.
 fn push_digits(out: &mut Vec<u8>, value: u64, count: usize) {
     let mut digits = [b'0'; 20];
+    write_digits(&mut digits[..count], value);
+    out.extend_from_slice(&digits[..count]);
+}
+
+/// Fills `slot` with the last `slot.len()` digits of `value`, zero-padded.
+#[inline]
+fn write_digits(slot: &mut [u8], value: u64) {
     let mut rest = value;
-    for digit in digits[..count].iter_mut().rev() {
+    for digit in slot.iter_mut().rev() {
         *digit = b'0' + (rest % 10) as u8;
         rest /= 10;
     }
-    out.extend_from_slice(&digits[..count]);
 }
 
 /// A length in an inch file's own unit, ` (… in)`, beside the mm; empty for mm files.
