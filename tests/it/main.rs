@@ -22,6 +22,7 @@ mod diagnose_periodic;
 mod evaluate_ecmc;
 mod fagor;
 mod flags;
+mod generated_docs;
 mod http;
 mod injected;
 mod model;
