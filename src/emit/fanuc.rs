@@ -230,11 +230,13 @@ impl ParameterBackup {
         })
     }
 
-    /// Bit `bit` of a bit parameter (`P00000010`: the first digit is bit 0).
+    /// Bit `bit` of a bit parameter: \[manual\] B-63950EN/02 p.8 and p.12,
+    /// whose examples read `P00000001` as bit 0 set and `P00001000` as bit 3
+    /// set: the last digit is bit 0 (as #7 … #0 on the screen).
     fn bit(&self, number: u32, index: Option<(char, usize)>, bit: usize) -> Result<bool, String> {
         let entry = self.value(number, index)?;
         let bits = entry.value.as_bytes();
-        match bits.get(bit) {
+        match bits.get(7usize.saturating_sub(bit)) {
             Some(b'0') if bits.len() == 8 => Ok(false),
             Some(b'1') if bits.len() == 8 => Ok(true),
             _ => Err(format!(
@@ -386,14 +388,15 @@ fn parameter_number<'a>(line: &Line<'a>, content: &'a str) -> Result<(u32, &'a s
     Ok((value, values))
 }
 
-/// The values of one parameter line: `P<value>` or `(A|L|S)<n>(P|M|I)<value>…`.
+/// The values of one parameter line: `P<value>` or `(A|L|S|T)<n>(P|M|I)<value>…`.
 fn parameter_values(line: &Line<'_>, mut rest: &str) -> Result<Vec<Entry>, ParseError> {
     let mut values = Vec::new();
     loop {
         let Some(first) = rest.chars().next() else {
             break;
         };
-        let index = if matches!(first, 'A' | 'L' | 'S') {
+        // [file] A<axis>, L<path>, S<spindle>, and T<n> on a few parameters.
+        let index = if first.is_ascii_uppercase() && !matches!(first, 'P' | 'M' | 'I') {
             let digits = &rest[1..];
             let end = digits
                 .find(|c: char| !c.is_ascii_digit())
@@ -446,6 +449,15 @@ pub fn looks_like(text: &str) -> bool {
                 && l.get(6..9) == Some("Q0P")
                 && l[1..6].bytes().all(|b| b.is_ascii_digit())
         })
+}
+
+/// Whether the text is a parameter backup: a `%` line, then `N<5 digits>Q1`.
+pub fn looks_like_parameters(text: &str) -> bool {
+    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+    lines.next() == Some("%")
+        && lines
+            .next()
+            .is_some_and(|l| l.starts_with('N') && l.get(6..8) == Some("Q1"))
 }
 
 /// One data line of a pitch file: its point, value and line.
@@ -570,6 +582,62 @@ pub fn read(input: &str, p: &AxisParameters) -> Result<CompensationTable, ParseE
         reference_mm: p.position(p.reference_point),
         suggested_backlash_mm: None,
     })
+}
+
+/// The control's points inside the measured range `first_mm ..= last_mm`:
+/// the first one's position and their count; refused when the reference
+/// point is not among them (the new compensation is zero there, which only
+/// a measurement across it can tell).
+pub fn points_in(p: &AxisParameters, first_mm: f64, last_mm: f64) -> Result<(f64, usize), String> {
+    let inside: Vec<i64> = (p.first_point()..=p.most_positive)
+        .filter(|n| {
+            let x = p.position(*n);
+            x >= first_mm - 1e-6 && x <= last_mm + 1e-6
+        })
+        .collect();
+    let reference = p.position(p.reference_point);
+    match (inside.first(), inside.last()) {
+        (Some(a), Some(b)) if (*a..=*b).contains(&p.reference_point) => {
+            Ok((p.position(*a), inside.len()))
+        }
+        _ => Err(format!(
+            "the reference point 3620 = {} of axis {} is at {reference} ({}), outside the measured range {first_mm} … {last_mm}: the Fanuc compensation is zero there, so the test must reach it",
+            p.reference_point, p.axis, p.source
+        )),
+    }
+}
+
+/// What to tell the user of a table written with `p`: a magnification too
+/// coarse for the error, with the one that would do (every point rescaled).
+pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
+    let Ok(p) = parameters_for(table, options) else {
+        return Vec::new();
+    };
+    let values = table
+        .values
+        .for_direction(crate::measurement::Direction::Up);
+    let (low, high) = values
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let range = high - low;
+    let largest_step = values
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
+    // The finest magnification whose points still hold every section's change.
+    let finest = ((largest_step / p.detection_unit / POINT_LIMIT as f64).ceil() as i64).max(1);
+    let mut notes = Vec::new();
+    if p.unit() > range / 10.0 && finest < p.magnification {
+        notes.push(format!(
+            "Fanuc: 3623 = {} gives steps of {} mm, coarse for an error of {} mm peak to valley; 3623 = {finest} would give {} mm steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data)",
+            p.magnification,
+            crate::emit::minimal(p.unit(), 7),
+            crate::emit::minimal(range, 4),
+            crate::emit::minimal(p.detection_unit * finest as f64, 7),
+            p.magnification
+        ));
+    }
+    notes
 }
 
 /// The parameters a table is written with: the backup's, or axcomp's

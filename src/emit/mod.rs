@@ -741,6 +741,12 @@ pub fn read_any(
             ));
         };
         (Controller::Fanuc, fanuc::read(text, parameters)?)
+    } else if fanuc::looks_like_parameters(text) {
+        return Err(ParseError::new(
+            1,
+            1,
+            "this is a Fanuc parameter backup (N…Q1 lines), not the pitch error compensation data: give it with --fanuc-parameters and the pitch file (PITCH.TXT, N1…Q0 lines) as the table",
+        ));
     } else if fagor8065::looks_like(text) {
         (Controller::Fagor8065, fagor8065::read(text, &axis.axis)?)
     } else if fagor8055::looks_like(text) {
