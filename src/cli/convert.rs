@@ -29,7 +29,7 @@ pub struct ConvertArgs {
     #[arg(required = true, num_args = 1..=2, value_name = "FILE")]
     pub files: Vec<PathBuf>,
 
-    /// The controller: itnc530, tnc640, sinumerik840d, linuxcnc, fagor8055 or fagor8065.
+    /// The controller: itnc530, tnc640, sinumerik840d, linuxcnc, fagor8055, fagor8065 or fanuc (with --fanuc-parameters: the control's points; --existing PITCH.TXT is updated in place).
     #[arg(long, value_name = "CONTROLLER", value_parser = parse_controller, help_heading = "Table")]
     pub controller: Controller,
 

@@ -46,6 +46,13 @@ pub const POINT_LIMIT: i64 = 127;
 /// Parameters": "maximum of 128 compensation points between extremes").
 pub const MAX_POINTS: usize = 128;
 
+/// The largest point a data number can name (N99999).
+const MAX_POINT: i64 = 99_999 - DATA_NUMBER_OFFSET;
+
+/// \[reconstructed\] The largest |value| a data line is read with: 8 digits,
+/// as the parameters' (no file holds more; the sums then never overflow).
+const READ_LIMIT: i64 = 99_999_999;
+
 /// The parameter backup of a Fanuc control (`CNC-PARA.TXT`): every
 /// parameter's values, with where they stand in the file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -344,7 +351,7 @@ fn check_parameters(p: &AxisParameters) -> Result<(), String> {
             p.magnification
         ));
     }
-    if !(p.interval > 0.0) {
+    if !(p.interval > 0.0 && p.interval.is_finite() && p.reference_position.is_finite()) {
         return Err(format!(
             "3624 of axis {axis} is {}: the interval must be > 0",
             p.interval
@@ -359,10 +366,10 @@ fn check_parameters(p: &AxisParameters) -> Result<(), String> {
             p.source
         ));
     }
-    if p.first_point() < 0 {
+    if p.first_point() < 0 || p.most_positive > MAX_POINT {
         return Err(format!(
-            "3621 of axis {axis} is {}: the points start at 0",
-            p.most_negative
+            "3621 … 3622 of axis {axis} are {} … {}: the points are 0 … {MAX_POINT} (data numbers N10000 … N99999)",
+            p.most_negative, p.most_positive
         ));
     }
     Ok(())
@@ -492,7 +499,9 @@ fn parse_pitch(input: &str) -> Result<(BTreeMap<i64, DataLine<'_>>, Line<'_>), P
         };
         let value: i64 = value_text
             .parse()
-            .map_err(|_| line.expected_at(value_text, "an integer value"))?;
+            .ok()
+            .filter(|v: &i64| v.abs() <= READ_LIMIT)
+            .ok_or_else(|| line.expected_at(value_text, "an integer value of at most 8 digits"))?;
         if number < DATA_NUMBER_OFFSET {
             return Err(line.error_at(
                 content,
@@ -726,7 +735,7 @@ fn new_increments(
                 p.axis, p.interval
             )));
         }
-        increments.insert(points[k], absolute[k] - absolute[k - 1]);
+        increments.insert(points[k], absolute[k].saturating_sub(absolute[k - 1]));
     }
     check_limits(&increments, p)?;
     Ok(increments)
@@ -734,13 +743,14 @@ fn new_increments(
 
 /// Refuses increments beyond a point's limit, naming the magnification that would hold them.
 fn check_limits(increments: &BTreeMap<i64, i64>, p: &AxisParameters) -> Result<(), EmitError> {
-    let Some((&point, &value)) = increments.iter().max_by_key(|(_, v)| v.abs()) else {
+    let Some((&point, &value)) = increments.iter().max_by_key(|(_, v)| v.unsigned_abs()) else {
         return Ok(());
     };
-    if value.abs() <= POINT_LIMIT {
+    if value.unsigned_abs() <= POINT_LIMIT as u64 {
         return Ok(());
     }
-    let needed = (value.abs() as f64 * p.magnification as f64 / POINT_LIMIT as f64).ceil() as i64;
+    let needed =
+        (value.unsigned_abs() as f64 * p.magnification as f64 / POINT_LIMIT as f64).ceil() as i64;
     Err(EmitError::Profile(format!(
         "point {point} of axis {} needs {value} × {} = {} mm, beyond ±{POINT_LIMIT} units a point holds (3623 = {}): set 3623 = {needed} (every point rescaled; units of {} mm) and convert again",
         p.axis,
@@ -933,6 +943,97 @@ mod tests {
         options.axes[0].fanuc = Some(manual_parameters());
         let written = write(&table, &options).unwrap();
         assert_eq!(written, text.replacen("%\n", "%\nN10032Q0P0\n", 1));
+    }
+
+    fn table(positions_mm: Vec<f64>, values: Vec<f64>) -> CompensationTable {
+        CompensationTable {
+            axis: "X".into(),
+            reference_mm: positions_mm[0],
+            positions_mm,
+            values: TableValues::Mean(values),
+            suggested_backlash_mm: None,
+        }
+    }
+
+    fn options_with(p: AxisParameters) -> EmitOptions {
+        let mut options = EmitOptions::for_axis(&Default::default(), "X", "").unwrap();
+        options.axes[0].fanuc = Some(p);
+        options
+    }
+
+    #[test]
+    fn the_worked_example() {
+        // formats/fanuc/README.md: 2.3 µm long at 100 mm, 1 µm units: the
+        // correction −2.3 µm rounds to −2 units at the point at 100 mm.
+        let t = table(vec![0.0, 100.0], vec![0.0, 0.0023]);
+        let p = AxisParameters::default_for("X", 2, 100.0, 0, 0.0);
+        assert_eq!(
+            write(&t, &options_with(p)).unwrap(),
+            "%\nN10000Q0P0\nN10001Q0P-2 \n%"
+        );
+    }
+
+    #[test]
+    fn a_point_beyond_its_limit_names_the_magnification_that_holds_it() {
+        // −0.2 mm over one section in 1 µm units: 200 > 127, 3623 = 2 holds it.
+        let t = table(vec![0.0, 100.0], vec![0.0, -0.2]);
+        let p = AxisParameters::default_for("X", 2, 100.0, 0, 0.0);
+        let error = write(&t, &options_with(p)).unwrap_err().to_string();
+        assert!(error.contains("needs 200"), "{error}");
+        assert!(error.contains("set 3623 = 2"), "{error}");
+    }
+
+    #[test]
+    fn a_coarse_magnification_is_said_with_the_finer_one() {
+        // Units of 0.001 mm × 10 = 0.01 mm for an error of 0.02 mm peak to
+        // valley; 3623 = 1 holds its 0.01 mm sections (10 units).
+        let t = table(vec![0.0, 100.0, 200.0], vec![0.0, 0.01, 0.02]);
+        let p = AxisParameters {
+            magnification: 10,
+            ..AxisParameters::default_for("X", 3, 100.0, 0, 0.0)
+        };
+        let notes = notes(&t, &options_with(p.clone()));
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].contains("3623 = 1 would give 0.001 mm steps"),
+            "{notes:?}"
+        );
+        let fine = AxisParameters {
+            magnification: 1,
+            ..p
+        };
+        assert!(super::notes(&t, &options_with(fine)).is_empty());
+    }
+
+    #[test]
+    fn a_rotary_reference_point_holds_the_last_points_value() {
+        // 0i-PB p.100: reference 1 = most negative 1, 90° apart, 3622 = 1 + 360/90.
+        let p = AxisParameters {
+            most_negative: 1,
+            most_positive: 5,
+            rotary: true,
+            ..AxisParameters::default_for("B", 5, 90.0, 1, 0.0)
+        };
+        // Errors in whole units of 0.001° (detection unit assumed, 3623 = 1).
+        let t = table(
+            vec![0.0, 90.0, 180.0, 270.0, 360.0],
+            vec![0.0, 0.002, 0.001, -0.003, 0.0],
+        );
+        let text = write(&t, &options_with(p.clone())).unwrap();
+        let values = increments_of(&text);
+        // Absolute corrections 0, −2, −1, 3, 0: increments −2, 1, 4, −3; the
+        // reference point 1 takes point 5's −3; they sum to 0 over the turn.
+        assert_eq!(
+            values,
+            vec![(0, 0), (1, -3), (2, -2), (3, 1), (4, 4), (5, -3)]
+        );
+        let back = read(&text, &p).unwrap();
+        assert_eq!(back.positions_mm.len(), 6);
+    }
+
+    fn increments_of(text: &str) -> Vec<(i64, i64)> {
+        let (data, _) = parse_pitch(text).unwrap();
+        data.iter().map(|(n, d)| (*n, d.value)).collect()
     }
 
     #[test]

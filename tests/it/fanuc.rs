@@ -15,6 +15,9 @@ use axcomp::measurement::Direction;
 
 use crate::util::{assert_golden, axcomp, root, shared_data};
 
+/// The golden files `golden_files_read_back` writes (`formats/fanuc/golden/`).
+pub const GOLDENS: &[&str] = &["synth-x-HM100TS.TXT", "sample-mean.TXT"];
+
 fn data(name: &str) -> String {
     shared_data(&format!("fanuc/HM100TS__{name}"))
         .display()
@@ -351,4 +354,45 @@ fn golden_files_read_back() {
     let (_, table) = emit::read_any(&written, &options, None).unwrap();
     assert_eq!(table.positions_mm.len(), count);
     assert_eq!(table.values.for_direction(Direction::Up)[0], 0.0);
+}
+
+/// What `fuzz/fuzz_targets/read_fanuc.rs` asks of any input, on the real
+/// files and the golden ones: no panic, and a pitch file that reads takes
+/// its own table back with `update` and reads back to the same points.
+#[test]
+fn the_fuzz_property_holds_on_the_real_files() {
+    let files = [
+        data("PITCH.TXT"),
+        data("CNC-PARA.TXT"),
+        data("SYS-CONF.TXT"),
+        root()
+            .join("formats/fanuc/golden/synth-x-HM100TS.TXT")
+            .display()
+            .to_string(),
+    ];
+    let parameters = AxisParameters {
+        most_negative: 1,
+        most_positive: 41,
+        ..AxisParameters::default_for("X", 42, 40.0, 40, 0.0)
+    };
+    let mut read_tables = 0;
+    for file in files {
+        let (text, _) = emit::decode_table(&std::fs::read(&file).unwrap()).unwrap();
+        if let Ok(backup) = ParameterBackup::parse(&text, "fuzz") {
+            for (_, name) in backup.axis_names() {
+                let _ = backup.axis(&name);
+            }
+        }
+        let Ok(table) = emit::fanuc::read(&text, &parameters) else {
+            continue;
+        };
+        read_tables += 1;
+        let mut options = EmitOptions::for_axis(&MachineProfile::default(), "X", "").unwrap();
+        options.axes[0].fanuc = Some(parameters.clone());
+        let updated = emit::fanuc::update(&text, &table, &options).unwrap();
+        assert_eq!(updated, text, "{file}: its own table changes nothing");
+        let back = emit::fanuc::read(&updated, &parameters).unwrap();
+        assert_eq!(back.positions_mm, table.positions_mm);
+    }
+    assert_eq!(read_tables, 2);
 }

@@ -351,7 +351,7 @@ fn bad_input_is_a_400_with_the_clis_position() {
         "/api/convert",
         Form::new()
             .file("file", "sample-x.rtl", &read(&sample()))
-            .text("controller", "fanuc"),
+            .text("controller", "mazak"),
         &[],
     );
     assert_eq!(answer.status, 400);
