@@ -396,3 +396,50 @@ fn the_fuzz_property_holds_on_the_real_files() {
     }
     assert_eq!(read_tables, 2);
 }
+
+/// The machine profile names the Fanuc control by its parameter backup
+/// (`controller.fanuc_parameters`): convert then uses its points without
+/// the flag.
+#[test]
+fn the_profile_names_the_fanuc_control() {
+    let directory = tempfile::tempdir().unwrap();
+    let path = |name: &str| directory.path().join(name).display().to_string();
+    ok(&["synth", "--truth", &truth(), "-o", &path("x.rtl")]);
+    std::fs::write(
+        path("hm100ts.toml"),
+        format!(
+            "[controller]\nfanuc_parameters = {:?}\n",
+            data("CNC-PARA.TXT")
+        ),
+    )
+    .unwrap();
+    let (rtl, profile, out) = (path("x.rtl"), path("hm100ts.toml"), path("PITCH.TXT"));
+    let args = [
+        "convert",
+        &rtl,
+        "--controller",
+        "fanuc",
+        "--machine",
+        &profile,
+        "-o",
+        &out,
+        "-q",
+    ];
+    let run = ok(&args);
+    assert!(
+        run.stdout.contains(
+            "3620 = 40, 3621 = 1, 3622 = 41, 3623 = 10, 3624 = 40 (as in the parameter backup)"
+        ),
+        "{}",
+        run.stdout
+    );
+    // Named relative to the profile, a missing backup is an error naming it.
+    std::fs::write(
+        &profile,
+        "[controller]\nfanuc_parameters = \"CNC-PARA.TXT\"\n",
+    )
+    .unwrap();
+    let run = axcomp(args);
+    assert_eq!(run.code, 2);
+    assert!(run.stderr.contains("CNC-PARA.TXT"), "{}", run.stderr);
+}
