@@ -398,10 +398,7 @@ fn parameter_number<'a>(line: &Line<'a>, content: &'a str) -> Result<(u32, &'a s
 /// The values of one parameter line: `P<value>` or `(A|L|S|T)<n>(P|M|I)<value>…`.
 fn parameter_values(line: &Line<'_>, mut rest: &str) -> Result<Vec<Entry>, ParseError> {
     let mut values = Vec::new();
-    loop {
-        let Some(first) = rest.chars().next() else {
-            break;
-        };
+    while let Some(first) = rest.chars().next() {
         // [file] A<axis>, L<path>, S<spindle>, and T<n> on a few parameters.
         let index = if first.is_ascii_uppercase() && !matches!(first, 'P' | 'M' | 'I') {
             let digits = &rest[1..];
