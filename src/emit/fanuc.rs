@@ -633,6 +633,15 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     // The finest magnification whose points still hold every section's change.
     let finest = ((largest_step / p.detection_unit / POINT_LIMIT as f64).ceil() as i64).max(1);
     let mut notes = Vec::new();
+    if let Some(k) = closing_point(table, &p) {
+        let closure = values[k] - values[0];
+        if closure.abs() > p.unit() / 2.0 {
+            notes.push(format!(
+                "Fanuc: the points of one turn sum to zero (0i-PB parameter manual): the measured {}° between the start and the end of the turn is left out",
+                crate::emit::minimal(closure, 6)
+            ));
+        }
+    }
     if p.unit() > range / 10.0 && finest < p.magnification {
         notes.push(format!(
             "Fanuc: 3623 = {} gives steps of {} mm, coarse for an error of {} mm peak to valley; 3623 = {finest} would give {} mm steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data)",
@@ -677,6 +686,9 @@ pub fn parameters_for(
         table.reference_mm,
     );
     p.rotary = options.kind == AxisKind::Rotary;
+    if p.rotary {
+        p.travel_per_turn = 360.0;
+    }
     Ok(p)
 }
 
@@ -720,10 +732,10 @@ fn new_increments(
         )));
     }
     let unit = p.unit();
-    let values = table
-        .values
-        .for_direction(crate::measurement::Direction::Up);
-    let absolute: Vec<i64> = values.iter().map(|v| (-v / unit).round() as i64).collect();
+    let absolute: Vec<i64> = wanted(table, p)
+        .iter()
+        .map(|v| (-v / unit).round() as i64)
+        .collect();
     let mut increments = BTreeMap::new();
     for k in 1..points.len() {
         if points[k] != points[k - 1] + 1 {
@@ -736,6 +748,39 @@ fn new_increments(
     }
     check_limits(&increments, p)?;
     Ok(increments)
+}
+
+/// The table's values as the control can hold them: \[manual\] 0i-PB
+/// p.100, on a rotary axis the points of one turn sum to zero, else the
+/// error accumulates turn after turn: the end of a full turn takes the
+/// start's value (`notes` says what is dropped).
+fn wanted(table: &CompensationTable, p: &AxisParameters) -> Vec<f64> {
+    let mut values = table
+        .values
+        .for_direction(crate::measurement::Direction::Up)
+        .to_vec();
+    if let Some(k) = closing_point(table, p) {
+        values[k] = values[0];
+    }
+    values
+}
+
+/// On a rotary axis, the index of the table point one turn after its first
+/// point (3625, 0 for 360°), when the table reaches it.
+fn closing_point(table: &CompensationTable, p: &AxisParameters) -> Option<usize> {
+    if !p.rotary {
+        return None;
+    }
+    let turn = if p.travel_per_turn > 0.0 {
+        p.travel_per_turn
+    } else {
+        360.0
+    };
+    let first = table.positions_mm.first()?;
+    table
+        .positions_mm
+        .iter()
+        .position(|x| (x - first - turn).abs() < 1e-6)
 }
 
 /// Refuses increments beyond a point's limit, naming the magnification that would hold them.
@@ -843,10 +888,7 @@ pub fn check_read_back(
     let back = read(text, &p).map_err(|e| {
         EmitError::Internal(format!("the written fanuc table does not read back: {e}"))
     })?;
-    let values = table
-        .values
-        .for_direction(crate::measurement::Direction::Up);
-    for (position, value) in table.positions_mm.iter().zip(values) {
+    for (position, value) in table.positions_mm.iter().zip(wanted(table, &p)) {
         let read = back.value_at(*position, crate::measurement::Direction::Up);
         if (read - value).abs() > p.unit() / 2.0 + 1e-12 {
             return Err(EmitError::Internal(format!(
@@ -888,7 +930,7 @@ pub fn activation(file_name: &str, table: &CompensationTable, options: &EmitOpti
             let what = if p.from_backup {
                 "as in the parameter backup"
             } else {
-                "axcomp's numbering; detection unit assumed 0.001 mm: check 1013 and 1820"
+                "axcomp's numbering; detection unit assumed 0.001 mm (0.001° on a rotary axis): check 1013 and 1820"
             };
             format!("{} ({what})", p.settings())
         },
@@ -1026,6 +1068,23 @@ mod tests {
         );
         let back = read(&text, &p).unwrap();
         assert_eq!(back.positions_mm.len(), 6);
+        // A turn that does not close (0.002° at 360°) is closed, and said.
+        let open = table(
+            vec![0.0, 90.0, 180.0, 270.0, 360.0],
+            vec![0.0, 0.002, 0.001, -0.003, 0.002],
+        );
+        let mut options = options_with(p);
+        options.kind = AxisKind::Rotary;
+        let text = write(&open, &options).unwrap();
+        // Points 2 … 5, one turn, sum to zero.
+        let turn: i64 = increments_of(&text)[2..].iter().map(|(_, v)| v).sum();
+        assert_eq!(turn, 0);
+        check_read_back(&text, &open, &options).unwrap();
+        let notes = notes(&open, &options);
+        assert!(
+            notes[0].contains("0.002° between the start and the end"),
+            "{notes:?}"
+        );
     }
 
     fn increments_of(text: &str) -> Vec<(i64, i64)> {
