@@ -443,3 +443,58 @@ fn the_profile_names_the_fanuc_control() {
     assert_eq!(run.code, 2);
     assert!(run.stderr.contains("CNC-PARA.TXT"), "{}", run.stderr);
 }
+
+/// `diagnose --table` and `predict --table` take the machine's pitch file
+/// with its parameter backup: the loop closes on a Fanuc machine.
+#[test]
+fn diagnose_and_predict_take_the_real_pitch_file() {
+    let directory = tempfile::tempdir().unwrap();
+    let path = |name: &str| directory.path().join(name).display().to_string();
+    let (pitch, parameters) = (data("PITCH.TXT"), data("CNC-PARA.TXT"));
+    let (before, after) = (path("before.rtl"), path("after.rtl"));
+    ok(&[
+        "synth",
+        "--truth",
+        &truth(),
+        "-o",
+        &before,
+        "--table",
+        &pitch,
+        "--fanuc-parameters",
+        &parameters,
+        "--o2",
+        &after,
+    ]);
+    let run = ok(&[
+        "diagnose",
+        "--after",
+        &after,
+        "--before",
+        &before,
+        "--table",
+        &pitch,
+        "--fanuc-parameters",
+        &parameters,
+        "-q",
+    ]);
+    assert!(run.stdout.contains("HM100TS__PITCH.TXT"), "{}", run.stdout);
+    // The prediction with the table equals the re-test synth made with it:
+    // the residual is noise (σ = 0.3 µm).
+    assert!(
+        run.stdout.contains("nothing beyond noise"),
+        "{}",
+        run.stdout
+    );
+    let table = format!("X={pitch}");
+    let run = ok(&[
+        "predict",
+        "--measured",
+        &format!("X={before}"),
+        "--table",
+        &table,
+        "--fanuc-parameters",
+        &parameters,
+        "-q",
+    ]);
+    assert!(run.stdout.contains("with the table"), "{}", run.stdout);
+}
