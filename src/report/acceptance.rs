@@ -791,6 +791,8 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
                         &Line {
                             first_target_mm,
                             angle_urad: None,
+                            times_recorded: !diagnosis.time_assumed,
+                            run_h: diagnosis.run_h,
                         },
                     ),
                 )
