@@ -23,6 +23,7 @@ mod http;
 mod injected;
 mod linuxcnc;
 mod model;
+mod numbers;
 mod outputs;
 mod predict;
 mod read_api_pos;
