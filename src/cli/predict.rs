@@ -21,7 +21,8 @@ use axcomp::units::{LengthUnit, mm_to_um};
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, StandardArg, Verbosity, load, load_effects,
-    load_machine, name_axis, parse_position, print_json, print_text, print_warnings, read_table,
+    load_machine, name_axis, parse_position, print_json, print_test_warnings, print_text,
+    print_warnings, read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -167,6 +168,12 @@ pub fn run(args: &PredictArgs) -> Result<()> {
                 path.display()
             );
         }
+        print_test_warnings(
+            &path,
+            &result.measurement,
+            args.verbosity.quiet,
+            Default::default(),
+        );
         let line = line.map_or(line_mm, |l| complete(Some(l), reference));
         measurements.push((result.measurement, line));
         optics.push([0.0; 3]);

@@ -411,6 +411,23 @@ pub fn render(report: &PredictJson) -> String {
         um(Some(report.volumetric_max_um)),
         at(&report.volumetric_max_at_mm),
     );
+    // The map of each direction carries the reversal its first test measured.
+    let reversals: Vec<String> = report
+        .retest
+        .iter()
+        .chain(&report.also)
+        .filter_map(|r| {
+            r.measured_b_mean_um
+                .map(|b| format!("{} B̄ = {} µm", r.axis, um(Some(b))))
+        })
+        .collect();
+    if !reversals.is_empty() {
+        let _ = writeln!(
+            out,
+            "  (the worse of ↑ and ↓: each direction keeps what the tables leave of the reversal the first test measured, {})",
+            reversals.join(", ")
+        );
+    }
     // Without a positioning table that line would repeat "without the tables".
     if report.retest.is_some()
         && report.volumetric_max_positioning_only_um != report.volumetric_max_um

@@ -28,6 +28,7 @@ mod generated_docs;
 mod http;
 mod injected;
 mod model;
+mod numbers;
 mod outputs;
 mod page;
 mod pixels;
