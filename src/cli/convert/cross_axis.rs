@@ -97,6 +97,7 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
                 .optics_offset
                 .unwrap_or([None; 3])
                 .map(|v| v.unwrap_or(0.0)),
+            optics_on: None,
         }],
     };
     let state = assemble(
