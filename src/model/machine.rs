@@ -251,15 +251,6 @@ impl Machine {
             .volumetric_error(errors, position_mm, method)
     }
 
-    /// An optic on a test of `axis` where it physically is: on the body the
-    /// axis moves ([`ChainCode::body_moved_by`]), `offset_mm` from the tool tip.
-    pub fn optics_on_moving_body(&self, axis: Axis, offset_mm: [f64; 3]) -> Optics {
-        Optics {
-            body: self.chain().body_moved_by(axis),
-            offset_mm,
-        }
-    }
-
     /// The machine as a test's moving optic sees it: the point of the body
     /// that carries the optic moved by the optic's offset, so the angles of
     /// the axes under that body (and only those) take the offset into their

@@ -362,8 +362,8 @@ pub struct PositioningTest {
     pub file: String,
     /// Machine position of the line, mm.
     pub line_mm: [f64; 3],
-    /// Moving optics from the tool tip, mm.
-    pub optics_offset_mm: [f64; 3],
+    /// Its moving optic, as taken.
+    pub optics: Optics,
 }
 
 /// Where a test's moving optic was taken to be.
@@ -469,12 +469,12 @@ pub fn assemble(
                     None => axis_named("a positioning test", measurement.axis())?,
                 };
                 claim(positioning_error(axis), Source::Measured(test.file.clone()))?;
-                taken_optics(axis, test);
+                let optics = taken_optics(axis, test);
                 positioning.push(PositioningTest {
                     measurement: (**measurement).clone(),
                     file: test.file.clone(),
                     line_mm: line_of(axis),
-                    optics_offset_mm: test.optics_offset_mm,
+                    optics,
                 });
             }
             SurveyFile::Geometry(geometry) => {
@@ -512,7 +512,7 @@ pub fn assemble(
                             measurement: positioning_measurement(geometry, column, &test.file)?,
                             file: test.file.clone(),
                             line_mm: line_of(axis),
-                            optics_offset_mm: test.optics_offset_mm,
+                            optics,
                         });
                         continue;
                     }

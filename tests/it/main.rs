@@ -32,6 +32,7 @@ mod serve;
 mod servo;
 mod standards;
 mod survey;
+mod survey_optics;
 mod together;
 mod util;
 mod verdict;

@@ -36,7 +36,7 @@ pub(crate) fn predicted_errors(machine: &Machine, state: &MeasuredState) -> Geom
         .map(|p| MeasuredAxis {
             measurement: &p.measurement,
             line_mm: p.line_mm,
-            optics_offset_mm: p.optics_offset_mm,
+            optics: p.optics,
         })
         .collect();
     calibrate_positioning(machine, &state.errors, &measured).unwrap()
