@@ -71,7 +71,7 @@ use crate::evaluate::{
 use crate::measurement::{Direction, Measurement, Run};
 use crate::model::{
     Axis, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid,
-    Interpolation, Machine, Method, ModelError,
+    Interpolation, Machine, Method, ModelError, Optics,
 };
 use crate::units::um_to_mm;
 
@@ -84,9 +84,10 @@ pub struct MeasuredAxis<'a> {
     pub measurement: &'a Measurement,
     /// Machine position of the line (the measured axis's own coordinate is ignored), mm.
     pub line_mm: [f64; 3],
-    /// Where the laser's moving optics sit relative to the tool tip, mm
-    /// (zero: at the tool tip); the Abbe arms of the test are the tool's plus this.
-    pub optics_offset_mm: [f64; 3],
+    /// Where the laser's moving optic sits ([`Optics::AT_TOOL_TIP`]: at the
+    /// tool tip): the Abbe arms of the axes under its body are their arms to
+    /// the tool plus its offset (`Machine::with_optics`).
+    pub optics: Optics,
 }
 
 /// What `predict` is given.
@@ -577,7 +578,7 @@ pub fn calibrate_positioning(
         given.push(name);
         let known = KnownError::from_evaluation(&evaluate(measured.measurement))
             .ok_or(PredictError::NoMeans(axis))?;
-        let machine = with_optics(machine, measured.optics_offset_mm)?;
+        let machine = machine.with_optics(&measured.optics)?;
         let sign = positioning_sign(&machine, axis)?;
         // The others' contribution on the measured line, with EAA still zero.
         let values: Vec<f64> = known
@@ -592,15 +593,6 @@ pub fn calibrate_positioning(
         errors.set(name, ErrorFunction::Table(table))?;
     }
     Ok(errors)
-}
-
-/// The machine as a test with optics `offset_mm` from the tool tip sees it.
-pub fn with_optics(machine: &Machine, offset_mm: [f64; 3]) -> Result<Machine, PredictError> {
-    if offset_mm == [0.0; 3] {
-        return Ok(machine.clone());
-    }
-    let tool = machine.tool_offset_mm();
-    Ok(machine.with_tool_offset([0, 1, 2].map(|i| tool[i] + offset_mm[i]))?)
 }
 
 /// An axis and the line its re-test runs on.

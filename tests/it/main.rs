@@ -42,6 +42,7 @@ mod server;
 mod servo;
 mod standards;
 mod survey;
+mod survey_optics;
 mod together;
 mod util;
 mod verdict;
