@@ -485,6 +485,17 @@ fn diagnose_and_predict_take_the_real_pitch_file() {
         "{}",
         run.stdout
     );
+    // The machine's X travels −1000 … +1 mm (1320/1321): the bundled model's
+    // 0 … 750 mm does not cover the test, so predict needs this machine's stroke.
+    let machine = path("machine.toml");
+    let description = std::fs::read_to_string("fixtures/machines/mcv754-quick.toml")
+        .unwrap()
+        .replace(
+            "[kinematics.axes.X]\nstroke_mm = [0.0, 750.0]",
+            "[kinematics.axes.X]\nstroke_mm = [-1000.0, 1.0]",
+        );
+    assert!(description.contains("[-1000.0, 1.0]"));
+    std::fs::write(&machine, description).unwrap();
     let table = format!("X={pitch}");
     let run = ok(&[
         "predict",
@@ -494,6 +505,8 @@ fn diagnose_and_predict_take_the_real_pitch_file() {
         &table,
         "--fanuc-parameters",
         &parameters,
+        "--machine",
+        &machine,
         "-q",
     ]);
     assert!(run.stdout.contains("with the table"), "{}", run.stdout);
