@@ -11,7 +11,8 @@
 //!   "backlash_parameter": {"name": "MD32450 $MA_BACKLASH[0,X1]", "value": 0.0032,
 //!                          "unit": "mm" | "inch", "sign": "…", "note": "…" | null} | null,
 //!   "backlash_note": "…" | null, "activation": "…", "file_unit": "mm" | "inch",
-//!   "effects": ["…what --effects changed…"], "warnings": [...] }
+//!   "effects": ["…what --effects changed…"], "notes": ["…"],
+//!   "update": {…} | null (`report::update`), "warnings": [...] }
 //! ```
 //! Values are the axis error actual − target in µm, zero at the reference,
 //! before each controller's own sign convention (see `formats/`).
@@ -115,6 +116,10 @@ pub struct ConvertJson {
     pub activation: String,
     /// What `--effects` changed, as sentences (empty without it).
     pub effects: Vec<String>,
+    /// What the table must say of itself (a one-direction test), as sentences.
+    pub notes: Vec<String>,
+    /// What an update (`--existing`) kept and changed, or `None`.
+    pub update: Option<super::update::UpdateJson>,
     /// Warnings from reading and evaluating.
     pub warnings: Vec<String>,
 }
@@ -165,6 +170,8 @@ impl ConvertJson {
             backlash_note: None,
             activation,
             effects: Vec::new(),
+            notes: Vec::new(),
+            update: None,
             warnings,
         }
     }
@@ -232,6 +239,12 @@ impl ConvertJson {
         for effect in &self.effects {
             let _ = writeln!(out, "Effect: {effect}");
         }
+        for line in self.update.iter().flat_map(|u| &u.lines) {
+            let _ = writeln!(out, "Update: {line}");
+        }
+        for note in &self.notes {
+            let _ = writeln!(out, "Note: {note}");
+        }
         if let Some(backlash_um) = self.suggested_backlash_um {
             match (&self.backlash_parameter, &self.backlash_note) {
                 (Some(parameter), _) => {
@@ -242,6 +255,13 @@ impl ConvertJson {
                     );
                     if let Some(note) = &parameter.note {
                         let _ = writeln!(out, "  note: {note}");
+                    }
+                    if parameter.unit != self.file_unit && self.kind == AxisKind::Linear {
+                        let _ = writeln!(
+                            out,
+                            "  unit: the parameter is in {} (the machine's unit) and the table file in {} (the unit its format is written in): both are right as printed",
+                            parameter.unit, self.file_unit
+                        );
                     }
                 }
                 (None, Some(note)) => {
@@ -328,7 +348,7 @@ impl Serialize for ConvertJson {
             AxisKind::Linear => ("mm", "um"),
             AxisKind::Rotary => ("deg", "arcsec"),
         };
-        let mut map = serializer.serialize_map(Some(18))?;
+        let mut map = serializer.serialize_map(Some(20))?;
         map.serialize_entry("file_unit", self.file_unit)?;
         map.serialize_entry("controller", self.controller)?;
         map.serialize_entry("file", &self.file)?;
@@ -349,6 +369,8 @@ impl Serialize for ConvertJson {
         map.serialize_entry("backlash_note", &self.backlash_note)?;
         map.serialize_entry("activation", &self.activation)?;
         map.serialize_entry("effects", &self.effects)?;
+        map.serialize_entry("notes", &self.notes)?;
+        map.serialize_entry("update", &self.update)?;
         map.serialize_entry("warnings", &self.warnings)?;
         map.end()
     }

@@ -18,6 +18,7 @@ mod diagnose;
 mod diagnose_periodic;
 mod evaluate_ecmc;
 mod fagor;
+mod fagor_update;
 mod flags;
 mod http;
 mod injected;
