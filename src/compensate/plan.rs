@@ -398,6 +398,103 @@ mod tests {
         );
     }
 
+    /// An old table over −100 … 600 mm, zero at 0 mm.
+    fn existing() -> CompensationTable {
+        CompensationTable {
+            axis: "X".into(),
+            positions_mm: vec![-100.0, 0.0, 250.0, 600.0],
+            values: crate::compensate::TableValues::Mean(vec![0.01, 0.0, 0.002, 0.003]),
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        }
+    }
+
+    #[test]
+    fn an_update_is_referred_to_the_existing_zero_inside_the_measured_range() {
+        let free = Capabilities {
+            free_positions: true,
+            ..ITNC
+        };
+        let old = existing();
+        let context = PlanContext {
+            only_direction: None,
+            existing: Some(&old),
+        };
+        let update = plan(&targets(), &[], &free, &Request::default(), &context).unwrap();
+        assert_eq!(update.options.reference_mm, Some(0.0));
+        assert_eq!(update.update.unwrap().measured_mm, (0.0, 500.0));
+        // A zero the test did not measure cannot refer the update.
+        let mut shifted = existing();
+        shifted.reference_mm = 600.0;
+        let context = PlanContext {
+            only_direction: None,
+            existing: Some(&shifted),
+        };
+        let error = plan(&targets(), &[], &free, &Request::default(), &context).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .starts_with("the existing table is zero (its reference) at 600 mm is outside the measured range 0 … 500 mm"),
+            "{error}"
+        );
+        let given = Request {
+            reference_mm: Some(250.0),
+            ..Request::default()
+        };
+        assert_eq!(
+            plan(&targets(), &[], &free, &given, &context)
+                .unwrap()
+                .options
+                .reference_mm,
+            Some(250.0)
+        );
+        let extrapolate = Request {
+            extrapolate: Some(Extrapolate::Hold),
+            ..given
+        };
+        assert_eq!(
+            plan(&targets(), &[], &free, &extrapolate, &context).unwrap_err(),
+            CompensateError::ExtrapolateUpdate
+        );
+        // One step: the kept −100 and 600 mm leave the 50 mm grid 0 … 500 mm
+        // uneven (100 mm gaps).
+        let context = PlanContext {
+            only_direction: None,
+            existing: Some(&old),
+        };
+        let error = plan(&targets(), &[], &ITNC, &Request::default(), &context).unwrap_err();
+        assert!(
+            error.to_string().contains("4 points from -100 to 600 mm"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn a_one_direction_test_says_where_its_curve_goes() {
+        let down = PlanContext {
+            only_direction: Some(Direction::Down),
+            existing: None,
+        };
+        let plan_down = plan(&targets(), &[], &ITNC, &Request::default(), &down).unwrap();
+        assert_eq!(
+            plan_down.table_notes,
+            vec!["the test ran ↓ only: the table is the ↓ curve, in its one column; the reversal (backlash) was not measured, so leave the backlash parameter as it is (measure both directions to check it)".to_string()]
+        );
+        let mut bidirectional = existing();
+        bidirectional.values = crate::compensate::TableValues::Bidirectional {
+            up: vec![0.0; 4],
+            down: vec![0.001; 4],
+        };
+        let update = PlanContext {
+            existing: Some(&bidirectional),
+            ..down
+        };
+        assert_eq!(
+            plan(&targets(), &[], &ITNC, &Request::default(), &update).unwrap_err(),
+            CompensateError::OneDirectionUpdate(Direction::Down)
+        );
+    }
+
     #[test]
     fn uneven_targets_need_a_step_where_the_controller_takes_only_one() {
         let uneven = [0.0, 10.0, 25.0, 40.0];

@@ -49,6 +49,8 @@ pub struct KeptRange {
 pub struct UpdateSummary {
     /// Old points outside the measured range, kept with their old values, by runs.
     pub kept: Vec<KeptRange>,
+    /// The same points one by one, mm.
+    pub kept_points_mm: Vec<f64>,
     /// The measured range, mm.
     pub measured_mm: (f64, f64),
     /// How many points inside it got old + residual.
@@ -191,6 +193,12 @@ impl UpdatePlan {
             ..new
         };
         let summary = UpdateSummary {
+            kept_points_mm: old
+                .positions_mm
+                .iter()
+                .copied()
+                .filter(|&p| !self.inside(p))
+                .collect(),
             kept,
             measured_mm: self.measured_mm,
             updated,
@@ -201,5 +209,113 @@ impl UpdatePlan {
             added_mm,
         };
         (table, summary)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(positions_mm: Vec<f64>, values: TableValues) -> CompensationTable {
+        CompensationTable {
+            axis: "X".into(),
+            positions_mm,
+            values,
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        }
+    }
+
+    #[test]
+    fn old_points_outside_the_measured_range_stay_as_they_were() {
+        // Old: −200, −100, 0, 150, 300, 400 mm; measured 0 … 300 mm on a 100 mm grid.
+        let old = table(
+            vec![-200.0, -100.0, 0.0, 150.0, 300.0, 400.0],
+            TableValues::Mean(vec![0.02, 0.01, 0.0, 0.004, 0.006, 0.008]),
+        );
+        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0, 300.0], None).unwrap();
+        assert_eq!(update.reference_mm, 0.0);
+        // Built (old + residual, zero at 0 mm) on 0, 100, 200, 300.
+        let new = table(
+            vec![0.0, 100.0, 200.0, 300.0],
+            TableValues::Mean(vec![0.0, 0.003, 0.005, 0.007]),
+        );
+        let (merged, summary) = update.apply(new);
+        assert_eq!(
+            merged.positions_mm,
+            vec![-200.0, -100.0, 0.0, 100.0, 200.0, 300.0, 400.0]
+        );
+        assert_eq!(
+            merged.values,
+            TableValues::Mean(vec![0.02, 0.01, 0.0, 0.003, 0.005, 0.007, 0.008])
+        );
+        assert_eq!(
+            summary.kept,
+            vec![
+                KeptRange {
+                    first_mm: -200.0,
+                    last_mm: -100.0,
+                    count: 2
+                },
+                KeptRange {
+                    first_mm: 400.0,
+                    last_mm: 400.0,
+                    count: 1
+                }
+            ]
+        );
+        assert_eq!(summary.updated, 4);
+        assert_eq!(summary.dropped_mm, vec![150.0]);
+        assert_eq!(summary.added_mm, vec![100.0, 200.0]);
+    }
+
+    #[test]
+    fn at_a_given_reference_the_update_adds_nothing() {
+        // Old 0 at 0 mm and 0.004 mm at 100 mm; --reference 100: the built
+        // table is zero there, the old 0.004 mm is put back.
+        let old = table(
+            vec![0.0, 100.0, 200.0],
+            TableValues::Mean(vec![0.0, 0.004, 0.006]),
+        );
+        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0], Some(100.0)).unwrap();
+        let new = table(
+            vec![0.0, 100.0, 200.0],
+            TableValues::Mean(vec![-0.001, 0.0, 0.003]),
+        );
+        let (merged, summary) = update.apply(new);
+        let TableValues::Mean(values) = merged.values else {
+            panic!("mean")
+        };
+        for (got, expected) in values.iter().zip([0.003, 0.004, 0.007]) {
+            assert!((got - expected).abs() < 1e-15, "{values:?}");
+        }
+        assert!(!summary.at_existing_zero);
+        assert!((summary.existing_at_reference_mm - 0.004).abs() < 1e-15);
+        // A reference the test did not measure is refused.
+        assert!(matches!(
+            UpdatePlan::new(&old, &[0.0, 100.0], Some(150.0)),
+            Err(CompensateError::UpdateReference { given: true, .. })
+        ));
+    }
+
+    #[test]
+    fn a_bidirectional_old_table_keeps_both_columns_outside() {
+        let old = table(
+            vec![-100.0, 0.0, 100.0],
+            TableValues::Bidirectional {
+                up: vec![0.001, 0.0, 0.002],
+                down: vec![0.003, 0.0, 0.004],
+            },
+        );
+        let update = UpdatePlan::new(&old, &[0.0, 100.0], None).unwrap();
+        let new = table(vec![0.0, 100.0], TableValues::Mean(vec![0.0, 0.005]));
+        let (merged, _) = update.apply(new);
+        assert_eq!(
+            merged.values,
+            TableValues::Bidirectional {
+                up: vec![0.001, 0.0, 0.005],
+                down: vec![0.003, 0.0, 0.005],
+            }
+        );
     }
 }

@@ -224,9 +224,14 @@ impl ConvertJson {
         } else {
             format!(" (also {})", self.also.join(", "))
         };
+        // An update referred to a point where the old table was not zero keeps that value there.
+        let zero = match &self.update {
+            Some(update) if !update.zero_at_reference => "as it was",
+            _ => "zero",
+        };
         let _ = writeln!(
             out,
-            "Wrote {} for {}: {} table of axis {}{also}, {} points from {} to {}{position_unit}, {step}, zero at {}{position_unit}",
+            "Wrote {} for {}: {} table of axis {}{also}, {} points from {} to {}{position_unit}, {step}, {zero} at {}{position_unit}",
             self.file,
             self.controller,
             self.mode,
@@ -277,7 +282,12 @@ impl ConvertJson {
         }
         let _ = writeln!(
             out,
-            "\nCompensation table [{value_unit}] (axis error actual − target, zero at the reference)"
+            "\nCompensation table [{value_unit}] (axis error actual − target, zero at the reference{})",
+            if self.update.is_some() {
+                "; kept: the old value, outside the measured range; new: a point the old table did not have"
+            } else {
+                ""
+            }
         );
         let position_header = format!("position {}", position_unit.trim_start());
         if self.file_unit == LengthUnit::Inch.as_str() {
@@ -287,18 +297,30 @@ impl ConvertJson {
             ValuesJson::Mean { mean } => {
                 let _ = writeln!(out, "{position_header:>12}  {:>9}", "value");
                 for (p, v) in self.positions_mm.iter().zip(mean) {
-                    let _ = writeln!(out, "{p:>12}  {:>9}", um(Some(*v)));
+                    let mark = self.row_mark(*p);
+                    let _ = writeln!(out, "{p:>12}  {:>9}{mark}", um(Some(*v)));
                 }
             }
             ValuesJson::Bidirectional { up, down } => {
                 let _ = writeln!(out, "{position_header:>12}  {:>9}  {:>9}", "↑", "↓");
                 for ((p, u), d) in self.positions_mm.iter().zip(up).zip(down) {
-                    let _ = writeln!(out, "{p:>12}  {:>9}  {:>9}", um(Some(*u)), um(Some(*d)));
+                    let mark = self.row_mark(*p);
+                    let _ = writeln!(
+                        out,
+                        "{p:>12}  {:>9}  {:>9}{mark}",
+                        um(Some(*u)),
+                        um(Some(*d))
+                    );
                 }
             }
         }
         let _ = writeln!(out, "\nActivation:\n{}", self.activation);
         out
+    }
+
+    /// How an update's row came about (`kept`, `new`, or nothing).
+    fn row_mark(&self, position_mm: f64) -> &'static str {
+        self.update.as_ref().map_or("", |u| u.row_mark(position_mm))
     }
 
     /// The table of an inch file: positions and values in inches, as the
@@ -334,6 +356,7 @@ impl ConvertJson {
                     um(Some(value_um))
                 );
             }
+            out.push_str(self.row_mark(*p));
             out.push('\n');
         }
         let _ = writeln!(out, "\nActivation:\n{}", self.activation);

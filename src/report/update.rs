@@ -48,6 +48,27 @@ pub struct UpdateJson {
     pub added_mm: Vec<f64>,
     /// What the terminal prints.
     pub lines: Vec<String>,
+    /// Whether the new table is zero at the reference (the existing table is).
+    #[serde(skip)]
+    pub zero_at_reference: bool,
+    /// Every kept point, mm (for marking the printed table's rows).
+    #[serde(skip)]
+    pub kept_points_mm: Vec<f64>,
+}
+
+impl UpdateJson {
+    /// What a row of the printed table is: `kept` (the old value), `new`
+    /// (a point the old table did not have) or nothing (old + residual).
+    pub fn row_mark(&self, position_mm: f64) -> &'static str {
+        let among = |list: &[f64]| list.iter().any(|p| (p - position_mm).abs() < 1e-6);
+        if among(&self.kept_points_mm) {
+            "  kept"
+        } else if among(&self.added_mm) {
+            "  new"
+        } else {
+            ""
+        }
+    }
 }
 
 impl UpdateJson {
@@ -74,6 +95,8 @@ impl UpdateJson {
             dropped_mm: summary.dropped_mm.clone(),
             added_mm: summary.added_mm.clone(),
             lines: lines(summary, file_unit),
+            zero_at_reference: summary.existing_at_reference_mm.abs() < 1e-12,
+            kept_points_mm: summary.kept_points_mm.clone(),
         }
     }
 }
@@ -196,6 +219,7 @@ mod tests {
             at_existing_zero: true,
             dropped_mm: vec![],
             added_mm: vec![3302.0],
+            kept_points_mm: vec![],
         };
         let lines = lines(&summary, "mm");
         assert_eq!(

@@ -181,6 +181,17 @@ fn the_update_says_per_range_what_it_kept() {
             .contains("Update: grid changed: new points at 3302 mm (the old table had none there)"),
         "{stdout}"
     );
+    // The printed table shows which rows are kept and which are new.
+    let row = |position: &str| {
+        stdout
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(position))
+            .unwrap_or_else(|| panic!("no row {position}: {stdout}"))
+            .to_string()
+    };
+    assert!(row("-127").ends_with("-12.70  kept"), "{}", row("-127"));
+    assert!(row("3302").ends_with("  new"), "{}", row("3302"));
+    assert!(row("0").ends_with(" 0.00"), "{}", row("0"));
     // The 8055 in inch: the ranges in inch, with mm.
     let (laser, table, controller, axis) = CASES[1];
     let (stdout, _) = update(
