@@ -226,6 +226,11 @@ pub fn convert(
     );
     report.effects = plan.notes;
     report.notes = plan.table_notes;
+    if table.controller == Controller::Fanuc {
+        report
+            .effects
+            .extend(emit::fanuc::notes(&compensation, options));
+    }
     if measurement.kind() == AxisKind::Linear {
         report.file_unit = table.controller.file_unit(options.machine_unit).as_str();
     }
