@@ -207,11 +207,18 @@ pub fn convert(
     )?;
     let mut compensation =
         build_table_with_effects(measurement, &evaluation, &plan.options, table.effects)?;
-    let update = plan.update.as_ref().map(|update| {
-        let (updated, summary) = update.apply(compensation.clone());
-        compensation = updated;
-        summary
-    });
+    // A Fanuc pitch file is updated in place point by point (its data are
+    // increments, emit::fanuc::update): the points outside the table stay as
+    // they were there.
+    let update = plan
+        .update
+        .as_ref()
+        .filter(|_| table.controller != Controller::Fanuc)
+        .map(|update| {
+            let (updated, summary) = update.apply(compensation.clone());
+            compensation = updated;
+            summary
+        });
     let bytes = emit::write_bytes(table.controller, &compensation, options, table.existing)?;
     let activation = emit::activation(table.controller, &compensation, &table.file_name, options);
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
