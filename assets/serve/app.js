@@ -255,6 +255,11 @@ async function convert() {
         " (" + c.backlash_parameter.sign + ")"
       : (c.backlash_note || "");
     $("activation").textContent = c.activation;
+    // What an update kept and changed, and what a one-direction table is (convert prints the same).
+    $("table-notes").replaceChildren(...[
+      ...(c.update ? c.update.lines.map((line) => "Update: " + line) : []),
+      ...(c.notes || []).map((note) => "Note: " + note),
+    ].map((line) => element("li", line)));
     $("table-plot").innerHTML = answer.table_svg || "";
     $("table-result").hidden = false;
     $("download").dataset.name = answer.file_name;

@@ -87,9 +87,12 @@ pub struct ConvertArgs {
     #[arg(long, value_name = "N", requires = "step", help_heading = "Grid")]
     pub count: Option<usize>,
 
-    /// Position where the table is zero, mm (default: the first point).
+    /// Position where the table is zero, mm (default: the first point; with
+    /// --existing, the existing table's zero).
     ///
-    /// Controllers reference the axis there; seed 001 zeroes the first point.
+    /// Controllers reference the axis there. With --existing it is where the
+    /// update adds nothing (inside the measured range); the old table's zero
+    /// is its machine reference point, so the default keeps it.
     #[arg(
         long,
         value_name = "MM",
@@ -106,8 +109,10 @@ pub struct ConvertArgs {
     /// The table that was active during the measurement (any format convert writes).
     ///
     /// The measurement then shows the residual; the new table is the old one
-    /// plus that residual, on the new grid. A Fagor 8065 .mp file is updated
-    /// in place: only its leadscrew lines change.
+    /// plus that residual, referred to the old table's zero, on the new grid
+    /// inside the measured range; every old point outside it is kept as it
+    /// was. A Fagor 8065 .mp file is updated in place: only its leadscrew
+    /// lines change.
     #[arg(long, value_name = "TABLE", help_heading = "Table")]
     pub existing: Option<PathBuf>,
 
@@ -229,6 +234,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     options.max_points = args.max_points.or(options.max_points);
     options.machine_unit = profile.table_unit(args.controller, measurement.metadata.length_unit);
     options.kind = measurement.kind();
+    let mut active = None;
     if let Some(existing) = &args.existing {
         // The table was active during the test: its axis, over the test's range.
         let test_name = args
@@ -237,7 +243,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
             .join(" + ");
-        let (_, active, doubts) = read_active_table(
+        let (_, table, doubts) = read_active_table(
             existing,
             &measurement,
             test_name,
@@ -245,7 +251,8 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             Some(args.linuxcnc_type),
         )?;
         warnings.extend(doubts);
-        measurement = compensate::add_existing_table(&measurement, &active)?;
+        measurement = compensate::add_existing_table(&measurement, &table)?;
+        active = Some(table);
     }
     let effects = match &args.effects {
         Some(path) => load_effects(path)?,
@@ -282,6 +289,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             request: &request,
             effects: &effects,
             existing: existing_bytes.as_deref(),
+            active: active.as_ref(),
             output: args.output.display().to_string(),
             file_name,
             also: args.also.clone(),

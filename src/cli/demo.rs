@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::effects::build_table_with_effects;
-use axcomp::compensate::plan::{Request, plan};
+use axcomp::compensate::plan::{PlanContext, Request, plan};
 use axcomp::compensate::{self, CompensationTable, Extrapolate, GridSpec, TableMode, TableOptions};
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
@@ -291,6 +291,7 @@ fn next_table(
             mode: measured.then_some(TableMode::Bidirectional),
             ..Request::default()
         },
+        &PlanContext::default(),
     )?;
     Ok(build_table_with_effects(
         &without,

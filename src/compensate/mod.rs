@@ -40,6 +40,7 @@ pub mod cross_axis;
 pub mod effects;
 pub mod plan;
 pub mod retest;
+pub mod update;
 
 use crate::evaluate::Evaluation;
 use crate::evaluate::conformance::FULL_TURN_DEG;
@@ -289,6 +290,31 @@ pub enum CompensateError {
         /// Last point.
         last_mm: f64,
     },
+    /// An update cannot be referred where the test did not measure.
+    #[error(
+        "{} {reference_mm} mm is outside the measured range {first_mm} … {last_mm} mm: the test did not measure the residual there, so the update cannot be referred to it; give --reference with the position inside the measured range where the update should add nothing (the machine's reference point)",
+        if *given { "the reference" } else { "the existing table is zero (its reference) at" }
+    )]
+    UpdateReference {
+        /// The reference.
+        reference_mm: f64,
+        /// Whether `--reference` gave it (else it is the existing table's zero).
+        given: bool,
+        /// First measured target.
+        first_mm: f64,
+        /// Last measured target.
+        last_mm: f64,
+    },
+    /// A one-direction test cannot update a table with a column per direction.
+    #[error(
+        "the existing table has a column per direction, and this test ran {0} only: the other direction's column would be lost (replaced by the {0} curve); measure both directions, or write a new table without --existing"
+    )]
+    OneDirectionUpdate(Direction),
+    /// `--extrapolate` has no meaning in an update.
+    #[error(
+        "--extrapolate does not apply with --existing: outside the measured range the existing table's values are kept as they are"
+    )]
+    ExtrapolateUpdate,
     /// The grid is not usable.
     #[error("invalid grid: {0}")]
     Grid(String),

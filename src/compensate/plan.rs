@@ -11,13 +11,25 @@
 //!   (linear interpolation then leaves < 5 % of its amplitude), rounded down
 //!   to a step the controller's format writes exactly;
 //! - what an effect takes out of the table or leaves to another remedy is a
-//!   note.
+//!   note;
+//! - a **one-direction test** gives a mean table of its one curve: the note
+//!   says where the controller puts it and that the reversal (backlash) was
+//!   not measured; it cannot update a table with a column per direction;
+//! - an **existing table** (`--existing`) makes the table an update
+//!   ([`UpdatePlan`]): referred to the existing table's own zero unless
+//!   `--reference` says otherwise, every old point outside the measured range
+//!   kept.
 //!
 //! The user's `--mode` and `--step` win, except that a step coarser than a
 //! periodic error allows is refined.
 
-use super::{CompensateError, Extrapolate, GridSpec, TableMode, TableOptions, regular_step};
+use super::update::UpdatePlan;
+use super::{
+    CompensateError, CompensationTable, Extrapolate, GridSpec, TableMode, TableOptions,
+    regular_step,
+};
 use crate::effects::{Effect, TableRole};
+use crate::measurement::Direction;
 
 /// What the controller can take, as far as a table's plan is concerned
 /// (filled by the caller from `emit::Controller`).
@@ -31,6 +43,18 @@ pub struct Capabilities {
     pub free_positions: bool,
     /// The smallest step its format writes exactly, mm.
     pub resolution_mm: f64,
+    /// Where it keeps a mean table and how it applies it ("the positive
+    /// column …, applied in both directions").
+    pub mean_table: &'static str,
+}
+
+/// What is known of the test and the control beyond the targets.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanContext<'a> {
+    /// The one direction the test ran, when it ran only one.
+    pub only_direction: Option<Direction>,
+    /// The table that was active during the test (`--existing`).
+    pub existing: Option<&'a CompensationTable>,
 }
 
 /// What the user asked for (`None`: let the plan decide).
@@ -57,6 +81,11 @@ pub struct Plan {
     pub options: TableOptions,
     /// One line per decision an effect made (empty without effects).
     pub notes: Vec<String>,
+    /// What the table must say of itself: a one-direction test's curve and
+    /// where it goes.
+    pub table_notes: Vec<String>,
+    /// The update of the existing table, when there is one.
+    pub update: Option<UpdatePlan>,
 }
 
 /// The plan for a table over `targets_mm` (the measured targets, ascending).
@@ -65,24 +94,108 @@ pub fn plan(
     effects: &[Effect],
     controller: &Capabilities,
     request: &Request,
+    context: &PlanContext<'_>,
 ) -> Result<Plan, CompensateError> {
     let mut notes = Vec::new();
     let mode = mode(effects, controller, request, &mut notes);
+    let table_notes = one_direction(mode, controller, context)?;
+    let update = match context.existing {
+        Some(_) if request.extrapolate.is_some() => {
+            return Err(CompensateError::ExtrapolateUpdate);
+        }
+        Some(existing) => Some(UpdatePlan::new(existing, targets_mm, request.reference_mm)?),
+        None => None,
+    };
     let step_mm = effects_step(effects, controller, request, &mut notes);
     for effect in effects {
         if let TableRole::TakenOut { note } | TableRole::NotATable { note } = effect.in_table() {
             notes.push(note);
         }
     }
+    let grid = grid(targets_mm, controller, request, step_mm)?;
+    if let Some(update) = &update {
+        check_update_grid(update, targets_mm, grid, controller)?;
+    }
     Ok(Plan {
         options: TableOptions {
             mode,
-            grid: grid(targets_mm, controller, request, step_mm)?,
-            reference_mm: request.reference_mm,
-            extrapolate: request.extrapolate.unwrap_or(Extrapolate::Refuse),
+            grid,
+            reference_mm: update
+                .as_ref()
+                .map_or(request.reference_mm, |u| Some(u.reference_mm)),
+            // An update keeps the old values outside the measured range
+            // (`UpdatePlan::apply` replaces whatever is built there).
+            extrapolate: match update {
+                Some(_) => Extrapolate::Hold,
+                None => request.extrapolate.unwrap_or(Extrapolate::Refuse),
+            },
         },
         notes,
+        table_notes,
+        update,
     })
+}
+
+/// A controller with one step takes an update only when the kept old
+/// points lie on the new grid's step.
+fn check_update_grid(
+    update: &UpdatePlan,
+    targets_mm: &[f64],
+    grid: GridSpec,
+    controller: &Capabilities,
+) -> Result<(), CompensateError> {
+    if controller.free_positions {
+        return Ok(());
+    }
+    let (first, last) = update.measured_mm;
+    let mut positions = super::grid_positions(targets_mm, grid)?;
+    positions.extend(
+        update
+            .existing
+            .positions_mm
+            .iter()
+            .filter(|&&p| p < first - 1e-9 || p > last + 1e-9),
+    );
+    positions.sort_by(f64::total_cmp);
+    positions.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    if regular_step(&positions).is_some() {
+        return Ok(());
+    }
+    let old = &update.existing.positions_mm;
+    Err(CompensateError::Grid(format!(
+        "the update keeps the existing table's points outside the measured range {first} … {last} mm, and with them the points are unevenly spaced, which {} cannot take: put the new points on the existing table's grid ({} points from {} to {} mm; --start, --step, --count)",
+        controller.name,
+        old.len(),
+        old[0],
+        old[old.len() - 1]
+    )))
+}
+
+/// What a one-direction test's table must say: its one curve goes where the
+/// controller keeps a mean table, and the reversal was not measured. A table
+/// with a column per direction is not updated from one direction.
+fn one_direction(
+    mode: TableMode,
+    controller: &Capabilities,
+    context: &PlanContext<'_>,
+) -> Result<Vec<String>, CompensateError> {
+    let Some(direction) = context.only_direction else {
+        return Ok(Vec::new());
+    };
+    if context
+        .existing
+        .is_some_and(|t| t.values.mode() == TableMode::Bidirectional)
+    {
+        return Err(CompensateError::OneDirectionUpdate(direction));
+    }
+    if mode == TableMode::Bidirectional {
+        // build_table refuses it, naming the missing direction.
+        return Ok(Vec::new());
+    }
+    Ok(vec![format!(
+        "the test ran {direction} only: the table is the {direction} curve, in {}; the reversal (backlash) was not measured, so leave the backlash parameter as it is (measure both directions to check it)",
+        controller.mean_table
+    )])
 }
 
 fn mode(
@@ -179,6 +292,7 @@ mod tests {
         bidirectional: true,
         free_positions: false,
         resolution_mm: 0.0001,
+        mean_table: "its one column",
     };
 
     fn targets() -> Vec<f64> {
@@ -187,7 +301,14 @@ mod tests {
 
     #[test]
     fn without_effects_a_mean_table_at_the_targets() {
-        let plan = plan(&targets(), &[], &ITNC, &Request::default()).unwrap();
+        let plan = plan(
+            &targets(),
+            &[],
+            &ITNC,
+            &Request::default(),
+            &PlanContext::default(),
+        )
+        .unwrap();
         assert_eq!(plan.options.mode, TableMode::Mean);
         assert_eq!(plan.options.grid, GridSpec::Targets);
         assert!(plan.notes.is_empty());
@@ -196,14 +317,28 @@ mod tests {
     #[test]
     fn a_reversal_makes_it_bidirectional_where_the_controller_takes_it() {
         let effects = [Effect::Reversal(Reversal { b_um: -3.0 })];
-        let bidirectional = plan(&targets(), &effects, &ITNC, &Request::default()).unwrap();
+        let bidirectional = plan(
+            &targets(),
+            &effects,
+            &ITNC,
+            &Request::default(),
+            &PlanContext::default(),
+        )
+        .unwrap();
         assert_eq!(bidirectional.options.mode, TableMode::Bidirectional);
         let mean_only = Capabilities {
             bidirectional: false,
             name: "LinuxCNC",
             ..ITNC
         };
-        let mean = plan(&targets(), &effects, &mean_only, &Request::default()).unwrap();
+        let mean = plan(
+            &targets(),
+            &effects,
+            &mean_only,
+            &Request::default(),
+            &PlanContext::default(),
+        )
+        .unwrap();
         assert_eq!(mean.options.mode, TableMode::Mean);
         assert!(
             mean.notes[0].contains("LinuxCNC takes no bidirectional table"),
@@ -216,7 +351,7 @@ mod tests {
             ..Request::default()
         };
         assert_eq!(
-            plan(&targets(), &effects, &ITNC, &asked)
+            plan(&targets(), &effects, &ITNC, &asked, &PlanContext::default())
                 .unwrap()
                 .options
                 .mode,
@@ -235,7 +370,14 @@ mod tests {
             }),
             Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),
         ];
-        let plan = plan(&targets(), &effects, &ITNC, &Request::default()).unwrap();
+        let plan = plan(
+            &targets(),
+            &effects,
+            &ITNC,
+            &Request::default(),
+            &PlanContext::default(),
+        )
+        .unwrap();
         let GridSpec::Regular {
             start_mm,
             step_mm,
@@ -256,10 +398,114 @@ mod tests {
         );
     }
 
+    /// An old table over −100 … 600 mm, zero at 0 mm.
+    fn existing() -> CompensationTable {
+        CompensationTable {
+            axis: "X".into(),
+            positions_mm: vec![-100.0, 0.0, 250.0, 600.0],
+            values: crate::compensate::TableValues::Mean(vec![0.01, 0.0, 0.002, 0.003]),
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        }
+    }
+
+    #[test]
+    fn an_update_is_referred_to_the_existing_zero_inside_the_measured_range() {
+        let free = Capabilities {
+            free_positions: true,
+            ..ITNC
+        };
+        let old = existing();
+        let context = PlanContext {
+            only_direction: None,
+            existing: Some(&old),
+        };
+        let update = plan(&targets(), &[], &free, &Request::default(), &context).unwrap();
+        assert_eq!(update.options.reference_mm, Some(0.0));
+        assert_eq!(update.update.unwrap().measured_mm, (0.0, 500.0));
+        // A zero the test did not measure cannot refer the update.
+        let mut shifted = existing();
+        shifted.reference_mm = 600.0;
+        let context = PlanContext {
+            only_direction: None,
+            existing: Some(&shifted),
+        };
+        let error = plan(&targets(), &[], &free, &Request::default(), &context).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .starts_with("the existing table is zero (its reference) at 600 mm is outside the measured range 0 … 500 mm"),
+            "{error}"
+        );
+        let given = Request {
+            reference_mm: Some(250.0),
+            ..Request::default()
+        };
+        assert_eq!(
+            plan(&targets(), &[], &free, &given, &context)
+                .unwrap()
+                .options
+                .reference_mm,
+            Some(250.0)
+        );
+        let extrapolate = Request {
+            extrapolate: Some(Extrapolate::Hold),
+            ..given
+        };
+        assert_eq!(
+            plan(&targets(), &[], &free, &extrapolate, &context).unwrap_err(),
+            CompensateError::ExtrapolateUpdate
+        );
+        // One step: the kept −100 and 600 mm leave the 50 mm grid 0 … 500 mm
+        // uneven (100 mm gaps).
+        let context = PlanContext {
+            only_direction: None,
+            existing: Some(&old),
+        };
+        let error = plan(&targets(), &[], &ITNC, &Request::default(), &context).unwrap_err();
+        assert!(
+            error.to_string().contains("4 points from -100 to 600 mm"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn a_one_direction_test_says_where_its_curve_goes() {
+        let down = PlanContext {
+            only_direction: Some(Direction::Down),
+            existing: None,
+        };
+        let plan_down = plan(&targets(), &[], &ITNC, &Request::default(), &down).unwrap();
+        assert_eq!(
+            plan_down.table_notes,
+            vec!["the test ran ↓ only: the table is the ↓ curve, in its one column; the reversal (backlash) was not measured, so leave the backlash parameter as it is (measure both directions to check it)".to_string()]
+        );
+        let mut bidirectional = existing();
+        bidirectional.values = crate::compensate::TableValues::Bidirectional {
+            up: vec![0.0; 4],
+            down: vec![0.001; 4],
+        };
+        let update = PlanContext {
+            existing: Some(&bidirectional),
+            ..down
+        };
+        assert_eq!(
+            plan(&targets(), &[], &ITNC, &Request::default(), &update).unwrap_err(),
+            CompensateError::OneDirectionUpdate(Direction::Down)
+        );
+    }
+
     #[test]
     fn uneven_targets_need_a_step_where_the_controller_takes_only_one() {
         let uneven = [0.0, 10.0, 25.0, 40.0];
-        let error = plan(&uneven, &[], &ITNC, &Request::default()).unwrap_err();
+        let error = plan(
+            &uneven,
+            &[],
+            &ITNC,
+            &Request::default(),
+            &PlanContext::default(),
+        )
+        .unwrap_err();
         assert!(
             error.to_string().contains("iTNC 530 needs one step"),
             "{error}"
@@ -269,10 +515,16 @@ mod tests {
             ..ITNC
         };
         assert_eq!(
-            plan(&uneven, &[], &free, &Request::default())
-                .unwrap()
-                .options
-                .grid,
+            plan(
+                &uneven,
+                &[],
+                &free,
+                &Request::default(),
+                &PlanContext::default()
+            )
+            .unwrap()
+            .options
+            .grid,
             GridSpec::Targets
         );
     }

@@ -50,6 +50,18 @@ pub fn looks_like(text: &str) -> bool {
     text.contains("/LSCRWDATA/")
 }
 
+/// Why `convert` writes no new `.mp` file: the control's `.mp` is the axis'
+/// whole parameter table, and a file of the leadscrew lines alone, under
+/// header lines whose meaning is not known, is not known to load (no public
+/// 8065 manual page describes the file); the control's own export, updated
+/// in place, is.
+pub const NEEDS_EXPORT: &str = "a Fagor 8065 takes the axis' whole parameter table (<axis>.mp), not the leadscrew lines alone: export the axis' .mp from the control (its machine-parameter table) and give it with --existing; axcomp then changes only its leadscrew lines (/LSCRWDATA) and keeps every other parameter";
+
+/// Whether `bytes` are an `.mp` file with a leadscrew table to update.
+pub fn is_parameter_file(bytes: &[u8]) -> bool {
+    super::decode_table(bytes).is_ok_and(|(text, _)| looks_like(&text))
+}
+
 /// A new `.mp` file holding only the leadscrew table, CRLF (encoded UTF-16LE
 /// by `emit::write_bytes`). \[reconstructed\] The four header lines are
 /// copied in form from the real export; what `3100`, `MM ;0` and

@@ -127,6 +127,43 @@ impl Controller {
             bidirectional: self.supports_bidirectional(),
             free_positions: self.accepts_free_positions(),
             resolution_mm: resolution_mm(self, machine_unit),
+            mean_table: self.mean_table(),
+        }
+    }
+
+    /// The unit of the lengths in its file on a machine in `machine_unit`:
+    /// the machine's for the Fagor 8055 and LinuxCNC, whose files hold
+    /// machine units (Fanuc: counts of the machine's detection unit); mm for the others, whose files state mm (Heidenhain
+    /// `MM`, the Fagor 8065's 4-decimal mm) or are written in mm as the
+    /// manufacturer's example (Sinumerik LEC and CEC).
+    pub fn file_unit(self, machine_unit: LengthUnit) -> LengthUnit {
+        match self {
+            Controller::Fagor8055 | Controller::LinuxCnc | Controller::Fanuc => machine_unit,
+            _ => LengthUnit::Millimetre,
+        }
+    }
+
+    /// Where the controller keeps a mean table and how it applies it (the
+    /// facts are in each controller's `formats/` folder).
+    fn mean_table(self) -> &'static str {
+        match self {
+            Controller::Itnc530 => "the axis column, which the iTNC 530 applies in both directions",
+            Controller::Tnc640 => {
+                "the axis column with the BACKLASH column empty, which the TNC 640 applies in both directions"
+            }
+            Controller::Sinumerik840d => {
+                "one LEC table ($AA_ENC_COMP), which the control applies in both directions"
+            }
+            Controller::LinuxCnc => "both the forward and the reverse column alike",
+            Controller::Fagor8055 => {
+                "the positive-direction column (the negative-direction column all zero), which the 8055 then applies in both directions"
+            }
+            Controller::Fagor8065 => {
+                "POSERROR with BIDIR = 0 (NEGERROR all zero), which the 8065 then applies in both directions"
+            }
+            Controller::Fanuc => {
+                "the pitch error compensation data, which the control applies in both directions"
+            }
         }
     }
 

@@ -11,7 +11,8 @@
 //!   "backlash_parameter": {"name": "MD32450 $MA_BACKLASH[0,X1]", "value": 0.0032,
 //!                          "unit": "mm" | "inch", "sign": "…", "note": "…" | null} | null,
 //!   "backlash_note": "…" | null, "activation": "…", "file_unit": "mm" | "inch",
-//!   "effects": ["…what --effects changed…"], "warnings": [...] }
+//!   "effects": ["…what --effects changed…"], "notes": ["…"],
+//!   "update": {…} | null (`report::update`), "warnings": [...] }
 //! ```
 //! Values are the axis error actual − target in µm, zero at the reference,
 //! before each controller's own sign convention (see `formats/`).
@@ -115,6 +116,10 @@ pub struct ConvertJson {
     pub activation: String,
     /// What `--effects` changed, as sentences (empty without it).
     pub effects: Vec<String>,
+    /// What the table must say of itself (a one-direction test), as sentences.
+    pub notes: Vec<String>,
+    /// What an update (`--existing`) kept and changed, or `None`.
+    pub update: Option<super::update::UpdateJson>,
     /// Warnings from reading and evaluating.
     pub warnings: Vec<String>,
 }
@@ -165,6 +170,8 @@ impl ConvertJson {
             backlash_note: None,
             activation,
             effects: Vec::new(),
+            notes: Vec::new(),
+            update: None,
             warnings,
         }
     }
@@ -217,9 +224,14 @@ impl ConvertJson {
         } else {
             format!(" (also {})", self.also.join(", "))
         };
+        // An update referred to a point where the old table was not zero keeps that value there.
+        let zero = match &self.update {
+            Some(update) if !update.zero_at_reference => "as it was",
+            _ => "zero",
+        };
         let _ = writeln!(
             out,
-            "Wrote {} for {}: {} table of axis {}{also}, {} points from {} to {}{position_unit}, {step}, zero at {}{position_unit}",
+            "Wrote {} for {}: {} table of axis {}{also}, {} points from {} to {}{position_unit}, {step}, {zero} at {}{position_unit}",
             self.file,
             self.controller,
             self.mode,
@@ -232,6 +244,12 @@ impl ConvertJson {
         for effect in &self.effects {
             let _ = writeln!(out, "Effect: {effect}");
         }
+        for line in self.update.iter().flat_map(|u| &u.lines) {
+            let _ = writeln!(out, "Update: {line}");
+        }
+        for note in &self.notes {
+            let _ = writeln!(out, "Note: {note}");
+        }
         if let Some(backlash_um) = self.suggested_backlash_um {
             match (&self.backlash_parameter, &self.backlash_note) {
                 (Some(parameter), _) => {
@@ -242,6 +260,13 @@ impl ConvertJson {
                     );
                     if let Some(note) = &parameter.note {
                         let _ = writeln!(out, "  note: {note}");
+                    }
+                    if parameter.unit != self.file_unit && self.kind == AxisKind::Linear {
+                        let _ = writeln!(
+                            out,
+                            "  unit: the parameter is in {} (the machine's unit) and the table file in {} (the unit its format is written in): both are right as printed",
+                            parameter.unit, self.file_unit
+                        );
                     }
                 }
                 (None, Some(note)) => {
@@ -257,7 +282,12 @@ impl ConvertJson {
         }
         let _ = writeln!(
             out,
-            "\nCompensation table [{value_unit}] (axis error actual − target, zero at the reference)"
+            "\nCompensation table [{value_unit}] (axis error actual − target, zero at the reference{})",
+            if self.update.is_some() {
+                "; kept: the old value, outside the measured range; new: a point the old table did not have"
+            } else {
+                ""
+            }
         );
         let position_header = format!("position {}", position_unit.trim_start());
         if self.file_unit == LengthUnit::Inch.as_str() {
@@ -267,18 +297,30 @@ impl ConvertJson {
             ValuesJson::Mean { mean } => {
                 let _ = writeln!(out, "{position_header:>12}  {:>9}", "value");
                 for (p, v) in self.positions_mm.iter().zip(mean) {
-                    let _ = writeln!(out, "{p:>12}  {:>9}", um(Some(*v)));
+                    let mark = self.row_mark(*p);
+                    let _ = writeln!(out, "{p:>12}  {:>9}{mark}", um(Some(*v)));
                 }
             }
             ValuesJson::Bidirectional { up, down } => {
                 let _ = writeln!(out, "{position_header:>12}  {:>9}  {:>9}", "↑", "↓");
                 for ((p, u), d) in self.positions_mm.iter().zip(up).zip(down) {
-                    let _ = writeln!(out, "{p:>12}  {:>9}  {:>9}", um(Some(*u)), um(Some(*d)));
+                    let mark = self.row_mark(*p);
+                    let _ = writeln!(
+                        out,
+                        "{p:>12}  {:>9}  {:>9}{mark}",
+                        um(Some(*u)),
+                        um(Some(*d))
+                    );
                 }
             }
         }
         let _ = writeln!(out, "\nActivation:\n{}", self.activation);
         out
+    }
+
+    /// How an update's row came about (`kept`, `new`, or nothing).
+    fn row_mark(&self, position_mm: f64) -> &'static str {
+        self.update.as_ref().map_or("", |u| u.row_mark(position_mm))
     }
 
     /// The table of an inch file: positions and values in inches, as the
@@ -314,6 +356,7 @@ impl ConvertJson {
                     um(Some(value_um))
                 );
             }
+            out.push_str(self.row_mark(*p));
             out.push('\n');
         }
         let _ = writeln!(out, "\nActivation:\n{}", self.activation);
@@ -328,7 +371,7 @@ impl Serialize for ConvertJson {
             AxisKind::Linear => ("mm", "um"),
             AxisKind::Rotary => ("deg", "arcsec"),
         };
-        let mut map = serializer.serialize_map(Some(18))?;
+        let mut map = serializer.serialize_map(Some(20))?;
         map.serialize_entry("file_unit", self.file_unit)?;
         map.serialize_entry("controller", self.controller)?;
         map.serialize_entry("file", &self.file)?;
@@ -349,6 +392,8 @@ impl Serialize for ConvertJson {
         map.serialize_entry("backlash_note", &self.backlash_note)?;
         map.serialize_entry("activation", &self.activation)?;
         map.serialize_entry("effects", &self.effects)?;
+        map.serialize_entry("notes", &self.notes)?;
+        map.serialize_entry("update", &self.update)?;
         map.serialize_entry("warnings", &self.warnings)?;
         map.end()
     }

@@ -28,4 +28,5 @@ pub mod servo;
 pub mod terminal;
 pub mod tolerance;
 pub mod uncertainty;
+pub mod update;
 pub mod verdict;

@@ -542,13 +542,14 @@ fn table_of(form: &Form, field: &str, effects: &[Effect]) -> Result<Table, ApiEr
     options.kind = measurement.kind();
     let mut measurement = measurement;
     let label = file_label(form.files(field));
-    let existing = match active_table(form, &measurement, label, &profile, linuxcnc_type)? {
+    let (existing, active) = match active_table(form, &measurement, label, &profile, linuxcnc_type)?
+    {
         Some(((_, bytes), _, active, doubts)) => {
             warnings.extend(doubts);
             measurement = compensate::add_existing_table(&measurement, &active)?;
-            Some(bytes)
+            (Some(bytes), Some(active))
         }
-        None => None,
+        None => (None, None),
     };
     let converted = workflow::convert(
         &measurement,
@@ -574,6 +575,7 @@ fn table_of(form: &Form, field: &str, effects: &[Effect]) -> Result<Table, ApiEr
             },
             effects,
             existing: existing.as_deref(),
+            active: active.as_ref(),
             output: file_name.clone(),
             file_name: file_name.clone(),
             also: Vec::new(),

@@ -8,7 +8,7 @@
 //! settings already parsed.
 
 use crate::compensate::effects::build_table_with_effects;
-use crate::compensate::plan::{Request, plan};
+use crate::compensate::plan::{PlanContext, Request, plan};
 use crate::compensate::{CompensateError, CompensationTable};
 use crate::diagnose::KnownPeriod;
 use crate::effects::Effect;
@@ -20,11 +20,12 @@ use crate::evaluate::verdict::{
     with_overrides,
 };
 use crate::evaluate::{Evaluation, Standard, evaluate, evaluate_with};
-use crate::measurement::{AxisKind, Measurement, RunSelector};
+use crate::measurement::{AxisKind, Direction, Measurement, RunSelector};
 use crate::report::acceptance::TestRecord;
 use crate::report::convert::ConvertJson;
 use crate::report::json::EvaluationJson;
 use crate::report::uncertainty::UncertaintyJson;
+use crate::report::update::UpdateJson;
 use crate::report::verdict;
 use crate::units::{AngleUnit, LengthUnit};
 
@@ -150,6 +151,9 @@ pub struct TableRequest<'a> {
     pub effects: &'a [Effect],
     /// The file that was active, when the new table goes back into it (a Fagor 8065 `.mp`).
     pub existing: Option<&'a [u8]>,
+    /// The table that was active during the test (already added to the
+    /// measurement): the new table is its update.
+    pub active: Option<&'a CompensationTable>,
     /// The output as the user named it (`-o`), shown in the JSON.
     pub output: String,
     /// Its file name, which the activation text names.
@@ -176,17 +180,45 @@ pub fn convert(
     warnings: &mut Vec<Warning>,
     table: &TableRequest<'_>,
 ) -> Result<Converted, WorkflowError> {
+    if table.controller == Controller::Fagor8065
+        && !table
+            .existing
+            .is_some_and(emit::fagor8065::is_parameter_file)
+    {
+        return Err(EmitError::Profile(emit::fagor8065::NEEDS_EXPORT.to_string()).into());
+    }
     let evaluation = evaluate(measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
     let options = table.options;
+    let only_direction = match Direction::BOTH.map(|d| measurement.run_count(d) > 0) {
+        [true, false] => Some(Direction::Up),
+        [false, true] => Some(Direction::Down),
+        _ => None,
+    };
     let plan = plan(
         measurement.targets_mm(),
         table.effects,
         &table.controller.capabilities(options.machine_unit),
         table.request,
+        &PlanContext {
+            only_direction,
+            existing: table.active,
+        },
     )?;
-    let compensation =
+    let mut compensation =
         build_table_with_effects(measurement, &evaluation, &plan.options, table.effects)?;
+    // A Fanuc pitch file is updated in place point by point (its data are
+    // increments, emit::fanuc::update): the points outside the table stay as
+    // they were there.
+    let update = plan
+        .update
+        .as_ref()
+        .filter(|_| table.controller != Controller::Fanuc)
+        .map(|update| {
+            let (updated, summary) = update.apply(compensation.clone());
+            compensation = updated;
+            summary
+        });
     let bytes = emit::write_bytes(table.controller, &compensation, options, table.existing)?;
     let activation = emit::activation(table.controller, &compensation, &table.file_name, options);
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
@@ -200,14 +232,16 @@ pub fn convert(
         warning_texts,
     );
     report.effects = plan.notes;
+    report.notes = plan.table_notes;
     if table.controller == Controller::Fanuc {
         report
             .effects
             .extend(emit::fanuc::notes(&compensation, options));
     }
     if measurement.kind() == AxisKind::Linear {
-        report.file_unit = options.machine_unit.as_str();
+        report.file_unit = table.controller.file_unit(options.machine_unit).as_str();
     }
+    report.update = update.map(|summary| UpdateJson::new(&summary, report.file_unit));
     if let Some(backlash_mm) = compensation.suggested_backlash_mm {
         report.set_backlash(table.controller.backlash_parameter(backlash_mm, options));
     }

@@ -229,8 +229,15 @@ fn cases() -> Vec<Case> {
             "sample-bidirectional-ALX",
         ),
         // (An updated .mp would copy the third-party file's other lines into
-        // the repository: tests/it/fagor.rs checks the update instead.)
-        case(inch(), "fagor8065", &[], "api-inch-X.mp"),
+        // the repository: tests/it/fagor.rs checks the update instead; without
+        // the control's .mp no file is written, tests/it/fagor_update.rs.)
+        // A hand-made .mp (fixtures/README.md) updated.
+        case(
+            inch(),
+            "fagor8065",
+            &["--existing", "fixtures/fagor8065/X.mp"],
+            "api-update-X.mp",
+        ),
         // A rotary C axis over a full turn (issue 14): degrees in every file,
         // a Sinumerik modulo table, LinuxCNC with the ends held.
         case(rotary(), "itnc530", &[], "rotary-c-mean.COM"),

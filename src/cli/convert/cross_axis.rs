@@ -11,7 +11,7 @@ use anyhow::{Result, bail};
 use serde::Serialize;
 
 use axcomp::compensate::cross_axis::CrossAxisTable;
-use axcomp::compensate::plan::{Request, plan};
+use axcomp::compensate::plan::{PlanContext, Request, plan};
 use axcomp::compensate::{CompensateError, grid_positions};
 use axcomp::emit::{Controller, EmitOptions, MachineProfile, sinumerik840d, tnc640};
 use axcomp::model::{ErrorComponent, ErrorName, GeometricErrors, Machine};
@@ -306,7 +306,15 @@ fn build(
         reference_mm: args.reference,
         extrapolate: None,
     };
-    let spec = plan(targets, &[], &capabilities, &request)?.options.grid;
+    let spec = plan(
+        targets,
+        &[],
+        &capabilities,
+        &request,
+        &PlanContext::default(),
+    )?
+    .options
+    .grid;
     let positions = grid_positions(targets, spec)?;
     let (first_mm, last_mm) = (targets[0], targets[targets.len() - 1]);
     if let Some(&position_mm) = positions

@@ -1,0 +1,321 @@
+//! Updating the table the control has (`convert --existing`): what the new
+//! table keeps of the old one, and where the update is referred.
+//!
+//! A test taken with a table active measures the residual e; inside the
+//! measured range the next table is old + e − e(r) (`add_existing_table`
+//! adds the old table to the readings, `build_table` shifts), where r is the
+//! reference: the existing table's own zero unless `--reference` names
+//! another point. At r the update adds nothing, so the control's zero stays
+//! where it was (a laser zeroed at the first target would otherwise shift the
+//! whole table by e(first)). Outside the measured range the test says
+//! nothing: every old point there stays with its old value. The grid inside
+//! the measured range is the new one; old points it drops and new points it
+//! adds are listed, so the engineer sees a changed grid.
+//!
+//! Pure: no I/O. Lengths in mm (degrees on a rotary axis).
+
+use super::{CompensateError, CompensationTable, TableValues};
+use crate::measurement::Direction;
+
+/// Two positions closer than this are one point, mm.
+const SAME_POINT_MM: f64 = 1e-6;
+
+/// An update of `existing` by a test over `measured_mm`, referred to `reference_mm`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UpdatePlan {
+    /// The table the control had during the test.
+    pub existing: CompensationTable,
+    /// The first and last measured target, mm.
+    pub measured_mm: (f64, f64),
+    /// Where the update adds nothing, mm.
+    pub reference_mm: f64,
+    /// Whether the reference is the existing table's own zero (not `--reference`).
+    pub at_existing_zero: bool,
+}
+
+/// Consecutive old points kept as they were: first, last, how many.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KeptRange {
+    /// First point, mm.
+    pub first_mm: f64,
+    /// Last point, mm.
+    pub last_mm: f64,
+    /// Number of points.
+    pub count: usize,
+}
+
+/// What an update did, for the engineer to read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UpdateSummary {
+    /// Old points outside the measured range, kept with their old values, by runs.
+    pub kept: Vec<KeptRange>,
+    /// The same points one by one, mm.
+    pub kept_points_mm: Vec<f64>,
+    /// The measured range, mm.
+    pub measured_mm: (f64, f64),
+    /// How many points inside it got old + residual.
+    pub updated: usize,
+    /// Where the update adds nothing, mm.
+    pub reference_mm: f64,
+    /// The existing table's value there, mm (0 at its own zero).
+    pub existing_at_reference_mm: f64,
+    /// Whether the reference is the existing table's own zero.
+    pub at_existing_zero: bool,
+    /// Old points inside the measured range that the new grid does not have, mm.
+    pub dropped_mm: Vec<f64>,
+    /// New points the old table did not have, mm.
+    pub added_mm: Vec<f64>,
+}
+
+impl UpdatePlan {
+    /// The plan of an update, or why it cannot be referred: the reference
+    /// (`given`, else the existing table's zero) must lie inside the measured
+    /// range, where the test measured the residual.
+    pub fn new(
+        existing: &CompensationTable,
+        targets_mm: &[f64],
+        given_reference_mm: Option<f64>,
+    ) -> Result<UpdatePlan, CompensateError> {
+        let measured_mm = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
+        let reference_mm = given_reference_mm.unwrap_or(existing.reference_mm);
+        if reference_mm < measured_mm.0 - 1e-9 || reference_mm > measured_mm.1 + 1e-9 {
+            return Err(CompensateError::UpdateReference {
+                reference_mm,
+                given: given_reference_mm.is_some(),
+                first_mm: measured_mm.0,
+                last_mm: measured_mm.1,
+            });
+        }
+        Ok(UpdatePlan {
+            existing: existing.clone(),
+            measured_mm,
+            reference_mm,
+            at_existing_zero: given_reference_mm.is_none(),
+        })
+    }
+
+    fn inside(&self, position_mm: f64) -> bool {
+        position_mm >= self.measured_mm.0 - 1e-9 && position_mm <= self.measured_mm.1 + 1e-9
+    }
+
+    /// The existing table's value at `position_mm`, the mean of its two
+    /// directions (the value a mean table is zeroed by).
+    fn existing_at(&self, position_mm: f64) -> f64 {
+        let old = &self.existing;
+        (old.value_at(position_mm, Direction::Up) + old.value_at(position_mm, Direction::Down))
+            / 2.0
+    }
+
+    /// The updated table from `new` (old + residual, zero at the reference,
+    /// built on the new grid): the old value at the reference put back so the
+    /// update adds nothing there, the points outside the measured range
+    /// replaced by the old table's values, and every old point outside the
+    /// measured range added.
+    pub fn apply(&self, new: CompensationTable) -> (CompensationTable, UpdateSummary) {
+        let old = &self.existing;
+        let at_reference = self.existing_at(self.reference_mm);
+        let bidirectional = new.values.mode() == super::TableMode::Bidirectional
+            || old.values.mode() == super::TableMode::Bidirectional;
+        // (position, ↑, ↓) of every point of the updated table.
+        let mut rows: Vec<(f64, f64, f64)> = Vec::new();
+        let mut updated = 0;
+        for (index, &p) in new.positions_mm.iter().enumerate() {
+            let value = |d: Direction| {
+                if self.inside(p) {
+                    new.values.for_direction(d)[index] + at_reference
+                } else {
+                    old.value_at(p, d)
+                }
+            };
+            updated += usize::from(self.inside(p));
+            rows.push((p, value(Direction::Up), value(Direction::Down)));
+        }
+        let mut kept = Vec::new();
+        let mut dropped_mm = Vec::new();
+        for (index, &p) in old.positions_mm.iter().enumerate() {
+            let on_new_grid = new
+                .positions_mm
+                .iter()
+                .any(|q| (q - p).abs() < SAME_POINT_MM);
+            if self.inside(p) {
+                if !on_new_grid {
+                    dropped_mm.push(p);
+                }
+                continue;
+            }
+            let value = |d: Direction| old.values.for_direction(d)[index];
+            match rows
+                .iter_mut()
+                .find(|row| (row.0 - p).abs() < SAME_POINT_MM)
+            {
+                Some(row) => *row = (p, value(Direction::Up), value(Direction::Down)),
+                None => rows.push((p, value(Direction::Up), value(Direction::Down))),
+            }
+            match kept.last_mut() {
+                Some(KeptRange { last_mm, count, .. })
+                    if old.positions_mm[index - 1] == *last_mm =>
+                {
+                    *last_mm = p;
+                    *count += 1;
+                }
+                _ => kept.push(KeptRange {
+                    first_mm: p,
+                    last_mm: p,
+                    count: 1,
+                }),
+            }
+        }
+        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let added_mm = new
+            .positions_mm
+            .iter()
+            .copied()
+            .filter(|p| {
+                !old.positions_mm
+                    .iter()
+                    .any(|q| (q - p).abs() < SAME_POINT_MM)
+            })
+            .collect();
+        let positions_mm: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let up: Vec<f64> = rows.iter().map(|r| r.1).collect();
+        let values = if bidirectional {
+            TableValues::Bidirectional {
+                up,
+                down: rows.iter().map(|r| r.2).collect(),
+            }
+        } else {
+            TableValues::Mean(up)
+        };
+        let table = CompensationTable {
+            positions_mm,
+            values,
+            reference_mm: self.reference_mm,
+            ..new
+        };
+        let summary = UpdateSummary {
+            kept_points_mm: old
+                .positions_mm
+                .iter()
+                .copied()
+                .filter(|&p| !self.inside(p))
+                .collect(),
+            kept,
+            measured_mm: self.measured_mm,
+            updated,
+            reference_mm: self.reference_mm,
+            existing_at_reference_mm: at_reference,
+            at_existing_zero: self.at_existing_zero,
+            dropped_mm,
+            added_mm,
+        };
+        (table, summary)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(positions_mm: Vec<f64>, values: TableValues) -> CompensationTable {
+        CompensationTable {
+            axis: "X".into(),
+            positions_mm,
+            values,
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        }
+    }
+
+    #[test]
+    fn old_points_outside_the_measured_range_stay_as_they_were() {
+        // Old: −200, −100, 0, 150, 300, 400 mm; measured 0 … 300 mm on a 100 mm grid.
+        let old = table(
+            vec![-200.0, -100.0, 0.0, 150.0, 300.0, 400.0],
+            TableValues::Mean(vec![0.02, 0.01, 0.0, 0.004, 0.006, 0.008]),
+        );
+        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0, 300.0], None).unwrap();
+        assert_eq!(update.reference_mm, 0.0);
+        // Built (old + residual, zero at 0 mm) on 0, 100, 200, 300.
+        let new = table(
+            vec![0.0, 100.0, 200.0, 300.0],
+            TableValues::Mean(vec![0.0, 0.003, 0.005, 0.007]),
+        );
+        let (merged, summary) = update.apply(new);
+        assert_eq!(
+            merged.positions_mm,
+            vec![-200.0, -100.0, 0.0, 100.0, 200.0, 300.0, 400.0]
+        );
+        assert_eq!(
+            merged.values,
+            TableValues::Mean(vec![0.02, 0.01, 0.0, 0.003, 0.005, 0.007, 0.008])
+        );
+        assert_eq!(
+            summary.kept,
+            vec![
+                KeptRange {
+                    first_mm: -200.0,
+                    last_mm: -100.0,
+                    count: 2
+                },
+                KeptRange {
+                    first_mm: 400.0,
+                    last_mm: 400.0,
+                    count: 1
+                }
+            ]
+        );
+        assert_eq!(summary.updated, 4);
+        assert_eq!(summary.dropped_mm, vec![150.0]);
+        assert_eq!(summary.added_mm, vec![100.0, 200.0]);
+    }
+
+    #[test]
+    fn at_a_given_reference_the_update_adds_nothing() {
+        // Old 0 at 0 mm and 0.004 mm at 100 mm; --reference 100: the built
+        // table is zero there, the old 0.004 mm is put back.
+        let old = table(
+            vec![0.0, 100.0, 200.0],
+            TableValues::Mean(vec![0.0, 0.004, 0.006]),
+        );
+        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0], Some(100.0)).unwrap();
+        let new = table(
+            vec![0.0, 100.0, 200.0],
+            TableValues::Mean(vec![-0.001, 0.0, 0.003]),
+        );
+        let (merged, summary) = update.apply(new);
+        let TableValues::Mean(values) = merged.values else {
+            panic!("mean")
+        };
+        for (got, expected) in values.iter().zip([0.003, 0.004, 0.007]) {
+            assert!((got - expected).abs() < 1e-15, "{values:?}");
+        }
+        assert!(!summary.at_existing_zero);
+        assert!((summary.existing_at_reference_mm - 0.004).abs() < 1e-15);
+        // A reference the test did not measure is refused.
+        assert!(matches!(
+            UpdatePlan::new(&old, &[0.0, 100.0], Some(150.0)),
+            Err(CompensateError::UpdateReference { given: true, .. })
+        ));
+    }
+
+    #[test]
+    fn a_bidirectional_old_table_keeps_both_columns_outside() {
+        let old = table(
+            vec![-100.0, 0.0, 100.0],
+            TableValues::Bidirectional {
+                up: vec![0.001, 0.0, 0.002],
+                down: vec![0.003, 0.0, 0.004],
+            },
+        );
+        let update = UpdatePlan::new(&old, &[0.0, 100.0], None).unwrap();
+        let new = table(vec![0.0, 100.0], TableValues::Mean(vec![0.0, 0.005]));
+        let (merged, _) = update.apply(new);
+        assert_eq!(
+            merged.values,
+            TableValues::Bidirectional {
+                up: vec![0.001, 0.0, 0.005],
+                down: vec![0.003, 0.0, 0.005],
+            }
+        );
+    }
+}

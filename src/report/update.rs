@@ -1,0 +1,236 @@
+//! What `convert --existing` says of the update: per range, what the new
+//! table kept of the old one and what it changed (`compensate::update`).
+//!
+//! # Wire format (`"update"` in `convert --json`, null without `--existing`)
+//!
+//! ```text
+//! { "kept_mm": [{"first": -4953.0, "last": -2286.0, "count": 22}, …],
+//!   "measured_mm": [-2159.0, 0.0], "updated": 18, "reference_mm": 0.0,
+//!   "reference": "existing zero" | "given",
+//!   "dropped_mm": [...], "added_mm": [...], "lines": ["…", …] }
+//! ```
+//! Positions in mm; `lines` are the sentences the terminal prints, with
+//! positions in the file's unit (inch files: inch and mm).
+
+use serde::Serialize;
+
+use crate::compensate::update::{KeptRange, UpdateSummary};
+use crate::report::format::inch_text;
+use crate::units::LengthUnit;
+
+/// Old points kept as they were, one run.
+#[derive(Clone, Debug, Serialize)]
+pub struct KeptJson {
+    /// First point, mm.
+    pub first: f64,
+    /// Last point, mm.
+    pub last: f64,
+    /// How many points.
+    pub count: usize,
+}
+
+/// The update, for `--json` and the terminal.
+#[derive(Clone, Debug, Serialize)]
+pub struct UpdateJson {
+    /// Old points outside the measured range, kept as they were, by runs.
+    pub kept_mm: Vec<KeptJson>,
+    /// The measured range, mm.
+    pub measured_mm: [f64; 2],
+    /// Points inside it that got old + residual.
+    pub updated: usize,
+    /// Where the update adds nothing, mm.
+    pub reference_mm: f64,
+    /// `existing zero` (the existing table's zero, the default) or `given` (`--reference`).
+    pub reference: &'static str,
+    /// Old points inside the measured range the new grid does not have, mm.
+    pub dropped_mm: Vec<f64>,
+    /// New points the old table did not have, mm.
+    pub added_mm: Vec<f64>,
+    /// What the terminal prints.
+    pub lines: Vec<String>,
+    /// Whether the new table is zero at the reference (the existing table is).
+    #[serde(skip)]
+    pub zero_at_reference: bool,
+    /// Every kept point, mm (for marking the printed table's rows).
+    #[serde(skip)]
+    pub kept_points_mm: Vec<f64>,
+}
+
+impl UpdateJson {
+    /// What a row of the printed table is: `kept` (the old value), `new`
+    /// (a point the old table did not have) or nothing (old + residual).
+    pub fn row_mark(&self, position_mm: f64) -> &'static str {
+        let among = |list: &[f64]| list.iter().any(|p| (p - position_mm).abs() < 1e-6);
+        if among(&self.kept_points_mm) {
+            "  kept"
+        } else if among(&self.added_mm) {
+            "  new"
+        } else {
+            ""
+        }
+    }
+}
+
+impl UpdateJson {
+    /// From the summary; positions written in `file_unit` (`mm`, `inch` or `deg`).
+    pub fn new(summary: &UpdateSummary, file_unit: &str) -> UpdateJson {
+        UpdateJson {
+            kept_mm: summary
+                .kept
+                .iter()
+                .map(|k| KeptJson {
+                    first: k.first_mm,
+                    last: k.last_mm,
+                    count: k.count,
+                })
+                .collect(),
+            measured_mm: [summary.measured_mm.0, summary.measured_mm.1],
+            updated: summary.updated,
+            reference_mm: summary.reference_mm,
+            reference: if summary.at_existing_zero {
+                "existing zero"
+            } else {
+                "given"
+            },
+            dropped_mm: summary.dropped_mm.clone(),
+            added_mm: summary.added_mm.clone(),
+            lines: lines(summary, file_unit),
+            zero_at_reference: summary.existing_at_reference_mm.abs() < 1e-12,
+            kept_points_mm: summary.kept_points_mm.clone(),
+        }
+    }
+}
+
+/// A position or a range `a…b` in the file's unit (inch files: and mm).
+fn range_text(first_mm: f64, last_mm: f64, file_unit: &str) -> String {
+    let number = |value: f64| {
+        let text = format!("{value:.4}");
+        let text = text.trim_end_matches('0').trim_end_matches('.');
+        if text == "-0" {
+            "0".to_string()
+        } else {
+            text.to_string()
+        }
+    };
+    let span = |f: &dyn Fn(f64) -> String| {
+        if (last_mm - first_mm).abs() < 1e-9 {
+            f(first_mm)
+        } else {
+            format!("{}…{}", f(first_mm), f(last_mm))
+        }
+    };
+    match file_unit {
+        "inch" => {
+            let inch = |mm: f64| inch_text(LengthUnit::Inch.from_mm(mm));
+            format!("{} in ({} mm)", span(&inch), span(&number))
+        }
+        "deg" => format!("{}°", span(&number)),
+        _ => format!("{} mm", span(&number)),
+    }
+}
+
+fn ranges_text(ranges: &[KeptRange], file_unit: &str) -> String {
+    let parts: Vec<String> = ranges
+        .iter()
+        .map(|k| {
+            let points = if k.count == 1 { "point" } else { "points" };
+            format!(
+                "{} ({} {points})",
+                range_text(k.first_mm, k.last_mm, file_unit),
+                k.count
+            )
+        })
+        .collect();
+    parts.join(" and ")
+}
+
+fn list_text(positions_mm: &[f64], file_unit: &str) -> String {
+    let parts: Vec<String> = positions_mm
+        .iter()
+        .map(|p| range_text(*p, *p, file_unit))
+        .collect();
+    parts.join(", ")
+}
+
+/// The sentences: what was kept, what was updated and where it is referred,
+/// how the grid changed.
+fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
+    let (first, last) = summary.measured_mm;
+    let measured = range_text(first, last, file_unit);
+    let mut lines = Vec::new();
+    if !summary.kept.is_empty() {
+        let kept: usize = summary.kept.iter().map(|k| k.count).sum();
+        lines.push(format!(
+            "{}: kept as {} (outside the measured {measured})",
+            ranges_text(&summary.kept, file_unit),
+            if kept == 1 { "it was" } else { "they were" }
+        ));
+    }
+    let reference = range_text(summary.reference_mm, summary.reference_mm, file_unit);
+    let why = if summary.at_existing_zero && summary.existing_at_reference_mm.abs() < 1e-12 {
+        "the existing table's zero".to_string()
+    } else if summary.at_existing_zero {
+        "the existing table's first point; it has no zero".to_string()
+    } else {
+        "--reference".to_string()
+    };
+    lines.push(format!(
+        "{measured} ({} points): the existing table plus the measured residual, referred to {reference} ({why}), where the update adds nothing",
+        summary.updated
+    ));
+    if !summary.dropped_mm.is_empty() {
+        lines.push(format!(
+            "grid changed: the old points at {} are not on the new grid (the new table follows the old one plus the residual between its points)",
+            list_text(&summary.dropped_mm, file_unit)
+        ));
+    }
+    if !summary.added_mm.is_empty() {
+        lines.push(format!(
+            "grid changed: new points at {} (the old table had none there)",
+            list_text(&summary.added_mm, file_unit)
+        ));
+    }
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_read_in_the_files_unit() {
+        let summary = UpdateSummary {
+            kept: vec![
+                KeptRange {
+                    first_mm: -4953.0,
+                    last_mm: -2286.0,
+                    count: 22,
+                },
+                KeptRange {
+                    first_mm: 127.0,
+                    last_mm: 127.0,
+                    count: 1,
+                },
+            ],
+            measured_mm: (-2159.0, 0.0),
+            updated: 18,
+            reference_mm: 0.0,
+            existing_at_reference_mm: 0.0,
+            at_existing_zero: true,
+            dropped_mm: vec![],
+            added_mm: vec![3302.0],
+            kept_points_mm: vec![],
+        };
+        let lines = lines(&summary, "mm");
+        assert_eq!(
+            lines[0],
+            "-4953…-2286 mm (22 points) and 127 mm (1 point): kept as they were (outside the measured -2159…0 mm)"
+        );
+        assert!(lines[1].contains("referred to 0 mm (the existing table's zero)"));
+        assert_eq!(
+            lines[2],
+            "grid changed: new points at 3302 mm (the old table had none there)"
+        );
+        assert_eq!(range_text(-2159.0, 0.0, "inch"), "-85…0 in (-2159…0 mm)");
+    }
+}
