@@ -97,7 +97,10 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     };
     let table = compensate::build_table(&before, &evaluation, &options)?;
     let mut active = None;
-    for controller in Controller::ALL {
+    for controller in Controller::ALL
+        .into_iter()
+        .filter(|c| !c.needs_the_controls_file())
+    {
         let emit_options = emit_options(&table.axis)?;
         let bytes = emit::write_bytes(controller, &table, &emit_options, None)?;
         let (text, _) = emit::decode_table(&bytes)
@@ -374,7 +377,7 @@ fn summary(s: &Summary<'_>) -> String {
     );
     let _ = writeln!(
         out,
-        " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC, Fagor 8055, 8065: {} points (tables/)",
+        " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC, Fagor 8055: {} points (tables/; Fagor 8065 and Fanuc: convert --existing updates the control's own file)",
         s.table.values.mode().as_str(),
         s.table.positions_mm.len()
     );

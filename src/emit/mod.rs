@@ -114,6 +114,15 @@ impl Controller {
         )
     }
 
+    /// Whether a table for this controller is written into the control's
+    /// own file, which axcomp cannot write from nothing: a Fagor 8065 table
+    /// is part of the axis' `.mp` export, and a Fanuc table counts in units
+    /// and points the parameter backup gives. `convert --existing` (with
+    /// `--fanuc-parameters` for Fanuc) updates them.
+    pub fn needs_the_controls_file(self) -> bool {
+        matches!(self, Controller::Fagor8065 | Controller::Fanuc)
+    }
+
     /// Whether the format holds separate ↑ and ↓ values.
     pub fn supports_bidirectional(self) -> bool {
         !matches!(self, Controller::Itnc530 | Controller::Fanuc)
