@@ -402,7 +402,13 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
         if csv.is_empty() {
             bail!("--csv: the {} test has no trace to write", test.name());
         }
-        write_new(path, &csv, args.overwrite.force)?;
+        let inputs = [
+            Some(Path::new(&args.axis)),
+            args.identify.as_deref(),
+            args.reversal.as_deref(),
+        ];
+        let inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
+        write_new(path, &csv, &inputs, args.overwrite.force)?;
     }
     if args.json_output.json {
         print_json(&report)

@@ -2,10 +2,10 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 
 use axcomp::measurement::{AxisKind, Measurement};
-use axcomp::output::write_all_new;
+use axcomp::output::{create_folder, write_all_new};
 use axcomp::read::{csv, rtl};
 use axcomp::synth::geometry::{self, GeometryPlan};
 use axcomp::synth::{self, RotaryTruth, Truth};
@@ -69,6 +69,18 @@ pub struct SynthArgs {
     pub verbosity: Verbosity,
 }
 
+impl SynthArgs {
+    /// Every file the command reads: never an output (`output::write_new`).
+    fn inputs(&self) -> Vec<&Path> {
+        let named = [
+            self.truth.as_deref(),
+            self.table.as_deref(),
+            self.machine_file.machine.as_deref(),
+        ];
+        named.into_iter().flatten().collect()
+    }
+}
+
 /// Runs `axcomp synth`.
 pub fn run(args: &SynthArgs) -> Result<()> {
     let (Some(truth_path), Some(output)) = (&args.truth, &args.output) else {
@@ -105,7 +117,7 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     if let Some((path, text)) = &second {
         files.push((path.as_path(), text.as_bytes()));
     }
-    write_all_new(&files, args.overwrite.force)?;
+    write_all_new(&files, &args.inputs(), args.overwrite.force)?;
     let mut summary = format!(
         "Wrote {} ({} targets, {} runs)\n",
         output.display(),
@@ -132,7 +144,11 @@ fn run_rotary(args: &SynthArgs, truth_path: &Path, output: &Path) -> Result<()> 
     let truth = load(truth_path, RotaryTruth::from_toml_str)?;
     let test = synth::rotary_test(&truth, args.seed)?;
     let text = render(&test, output)?;
-    write_all_new(&[(output, text.as_bytes())], args.overwrite.force)?;
+    write_all_new(
+        &[(output, text.as_bytes())],
+        &args.inputs(),
+        args.overwrite.force,
+    )?;
     print_text(&format!(
         "Wrote {} (rotary axis, {} targets, {} runs)\n",
         output.display(),
@@ -150,14 +166,14 @@ fn run_geometry(args: &SynthArgs) -> Result<()> {
     let plan = GeometryPlan::example();
     let truth = geometry::random_truth(&machine, &plan, args.seed)?;
     let synthetic = geometry::measure(&machine, &truth, &plan, args.seed)?;
-    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    create_folder(dir)?;
     let mut files: Vec<(PathBuf, &[u8])> = synthetic
         .tests
         .iter()
         .map(|(name, text)| (dir.join(name), text.as_bytes()))
         .collect();
     files.push((dir.join("survey.toml"), synthetic.survey.as_bytes()));
-    write_all_new(&files, args.overwrite.force)?;
+    write_all_new(&files, &args.inputs(), args.overwrite.force)?;
     let mut summary = String::new();
     for (path, _) in &files {
         summary.push_str(&format!("Wrote {}\n", path.display()));

@@ -253,7 +253,9 @@ pub fn run(args: &ToleranceArgs) -> Result<()> {
             &title,
             format,
         )?;
-        write_new(path, &bytes, args.overwrite.force)?;
+        let inputs: Vec<&std::path::Path> =
+            args.machine_file.machine.as_deref().into_iter().collect();
+        write_new(path, &bytes, &inputs, args.overwrite.force)?;
     }
     if args.json_output.json {
         print_json(&report)

@@ -21,6 +21,7 @@ mod fagor;
 mod flags;
 mod http;
 mod injected;
+mod inputs;
 mod linuxcnc;
 mod model;
 mod outputs;
