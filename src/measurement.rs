@@ -345,6 +345,23 @@ impl TestSetup {
 }
 
 impl Metadata {
+    /// Whether the file records that a laser interferometer measured the
+    /// test: a Renishaw `.rtl` (written only by its laser software), an API
+    /// `.pos` whose title names the laser. An ecmc test (a triangulation
+    /// sensor or an encoder, its `REF_PV`) and axcomp's CSV do not: their
+    /// uncertainty needs the user's equipment.
+    pub fn records_laser_interferometer(&self) -> bool {
+        match self.source_format {
+            Some(SourceFormat::Rtl) => true,
+            Some(SourceFormat::ApiPos) => self
+                .setup
+                .instrument
+                .as_ref()
+                .is_some_and(|name| name.to_ascii_lowercase().contains("laser")),
+            Some(SourceFormat::Ecmc | SourceFormat::Csv) | None => false,
+        }
+    }
+
     /// Duration of the test, s, when both start and end are known and parsed.
     pub fn duration_s(&self) -> Option<f64> {
         let start = self.date.as_ref()?.parsed?;

@@ -125,7 +125,7 @@ fn read_test(
     format: Option<SourceFormat>,
     axis: Option<&String>,
     standard: &dyn Standard,
-    equipment: &Equipment,
+    equipment: Option<&Equipment>,
 ) -> Result<Test> {
     let read::ReadResult {
         mut measurement,
@@ -176,7 +176,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         args.input_format.format,
         args.axis.as_ref(),
         standard,
-        &equipment,
+        equipment.as_ref(),
     )?;
     let angle = args.angle_unit.for_axis(&before.measurement)?;
     if before.measurement.kind() == AxisKind::Rotary {
@@ -200,7 +200,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             args.input_format.format,
             args.axis.as_ref(),
             standard,
-            &equipment,
+            equipment.as_ref(),
         )?),
         None => None,
     };

@@ -108,3 +108,204 @@ fn report_png_into_a_missing_parent_folder_is_refused() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(plots.join("deviation.png").exists());
 }
+
+// --- profiles and inputs are checked, not guessed ----------------------------
+
+/// A machine profile with `text` in a fresh folder.
+fn profile(text: &str) -> (tempfile::TempDir, PathBuf) {
+    let directory = tempfile::tempdir().unwrap();
+    let path = directory.path().join("M.toml");
+    std::fs::write(&path, text).unwrap();
+    (directory, path)
+}
+
+#[test]
+fn a_misspelt_profile_table_or_value_is_refused_at_its_line_by_every_command() {
+    let pos = shared_data("api-xd/example__8055__X Axis Forward.pos");
+    // `[controler]` wrote an mm Fagor table from an inch profile, exit 0.
+    let (directory, misspelt) = profile("[controler]\nunits = \"inch\"\n");
+    let table = directory.path().join("ALX");
+    let run = axcomp(strings(&[
+        &"convert",
+        &pos,
+        &"--controller",
+        &"fagor8055",
+        &"--axis",
+        &"X",
+        &"-o",
+        &table,
+        &"--machine",
+        &misspelt,
+    ]));
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert_eq!(
+        run.stderr,
+        format!(
+            "axcomp: error: {}:1:2: a machine profile has no table or key \"controler\"; \
+             expected name, controller, kinematics, acceptance\n",
+            misspelt.display()
+        )
+    );
+    assert!(!table.exists());
+    // `[acceptence]` gave no verdict and no word.
+    let (_directory, acceptance) = profile("name = \"VC 1810\"\n[acceptence]\nA = 10\n");
+    let run = axcomp(strings(&[&"evaluate", &pos, &"--machine", &acceptance]));
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(&format!(
+            "{}:2:2: a machine profile has no table or key \"acceptence\"",
+            acceptance.display()
+        )),
+        "{}",
+        run.stderr
+    );
+    // `units = "furlong"` passed `evaluate`, which reads only [acceptance].
+    let (_directory, furlong) =
+        profile("[controller]\nunits = \"furlong\"\n[acceptance]\nA = 10\n");
+    let run = axcomp(strings(&[&"evaluate", &pos, &"--machine", &furlong]));
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(&format!(
+            "{}:2:9: controller.units must be \"mm\" or \"inch\", found \"furlong\"",
+            furlong.display()
+        )),
+        "{}",
+        run.stderr
+    );
+    // The well-spelt profile is read (the verdict appears).
+    let (_directory, good) = profile("[controller]\nunits = \"inch\"\n[acceptance]\nA = 1000\n");
+    let run = axcomp(strings(&[
+        &"evaluate",
+        &pos,
+        &"--machine",
+        &good,
+        &"--json",
+    ]));
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(json["verdict"]["checks"][0]["figure"], "A");
+}
+
+#[test]
+fn evaluate_json_gives_no_axis_name_where_the_file_records_none() {
+    // The ecmccfg example records no axis (no TGT_SET_PV, no axis in its name).
+    let file = shared_data("ecmc/ecmccfg/examples__mcu1025_fat_sat__report.md_ISO230.dat");
+    let run = axcomp(strings(&[&"evaluate", &file, &"--json"]));
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(json["axis"], serde_json::Value::Null);
+    assert_eq!(json["axis_source"]["kind"], "not_recorded");
+    let run = axcomp(strings(&[&"evaluate", &file, &"--json", &"--axis", &"Z"]));
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(json["axis"], "Z");
+    // A file that records its axis keeps it.
+    let file = shared_data(
+        "ecmc/ecmc_target_muts_logger/muts__data__week42_22__xyz__target_y_report_ILD50.md_ISO230.dat",
+    );
+    let run = axcomp(strings(&[&"evaluate", &file, &"--json"]));
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(json["axis"], "Y");
+}
+
+// --- uncertainty from a known instrument -------------------------------------
+
+const ILD50_X: &str =
+    "ecmc/ecmc_target_muts_logger/muts__data__week42_22__xyz__target_x_report_ILD50.md_ISO230.dat";
+
+fn json_of(args: &[&dyn AsRef<std::ffi::OsStr>]) -> serde_json::Value {
+    let run = axcomp(strings(args));
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    serde_json::from_str(&run.stdout).unwrap()
+}
+
+#[test]
+fn a_sensor_or_encoder_test_gets_no_laser_uncertainty_unless_equipment_is_given() {
+    // Every real ecmc test: the reference is a sensor or an encoder (REF_PV).
+    for file in crate::util::shared_files("ecmc/ecmc_target_muts_logger", ".dat") {
+        let json = json_of(&[&"evaluate", &file, &"--json"]);
+        assert!(json.get("uncertainty_um").is_none(), "{}", file.display());
+        let warnings = json["warnings"].to_string();
+        assert!(
+            warnings.contains("not evaluated: instrument unknown (give --equipment)"),
+            "{}: {warnings}",
+            file.display()
+        );
+    }
+    let file = shared_data(ILD50_X);
+    // With --equipment the budget is the user's.
+    let json = json_of(&[
+        &"evaluate",
+        &file,
+        &"--json",
+        &"--equipment",
+        &"fixtures/equipment/hene-default.toml",
+    ]);
+    assert!(json["uncertainty_um"]["A"].as_f64().unwrap() > 0.0);
+    // Under ISO 14253-1 the check says why it has no U.
+    let json = json_of(&[
+        &"evaluate",
+        &file,
+        &"--json",
+        &"--decision",
+        &"iso14253-1",
+        &"--limit",
+        &"A=200",
+    ]);
+    let check = &json["verdict"]["checks"][0];
+    assert_eq!(check["U_um"], serde_json::Value::Null);
+    assert_eq!(
+        check["U_note"],
+        "U(A) not evaluated: instrument unknown (give --equipment); compared by its value alone"
+    );
+    // The acceptance report a customer signs shows no ± U for A either.
+    let directory = tempfile::tempdir().unwrap();
+    let html = directory.path().join("report.html");
+    let run = axcomp(strings(&[&"report", &file, &"-o", &html]));
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(!page.contains("id=\"uncertainty\""), "no budget section");
+    assert!(page.contains("instrument unknown (give --equipment)"));
+}
+
+#[test]
+fn laser_files_keep_their_uncertainty_and_pa_has_the_u_of_m() {
+    // A Renishaw .rtl and an API laser's .pos record a laser interferometer.
+    let pos = shared_data("api-xd/example__8055__X Axis Forward.pos");
+    for file in [PathBuf::from(SAMPLE), pos] {
+        let json = json_of(&[&"evaluate", &file, &"--json"]);
+        assert!(
+            json["uncertainty_um"]["A"].as_f64().unwrap() > 0.0,
+            "{}",
+            file.display()
+        );
+    }
+    // VDI 3441's Pa is M's formula (the range of the bidirectional means):
+    // the same U, and the same number judged the same way.
+    let iso = json_of(&[&"evaluate", &SAMPLE, &"--json"]);
+    let vdi = json_of(&[
+        &"evaluate",
+        &SAMPLE,
+        &"--json",
+        &"--standard",
+        &"vdi3441",
+        &"--decision",
+        &"iso14253-1",
+        &"--limit",
+        &"Pa=8.5",
+        &"--limit",
+        &"P=100",
+    ]);
+    let m = iso["figures_um"]["M"].as_f64().unwrap();
+    let u_m = iso["uncertainty_um"]["M"].as_f64().unwrap();
+    let checks = vdi["verdict"]["checks"].as_array().unwrap();
+    let pa = checks.iter().find(|c| c["figure"] == "Pa").unwrap();
+    assert!((pa["value_um"].as_f64().unwrap() - m).abs() < 1e-9);
+    assert_eq!(pa["U_um"].as_f64().unwrap(), u_m);
+    // M = 8.064 µm, U = 1.82 µm: 8.064 + 1.82 > 8.5 ≥ 8.064 − 1.82.
+    assert_eq!(pa["conformance"], "not-proven");
+    let p = checks.iter().find(|c| c["figure"] == "P").unwrap();
+    assert_eq!(
+        p["U_note"],
+        "U(P) not evaluated: no published form of its uncertainty; compared by its value alone"
+    );
+}
