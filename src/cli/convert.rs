@@ -89,7 +89,7 @@ pub struct ConvertArgs {
 
     /// Position where the table is zero, mm (default: the first point).
     ///
-    /// Controllers reference the axis there; seed 001 zeroes the first point.
+    /// Controllers reference the axis there; the usual choice is the first point.
     #[arg(
         long,
         value_name = "MM",

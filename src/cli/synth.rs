@@ -33,8 +33,7 @@ pub struct SynthArgs {
     pub output: Option<PathBuf>,
 
     /// Instead of a positioning test: the geometry tests of a synthetic
-    /// machine with random 21 errors (`synth::geometry`, the plan of the
-    /// issue 15 tests: one 6-DOF CSV per axis on a line away from the
+    /// machine with random 21 errors (`synth::geometry`: one 6-DOF CSV per axis on a line away from the
     /// reference, optics off the tool), X.csv, Y.csv, Z.csv, and the
     /// survey.toml naming them, written into the folder DIR.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["truth", "output", "table", "output2"])]
@@ -137,7 +136,7 @@ pub fn run(args: &SynthArgs) -> Result<()> {
 fn run_rotary(args: &SynthArgs, truth_path: &Path, output: &Path) -> Result<()> {
     if args.table.is_some() {
         bail!(
-            "{}: a rotary truth has no re-test with a table yet (issue 14); leave out --table and --o2",
+            "{}: a rotary truth has no re-test with a table yet; leave out --table and --o2",
             truth_path.display()
         );
     }

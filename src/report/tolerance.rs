@@ -545,7 +545,7 @@ pub fn axis_study_report(report: &AxisStudyJson) -> String {
         .modify(Columns::new(1..), Alignment::right());
     out.push_str(&table.to_string());
     out.push_str(
-        "\n  (P10: 9 of 10 axes improve at least this much; the thesis calls it \"P90\")\n",
+        "\n  (P10: 9 of 10 axes improve at least this much; Valášek 2021 calls it \"P90\")\n",
     );
     out
 }

@@ -309,3 +309,82 @@ fn laser_files_keep_their_uncertainty_and_pa_has_the_u_of_m() {
         "U(P) not evaluated: no published form of its uncertainty; compared by its value alone"
     );
 }
+
+// --- users read references, not project jargon -------------------------------
+
+/// Names of the project's own sources that a customer cannot look up.
+const JARGON: [&str; 7] = [
+    "seed 0",
+    "Seed 0",
+    "the thesis",
+    "thesis's",
+    "issue 1",
+    "NumPy peer",
+    "the issue",
+];
+
+#[test]
+fn help_report_and_page_cite_publications_not_project_jargon() {
+    let commands = [
+        "demo",
+        "evaluate",
+        "convert",
+        "synth",
+        "predict",
+        "diagnose",
+        "tolerance",
+        "servo-sim",
+        "report",
+        "serve",
+    ];
+    let mut texts = vec![("axcomp --help".to_string(), axcomp(["--help"]).stdout)];
+    for command in commands {
+        let run = axcomp([command, "--help"]);
+        assert_eq!(run.code, 0, "{command}: {}", run.stderr);
+        texts.push((format!("{command} --help"), run.stdout));
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let html = directory.path().join("report.html");
+    let run = axcomp(strings(&[&"report", &SAMPLE, &"-o", &html]));
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(
+        page.contains("Edlén 1966"),
+        "the report cites Edlén by year"
+    );
+    texts.push(("the report".into(), page));
+    let app = std::fs::read_to_string("assets/serve/index.html").unwrap()
+        + &std::fs::read_to_string("assets/serve/app.js").unwrap();
+    texts.push(("the web page".into(), app));
+    for (what, text) in &texts {
+        for word in JARGON {
+            assert!(!text.contains(word), "{what} says {word:?}");
+        }
+    }
+    // The help cites the models' sources by author and year.
+    let tolerance = &texts
+        .iter()
+        .find(|(w, _)| w == "tolerance --help")
+        .unwrap()
+        .1;
+    assert!(tolerance.contains("Valášek (2021)"), "{tolerance}");
+    let servo = &texts
+        .iter()
+        .find(|(w, _)| w == "servo-sim --help")
+        .unwrap()
+        .1;
+    assert!(servo.contains("Mendřický 2006"), "{servo}");
+    // The references page lists them with the standards.
+    let references = std::fs::read_to_string("docs/src/references.md").unwrap();
+    for cited in [
+        "Valášek, A. (2021)",
+        "Mendřický, R. (2006)",
+        "Edlén, B. (1966)",
+        "Birch, K. P. and Downs, M. J. (1993)",
+        "ISO 230-2:2014",
+        "ISO 14253-1",
+        "VDI/DGQ 3441",
+    ] {
+        assert!(references.contains(cited), "references.md lacks {cited}");
+    }
+}
