@@ -388,3 +388,94 @@ fn help_report_and_page_cite_publications_not_project_jargon() {
         assert!(references.contains(cited), "references.md lacks {cited}");
     }
 }
+
+// --- smaller: messages that say what differs, tables read by rank -------------
+
+#[test]
+fn joining_files_whose_targets_differ_says_which_target() {
+    let directory = tempfile::tempdir().unwrap();
+    // The same count and ends, one target 0.25 mm elsewhere.
+    let file = |name: &str, middle: f64, direction: &str| {
+        let mut text = String::from("# axis: X\ntarget_mm,run,direction,deviation_um\n");
+        for target in [0.0, 150.0, middle, 450.0, 600.0, 750.0] {
+            text.push_str(&format!("{target},1,{direction},1.0\n"));
+        }
+        let path = directory.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let up = file("up.csv", 300.0, "up");
+    let down = file("down.csv", 300.25, "down");
+    let run = axcomp(strings(&[&"evaluate", &up, &down]));
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(
+            "targets differ (6 targets 0.0…750.0 mm against 6 targets 0.0…750.0 mm): \
+             target 3 is at 300.0 mm in the first and 300.25 mm in the second"
+        ),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn a_start_beyond_the_measured_range_is_said_so() {
+    let directory = tempfile::tempdir().unwrap();
+    let table = directory.path().join("X.COM");
+    // The sample measures 0 … 750 mm.
+    let run = axcomp(strings(&[
+        &"convert",
+        &SAMPLE,
+        &"--controller",
+        &"tnc640",
+        &"-o",
+        &table,
+        &"--start",
+        &"800",
+        &"--step",
+        &"50",
+    ]));
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(
+            "the grid starts at 800 mm with a step of 50 mm, but the test measured 0 … 750 mm: \
+             no second point lies within it (give a start below 700 mm, or --count)"
+        ),
+        "{}",
+        run.stderr
+    );
+    assert!(!table.exists());
+}
+
+#[test]
+fn the_sweep_table_is_printed_by_rank() {
+    let run = axcomp([
+        "tolerance",
+        "--samples",
+        "200",
+        "--sweep",
+        "--sweep-values",
+        "0.015,0.03,0.045",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let table = run.stdout.split("Sensitivity of P90").nth(1).unwrap();
+    // Markdown rows after the header and its rule: `| rank | tolerance | …`.
+    let rows: Vec<(String, String)> = table
+        .lines()
+        .filter(|line| line.starts_with('|'))
+        .skip(2)
+        .map(|line| {
+            let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+            (cells[1].to_string(), cells[2].to_string())
+        })
+        .collect();
+    assert_eq!(rows.len(), 13, "{table}");
+    let ranks: Vec<usize> = rows
+        .iter()
+        .filter_map(|(rank, _)| rank.parse().ok())
+        .collect();
+    assert_eq!(ranks.len(), 12, "{table}");
+    assert_eq!(ranks[0], 1, "{table}");
+    assert!(ranks.windows(2).all(|w| w[0] <= w[1]), "{table}");
+    assert_eq!(rows.last().unwrap(), &(String::new(), "all".to_string()));
+}
