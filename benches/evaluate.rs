@@ -100,7 +100,7 @@ fn bench(c: &mut Criterion) {
                 EvaluationReportOptions {
                     exclude_runs: &[],
                     limits: &[],
-                    equipment: &equipment,
+                    equipment: Some(&equipment),
                     decision: Decision::default(),
                     angle: AngleUnit::default(),
                 },

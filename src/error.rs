@@ -77,6 +77,44 @@ impl ParseError {
     }
 }
 
+/// The top-level keys of a machine profile (`--machine`): `name`, and the
+/// tables each reader takes its part from (`[controller]` the tables' axis
+/// names and units, `[kinematics]` the model, `[acceptance]` the limits).
+/// The one list of them, so that a misspelt table (`[controler]`,
+/// `[acceptence]`) is refused by every reader instead of being skipped by
+/// each as another reader's.
+pub const MACHINE_PROFILE_KEYS: [&str; 4] = ["name", "controller", "kinematics", "acceptance"];
+
+/// Refuses a machine profile with a top-level key or table not in
+/// [`MACHINE_PROFILE_KEYS`], at its line and column.
+pub fn check_machine_profile_keys(text: &str) -> Result<(), ParseError> {
+    use serde::de::IgnoredAny;
+    /// The profile's top level; the parts are their readers' to check.
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct TopLevel {
+        name: Option<IgnoredAny>,
+        controller: Option<IgnoredAny>,
+        kinematics: Option<IgnoredAny>,
+        acceptance: Option<IgnoredAny>,
+    }
+    match toml::from_str::<TopLevel>(text) {
+        Ok(_) => Ok(()),
+        Err(error) => {
+            let mut parsed = ParseError::from_toml(text, &error);
+            if let Some(key) = parsed.message.strip_prefix("unknown field `") {
+                let key = key.split('`').next().unwrap_or_default();
+                parsed.message = format!(
+                    "a machine profile has no table or key {key:?}; expected {}",
+                    MACHINE_PROFILE_KEYS.join(", ")
+                );
+            }
+            Err(parsed)
+        }
+    }
+}
+
 /// Describes a token for an error message: quoted and shortened, or "end of line".
 pub fn describe_found(token: &str) -> String {
     if token.is_empty() {
@@ -209,6 +247,13 @@ pub enum Warning {
     /// Two inputs joined or compared may not belong together
     /// (`together`).
     Doubtful(Doubt),
+    /// No uncertainty budget: no equipment was given and the file records
+    /// no laser interferometer, so the bundled laser's data would describe
+    /// another instrument.
+    InstrumentUnknown {
+        /// The instrument as the file names it, if it does.
+        instrument: Option<String>,
+    },
 }
 
 /// Something that makes two inputs doubtful together; the user decides.
@@ -402,6 +447,17 @@ impl fmt::Display for Warning {
                  (then R and A are not evaluated); the {runs} runs of this test are more than it asks, and all are evaluated",
                 mm_text(*length_mm)
             ),
+            Warning::InstrumentUnknown { instrument } => {
+                let named = instrument.as_ref().map_or_else(
+                    || "names no instrument".to_string(),
+                    |name| format!("names {name}, not a laser interferometer"),
+                );
+                write!(
+                    f,
+                    "measurement uncertainty not evaluated: instrument unknown (give --equipment); the file {named}, \
+                     and the bundled laser's data would describe another instrument"
+                )
+            }
             Warning::EvenSpacing { step_mm } => write!(
                 f,
                 "targets evenly spaced every {} mm: a periodic error (screw lead, scale period) whose period divides the step \

@@ -345,6 +345,23 @@ impl TestSetup {
 }
 
 impl Metadata {
+    /// Whether the file records that a laser interferometer measured the
+    /// test: a Renishaw `.rtl` (written only by its laser software), an API
+    /// `.pos` whose title names the laser. An ecmc test (a triangulation
+    /// sensor or an encoder, its `REF_PV`) and axcomp's CSV do not: their
+    /// uncertainty needs the user's equipment.
+    pub fn records_laser_interferometer(&self) -> bool {
+        match self.source_format {
+            Some(SourceFormat::Rtl) => true,
+            Some(SourceFormat::ApiPos) => self
+                .setup
+                .instrument
+                .as_ref()
+                .is_some_and(|name| name.to_ascii_lowercase().contains("laser")),
+            Some(SourceFormat::Ecmc | SourceFormat::Csv) | None => false,
+        }
+    }
+
     /// Duration of the test, s, when both start and end are known and parsed.
     pub fn duration_s(&self) -> Option<f64> {
         let start = self.date.as_ref()?.parsed?;
@@ -354,14 +371,28 @@ impl Metadata {
     }
 }
 
+/// What differs where two files have as many targets and the same ends:
+/// the first target that is elsewhere.
+fn differing_target_text(difference: Option<(usize, f64, f64)>) -> String {
+    difference.map_or_else(String::new, |(number, first_mm, other_mm)| {
+        format!(
+            ": target {number} is at {first_mm:?} mm in the first and {other_mm:?} mm in the second"
+        )
+    })
+}
+
 /// Why a set of targets and runs is not a valid measurement.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MeasurementError {
     /// Two files to join have other targets.
     #[error(
-        "cannot join the files: targets differ ({count} targets {first_mm:?}…{last_mm:?} mm against {other_count} targets {other_first_mm:?}…{other_last_mm:?} mm)"
+        "cannot join the files: targets differ ({count} targets {first_mm:?}…{last_mm:?} mm against {other_count} targets {other_first_mm:?}…{other_last_mm:?} mm){}",
+        differing_target_text(*first_difference)
     )]
     TargetsDiffer {
+        /// The first target that differs, when both have as many: its
+        /// number (from 1) and its position in each, mm.
+        first_difference: Option<(usize, f64, f64)>,
         /// Targets of the first.
         count: usize,
         /// Its first target, mm.
@@ -666,7 +697,17 @@ impl Measurement {
                 .zip(&other.targets_mm)
                 .any(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
         {
+            let first_difference = (self.targets_mm.len() == other.targets_mm.len())
+                .then(|| {
+                    self.targets_mm
+                        .iter()
+                        .zip(&other.targets_mm)
+                        .position(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
+                        .map(|i| (i + 1, self.targets_mm[i], other.targets_mm[i]))
+                })
+                .flatten();
             return Err(MeasurementError::TargetsDiffer {
+                first_difference,
                 count: self.targets_mm.len(),
                 first_mm: self.targets_mm.first().copied().unwrap_or_default(),
                 last_mm: self.targets_mm.last().copied().unwrap_or_default(),

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::common::load;
+use super::common::load_part;
 use anyhow::Result;
 
 use axcomp::evaluate::Evaluation;
@@ -39,7 +39,7 @@ pub fn load_limits(
 ) -> Result<Vec<Limit>> {
     let profile = match profile {
         Some(path) => Some((
-            load(path, AcceptanceProfile::from_toml_str)?,
+            load_part(path, AcceptanceProfile::from_toml_str)?,
             path.display().to_string(),
         )),
         None => None,

@@ -12,7 +12,7 @@ use axcomp::emit::{Controller, EmitError, EmitOptions, MachineProfile};
 use axcomp::error::{ParseError, Warning};
 use axcomp::evaluate::Standard;
 use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
-use axcomp::evaluate::verdict::Decision;
+use axcomp::evaluate::verdict::{AcceptanceProfile, Decision};
 use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
@@ -140,7 +140,7 @@ pub fn load_machine(path: Option<&Path>) -> Result<Machine> {
     let Some(path) = path else {
         return Ok(Machine::bundled());
     };
-    load(path, Machine::from_toml_str)
+    load_part(path, Machine::from_toml_str)
 }
 
 /// The machine profile's `[controller]` part from `path`, or the defaults.
@@ -148,13 +148,39 @@ pub fn load_profile(path: Option<&Path>) -> Result<MachineProfile> {
     let Some(path) = path else {
         return Ok(MachineProfile::default());
     };
-    let mut profile = load(path, MachineProfile::from_toml_str)?;
+    let mut profile = load_part(path, MachineProfile::from_toml_str)?;
     // A Fanuc control: its parameter backup, named relative to the profile.
     if let Some(name) = &profile.controller.fanuc_parameters {
         let backup = path.parent().unwrap_or(Path::new(".")).join(name);
         profile.fanuc = Some(load_fanuc_parameters(&backup)?);
     }
     Ok(profile)
+}
+
+/// One part of the machine profile `path`, read by `part`, after the whole
+/// profile is checked: whichever part a command uses, an error in another
+/// (`units = "furlong"` under `evaluate`, which reads `[acceptance]`) is
+/// refused, not passed over as someone else's.
+pub fn load_part<T, E: Into<FileError>>(
+    path: &Path,
+    part: impl FnOnce(&str) -> Result<T, E>,
+) -> Result<T> {
+    load(path, |text| {
+        check_machine_profile(text)?;
+        part(text).map_err(Into::into)
+    })
+}
+
+/// Every part of a machine profile's text, each by its reader.
+fn check_machine_profile(text: &str) -> Result<(), FileError> {
+    MachineProfile::from_toml_str(text)?;
+    AcceptanceProfile::from_toml_str(text)?;
+    let has_kinematics =
+        toml::from_str::<toml::Table>(text).is_ok_and(|table| table.contains_key("kinematics"));
+    if has_kinematics {
+        Machine::from_toml_str(text)?;
+    }
+    Ok(())
 }
 
 /// The effects a diagnosis wrote (`diagnose --write-effects`), for
@@ -405,7 +431,12 @@ pub fn load_fanuc_parameters(path: &Path) -> Result<axcomp::emit::fanuc::Paramet
 /// that decides the verdict with it, the same in `evaluate` and `report`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct UncertaintyArgs {
-    /// Equipment profile (TOML) for the measurement uncertainty (default: a typical HeNe laser).
+    /// Equipment profile (TOML) for the measurement uncertainty.
+    ///
+    /// Without it the uncertainty is evaluated only for a file that records a
+    /// laser interferometer (.rtl, an API laser's .pos), with a typical HeNe
+    /// laser; for any other (an ecmc test's sensor or encoder, a CSV) it is
+    /// "not evaluated: instrument unknown".
     ///
     /// The laser's expanded uncertainty and k, whether it includes the air
     /// compensation, the air and material sensors' standard uncertainties,
@@ -435,21 +466,25 @@ pub fn parse_decision(name: &str) -> Result<Decision, String> {
     })
 }
 
-/// The equipment of `--equipment` (or the bundled profile), with its drift
-/// test read (relative to the profile) when it names one.
-pub fn load_equipment(args: &UncertaintyArgs) -> Result<Equipment> {
+/// The equipment of `--equipment`, with its drift test read (relative to
+/// the profile) when it names one; `None` without the flag (the workflow
+/// then takes the bundled laser only for a file that records a laser).
+pub fn load_equipment(args: &UncertaintyArgs) -> Result<Option<Equipment>> {
     let Some(path) = &args.equipment else {
-        return Ok(Equipment::bundled());
+        return Ok(None);
     };
     let name = path.display().to_string();
     let equipment = load(path, |text| Equipment::from_toml_str(text, &name))?;
     let Some(drift) = equipment.drift_test_path() else {
-        return Ok(equipment);
+        return Ok(Some(equipment));
     };
     let drift_path = path.parent().unwrap_or(Path::new("")).join(drift);
     let read = axcomp::read::read_paths(std::slice::from_ref(&drift_path), None)
         .with_context(|| format!("{name}: the drift test"))?;
-    Ok(equipment.with_drift_test(&read.measurement, &drift_path.display().to_string()))
+    Ok(Some(equipment.with_drift_test(
+        &read.measurement,
+        &drift_path.display().to_string(),
+    )))
 }
 
 /// Refuses a rotary axis where a command handles linear axes only

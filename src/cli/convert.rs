@@ -176,6 +176,19 @@ pub struct ConvertArgs {
     pub verbosity: Verbosity,
 }
 
+impl ConvertArgs {
+    /// Every file the command reads: never an output (`output::write_new`).
+    pub fn inputs(&self) -> Vec<&Path> {
+        let named = [
+            self.existing.as_deref(),
+            self.effects.as_deref(),
+            self.machine_file.machine.as_deref(),
+        ];
+        let files = self.files.iter().map(PathBuf::as_path);
+        files.chain(named.into_iter().flatten()).collect()
+    }
+}
+
 fn parse_controller(name: &str) -> Result<Controller, String> {
     Controller::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = Controller::ALL.iter().map(|c| c.name()).collect();
@@ -295,7 +308,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             also: args.also.clone(),
         },
     )?;
-    write_new(&args.output, &bytes, args.overwrite.force)?;
+    write_new(&args.output, &bytes, &args.inputs(), args.overwrite.force)?;
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

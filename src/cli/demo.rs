@@ -25,7 +25,7 @@ use axcomp::evaluate::uncertainty::Equipment;
 use axcomp::evaluate::{Evaluation, ISO_230_2, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::model::{GeometricErrors, Machine, Optics};
-use axcomp::output::write_all_new;
+use axcomp::output::{create_folder, write_all_new};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
 use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
@@ -317,13 +317,17 @@ fn write_all(out: &Path, files: &[Output], force: bool) -> Result<()> {
         .iter()
         .map(|(name, bytes)| (out.join(name), bytes.as_slice()))
         .collect();
+    // The folder itself only where its parent exists (a mistyped path must
+    // not become a tree of new folders); the demo's own subfolders inside it.
+    create_folder(out)?;
     for (path, _) in &files {
         if let Some(parent) = path.parent() {
             std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
         }
     }
-    // All or none, also when the file system refuses one of them.
-    write_all_new(&files, force)?;
+    // All or none, also when the file system refuses one of them. The demo
+    // reads only its compiled-in files: no input to protect.
+    write_all_new(&files, &[], force)?;
     Ok(())
 }
 

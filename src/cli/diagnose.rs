@@ -182,7 +182,15 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let name = |p: &Path| p.display().to_string();
     if let Some(path) = &args.write_effects {
         let text = diagnosis.effects_file(&name(&args.after));
-        write_new(path, text.as_bytes(), args.overwrite.force)?;
+        let inputs = [
+            Some(args.after.as_path()),
+            args.before.as_deref(),
+            args.table.as_deref(),
+            args.angular.as_deref(),
+            args.machine_file.machine.as_deref(),
+        ];
+        let inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
+        write_new(path, text.as_bytes(), &inputs, args.overwrite.force)?;
     }
     let mut report = DiagnoseJson::new(
         &diagnosis,

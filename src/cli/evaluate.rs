@@ -102,7 +102,7 @@ pub fn run(args: &EvaluateArgs) -> Result<()> {
         EvaluationReportOptions {
             exclude_runs: &args.exclude_runs,
             limits: &limits,
-            equipment: &equipment,
+            equipment: equipment.as_ref(),
             decision: args.uncertainty.decision,
             angle,
         },

@@ -86,13 +86,13 @@ pub enum Command {
     /// Draws random rail mounting surfaces within the tolerances, turns them
     /// into the 21 geometric errors through the guideway model, and reports
     /// the distribution of the largest volumetric error over the work volume
-    /// (seed 000). --sweep adds the sensitivity to each tolerance;
+    /// (Valášek 2021). --sweep adds the sensitivity to each tolerance;
     /// --single-axis runs the one-axis study instead.
     Tolerance(Box<tolerance::ToleranceArgs>),
-    /// Simulate a feed axis with a friction model (seed 004).
+    /// Simulate a feed axis with a friction model (Mendřický 2006).
     ///
-    /// The circle test prints the quadrant (reversal) error and current the
-    /// thesis tabulates; the ISO 230-2 cycle prints the simulated readings
+    /// The circle test prints the quadrant (reversal) error and current
+    /// Mendřický (2006) tabulates; the ISO 230-2 cycle prints the simulated readings
     /// after each dwell and their ISO 230-2 figures, including the reversal
     /// B that friction leaves through the structure's compliance.
     ServoSim(servo_sim::ServoSimArgs),

@@ -11,7 +11,7 @@ use axcomp::evaluate::Standard;
 use axcomp::evaluate::uncertainty::Equipment;
 use axcomp::evaluate::verdict::Decision;
 use axcomp::measurement::{AxisKind, Measurement, SourceFormat};
-use axcomp::output::write_all_new;
+use axcomp::output::{create_folder, write_all_new};
 use axcomp::read;
 use axcomp::report::acceptance::{ReportInput, TableRecord, charts};
 use axcomp::report::chart::chart;
@@ -92,7 +92,7 @@ pub struct ReportArgs {
     )]
     pub output: PathBuf,
 
-    /// Also write every plot as a PNG file into DIR (created if missing).
+    /// Also write every plot as a PNG file into DIR (created if missing; its parent must exist).
     ///
     /// The same plots as in the HTML, 960 × 600 pixels, text in the embedded
     /// font (no system fonts needed): deviation.png (or deviation-before.png
@@ -124,7 +124,7 @@ fn read_test(
     format: Option<SourceFormat>,
     axis: Option<&String>,
     standard: &dyn Standard,
-    equipment: &Equipment,
+    equipment: Option<&Equipment>,
 ) -> Result<Test> {
     let read::ReadResult {
         mut measurement,
@@ -175,7 +175,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         args.input_format.format,
         args.axis.as_ref(),
         standard,
-        &equipment,
+        equipment.as_ref(),
     )?;
     let angle = args.angle_unit.for_axis(&before.measurement)?;
     if before.measurement.kind() == AxisKind::Rotary {
@@ -199,7 +199,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             args.input_format.format,
             args.axis.as_ref(),
             standard,
-            &equipment,
+            equipment.as_ref(),
         )?),
         None => None,
     };
@@ -276,14 +276,18 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     // All files or none (output::write_all_new checks every target first);
     // a --png folder this run creates is removed again if nothing is written.
     let created = match &args.png {
-        Some(directory) if !directory.is_dir() => {
-            std::fs::create_dir_all(directory)
-                .with_context(|| format!("{}: cannot create the directory", directory.display()))?;
-            Some(directory)
-        }
+        Some(directory) if create_folder(directory)? => Some(directory),
         _ => None,
     };
-    if let Err(error) = write_all_new(&files, args.overwrite.force) {
+    let inputs = [
+        Some(args.file.as_path()),
+        args.after.as_deref(),
+        args.table.as_deref(),
+        args.machine_file.machine.as_deref(),
+        args.uncertainty.equipment.as_deref(),
+    ];
+    let inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
+    if let Err(error) = write_all_new(&files, &inputs, args.overwrite.force) {
         if let Some(directory) = created {
             let _ = std::fs::remove_dir(directory);
         }

@@ -29,11 +29,11 @@ use super::progress;
 /// Which test to simulate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum TestKind {
-    /// Circular test (thesis §6.3, Tab. 6.4).
+    /// Circular test (Mendřický 2006, §6.3, Tab. 6.4).
     Circle,
-    /// External force step at standstill (thesis §6.2).
+    /// External force step at standstill (Mendřický 2006, §6.2).
     Step,
-    /// One long move at constant feed (thesis §6.1).
+    /// One long move at constant feed (Mendřický 2006, §6.1).
     ConstantVelocity,
     /// ISO 230-2 bidirectional linear positioning cycle.
     #[value(name = "iso230-2")]
@@ -56,7 +56,7 @@ impl TestKind {
 pub struct ServoSimArgs {
     /// Axis: mcfv5050-x, mcfv5050-y (bundled) or a .toml axis file.
     ///
-    /// The bundled axes are the thesis's MCFV 5050 LN cross table
+    /// The bundled axes are the MCFV 5050 LN cross table of Mendřický (2006)
     /// (fixtures/axes/*.toml, each value commented with its source).
     #[arg(long, value_name = "AXIS", help_heading = "Model")]
     pub axis: String,
@@ -179,7 +179,7 @@ pub struct CircleFlags {
 pub struct MotionFlags {
     /// Feed, m/min [circle 16, constant-velocity 5, iso230-2 2].
     ///
-    /// The path feed of the circle (the thesis ran 3.2, 8, 16, 24 and
+    /// The path feed of the circle (Mendřický 2006 ran 3.2, 8, 16, 24 and
     /// 48 m/min), the cruise feed of the constant-velocity run, or the feed of
     /// every move of the ISO cycle.
     #[arg(long = "feed-m-min", value_name = "M_PER_MIN")]
@@ -242,7 +242,7 @@ pub struct IsoFlags {
     ///
     /// The drive holds its residual friction force through this stiffness,
     /// so the measured point lags the scale by F/k_c. The default (100 N/µm)
-    /// is illustrative, not from the thesis. 0 means rigid: the laser reads
+    /// is illustrative, not from Mendřický (2006). 0 means rigid: the laser reads
     /// the scale.
     // `alias`: the name it had before 0.2 (CHANGELOG.md).
     #[arg(
@@ -409,7 +409,13 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
         if csv.is_empty() {
             bail!("--csv: the {} test has no trace to write", test.name());
         }
-        write_new(path, &csv, args.overwrite.force)?;
+        let inputs = [
+            Some(Path::new(&args.axis)),
+            args.identify.as_deref(),
+            args.reversal.as_deref(),
+        ];
+        let inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
+        write_new(path, &csv, &inputs, args.overwrite.force)?;
     }
     if args.json_output.json {
         print_json(&report)

@@ -2,11 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 
 use axcomp::measurement::{AxisKind, Measurement};
 use axcomp::model::{Axis, OpticsBody};
-use axcomp::output::write_all_new;
+use axcomp::output::{create_folder, write_all_new};
 use axcomp::read::{csv, rtl};
 use axcomp::synth::geometry::{self, GeometryPlan};
 use axcomp::synth::{self, RotaryTruth, Truth};
@@ -33,8 +33,7 @@ pub struct SynthArgs {
     pub output: Option<PathBuf>,
 
     /// Instead of a positioning test: the geometry tests of a synthetic
-    /// machine with random 21 errors (`synth::geometry`, the plan of the
-    /// issue 15 tests: one 6-DOF CSV per axis on a line away from the
+    /// machine with random 21 errors (`synth::geometry`: one 6-DOF CSV per axis on a line away from the
     /// reference, optics off the tool), X.csv, Y.csv, Z.csv, and the
     /// survey.toml naming them, written into the folder DIR.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["truth", "output", "table", "output2"])]
@@ -76,6 +75,18 @@ pub struct SynthArgs {
     pub verbosity: Verbosity,
 }
 
+impl SynthArgs {
+    /// Every file the command reads: never an output (`output::write_new`).
+    fn inputs(&self) -> Vec<&Path> {
+        let named = [
+            self.truth.as_deref(),
+            self.table.as_deref(),
+            self.machine_file.machine.as_deref(),
+        ];
+        named.into_iter().flatten().collect()
+    }
+}
+
 /// Runs `axcomp synth`.
 pub fn run(args: &SynthArgs) -> Result<()> {
     let (Some(truth_path), Some(output)) = (&args.truth, &args.output) else {
@@ -112,7 +123,7 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     if let Some((path, text)) = &second {
         files.push((path.as_path(), text.as_bytes()));
     }
-    write_all_new(&files, args.overwrite.force)?;
+    write_all_new(&files, &args.inputs(), args.overwrite.force)?;
     let mut summary = format!(
         "Wrote {} ({} targets, {} runs)\n",
         output.display(),
@@ -132,14 +143,18 @@ pub fn run(args: &SynthArgs) -> Result<()> {
 fn run_rotary(args: &SynthArgs, truth_path: &Path, output: &Path) -> Result<()> {
     if args.table.is_some() {
         bail!(
-            "{}: a rotary truth has no re-test with a table yet (issue 14); leave out --table and --o2",
+            "{}: a rotary truth has no re-test with a table yet; leave out --table and --o2",
             truth_path.display()
         );
     }
     let truth = load(truth_path, RotaryTruth::from_toml_str)?;
     let test = synth::rotary_test(&truth, args.seed)?;
     let text = render(&test, output)?;
-    write_all_new(&[(output, text.as_bytes())], args.overwrite.force)?;
+    write_all_new(
+        &[(output, text.as_bytes())],
+        &args.inputs(),
+        args.overwrite.force,
+    )?;
     print_text(&format!(
         "Wrote {} (rotary axis, {} targets, {} runs)\n",
         output.display(),
@@ -160,14 +175,14 @@ fn run_geometry(args: &SynthArgs) -> Result<()> {
     };
     let truth = geometry::random_truth(&machine, &plan, args.seed)?;
     let synthetic = geometry::measure(&machine, &truth, &plan, args.seed)?;
-    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    create_folder(dir)?;
     let mut files: Vec<(PathBuf, &[u8])> = synthetic
         .tests
         .iter()
         .map(|(name, text)| (dir.join(name), text.as_bytes()))
         .collect();
     files.push((dir.join("survey.toml"), synthetic.survey.as_bytes()));
-    write_all_new(&files, args.overwrite.force)?;
+    write_all_new(&files, &args.inputs(), args.overwrite.force)?;
     let mut summary = String::new();
     for (path, _) in &files {
         summary.push_str(&format!("Wrote {}\n", path.display()));

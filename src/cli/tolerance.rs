@@ -38,7 +38,7 @@ pub struct ToleranceArgs {
 
     /// Number of random machines (or axes with --single-axis).
     ///
-    /// The thesis used 50,000: the smallest count at which P90 no longer
+    /// Valášek (2021) used 50,000: the smallest count at which P90 no longer
     /// changed in its fourth decimal (mm) between runs.
     #[arg(long, value_name = "N", default_value_t = 50_000, value_parser = parse_samples, help_heading = "Study")]
     pub samples: usize,
@@ -51,14 +51,14 @@ pub struct ToleranceArgs {
 
     /// Straightness tolerance of all six rail mounting surfaces, mm.
     ///
-    /// The peak-to-peak band of the generated surface profiles (seed 000
-    /// §3.2.2); the thesis's baseline is 0.03 mm.
+    /// The peak-to-peak band of the generated surface profiles (Valášek 2021,
+    /// §3.2.2); its baseline is 0.03 mm.
     #[arg(long, value_name = "MM", default_value_t = 0.03, value_parser = parse_length, help_heading = "Tolerances")]
     pub straightness: f64,
 
     /// One surface's straightness instead: AXIS.normal=MM or AXIS.lateral=MM (repeatable).
     ///
-    /// normal is the thesis's "vertical" straightness (normal to the rail
+    /// normal is Valášek's (2021) "vertical" straightness (normal to the rail
     /// mounting face), lateral its "horizontal"; e.g. X.normal=0.02.
     #[arg(long = "surface", value_name = "AXIS.DIR=MM", value_parser = parse_surface, help_heading = "Tolerances")]
     pub surfaces: Vec<(Axis, RailDirection, f64)>,
@@ -66,19 +66,19 @@ pub struct ToleranceArgs {
     /// Positioning tolerance of X, Y and Z, mm (0: no positioning errors).
     ///
     /// Positioning errors come from the same generator as the surfaces; the
-    /// thesis's full machine uses 0.01 mm, its sensitivity study none.
+    /// full machine of Valášek (2021) uses 0.01 mm, its sensitivity study none.
     #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
     pub positioning: f64,
 
     /// Largest squareness error of each axis pair, µm/m (uniform in ±; 0: none).
     ///
-    /// The thesis's full machine uses 30 µm/m, its sensitivity study none.
+    /// The full machine of Valášek (2021) uses 30 µm/m, its sensitivity study none.
     #[arg(long, value_name = "UM_PER_M", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
     pub squareness: f64,
 
     /// Parallelism of each saddle's carriage mounting faces to its datum face, mm (0: none).
     ///
-    /// The carriage side (seed 002 Obr. 8): the plane of the four pads the
+    /// The carriage side (docs/src/references.md, carriage side): the plane of the four pads the
     /// carriages are bolted to, tilted across and along the rails within a
     /// zone of this width; a constant roll and pitch of the moving body.
     #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = parse_length, help_heading = "Tolerances")]
@@ -109,13 +109,13 @@ pub struct ToleranceArgs {
 
     /// Width of the band the walk stays in, as a multiple of the tolerance.
     ///
-    /// 1 is the band ±tol/2 of the issue and the NumPy peer.
+    /// 1 is the band ±tol/2 (a tolerance as a full band).
     #[arg(long, value_name = "FACTOR", default_value_t = 1.0, value_parser = parse_positive, help_heading = "Profiles")]
     pub band_width: f64,
 
     /// Also vary each tolerance in turn and fit the slopes of P90.
     ///
-    /// One study per tolerance and value (the thesis's Tabs 4.6–4.12: X, Y, Z
+    /// One study per tolerance and value (Valášek 2021, Tabs 4.6–4.12: X, Y, Z
     /// normal and lateral, then all six together; then each saddle's
     /// carriage parallelism and flatness), the other tolerances as set.
     #[arg(long, help_heading = "Study")]
@@ -128,7 +128,7 @@ pub struct ToleranceArgs {
     /// Run the single-axis study instead: one axis, two rails, four carriages.
     ///
     /// Reports how much straighter the assembled axis is than its mounting
-    /// surfaces (seed 000 §3.5.1); uses --straightness, --stroke,
+    /// surfaces (Valášek 2021, §3.5.1); uses --straightness, --stroke,
     /// --rail-spacing, --carriage-pitch and the profile flags.
     #[arg(long, help_heading = "Single axis")]
     pub single_axis: bool,
@@ -253,7 +253,9 @@ pub fn run(args: &ToleranceArgs) -> Result<()> {
             &title,
             format,
         )?;
-        write_new(path, &bytes, args.overwrite.force)?;
+        let inputs: Vec<&std::path::Path> =
+            args.machine_file.machine.as_deref().into_iter().collect();
+        write_new(path, &bytes, &inputs, args.overwrite.force)?;
     }
     if args.json_output.json {
         print_json(&report)

@@ -270,6 +270,13 @@ fn grid(
         });
     };
     let start_mm = request.start_mm.unwrap_or(first);
+    if request.count.is_none() && start_mm + step_mm > last + 1e-9 {
+        return Err(CompensateError::Grid(format!(
+            "the grid starts at {start_mm} mm with a step of {step_mm} mm, but the test measured \
+             {first} … {last} mm: no second point lies within it (give a start below {} mm, or --count)",
+            last - step_mm
+        )));
+    }
     // A --count belongs to the --step it was given with, not to a finer step of the effects.
     let count = match request.count.filter(|_| Some(step_mm) == request.step_mm) {
         Some(count) => count,

@@ -35,7 +35,7 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 
 use super::EmitError;
-use crate::error::ParseError;
+use crate::error::{ParseError, check_machine_profile_keys};
 use crate::units::LengthUnit;
 
 /// A machine profile as read from TOML (only the `[controller]` part).
@@ -177,9 +177,11 @@ const AXIS_LETTERS: [&str; 9] = ["X", "Y", "Z", "A", "B", "C", "U", "V", "W"];
 
 impl MachineProfile {
     /// Parses a profile; unknown keys under `[controller]` are errors (a typo
-    /// must not silently fall back to a default), other top-level tables are
-    /// left to their own readers.
+    /// must not silently fall back to a default), and so are top-level tables
+    /// that belong to no reader (`check_machine_profile_keys`); the other
+    /// readers' tables are left to them.
     pub fn from_toml_str(text: &str) -> Result<MachineProfile, ParseError> {
+        check_machine_profile_keys(text)?;
         toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e))
     }
 

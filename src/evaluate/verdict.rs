@@ -44,7 +44,8 @@
 //! optionally `min_um` (per length). Every value must be finite and above 0.
 //! Unknown keys are errors, at their line and column; `[acceptance.axes.NAME]`
 //! tables for axes other than the measured one are ignored (one profile
-//! serves the whole machine). Other top-level tables belong to other readers.
+//! serves the whole machine). Other top-level tables belong to other readers;
+//! one that no reader knows (`[acceptence]`) is an error at its line.
 //!
 //! Pure: no I/O. Lengths in mm inside; µm only at the TOML boundary, through
 //! `crate::units`.
@@ -55,7 +56,7 @@ use std::fmt;
 use serde::Deserialize;
 use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 
-use crate::error::ParseError;
+use crate::error::{ParseError, check_machine_profile_keys};
 use crate::evaluate::uncertainty::Budget;
 use crate::evaluate::{Evaluation, StandardFigure};
 use crate::measurement::Direction;
@@ -189,12 +190,14 @@ impl Figure {
     }
 
     /// The expanded uncertainty of the figure, mm: U(E) = U(M) = U(A) = the
-    /// budget's U (standards.md §4); `None` for the figures whose U is not
-    /// evaluated (R and B: no public form; the unidirectional figures: the
-    /// spec names only E, M and A; VDI 3441's: standards.md gives no form).
+    /// budget's U (standards.md §4), and VDI 3441's Pa, which is M's formula
+    /// (the range of the bidirectional mean deviations), has U(M); `None`
+    /// for the figures whose U is not evaluated (R and B: no public form;
+    /// the unidirectional figures: the spec names only E, M and A; VDI 3441's
+    /// P, Ps and U: standards.md gives no form).
     pub fn expanded_uncertainty_mm(self, budget: &Budget) -> Option<f64> {
         match self {
-            Figure::A | Figure::E | Figure::M => Some(budget.expanded_mm),
+            Figure::A | Figure::E | Figure::M | Figure::Pa => Some(budget.expanded_mm),
             _ => None,
         }
     }
@@ -516,6 +519,9 @@ pub struct Verdict {
     pub travel_mm: f64,
     /// The decision rule.
     pub decision: Decision,
+    /// Whether there was an uncertainty budget (none: the instrument is
+    /// unknown, and no figure has a U).
+    pub budget: bool,
 }
 
 impl Verdict {
@@ -647,6 +653,7 @@ pub fn verdict_with(
         checks,
         travel_mm,
         decision,
+        budget: budget.is_some(),
     })
 }
 
@@ -677,6 +684,7 @@ impl AcceptanceProfile {
     /// assert_eq!(error.position.line, 2);
     /// ```
     pub fn from_toml_str(text: &str) -> Result<AcceptanceProfile, ParseError> {
+        check_machine_profile_keys(text)?;
         let raw: RawFile = toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e))?;
         let Some(acceptance) = raw.acceptance else {
             return Ok(AcceptanceProfile::default());
@@ -724,7 +732,8 @@ impl AcceptanceProfile {
 // about: toml attaches the span of the key (unknown figure or key) or of the
 // value (bad number) to an error raised while deserialising it.
 
-/// The whole file: only `[acceptance]`; other tables belong to other readers.
+/// The whole file: only `[acceptance]`; other tables belong to other readers
+/// (and a table no reader knows is refused first: `check_machine_profile_keys`).
 #[derive(Deserialize)]
 struct RawFile {
     acceptance: Option<RawLimits<true>>,

@@ -73,7 +73,7 @@ use super::description::{
 };
 use super::guideway::{Guideway, GuidewayMap, THESIS_STIFFNESS_N_PER_MM};
 use super::volumetric::{ErrorMap, Grid, Kinematics, Method, VolumetricError};
-use crate::error::ParseError;
+use crate::error::{ParseError, check_machine_profile_keys};
 
 /// The bundled description of seed 000's machine.
 const BUNDLED_TOML: &str = include_str!("../../fixtures/machines/mcv754-quick.toml");
@@ -114,6 +114,7 @@ impl Machine {
     /// # Ok::<(), axcomp::model::ModelError>(())
     /// ```
     pub fn from_toml_str(text: &str) -> Result<Machine, ModelError> {
+        check_machine_profile_keys(text).map_err(ModelError::Toml)?;
         let raw: RawFile = toml::from_str(text).map_err(|error| toml_error(text, &error))?;
         let Some(kinematics) = raw.kinematics else {
             return Err(ModelError::invalid(
@@ -337,7 +338,8 @@ fn toml_error(text: &str, error: &toml::de::Error) -> ModelError {
 }
 
 /// The whole file: only what the model reads. Other top-level tables
-/// (`[controller]` for `axcomp convert`, …) belong to other readers.
+/// (`[controller]` for `axcomp convert`, …) belong to other readers; one
+/// that no reader knows is refused first (`check_machine_profile_keys`).
 #[derive(Deserialize)]
 struct RawFile {
     name: Option<String>,
@@ -749,7 +751,11 @@ mod tests {
                 "offset_mm = [0.0, -280.0, inf]",
                 "kinematics.tool.offset_mm: expected finite numbers, found inf",
             ),
-            ("[kinematics]\n", "[kinematic]\n", "missing field `chain`"),
+            (
+                "[kinematics]\n",
+                "[kinematic]\n",
+                "a machine profile has no table or key \"kinematic\"",
+            ),
         ];
         for (replace, by, message) in cases {
             let error = with(replace, by).unwrap_err();

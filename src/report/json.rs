@@ -70,7 +70,7 @@
 //!
 //! `axis_source` says where `axis` came from: `{"kind": "file", "field": …}`
 //! (the field of the file that states it), `{"kind": "given"}` (`--axis`) or
-//! `{"kind": "not_recorded"}`, when `axis` is only the placeholder `X`.
+//! `{"kind": "not_recorded"}`, when `axis` is `null`.
 
 use serde::Serialize;
 
@@ -89,8 +89,8 @@ use crate::units::{AngleUnit, DeviationUnit, opt_mm_to_um};
 pub struct EvaluationJson {
     /// Input format name (`rtl`, `ecmc`, `api-pos`, `csv`).
     pub format: Option<&'static str>,
-    /// Axis name (the placeholder `X` when `axis_source` is `not_recorded`).
-    pub axis: String,
+    /// Axis name; `null` when `axis_source` is `not_recorded` (no name is guessed).
+    pub axis: Option<String>,
     /// Where the axis name came from.
     pub axis_source: AxisSourceJson,
     /// The file read (the first, when two were joined).
@@ -811,7 +811,9 @@ impl EvaluationJson {
         };
         EvaluationJson {
             format: metadata.source_format.map(|f| f.name()),
-            axis: measurement.axis().to_string(),
+            axis: measurement
+                .axis_recorded()
+                .then(|| measurement.axis().to_string()),
             axis_source: AxisSourceJson::from_source(measurement.axis_source()),
             source_file: metadata
                 .source_file

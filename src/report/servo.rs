@@ -541,7 +541,7 @@ pub fn identify_text(json: &IdentifyJson) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "Friction of {} identified (seed 004 ch. 5)",
+        "Friction of {} identified (Mendřický 2006, ch. 5)",
         json.axis_source
     );
     let _ = writeln!(

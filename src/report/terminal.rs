@@ -85,7 +85,11 @@ fn header(out: &mut String, r: &EvaluationJson) {
         .map(|s| format!(", serial {s}"))
         .unwrap_or_default();
     rows.push(("Machine", format!("{}{serial}", text(&r.metadata.machine))));
-    rows.push(("Axis", r.axis_source.describe(&r.axis)));
+    rows.push((
+        "Axis",
+        r.axis_source
+            .describe(r.axis.as_deref().unwrap_or_default()),
+    ));
     rows.push(("Date", text(&r.metadata.date)));
     if r.metadata.operator.is_some() {
         rows.push(("Operator", text(&r.metadata.operator)));

@@ -490,7 +490,11 @@ fn sensitivity_table(rows: &[SensitivityJson]) -> String {
     }
     header.push("slope [µm/mm]".to_string());
     builder.push_record(header);
-    for row in rows {
+    // Read by rank, the first the most sensitive (the JSON keeps the sweep's
+    // order); the unranked `all` row last, ties in the sweep's order.
+    let mut by_rank: Vec<&SensitivityJson> = rows.iter().collect();
+    by_rank.sort_by_key(|row| row.rank.unwrap_or(usize::MAX));
+    for row in by_rank {
         let mut record = vec![
             row.rank.map_or(String::new(), |rank| rank.to_string()),
             row.tolerance.clone(),
@@ -545,7 +549,7 @@ pub fn axis_study_report(report: &AxisStudyJson) -> String {
         .modify(Columns::new(1..), Alignment::right());
     out.push_str(&table.to_string());
     out.push_str(
-        "\n  (P10: 9 of 10 axes improve at least this much; the thesis calls it \"P90\")\n",
+        "\n  (P10: 9 of 10 axes improve at least this much; Valášek 2021 calls it \"P90\")\n",
     );
     out
 }

@@ -14,7 +14,8 @@
 //!   "conformance": "fail",                         // or "pass", "not-proven"
 //!   "travel_mm": 750.0, "failed": ["A"],
 //!   "checks": [{ "figure": "A", "value_um": 13.19, "limit_um": 12.0, "pass": false,
-//!                "U_um": 3.49,                    // null where U is not evaluated (R, B, ↑, ↓, VDI 3441)
+//!                "U_um": 3.49,                    // null where U is not evaluated (R, B, ↑, ↓, VDI 3441 but Pa, unknown instrument)
+//!                "U_note": null,                  // iso14253-1 without U: why ("U(R) not evaluated: …")
 //!                "conformance": "fail",           // or "pass", "not-proven" (under the rule)
 //!                "outcome": "exceeds",            // value against limit alone: or "pass", "not evaluated"
 //!                "reason": "13.19 µm is above the limit 12 µm",   // null when it passes
@@ -85,6 +86,9 @@ pub struct CheckJson {
     pub pass: bool,
     /// The figure's expanded uncertainty, µm; `null` where not evaluated.
     pub U_um: Option<f64>,
+    /// Under ISO 14253-1, why a figure has no U (and is compared by its
+    /// value alone); `null` otherwise.
+    pub U_note: Option<String>,
     /// `pass`, `fail` or `not-proven`, under the rule.
     pub conformance: &'static str,
     /// The value against the limit alone: `pass`, `exceeds` or `not evaluated`.
@@ -111,14 +115,15 @@ impl VerdictJson {
             checks: verdict
                 .checks
                 .iter()
-                .map(|c| CheckJson::from_check(c, verdict.travel_mm, verdict.decision))
+                .map(|c| CheckJson::from_check(c, verdict))
                 .collect(),
         }
     }
 }
 
 impl CheckJson {
-    fn from_check(check: &Check, travel_mm: f64, decision: Decision) -> CheckJson {
+    fn from_check(check: &Check, verdict: &Verdict) -> CheckJson {
+        let (travel_mm, decision) = (verdict.travel_mm, verdict.decision);
         let figure = check.figure();
         let limit_um = mm_to_um(check.limit_mm);
         let value_um = check.value_mm.map(mm_to_um);
@@ -150,12 +155,23 @@ impl CheckJson {
                  a figure that is not evaluated cannot pass"
             )),
         };
+        // Under ISO 14253-1 a figure judged without a U says why.
+        let u_note = match (decision, u_um, verdict.budget) {
+            (Decision::Iso14253_1, None, false) => Some(format!(
+                "U({figure}) not evaluated: instrument unknown (give --equipment); compared by its value alone"
+            )),
+            (Decision::Iso14253_1, None, true) => Some(format!(
+                "U({figure}) not evaluated: no published form of its uncertainty; compared by its value alone"
+            )),
+            _ => None,
+        };
         CheckJson {
             figure: figure.name(),
             value_um,
             limit_um,
             pass: check.pass(),
             U_um: u_um,
+            U_note: u_note,
             conformance: check.conformance.name(),
             outcome: match check.outcome {
                 Outcome::Pass => "pass",

@@ -50,7 +50,6 @@ use crate::diagnose::{DiagnoseInput, Diagnosis, diagnose};
 use crate::effects::{Effect, read_effects};
 use crate::emit::{self, Controller, EmitOptions, MachineProfile};
 use crate::error::Warning;
-use crate::evaluate::uncertainty::Equipment;
 use crate::evaluate::verdict::{AcceptanceProfile, Decision, Figure, Limit, parse_limit};
 use crate::evaluate::{self, Standard, evaluate_with};
 use crate::measurement::{AxisKind, Measurement, SourceFormat};
@@ -421,10 +420,9 @@ async fn api_evaluate(multipart: Multipart) -> Result<axum::Json<EvaluateAnswer>
         let (measurement, mut warnings) = measurement(&form, "file")?;
         let standard = standard(&form)?;
         let profile = profile(&form)?;
-        let equipment = Equipment::bundled();
         let evaluation = evaluate_with(&measurement, standard);
         let limits = limits(&form, &profile, measurement.axis(), &evaluation)?;
-        let test = Test::new(measurement.clone(), warnings.clone(), standard, &equipment)?;
+        let test = Test::new(measurement.clone(), warnings.clone(), standard, None)?;
         let evaluation = workflow::evaluation_report(
             &measurement,
             evaluation,
@@ -432,7 +430,7 @@ async fn api_evaluate(multipart: Multipart) -> Result<axum::Json<EvaluateAnswer>
             workflow::EvaluationReportOptions {
                 exclude_runs: &[],
                 limits: &limits,
-                equipment: &equipment,
+                equipment: None,
                 decision: decision(&form)?,
                 angle: AngleUnit::default(),
             },
@@ -520,12 +518,7 @@ fn recorded_axis(measurement: &Measurement) -> Result<&str, ApiError> {
 fn table_of(form: &Form, field: &str, effects: &[Effect]) -> Result<Table, ApiError> {
     let profile = profile(form)?.machine;
     let (measurement, mut warnings) = measurement(form, field)?;
-    let before = Test::new(
-        measurement.clone(),
-        warnings.clone(),
-        standard(form)?,
-        &Equipment::bundled(),
-    )?;
+    let before = Test::new(measurement.clone(), warnings.clone(), standard(form)?, None)?;
     let axis = recorded_axis(&measurement)?.to_string();
     let controller_name = form.text("controller").unwrap_or("tnc640");
     let controller = Controller::from_name(controller_name)
@@ -706,7 +699,6 @@ struct Retest {
 
 fn retest(form: &Form) -> Result<Retest, ApiError> {
     let standard = standard(form)?;
-    let equipment = Equipment::bundled();
     let (before, before_warnings) = measurement(form, "file")?;
     let (after, mut after_warnings) = measurement(form, "after")?;
     for test in [&before, &after] {
@@ -756,8 +748,8 @@ fn retest(form: &Form) -> Result<Retest, ApiError> {
         effects_toml: diagnosis.effects_file(&after_label),
         report,
         diagnosis,
-        before: Test::new(before, before_warnings, standard, &equipment)?,
-        after: Test::new(after, after_warnings, standard, &equipment)?,
+        before: Test::new(before, before_warnings, standard, None)?,
+        after: Test::new(after, after_warnings, standard, None)?,
     })
 }
 
@@ -818,15 +810,14 @@ async fn api_retest(multipart: Multipart) -> Result<axum::Json<RetestAnswer>, Ap
 async fn api_report(multipart: Multipart) -> Result<Response, ApiError> {
     answer(multipart, |form| {
         let standard = standard(&form)?;
-        let equipment = Equipment::bundled();
         let (measurement, warnings) = measurement(&form, "file")?;
-        let mut before = Test::new(measurement, warnings, standard, &equipment)?;
+        let mut before = Test::new(measurement, warnings, standard, None)?;
         let label = file_label(form.files("file"));
         let after = match form.files("after") {
             [] => None,
             files => {
                 let (measurement, warnings) = self::measurement(&form, "after")?;
-                let mut after = Test::new(measurement, warnings, standard, &equipment)?;
+                let mut after = Test::new(measurement, warnings, standard, None)?;
                 after.warnings.extend(check_together(
                     Pairing::BeforeAfter,
                     &Input::measurement(&before.measurement, label.clone()),

@@ -59,8 +59,9 @@ pub struct EvaluationReportOptions<'a> {
     pub exclude_runs: &'a [RunSelector],
     /// The acceptance limits; empty: no verdict.
     pub limits: &'a [Limit],
-    /// The equipment of the uncertainty budget.
-    pub equipment: &'a Equipment,
+    /// The equipment of the uncertainty budget (`--equipment`); without it
+    /// the bundled laser where the file records one ([`budget_of`]).
+    pub equipment: Option<&'a Equipment>,
     /// The verdict's decision rule.
     pub decision: Decision,
     /// The unit of a rotary axis' deviations (`--angle-unit`).
@@ -94,16 +95,40 @@ pub fn evaluation_report(
             });
         }
         AxisKind::Rotary => None,
-        AxisKind::Linear => Some(budget(measurement, equipment)?),
+        AxisKind::Linear => budget_of(measurement, equipment, warnings)?,
     };
-    let verdict = budget
-        .as_ref()
-        .and_then(|budget| verdict::judge(&evaluation, limits, decision, Some(budget)));
+    let verdict = match measurement.kind() {
+        AxisKind::Rotary => None,
+        AxisKind::Linear => verdict::judge(&evaluation, limits, decision, budget.as_ref()),
+    };
     let mut report =
         EvaluationJson::from_evaluation(measurement, evaluation, exclude_runs, warnings, angle);
     report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
     report.verdict = verdict;
     Ok(report)
+}
+
+/// The uncertainty budget of a linear test: with `given` equipment
+/// (`--equipment`), else with the bundled laser where the file records a
+/// laser interferometer; otherwise none, and a warning says why (a sensor or
+/// an encoder is not the bundled laser).
+pub fn budget_of(
+    measurement: &Measurement,
+    given: Option<&Equipment>,
+    warnings: &mut Vec<Warning>,
+) -> Result<Option<Budget>, UncertaintyError> {
+    match given {
+        Some(equipment) => Ok(Some(budget(measurement, equipment)?)),
+        None if measurement.metadata.records_laser_interferometer() => {
+            Ok(Some(budget(measurement, &Equipment::bundled())?))
+        }
+        None => {
+            warnings.push(Warning::InstrumentUnknown {
+                instrument: measurement.metadata.setup.instrument.clone(),
+            });
+            Ok(None)
+        }
+    }
 }
 
 /// The acceptance limits for `axis`: the profile's `[acceptance]` (the
@@ -261,7 +286,8 @@ pub struct Test {
     pub evaluation: Evaluation,
     /// The reader's and the evaluation's warnings.
     pub warnings: Vec<Warning>,
-    /// `None` on a rotary axis: the budget is the laser's, for lengths.
+    /// `None` on a rotary axis (the budget is the laser's, for lengths) and
+    /// where the instrument is unknown (`budget_of`).
     pub budget: Option<Budget>,
 }
 
@@ -271,12 +297,12 @@ impl Test {
         measurement: Measurement,
         mut warnings: Vec<Warning>,
         standard: &dyn Standard,
-        equipment: &Equipment,
+        equipment: Option<&Equipment>,
     ) -> Result<Test, WorkflowError> {
         let evaluation = evaluate_with(&measurement, standard);
         warnings.extend(evaluation.warnings.iter().cloned());
         let budget = match measurement.kind() {
-            AxisKind::Linear => Some(budget(&measurement, equipment)?),
+            AxisKind::Linear => budget_of(&measurement, equipment, &mut warnings)?,
             AxisKind::Rotary => None,
         };
         Ok(Test {

@@ -28,6 +28,7 @@ mod flags;
 mod generated_docs;
 mod http;
 mod injected;
+mod inputs;
 mod model;
 mod numbers;
 mod outputs;

@@ -131,7 +131,12 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
             &options,
         )?,
     };
-    write_new(&args.output, text.as_bytes(), args.overwrite.force)?;
+    write_new(
+        &args.output,
+        text.as_bytes(),
+        &args.inputs(),
+        args.overwrite.force,
+    )?;
     let file_name = args.output.file_name().map_or_else(
         || args.output.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
