@@ -178,7 +178,12 @@ pub fn convert(
 ) -> Result<Converted, WorkflowError> {
     let evaluation = evaluate(measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
-    let options = table.options;
+    // The file records its source where the format has comments.
+    let mut options = table.options.clone();
+    options
+        .provenance
+        .get_or_insert_with(|| emit::Provenance::of(measurement));
+    let options = &options;
     let plan = plan(
         measurement.targets_mm(),
         table.effects,

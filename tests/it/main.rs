@@ -22,6 +22,7 @@ mod flags;
 mod http;
 mod injected;
 mod linuxcnc;
+mod loadable;
 mod model;
 mod outputs;
 mod predict;
