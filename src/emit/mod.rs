@@ -853,12 +853,13 @@ pub fn write_cross_axis(
     }
 }
 
-/// How to activate a cross-axis table written by [`write_cross_axis`].
+/// How to activate a cross-axis table written by [`write_cross_axis`]
+/// (`existing`: into the table axis's existing table).
 pub fn cross_axis_activation(
     controller: Controller,
     cross: &CrossAxisTable,
     profile: &MachineProfile,
-    file_name: &str,
+    (file_name, existing): (&str, bool),
     options: &EmitOptions,
 ) -> Result<String, EmitError> {
     let input = profile.axis(&cross.table_axis)?;
@@ -876,9 +877,11 @@ pub fn cross_axis_activation(
                 options,
             )
         }
-        _ => {
-            tnc640::cross_axis_activation(file_name, (&input.tnc640_column, &output.tnc640_column))
-        }
+        _ => tnc640::cross_axis_activation(
+            file_name,
+            (&input.tnc640_column, &output.tnc640_column),
+            existing,
+        ),
     })
 }
 

@@ -340,9 +340,18 @@ pub fn write_cross_axis(
 
 /// The `.CMA` entry of a cross-axis `.COM`: in the table axis's column,
 /// the axis's one active table.
-pub fn cross_axis_activation(file_name: &str, (input, output): (&str, &str)) -> String {
+pub fn cross_axis_activation(
+    file_name: &str,
+    (input, output): (&str, &str),
+    existing: bool,
+) -> String {
+    let own = if existing {
+        "as in the existing table"
+    } else {
+        "0 here: give the table on the control with --existing to keep it"
+    };
     format!(
-        "enter {file_name} in the .CMA column of axis {input} (\"[axis in column] = F(axis in whose .CMA column the .COM is entered)\", MANUALplus 620 TM p.716/718): its {output} column moves {output} as a function of {input}. An axis has one active table (p.718): {file_name} is {input}'s whole table, its {input} column the positioning compensation and its {output} column this one; load it in place of {input}'s table, not beside it"
+        "enter {file_name} in the .CMA column of axis {input} (\"[axis in column] = F(axis in whose .CMA column the .COM is entered)\", MANUALplus 620 TM p.716/718): its {output} column moves {output} as a function of {input}. An axis has one active table (p.718): {file_name} is {input}'s whole table, its {input} column the positioning compensation ({own}); load it in place of {input}'s table, not beside it"
     )
 }
 

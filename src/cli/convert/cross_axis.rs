@@ -169,8 +169,13 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
     );
     // The value as in the file: the CEC holds −error when it holds corrections.
     let sign = emit::cross_axis_file_sign(args.controller, &options);
-    let activation =
-        emit::cross_axis_activation(args.controller, &table, &profile, &file_name, &options)?;
+    let activation = emit::cross_axis_activation(
+        args.controller,
+        &table,
+        &profile,
+        (&file_name, existing.is_some()),
+        &options,
+    )?;
     let report = CrossAxisJson {
         table: format!("{direction} = F({axis})"),
         error: name.as_str().to_string(),
