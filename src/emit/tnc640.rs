@@ -324,7 +324,7 @@ pub fn write_cross_axis(
         Some(text) => {
             let old =
                 parse(text).map_err(|e| EmitError::Profile(format!("the existing table: {e}")))?;
-            let others = old.filled_others(&[output.tnc640_column.clone()]);
+            let others = old.filled_others(std::slice::from_ref(&output.tnc640_column));
             same_points(&old.positions_mm, &table.positions_mm, &others)?;
             old
         }
