@@ -17,7 +17,7 @@ use axcomp::workflow;
 
 use super::common::{
     AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load,
-    load_profile, name_axis, print_json, print_text, print_warnings, read_active_table,
+    name_axis, print_json, print_text, print_warnings, read_active_table,
 };
 use super::servo_sim::load_axis;
 
@@ -147,7 +147,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         }
         None => None,
     };
-    let profile = load_profile(args.machine_file.machine.as_deref())?;
+    let profile = args.machine_file.profile()?;
     let known_periods = workflow::known_periods(&profile, &after.measurement);
     let table = match &args.table {
         Some(path) => {

@@ -8,6 +8,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use clap_complete::Shell;
 
+use super::common::Verbosity;
+
 /// Flags of `axcomp completions`.
 #[derive(Debug, Args)]
 pub struct CompletionsArgs {
@@ -17,6 +19,10 @@ pub struct CompletionsArgs {
     /// ~/.local/share/bash-completion/completions/axcomp`.
     #[arg(value_name = "SHELL")]
     pub shell: Shell,
+
+    /// -q/--quiet (the same in every command; this one prints no warnings).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Flags of `axcomp man`.
@@ -29,6 +35,10 @@ pub struct ManArgs {
     /// convert > axcomp-convert.1`.
     #[arg(value_name = "COMMAND")]
     pub command: Option<String>,
+
+    /// -q/--quiet (the same in every command; this one prints no warnings).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// Prints the completion script for the shell.

@@ -22,6 +22,7 @@ mod diagnose_periodic;
 mod doc_examples;
 mod evaluate_ecmc;
 mod fagor;
+mod fanuc;
 mod flags;
 mod generated_docs;
 mod http;

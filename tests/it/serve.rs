@@ -58,11 +58,13 @@ fn the_table_download_is_what_convert_writes() {
         ("linuxcnc", "x.comp"),
         ("fagor8055", "ALX"),
         ("fagor8065", "X.mp"),
+        ("fanuc", "PITCH.TXT"),
     ];
     for (controller, name) in expected_names {
         // The iTNC 530 takes neither a bidirectional table nor a datum
-        // other than the first point: the defaults there.
-        let others = controller != "itnc530";
+        // other than the first point, Fanuc no bidirectional table: the
+        // defaults there.
+        let others = !matches!(controller, "itnc530" | "fanuc");
         let mut form = Form::new()
             .file("file", "sample-x.rtl", &read(&sample()))
             .text("controller", controller)
@@ -274,7 +276,7 @@ fn bad_input_is_a_400_with_the_clis_position() {
         "/api/convert",
         Form::new()
             .file("file", "sample-x.rtl", &read(&sample()))
-            .text("controller", "fanuc"),
+            .text("controller", "mazak"),
         &[],
     );
     assert_eq!(answer.status, 400);
