@@ -101,6 +101,17 @@ pub fn reading_times_h(measurement: &Measurement, timing: CycleTiming) -> (Vec<V
     (hours, assumed)
 }
 
+/// One run's mean duration on the clock of `times` (`[run][target]`, any
+/// unit): the time of the last reading over the number of runs. A drift of a
+/// test whose times are not recorded is per run, on this clock.
+pub fn run_h(times: &[Vec<f64>]) -> f64 {
+    if times.is_empty() {
+        0.0
+    } else {
+        duration_s(times) / times.len() as f64
+    }
+}
+
 /// The time of the last reading, s.
 pub fn duration_s(times: &[Vec<f64>]) -> f64 {
     times.iter().flatten().fold(0.0, |max: f64, t| max.max(*t))
@@ -138,5 +149,7 @@ mod tests {
             timing,
         );
         assert!(close(two[2][0], 12.5), "{two:?}");
+        // One run's mean duration: 10.3 s over 2 runs.
+        assert!(close(run_h(&times), 5.15));
     }
 }

@@ -14,6 +14,8 @@
 
 use std::path::Path;
 
+use chrono::NaiveDateTime;
+
 use crate::error::{Doubt, Warning};
 use crate::measurement::{AxisKind, Measurement};
 use crate::units::LengthUnit;
@@ -53,6 +55,8 @@ pub struct Input<'a> {
     pub file: Option<&'a Path>,
     /// The readings, to recognise the same test given twice (tables have none).
     pub readings: Option<&'a Measurement>,
+    /// When it was measured, as the file records it (parsed), if it does.
+    pub date: Option<NaiveDateTime>,
 }
 
 impl<'a> Input<'a> {
@@ -68,6 +72,7 @@ impl<'a> Input<'a> {
             kind: Some(measurement.kind()),
             file: measurement.metadata.source_file.as_deref(),
             readings: Some(measurement),
+            date: measurement.metadata.date.as_ref().and_then(|d| d.parsed),
         }
     }
 
@@ -85,6 +90,7 @@ impl<'a> Input<'a> {
             kind: None,
             file: None,
             readings: None,
+            date: None,
         }
     }
 }
@@ -125,28 +131,77 @@ pub enum NotTogether {
         what: &'static str,
     },
     /// The target ranges have nothing in common.
-    #[error(
-        "{first} covers {first_from} … {first_to}{unit}, {second} {second_from} … {second_to}{unit}: the ranges do not overlap, so they are not {what}"
-    )]
+    #[error("{ranges}: the ranges do not overlap, so they are not {what}")]
     DisjointRanges {
-        /// After a position: ` mm`, or `°` on a rotary axis.
-        unit: &'static str,
-        /// The first input.
-        first: String,
-        /// Its first target, mm.
-        first_from: f64,
-        /// Its last target, mm.
-        first_to: f64,
-        /// The second input.
-        second: String,
-        /// Its first point, mm.
-        second_from: f64,
-        /// Its last point, mm.
-        second_to: f64,
+        /// The two inputs and their ranges.
+        ranges: Ranges,
         /// What they would have to be.
         what: &'static str,
     },
+    /// A re-test that lies mostly where the first test measured nothing.
+    #[error(
+        "{ranges}: only {common_pct:.0} % of the re-test lies where the first test measured (at least {MIN_RETEST_COVERED_PCT} % is needed), so they are not a test and its re-test of the same stretch; measure the re-test over the first test's targets"
+    )]
+    RetestElsewhere {
+        /// The first test and the re-test with their ranges.
+        ranges: Ranges,
+        /// The share of the re-test's range inside the first test's, %.
+        common_pct: f64,
+    },
+    /// The "first" test was measured after the re-test, by the dates the files record.
+    #[error(
+        "{first} was measured on {first_date}, {second} on {second_date}: the first test is the later one by the dates the files record; give the earlier test as the first test (--before, or the report's FILE) and the later one as the re-test (--after)"
+    )]
+    SwappedDates {
+        /// The first test.
+        first: String,
+        /// Its recorded date.
+        first_date: NaiveDateTime,
+        /// The re-test.
+        second: String,
+        /// Its recorded date.
+        second_date: NaiveDateTime,
+    },
 }
+
+/// Two inputs and their ranges, as a refusal names them: `a.rtl covers
+/// 0 … 750 mm, b.rtl 400 … 1150 mm`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ranges {
+    /// After a position: ` mm`, or `°` on a rotary axis.
+    pub unit: &'static str,
+    /// The first input.
+    pub first: String,
+    /// Its range, mm (° on a rotary axis).
+    pub first_mm: (f64, f64),
+    /// The second input.
+    pub second: String,
+    /// Its range.
+    pub second_mm: (f64, f64),
+}
+
+impl std::fmt::Display for Ranges {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Ranges {
+            unit,
+            first,
+            first_mm,
+            second,
+            second_mm,
+        } = self;
+        write!(
+            f,
+            "{first} covers {} … {}{unit}, {second} {} … {}{unit}",
+            first_mm.0, first_mm.1, second_mm.0, second_mm.1
+        )
+    }
+}
+
+/// The least share of a re-test's range, %, that must lie within the first
+/// test's range: below it the prediction from the first test would cover
+/// little of the re-test (beyond its targets only its end values, held), and
+/// the two are tests of different stretches, not a test and its re-test.
+pub const MIN_RETEST_COVERED_PCT: f64 = 10.0;
 
 /// Checks that two inputs belong together for `pairing`: the refusal, or
 /// the doubts as warnings (empty when nothing is odd).
@@ -154,7 +209,10 @@ pub enum NotTogether {
 /// Refused: another axis (compared case-insensitively); the same file
 /// (same path) or the same readings twice (one test is not two, and a
 /// re-test never repeats a test to the last digit); ranges without a common
-/// stretch. Doubtful: other machine names; other units of the original files;
+/// stretch; for a test and its re-test, a re-test that lies mostly (more
+/// than 100 − [`MIN_RETEST_COVERED_PCT`] % of its range) outside the first
+/// test's range, or a first test whose recorded date is later than the
+/// re-test's. Doubtful: other machine names; other units of the original files;
 /// ranges that differ by more than 1 % of the longer one, or, for a table,
 /// a test that reaches beyond the table's points (the controller holds the
 /// end values there).
@@ -215,21 +273,46 @@ pub fn check_together(
     let common_mm = a_to.min(b_to) - a_from.max(b_from);
     // A single common point is no common stretch (a table's end point on a test's start).
     let tolerance_mm = 1e-6;
+    let ranges = || Ranges {
+        unit,
+        first: first.label.clone(),
+        first_mm: first.range_mm,
+        second: second.label.clone(),
+        second_mm: second.range_mm,
+    };
     if common_mm.is_nan() || common_mm <= tolerance_mm {
         return Err(NotTogether::DisjointRanges {
-            unit,
-            first: first.label.clone(),
-            first_from: a_from,
-            first_to: a_to,
-            second: second.label.clone(),
-            second_from: b_from,
-            second_to: b_to,
+            ranges: ranges(),
             what: match pairing {
                 Pairing::OneTest => "one test",
                 Pairing::BeforeAfter => "a test and its re-test",
                 Pairing::TableOnTest => "a table and a test it applies to",
             },
         });
+    }
+    if pairing == Pairing::BeforeAfter {
+        let retest_mm = b_to - b_from;
+        let common_pct = if retest_mm > 0.0 {
+            100.0 * common_mm / retest_mm
+        } else {
+            100.0
+        };
+        if common_pct < MIN_RETEST_COVERED_PCT {
+            return Err(NotTogether::RetestElsewhere {
+                ranges: ranges(),
+                common_pct,
+            });
+        }
+        if let (Some(first_date), Some(second_date)) = (first.date, second.date)
+            && first_date > second_date
+        {
+            return Err(NotTogether::SwappedDates {
+                first: first.label.clone(),
+                first_date,
+                second: second.label.clone(),
+                second_date,
+            });
+        }
     }
     let mut warnings = Vec::new();
     if let (Some(a), Some(b)) = (first.machine, second.machine)
@@ -423,5 +506,46 @@ mod tests {
         let warnings = check_together(Pairing::TableOnTest, &measured, &short).unwrap();
         assert!(warnings[0].to_string().contains("holds its end values"));
         assert!(check_together(Pairing::TableOnTest, &measured, &off).is_err());
+    }
+
+    /// By hand: the first test covers −20 … 20 mm, the re-test 0 … 750 mm;
+    /// they share 0 … 20 mm, 20 / 750 = 2.7 % of the re-test.
+    #[test]
+    fn a_retest_mostly_elsewhere_is_refused() {
+        let first = test("X", vec![-20.0, 0.0, 20.0], 0.001, "M1");
+        let retest = test("X", vec![0.0, 375.0, 750.0], 0.002, "M1");
+        let error = check(Pairing::BeforeAfter, &first, &retest).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "a.rtl covers -20 … 20 mm, b.rtl 0 … 750 mm: only 3 % of the re-test lies where the first test measured (at least 10 % is needed), so they are not a test and its re-test of the same stretch; measure the re-test over the first test's targets"
+        );
+        // The other way round the re-test lies wholly inside: a doubt only.
+        assert!(check(Pairing::BeforeAfter, &retest, &first).is_ok());
+        // Two files of one test are not judged by it.
+        assert!(check(Pairing::OneTest, &first, &retest).is_ok());
+    }
+
+    #[test]
+    fn a_first_test_dated_after_its_retest_is_refused() {
+        let dated = |text: &str, offset: f64| {
+            let mut m = test("X", vec![0.0, 500.0, 1000.0], offset, "M1");
+            m.metadata.date = Some(crate::measurement::TestDate {
+                raw: text.to_string(),
+                parsed: NaiveDateTime::parse_from_str(text, "%Y-%m-%d %H:%M:%S").ok(),
+            });
+            m
+        };
+        let early = dated("2026-11-20 08:30:00", 0.001);
+        let late = dated("2026-11-20 10:00:00", 0.002);
+        assert_eq!(check(Pairing::BeforeAfter, &early, &late), Ok(Vec::new()));
+        let error = check(Pairing::BeforeAfter, &late, &early).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "a.rtl was measured on 2026-11-20 10:00:00, b.rtl on 2026-11-20 08:30:00: the first test is the later one by the dates the files record; give the earlier test as the first test (--before, or the report's FILE) and the later one as the re-test (--after)"
+        );
+        // Without a recorded date nothing is said.
+        let mut undated = late.clone();
+        undated.metadata.date = None;
+        assert!(check(Pairing::BeforeAfter, &undated, &early).is_ok());
     }
 }

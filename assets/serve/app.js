@@ -278,6 +278,7 @@ async function retest() {
     $("effects").replaceChildren(...(d.effects.length
       ? d.effects.map((e) => element("li", e.kind + ": " + e.explanation))
       : [element("li", "no effect beyond what the prediction carries")]));
+    $("retest-warnings").replaceChildren(...answer.warnings.map((w) => element("li", w)));
     $("residual-plot").innerHTML = answer.residual_svg || "";
     if (answer.next) {
       $("next-name").textContent = answer.next.file_name;

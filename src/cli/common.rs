@@ -480,6 +480,22 @@ pub struct LinuxCncType {
     pub linuxcnc_type: Option<u8>,
 }
 
+/// Prints the warnings `evaluate` gives a test (conformance, spacing,
+/// outliers…) that another command reads, each naming the file, unless
+/// `quiet`: a test diagnosed or predicted from says what evaluating it says.
+pub fn print_test_warnings(path: &Path, measurement: &Measurement, quiet: bool, angle: AngleUnit) {
+    if quiet {
+        return;
+    }
+    for warning in axcomp::evaluate::evaluate(measurement).warnings {
+        eprintln!(
+            "axcomp: warning: {}: {}",
+            path.display(),
+            warning.text_in(angle)
+        );
+    }
+}
+
 /// Prints warnings to stderr unless `quiet`.
 pub fn print_warnings(warnings: &[Warning], quiet: bool) {
     print_warnings_in(warnings, quiet, AngleUnit::default());

@@ -24,7 +24,7 @@ use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
 use axcomp::evaluate::uncertainty::Equipment;
 use axcomp::evaluate::{Evaluation, ISO_230_2, evaluate};
 use axcomp::measurement::{Measurement, SourceFormat};
-use axcomp::model::{GeometricErrors, Machine};
+use axcomp::model::{GeometricErrors, Machine, Optics};
 use axcomp::output::write_all_new;
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
@@ -117,7 +117,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let measured = [MeasuredAxis {
         measurement: &before,
         line_mm: machine.reference_mm(),
-        optics_offset_mm: [0.0; 3],
+        optics: Optics::AT_TOOL_TIP,
     }];
     let prediction = predict(&PredictInput {
         machine: &machine,

@@ -17,7 +17,7 @@ use axcomp::workflow;
 
 use super::common::{
     AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load,
-    name_axis, print_json, print_text, print_warnings, read_active_table,
+    name_axis, print_json, print_test_warnings, print_text, print_warnings, read_active_table,
 };
 use super::servo_sim::load_axis;
 
@@ -115,6 +115,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     print_warnings(&after.warnings, args.verbosity.quiet);
     name_axis(&mut after.measurement, args.axis.as_ref());
     let angle = args.angle_unit.for_axis(&after.measurement)?;
+    print_test_warnings(&args.after, &after.measurement, args.verbosity.quiet, angle);
     if after.measurement.kind() == AxisKind::Rotary {
         // Issue 14: a rotary re-test is diagnosed in ″ (per-revolution
         // harmonics, reversal, outlier runs); its effects file and an Abbe
@@ -143,6 +144,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
                 &Input::measurement(&after.measurement, args.after.display().to_string()),
             )?;
             print_warnings(&doubts, args.verbosity.quiet);
+            print_test_warnings(path, &result.measurement, args.verbosity.quiet, angle);
             Some(result.measurement)
         }
         None => None,

@@ -11,7 +11,7 @@ use axcomp::effects::Effect;
 use axcomp::emit::{Controller, sinumerik840d, tnc640};
 use axcomp::error::ParseError;
 use axcomp::measurement::Measurement;
-use axcomp::model::{GeometricErrors, read_error_description};
+use axcomp::model::{GeometricErrors, Optics, read_error_description};
 use axcomp::predict::survey::{MeasuredState, Survey, SurveyFile, assemble};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
@@ -21,7 +21,8 @@ use axcomp::units::{LengthUnit, mm_to_um};
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, StandardArg, Verbosity, load, load_effects,
-    load_machine, name_axis, parse_position, print_json, print_text, print_warnings, read_table,
+    load_machine, name_axis, parse_position, print_json, print_test_warnings, print_text,
+    print_warnings, read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -131,14 +132,14 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         None => GeometricErrors::default(),
     };
     let mut state = None;
-    let mut surveyed: Vec<(Measurement, [f64; 3], [f64; 3])> = Vec::new();
+    let mut surveyed: Vec<(Measurement, [f64; 3], Optics)> = Vec::new();
     if let Some(path) = &args.survey {
         let measured = load_survey(path, &machine, &errors, args.errors.is_some())?;
         errors = measured.errors.clone();
         surveyed = measured
             .positioning
             .iter()
-            .map(|p| (p.measurement.clone(), p.line_mm, p.optics_offset_mm))
+            .map(|p| (p.measurement.clone(), p.line_mm, p.optics))
             .collect();
         state = Some(measured);
     }
@@ -149,7 +150,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
     let reference = machine.reference_mm();
     let line_mm = complete(args.line, reference);
     let mut measurements: Vec<(Measurement, [f64; 3])> = Vec::new();
-    let mut optics: Vec<[f64; 3]> = Vec::new();
+    let mut optics: Vec<Optics> = Vec::new();
     for (measurement, line, offset) in surveyed {
         measurements.push((measurement, line));
         optics.push(offset);
@@ -167,17 +168,23 @@ pub fn run(args: &PredictArgs) -> Result<()> {
                 path.display()
             );
         }
+        print_test_warnings(
+            &path,
+            &result.measurement,
+            args.verbosity.quiet,
+            Default::default(),
+        );
         let line = line.map_or(line_mm, |l| complete(Some(l), reference));
         measurements.push((result.measurement, line));
-        optics.push([0.0; 3]);
+        optics.push(Optics::AT_TOOL_TIP);
     }
     let measured: Vec<MeasuredAxis<'_>> = measurements
         .iter()
         .zip(&optics)
-        .map(|((measurement, line_mm), optics_offset_mm)| MeasuredAxis {
+        .map(|((measurement, line_mm), optics)| MeasuredAxis {
             measurement,
             line_mm: *line_mm,
-            optics_offset_mm: *optics_offset_mm,
+            optics: *optics,
         })
         .collect();
     check_one_machine(args, &measurements)?;

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use axcomp::measurement::{AxisKind, Measurement};
+use axcomp::model::{Axis, OpticsBody};
 use axcomp::output::write_all_new;
 use axcomp::read::{csv, rtl};
 use axcomp::synth::geometry::{self, GeometryPlan};
@@ -38,6 +39,13 @@ pub struct SynthArgs {
     /// survey.toml naming them, written into the folder DIR.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["truth", "output", "table", "output2"])]
     pub geometry: Option<PathBuf>,
+
+    /// With --geometry: the body that carries every test's moving optic,
+    /// `tool` or `workpiece` (the laser on the other); default: the body
+    /// each test's axis moves, from the machine's chain (survey.toml states
+    /// the one taken).
+    #[arg(long = "optics-on", value_name = "BODY", requires = "geometry", value_parser = parse_optics_body)]
+    pub optics_on: Option<OpticsBody>,
 
     /// The compensation table the controller applies in the re-test (any format convert writes).
     #[arg(long, value_name = "TABLE", requires = "output2")]
@@ -146,7 +154,10 @@ fn run_geometry(args: &SynthArgs) -> Result<()> {
         bail!("give --truth T.toml -o FILE, or --geometry DIR");
     };
     let machine = load_machine(args.machine_file.machine.as_deref())?;
-    let plan = GeometryPlan::example();
+    let plan = GeometryPlan {
+        optics_on: [args.optics_on; 3],
+        ..GeometryPlan::example()
+    };
     let truth = geometry::random_truth(&machine, &plan, args.seed)?;
     let synthetic = geometry::measure(&machine, &truth, &plan, args.seed)?;
     std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
@@ -161,16 +172,31 @@ fn run_geometry(args: &SynthArgs) -> Result<()> {
     for (path, _) in &files {
         summary.push_str(&format!("Wrote {}\n", path.display()));
     }
+    let bodies: Vec<String> = Axis::ALL
+        .iter()
+        .map(|axis| {
+            let on = args
+                .optics_on
+                .unwrap_or_else(|| machine.chain().body_moved_by(*axis));
+            format!("{axis} on the {}", on.name())
+        })
+        .collect();
     summary.push_str(&format!(
-        "  {} with 21 random errors (seed {}); one 6-DOF test per axis ({} mm targets, {} runs each way, noise {:.1} µm and {:.1} µrad a reading), on a line away from the reference with the optics off the tool, as survey.toml states\n",
+        "  {} with 21 random errors (seed {}); one 6-DOF test per axis ({} mm targets, {} runs each way, noise {:.1} µm and {:.1} µrad a reading), on a line away from the reference with the moving optic off the tool tip ({}), as survey.toml states\n",
         machine.name(),
         args.seed,
         plan.step_mm,
         plan.runs,
         mm_to_um(plan.noise_mm),
         rad_to_um_per_m(plan.noise_rad),
+        bodies.join(", "),
     ));
     print_text(&summary)
+}
+
+/// `--optics-on`'s value.
+fn parse_optics_body(text: &str) -> Result<OpticsBody, String> {
+    OpticsBody::from_name(text).ok_or_else(|| format!("expected tool or workpiece, found {text:?}"))
 }
 
 /// The file text for an output path, by its extension.

@@ -233,7 +233,7 @@ mod tests {
                 amplitude_um: 1.0,
                 phase_rad: 0.0,
             }),
-            Effect::Drift(Drift { rate_um_per_h: 2.0 }),
+            Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),
         ];
         let plan = plan(&targets(), &effects, &ITNC, &Request::default()).unwrap();
         let GridSpec::Regular {

@@ -36,6 +36,8 @@ pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context 
         material_change_k,
         time_assumed,
         first_test_reversal_um: first_test_reversal_um(input),
+        // Known once the figures are: `diagnose` says them then.
+        retest_mean_reversal_um: None,
     }
 }
 
@@ -63,7 +65,7 @@ pub(super) fn accepted_effect(
         kind: context.kind,
     });
     if context.time_assumed && effect.kind() == Kind::Drift {
-        warnings.push("the file records no test duration: times assume a typical cycle (3 s dwell, 2000 mm/min)".to_string());
+        warnings.push("the file records no test duration: the drift is per run, in the order the runs were measured (the readings within a run spaced as a typical cycle: 3 s dwell, 2000 mm/min)".to_string());
     }
     AcceptedEffect {
         explanation: effect.explanation(context),

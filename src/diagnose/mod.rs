@@ -50,10 +50,11 @@ pub use angular_profile::AngularProfile;
 use crate::compensate::CompensateError;
 use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
-use crate::effects::{Effect, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape};
+use crate::effects::{Context, Effect, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape};
 use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
 use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::together::NotTogether;
+use crate::units::mm_to_um;
 use along_axis::{AlongAxisSelection, Background, select_along_axis};
 use between_runs::{select_between_runs, select_reversal};
 use findings::{accepted_effect, context, figures, stats};
@@ -255,8 +256,11 @@ pub struct Diagnosis {
     pub unexplained: Unexplained,
     /// Scatter of one reading left at the end, µm.
     pub noise_um: f64,
-    /// Whether reading times were assumed from a typical cycle.
+    /// Whether reading times were assumed from a typical cycle (a drift is
+    /// then per run).
     pub time_assumed: bool,
+    /// One run's mean duration on the clock of the readings' `time_h`, h.
+    pub run_h: f64,
     /// Every reading of the re-test in the order measured, with its residual
     /// and the fitted model (for plots).
     pub readings: Vec<ReadingResidual>,
@@ -480,6 +484,49 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         };
         problem.predicted_um[i] + systematic + scatter[i]
     })?;
+    // The reversal's sentence says the B̄ the figures show; where the fitted
+    // B differs from the change they show, it says why.
+    if let (Some(predicted_mm), Some(measured_mm)) =
+        (figures.predicted.b_mean_mm, figures.measured.b_mean_mm)
+    {
+        let context = Context {
+            retest_mean_reversal_um: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),
+            ..context
+        };
+        let others: Vec<String> = accepted
+            .iter()
+            .filter(|a| {
+                !matches!(a.effect, Effect::Reversal(_)) && !a.effect.kind().is_positional()
+            })
+            .map(|a| a.effect.model().label(&|v| format!("{v:.2}")))
+            .collect();
+        for found in accepted.iter_mut() {
+            let Effect::Reversal(reversal) = found.effect else {
+                continue;
+            };
+            let shown_um = if with_prediction {
+                mm_to_um(measured_mm - predicted_mm)
+            } else {
+                mm_to_um(measured_mm)
+            };
+            found.explanation = found.effect.explanation(&context);
+            if context.deviation(reversal.b_um) != context.deviation(shown_um) {
+                let why = if others.is_empty() {
+                    "it weighs each target by its readings, where B̄ is the plain mean of the targets' reversals".to_string()
+                } else {
+                    format!(
+                        "it is fitted with the {} taken out, which the measured B̄ includes",
+                        others.join(", ")
+                    )
+                };
+                found.explanation.push_str(&format!(
+                    " The fit's B = {} differs from that {}: {why}.",
+                    context.deviation(reversal.b_um),
+                    if with_prediction { "change" } else { "B̄" },
+                ));
+            }
+        }
+    }
     // A kind is either found or not: a second outlier run that fails a gate
     // after the first was accepted records a rejection of the same kind.
     rejected.retain(|r| !accepted.iter().any(|a| a.effect.kind() == r.kind));
@@ -496,6 +543,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         unexplained,
         noise_um,
         time_assumed,
+        run_h: problem.run_h,
         readings: problem
             .readings
             .iter()

@@ -35,6 +35,10 @@ pub(super) struct Problem {
     /// (which the prediction carries), µm²; 0 for a unidirectional test.
     pub(super) first_test_reversal_variance_um2: Vec<f64>,
     pub(super) run_count: usize,
+    /// Whether the reading times are the cycle model's, not the file's.
+    pub(super) time_assumed: bool,
+    /// One run's mean duration on the clock of the readings' `time_h`, h.
+    pub(super) run_h: f64,
     pub(super) targets_mm: Vec<f64>,
     /// Linear or rotary: on a rotary axis `_mm` holds ° and `_um` m° (1/1000 °).
     pub(super) kind: AxisKind,
@@ -78,6 +82,8 @@ impl Problem {
         Line {
             first_target_mm: self.first_target_mm(),
             angle_urad: self.angle_urad.as_deref(),
+            times_recorded: !self.time_assumed,
+            run_h: self.run_h,
         }
     }
 
@@ -231,6 +237,8 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         first_test_variance_um2,
         first_test_reversal_variance_um2,
         run_count: after.runs().len(),
+        time_assumed,
+        run_h: cycle::run_h(&times),
         targets_mm: after.targets_mm().to_vec(),
         kind: after.kind(),
         deviation: after.kind().deviation_unit(input.angle),

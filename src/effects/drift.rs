@@ -1,28 +1,85 @@
 //! Drift: a deviation growing with the time of the reading.
+//!
+//! Its clock is the one the test records: hours when the file records the
+//! test's start and end (the cycle model scaled to them, `cycle`), or, when
+//! it does not, the runs in the order measured (one run = the cycle model's
+//! mean run): a rate per hour from a clock the file does not have would be
+//! the assumed feed and dwell's number, not the machine's.
 
 use serde::Deserialize;
 
 use super::{Context, Fit, Line, Model, OneNumber, Parameter, Reading, Shape, TableRole, column};
 use crate::measurement::Direction;
 
-/// Drift, µm/h.
+/// Drift, µm per hour or per run.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "DriftFile")]
+pub enum Drift {
+    /// The test's times are recorded: µm per hour from the start of the test.
+    PerHour {
+        /// µm/h.
+        rate_um_per_h: f64,
+    },
+    /// The test's times are not recorded: µm per run, in the order measured.
+    PerRun {
+        /// µm per run.
+        rate_um_per_run: f64,
+    },
+}
+
+/// The TOML form: one of the two keys.
+#[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Drift {
-    /// µm per hour from the start of the test.
-    pub rate_um_per_h: f64,
+struct DriftFile {
+    rate_um_per_h: Option<f64>,
+    rate_um_per_run: Option<f64>,
+}
+
+impl TryFrom<DriftFile> for Drift {
+    type Error = String;
+
+    fn try_from(file: DriftFile) -> Result<Drift, String> {
+        match (file.rate_um_per_h, file.rate_um_per_run) {
+            (Some(rate_um_per_h), None) => Ok(Drift::PerHour { rate_um_per_h }),
+            (None, Some(rate_um_per_run)) => Ok(Drift::PerRun { rate_um_per_run }),
+            _ => Err(
+                "a drift has one rate: rate_um_per_h (the test's times recorded) or rate_um_per_run"
+                    .to_string(),
+            ),
+        }
+    }
 }
 
 /// The one parameter, as it is shown and saved.
-const RATE: OneNumber = OneNumber {
+const PER_HOUR: OneNumber = OneNumber {
     key: "rate_um_per_h",
     name: "rate",
     unit: "µm/h",
 };
 
+/// The same per run.
+const PER_RUN: OneNumber = OneNumber {
+    key: "rate_um_per_run",
+    name: "rate",
+    unit: "µm/run",
+};
+
+impl Drift {
+    /// Its rate and the parameter that names it.
+    fn rate(self) -> (f64, OneNumber) {
+        match self {
+            Drift::PerHour { rate_um_per_h } => (rate_um_per_h, PER_HOUR),
+            Drift::PerRun { rate_um_per_run } => (rate_um_per_run, PER_RUN),
+        }
+    }
+}
+
 impl Model for Drift {
-    fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
-        self.rate_um_per_h * reading.time_h
+    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+        match *self {
+            Drift::PerHour { rate_um_per_h } => rate_um_per_h * reading.time_h,
+            Drift::PerRun { rate_um_per_run } => rate_um_per_run * line.runs_at(reading.time_h),
+        }
     }
 
     /// Not systematic in position: a table cannot take it.
@@ -31,32 +88,34 @@ impl Model for Drift {
     }
 
     fn in_table(&self) -> TableRole {
+        let (rate, parameter) = self.rate();
         TableRole::NotATable {
             note: format!(
-                "drift of {:.2} µm/h: not a table's business; measure again with the machine warm",
-                self.rate_um_per_h
+                "drift of {rate:.2} {}: not a table's business; measure again with the machine warm",
+                parameter.unit
             ),
         }
     }
 
-    fn explanation(&self, context: &Context) -> String {
-        let assumed = if context.time_assumed {
-            " (times assumed from a typical cycle: the file records no test duration)"
-        } else {
-            ""
-        };
-        format!(
-            "Deviation growing by {:.2} µm/h during the test{assumed}: the machine was warming up; run the axis until it is warm before measuring and re-measure.",
-            self.rate_um_per_h
-        )
+    fn explanation(&self, _: &Context) -> String {
+        match *self {
+            Drift::PerHour { rate_um_per_h } => format!(
+                "Deviation growing by {rate_um_per_h:.2} µm/h during the test: the machine was warming up; run the axis until it is warm before measuring and re-measure."
+            ),
+            Drift::PerRun { rate_um_per_run } => format!(
+                "Deviation growing by {rate_um_per_run:.2} µm per run during the test (per run, not per hour: the file records no times): the machine was warming up; run the axis until it is warm before measuring and re-measure."
+            ),
+        }
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        RATE.parameters(self.rate_um_per_h)
+        let (rate, parameter) = self.rate();
+        parameter.parameters(rate)
     }
 
     fn label(&self, number: &dyn Fn(f64) -> String) -> String {
-        RATE.label(Self::NAME, self.rate_um_per_h, number)
+        let (rate, parameter) = self.rate();
+        parameter.label(Self::NAME, rate, number)
     }
 }
 
@@ -64,13 +123,23 @@ impl Fit for Drift {
     const NAME: &'static str = "drift";
     const POSITIONAL: bool = false;
 
-    fn columns(_: Shape, readings: &[Reading], _: &Line<'_>) -> Vec<Vec<f64>> {
-        column(readings, |r| r.time_h)
+    fn columns(_: Shape, readings: &[Reading], line: &Line<'_>) -> Vec<Vec<f64>> {
+        if line.times_recorded {
+            column(readings, |r| r.time_h)
+        } else {
+            column(readings, |r| line.runs_at(r.time_h))
+        }
     }
 
-    fn from_fit(_: Shape, coefficients: &[f64], _: &Line<'_>) -> Drift {
-        Drift {
-            rate_um_per_h: coefficients[0],
+    fn from_fit(_: Shape, coefficients: &[f64], line: &Line<'_>) -> Drift {
+        if line.times_recorded {
+            Drift::PerHour {
+                rate_um_per_h: coefficients[0],
+            }
+        } else {
+            Drift::PerRun {
+                rate_um_per_run: coefficients[0],
+            }
         }
     }
 }

@@ -9,7 +9,7 @@
 //! |---------------|----------------------------------------------|--------------------------|
 //! | `reversal`    | +½ moving ↑, −½ moving ↓                      | B (↑ − ↓), µm            |
 //! | `scale`       | (x − first target) in m                      | µm/m                     |
-//! | `drift`       | time of the reading in h                     | µm/h                     |
+//! | `drift`       | time of the reading in h, or in runs         | µm/h, or µm/run          |
 //! | `periodic`    | sin(2πx/p), cos(2πx/p) for a scanned period p | amplitude µm, phase      |
 //! | `outlier-run` | 1 on the readings of one run, else 0         | offset µm                |
 //! | `abbe`        | the angular error ε(x) in µrad / 1000        | offset of the line, mm   |
@@ -69,6 +69,23 @@ pub struct Line<'a> {
     pub first_target_mm: f64,
     /// The angular error at each target, µrad (Abbe), if given.
     pub angle_urad: Option<&'a [f64]>,
+    /// Whether the file records the test's times ([`Reading::time_h`] then
+    /// follows them); otherwise a drift is per run.
+    pub times_recorded: bool,
+    /// One run's mean duration on the clock of [`Reading::time_h`], h
+    /// (`cycle::run_h`): a time in runs is `time_h / run_h`.
+    pub run_h: f64,
+}
+
+impl Line<'_> {
+    /// Runs from the start of the test at `time_h` (0 when no run has a duration).
+    pub fn runs_at(&self, time_h: f64) -> f64 {
+        if self.run_h > 0.0 {
+            time_h / self.run_h
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Which tests a periodic error is in, as a diagnosis fits it: its columns
@@ -126,6 +143,10 @@ pub struct Context {
     /// The first test's mean reversal B̄, µm, which the prediction carries (a
     /// reversal found is then the change since that test).
     pub first_test_reversal_um: Option<f64>,
+    /// The re-test's mean reversal B̄ as predicted and as measured, µm (the
+    /// diagnosis' figures): the sentence says these, and the backlash
+    /// parameter follows the measured one.
+    pub retest_mean_reversal_um: Option<(f64, f64)>,
 }
 
 /// A deviation held in µm (m°, 1/1000 °, on a rotary axis) as a sentence
@@ -450,6 +471,8 @@ impl Effect {
         let line = Line {
             first_target_mm: targets_mm.first().copied().unwrap_or(0.0),
             angle_urad: None,
+            times_recorded: measurement.metadata.duration_s().is_some(),
+            run_h: crate::cycle::run_h(times_h),
         };
         let runs = measurement.runs();
         measurement.map_readings(|run, target_index, value_mm| {

@@ -29,8 +29,18 @@ impl Model for Reversal {
     }
 
     fn explanation(&self, context: &Context) -> String {
-        let b_um = self.b_um;
-        let how = if b_um < 0.0 {
+        // What the re-test measures when the diagnosis gives it (its figures'
+        // B̄), else the fitted B: the sentence's numbers are the output's own.
+        let (predicted_um, measured_um) = context.retest_mean_reversal_um.unwrap_or_else(|| {
+            let before_um = context.first_test_reversal_um.unwrap_or(0.0);
+            (before_um, before_um + self.b_um)
+        });
+        let change_um = match context.first_test_reversal_um {
+            Some(_) => measured_um - predicted_um,
+            None => measured_um,
+        };
+        // What the axis does now, by the sign of the B̄ measured now.
+        let how = if measured_um < 0.0 {
             "the axis falls short in the direction it moves: lost motion from backlash, or friction force × drive compliance"
         } else {
             "the axis overshoots in the direction it moves (a leading encoder, or an elastic preload released at reversal)"
@@ -38,16 +48,20 @@ impl Model for Reversal {
         // Controllers take the backlash parameter in mm (or inch), not µm:
         // `convert` prints each one's own line (`Controller::backlash_parameter`).
         // On a rotary axis the parameter is in degrees (`emit`'s rotary tables).
-        let parameter = context.position(um_to_mm(-b_um), 4);
-        let b = context.deviation(b_um);
+        // Whatever the parameter was during the re-test, −B̄ measured now
+        // takes out what is left.
+        let parameter = context.position(um_to_mm(-measured_um), 4);
+        let d = |v: f64| context.deviation(v);
         match context.first_test_reversal_um {
-            Some(before_um) => format!(
-                "The reversal changed since the first test by B = {b} (B̄ {} then, about {} now; {how}); a bidirectional table from the re-test (convert --existing --effects) takes the new value out, or change the backlash parameter by {parameter} (convert prints it in the controller's own terms).",
-                context.deviation(before_um),
-                context.deviation(before_um + b_um),
+            Some(_) => format!(
+                "The reversal changed since the first test: B̄ {} predicted, {} measured now, a change of {} ({how}); a bidirectional table from the re-test (convert --existing --effects) takes it out, or change the backlash parameter by {parameter} (−B̄ now; convert prints it in the controller's own terms).",
+                d(predicted_um),
+                d(measured_um),
+                d(change_um),
             ),
             None => format!(
-                "Direction-dependent offset of B = {b} ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or change the backlash parameter by {parameter} (convert prints it in the controller's own terms)."
+                "Direction-dependent offset: B̄ {} measured ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or change the backlash parameter by {parameter} (−B̄; convert prints it in the controller's own terms).",
+                d(measured_um)
             ),
         }
     }

@@ -14,6 +14,8 @@ fn reading(target_mm: f64, direction: Direction, run: u32, time_h: f64) -> Readi
 const ORIGIN: Line<'static> = Line {
     first_target_mm: 0.0,
     angle_urad: None,
+    times_recorded: true,
+    run_h: 0.5,
 };
 
 /// One effect of every kind (the registry's order).
@@ -23,7 +25,7 @@ fn one_of_each() -> Vec<Effect> {
         Effect::Scale(Scale {
             scale_um_per_m: 11.5,
         }),
-        Effect::Drift(Drift { rate_um_per_h: 2.0 }),
+        Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),
         Effect::Periodic(Periodic {
             period_mm: 5.0,
             amplitude_um: 1.25,
@@ -55,8 +57,8 @@ fn columns_and_values_agree() {
     ];
     let angles = [30.0];
     let line = Line {
-        first_target_mm: 0.0,
         angle_urad: Some(&angles),
+        ..ORIGIN
     };
     let cases = [
         (Shape::Fixed(Kind::Reversal), vec![4.0]),
@@ -94,7 +96,7 @@ fn values_by_hand() {
     );
     let from_50 = Line {
         first_target_mm: 50.0,
-        angle_urad: None,
+        ..ORIGIN
     };
     assert_eq!(
         Effect::Scale(Scale {
@@ -104,7 +106,7 @@ fn values_by_hand() {
         1.6
     );
     assert_eq!(
-        Effect::Drift(Drift { rate_um_per_h: 4.0 }).value_um(&up, &ORIGIN),
+        Effect::Drift(Drift::PerHour { rate_um_per_h: 4.0 }).value_um(&up, &ORIGIN),
         1.0
     );
     let periodic = Effect::Periodic(Periodic {
@@ -201,7 +203,7 @@ fn bad_effects_are_refused_with_a_position() {
         read_effects("[[effect]]\nkind = \"drift\"\nrate_um_per_h = 1.0\ntests = [\"after\"]\n");
     assert_eq!(
         tests.unwrap(),
-        [Effect::Drift(Drift { rate_um_per_h: 1.0 })]
+        [Effect::Drift(Drift::PerHour { rate_um_per_h: 1.0 })]
     );
     let period =
         read_effects("[[effect]]\nkind = \"periodic\"\nperiod_mm = 0.0\namplitude_um = 1.0\n")
@@ -238,7 +240,7 @@ fn one_number_kinds_show_their_parameter_and_label() {
     let scale = Effect::Scale(Scale {
         scale_um_per_m: 11.5,
     });
-    let drift = Effect::Drift(Drift { rate_um_per_h: 2.0 });
+    let drift = Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 });
     assert_eq!(
         scale.parameters(),
         vec![Parameter::number("scale_um_per_m", "scale", "µm/m", 11.5)]
@@ -249,4 +251,26 @@ fn one_number_kinds_show_their_parameter_and_label() {
     );
     assert_eq!(scale.model().label(&two_decimals), "scale 11.50 µm/m");
     assert_eq!(drift.model().label(&two_decimals), "drift 2.00 µm/h");
+}
+
+/// A drift per run (a test that records no times) grows by its rate each
+/// run: at 0.75 h on a clock of 0.5 h a run, 1.5 runs, 2 µm/run gives 3 µm;
+/// its TOML takes one of the two rates, never both.
+#[test]
+fn a_drift_per_run_counts_runs_not_hours() {
+    let drift = Effect::Drift(Drift::PerRun {
+        rate_um_per_run: 2.0,
+    });
+    let late = reading(0.0, Direction::Up, 2, 0.75);
+    assert!((drift.value_um(&late, &ORIGIN) - 3.0).abs() < 1e-12);
+    assert_eq!(
+        drift.parameters(),
+        vec![Parameter::number("rate_um_per_run", "rate", "µm/run", 2.0)]
+    );
+    let read = read_effects("[[effect]]\nkind = \"drift\"\nrate_um_per_run = 2.0\n").unwrap();
+    assert_eq!(read, [drift]);
+    let both =
+        read_effects("[[effect]]\nkind = \"drift\"\nrate_um_per_h = 1.0\nrate_um_per_run = 2.0\n")
+            .unwrap_err();
+    assert!(both.message.contains("one rate"), "{both}");
 }

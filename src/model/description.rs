@@ -133,6 +133,18 @@ impl ChainCode {
         &self.workpiece
     }
 
+    /// The body an axis moves, as far as an optic on it goes: the tool's for
+    /// a tool-side axis, the workpiece's for a workpiece-side one (an optic
+    /// on a saddle moves with the table it carries while the saddle's axis
+    /// is measured).
+    pub fn body_moved_by(&self, axis: Axis) -> OpticsBody {
+        if self.tool.contains(&axis) {
+            OpticsBody::Tool
+        } else {
+            OpticsBody::Workpiece
+        }
+    }
+
     /// The axis whose joint carries a squareness error: the outer of the two
     /// when both are on one side, otherwise the tool-side one (eqs 63/64).
     pub fn squareness_axis(&self, pair: SquarenessPair) -> Axis {
@@ -151,6 +163,53 @@ impl ChainCode {
             second
         }
     }
+}
+
+/// The body that carries a laser's moving optic: the last body of one side
+/// of the chain, the one holding the tool (the spindle head) or the one
+/// holding the workpiece (the table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OpticsBody {
+    /// The body that holds the tool: the tool-side chain's last body.
+    Tool,
+    /// The body that holds the workpiece: the workpiece-side chain's last body.
+    Workpiece,
+}
+
+impl OpticsBody {
+    /// Both, as a survey names them.
+    pub const ALL: [OpticsBody; 2] = [OpticsBody::Tool, OpticsBody::Workpiece];
+
+    /// The name a survey writes: `tool` or `workpiece`.
+    pub fn name(self) -> &'static str {
+        match self {
+            OpticsBody::Tool => "tool",
+            OpticsBody::Workpiece => "workpiece",
+        }
+    }
+
+    /// The body a survey names.
+    pub fn from_name(name: &str) -> Option<OpticsBody> {
+        OpticsBody::ALL.into_iter().find(|b| b.name() == name)
+    }
+}
+
+/// Where a test's moving optic sits: on which body, and where on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Optics {
+    /// The body that carries it.
+    pub body: OpticsBody,
+    /// From the tool tip to the optic, mm: where across the axis the beam
+    /// meets it (held along the line, as the tool tip is).
+    pub offset_mm: [f64; 3],
+}
+
+impl Optics {
+    /// At the tool tip: the volumetric error itself.
+    pub const AT_TOOL_TIP: Optics = Optics {
+        body: OpticsBody::Tool,
+        offset_mm: [0.0; 3],
+    };
 }
 
 /// What a description file says, validated.

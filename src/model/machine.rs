@@ -68,7 +68,8 @@ use super::ModelError;
 use super::components::Axis;
 use super::components::GeometricErrors;
 use super::description::{
-    AxisDescription, BranchDeviations, ChainCode, Description, ErrorFrame, MappingSigns,
+    AxisDescription, BranchDeviations, ChainCode, Description, ErrorFrame, MappingSigns, Optics,
+    OpticsBody,
 };
 use super::guideway::{Guideway, GuidewayMap, THESIS_STIFFNESS_N_PER_MM};
 use super::volumetric::{ErrorMap, Grid, Kinematics, Method, VolumetricError};
@@ -248,6 +249,40 @@ impl Machine {
     ) -> VolumetricError {
         self.kinematics
             .volumetric_error(errors, position_mm, method)
+    }
+
+    /// The machine as a test's moving optic sees it: the point of the body
+    /// that carries the optic moved by the optic's offset, so the angles of
+    /// the axes under that body (and only those) take the offset into their
+    /// Abbe arms. Its volumetric error is what the optic reads, zero at the
+    /// reference position.
+    ///
+    /// The other optic (the laser head, the interferometer or the
+    /// straightness reference) stands on the other body, which the measured
+    /// axis does not move; so the reading is the error of the moving body's
+    /// point at the optic, and the other body's angles stay constant along
+    /// the test. On the tool's side that point is the tool tip (the tool
+    /// offset, eq. 59); on the workpiece's, the workpiece point under it
+    /// (eq. 60): seed 000 §2.5's EBX·(Z + z4 + 550) in E_x becomes
+    /// EBX·(Z + z4 + 550 + d_z) for an optic d_z from the tool tip on the
+    /// table (`../shared/notes/seed000-volumetric-model.md` §2.3–2.5). The
+    /// offset is held along the line, as the workpiece point is: the reading
+    /// is taken where the beam meets the optic across the axis.
+    pub fn with_optics(&self, optics: &Optics) -> Result<Machine, ModelError> {
+        let d = optics.offset_mm;
+        if d == [0.0; 3] {
+            return Ok(self.clone());
+        }
+        match optics.body {
+            OpticsBody::Tool => {
+                let tool = self.tool_offset_mm();
+                self.with_tool_offset([0, 1, 2].map(|i| tool[i] + d[i]))
+            }
+            OpticsBody::Workpiece => {
+                let point = self.workpiece_point_mm();
+                self.with_workpiece_point([0, 1, 2].map(|i| point[i] + d[i]))
+            }
+        }
     }
 
     /// The volumetric error at every point of `grid`.
@@ -535,6 +570,116 @@ mod tests {
         assert_eq!(machine.branch_deviations(), BranchDeviations::Sum);
         assert_eq!(machine.axis(Axis::Z).normal, Axis::Y);
         assert_eq!(machine.axis(Axis::Z).lateral(Axis::Z), Axis::X);
+    }
+
+    #[test]
+    fn an_optic_reads_the_error_at_its_own_point() {
+        // By hand from the notes' §2.5 expansion of the ZFYX chain (z4 = 80,
+        // z3 = 200, zt = 250 on the bundled machine), with each angle a line
+        // k·q through zero at the reference, k = 1e-8 rad/mm.
+        use crate::model::components::{ErrorFunction, ErrorName, ErrorTable, Interpolation};
+        const K: f64 = 1e-8;
+        let machine = Machine::bundled();
+        let line = |name: ErrorName, axis: Axis| {
+            let [low, high] = machine.axis(axis).stroke_mm;
+            let mut errors = GeometricErrors::default();
+            let table = ErrorTable::new(
+                vec![low, high],
+                vec![K * low, K * high],
+                Interpolation::Linear,
+            );
+            errors
+                .set(name, ErrorFunction::Table(table.unwrap()))
+                .unwrap();
+            errors
+        };
+        let table = |offset_mm| Optics {
+            body: OpticsBody::Workpiece,
+            offset_mm,
+        };
+        let head = |offset_mm| Optics {
+            body: OpticsBody::Tool,
+            offset_mm,
+        };
+        let cases = [
+            // X's pitch on the X line z = −120: E_x = EBX·(Z + z4 + 550), and an
+            // optic 150 mm below the point on the table shortens the arm.
+            (
+                ErrorName::EBX,
+                Axis::X,
+                [600.0, 100.0, -120.0],
+                table([0.0, 120.0, -150.0]),
+                0,
+                K * 600.0 * 360.0,
+            ),
+            (
+                ErrorName::EBX,
+                Axis::X,
+                [600.0, 100.0, -120.0],
+                Optics::AT_TOOL_TIP,
+                0,
+                K * 600.0 * 510.0,
+            ),
+            // On the spindle head, which X does not move, the offset reaches
+            // only Z's angles: X's pitch keeps the tool tip's arm.
+            (
+                ErrorName::EBX,
+                Axis::X,
+                [600.0, 100.0, -120.0],
+                head([0.0, 120.0, -150.0]),
+                0,
+                K * 600.0 * 510.0,
+            ),
+            // X's yaw has no arm in E_y at the tool (x = 0 from its frame);
+            // an optic 50 mm along X on the table gives it ECX·50.
+            (
+                ErrorName::ECX,
+                Axis::X,
+                [600.0, 100.0, -120.0],
+                table([50.0, 120.0, -150.0]),
+                1,
+                K * 600.0 * 50.0,
+            ),
+            (
+                ErrorName::ECX,
+                Axis::X,
+                [600.0, 100.0, -120.0],
+                head([50.0, 120.0, -150.0]),
+                1,
+                0.0,
+            ),
+            // Y's pitch: E_y = −EAY·(Z + z3 + z4 + 550), the optic on the table
+            // 150 mm lower: −k·y·(−400 + 830 − 150).
+            (
+                ErrorName::EAY,
+                Axis::Y,
+                [600.0, 300.0, -400.0],
+                table([100.0, 0.0, -150.0]),
+                1,
+                -K * 300.0 * 280.0,
+            ),
+            // Z's pitch on the head: E_y = EAZ·zt, the optic 50 mm further down.
+            (
+                ErrorName::EAZ,
+                Axis::Z,
+                [200.0, 400.0, -300.0],
+                head([0.0, 0.0, -50.0]),
+                1,
+                K * -300.0 * 300.0,
+            ),
+        ];
+        for (name, axis, p, optics, direction, expected) in cases {
+            let errors = line(name, axis);
+            let seen = machine.with_optics(&optics).unwrap();
+            for method in [Method::FirstOrder, Method::Full] {
+                let reading = seen.volumetric_error(&errors, p, method).translation_mm;
+                assert!(
+                    (reading[direction] - expected).abs() < 1e-12,
+                    "{name} {optics:?} {method:?}: {} against {expected}",
+                    reading[direction]
+                );
+            }
+        }
     }
 
     fn with(replace: &str, by: &str) -> Result<Machine, ModelError> {

@@ -78,7 +78,9 @@ pub use components::{
     Axis, AxisErrors, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, ErrorValues,
     GeometricErrors, Interpolation, Squareness, SquarenessPair,
 };
-pub use description::{AxisDescription, BranchDeviations, ChainCode, ErrorFrame, MappingSigns};
+pub use description::{
+    AxisDescription, BranchDeviations, ChainCode, ErrorFrame, MappingSigns, Optics, OpticsBody,
+};
 pub use error_description::read_error_description;
 pub use guideway::{
     CarriageDeviations, Guideway, GuidewayMap, GuidewayResponse, OutputWeights, RailProfiles,

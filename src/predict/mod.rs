@@ -71,7 +71,7 @@ use crate::evaluate::{
 use crate::measurement::{Direction, Measurement, Run};
 use crate::model::{
     Axis, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid,
-    Interpolation, Machine, Method, ModelError,
+    Interpolation, Machine, Method, ModelError, Optics,
 };
 use crate::units::um_to_mm;
 
@@ -84,9 +84,10 @@ pub struct MeasuredAxis<'a> {
     pub measurement: &'a Measurement,
     /// Machine position of the line (the measured axis's own coordinate is ignored), mm.
     pub line_mm: [f64; 3],
-    /// Where the laser's moving optics sit relative to the tool tip, mm
-    /// (zero: at the tool tip); the Abbe arms of the test are the tool's plus this.
-    pub optics_offset_mm: [f64; 3],
+    /// Where the laser's moving optic sits ([`Optics::AT_TOOL_TIP`]: at the
+    /// tool tip): the Abbe arms of the axes under its body are their arms to
+    /// the tool plus its offset (`Machine::with_optics`).
+    pub optics: Optics,
 }
 
 /// What `predict` is given.
@@ -278,6 +279,25 @@ pub enum PredictError {
         /// What is wrong.
         why: String,
     },
+    /// A measured test reaching beyond the model's stroke of its axis: the
+    /// model's errors (and its map) are not defined there.
+    #[error(
+        "the test of {axis} covers {from_mm} … {to_mm} mm, beyond the {axis} stroke {low_mm} … {high_mm} mm of the machine model ({machine}): a model that does not cover the test predicts nothing of it; give the machine's own description with --machine"
+    )]
+    BeyondStroke {
+        /// The axis.
+        axis: Axis,
+        /// The test's first target, mm.
+        from_mm: f64,
+        /// Its last target, mm.
+        to_mm: f64,
+        /// The model's stroke, mm.
+        low_mm: f64,
+        /// mm.
+        high_mm: f64,
+        /// The model's name.
+        machine: String,
+    },
     /// A bug.
     #[error("internal error, please report: {0}")]
     Internal(String),
@@ -290,6 +310,9 @@ pub enum PredictError {
 pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
     if input.tables.is_empty() && input.cross_tables.is_empty() {
         return Err(PredictError::NoTable);
+    }
+    for measured in input.measured {
+        within_stroke(input.machine, measured.measurement)?;
     }
     let errors = calibrated_errors(input)?;
     let retest_machine = match input.retest_tool_offset_mm {
@@ -321,42 +344,138 @@ pub fn predict(input: &PredictInput<'_>) -> Result<Prediction, PredictError> {
         )?);
     }
     let grid = Grid::over_strokes(&retest_machine, input.grid_step_mm)?;
-    let before = retest_machine.error_map(&errors, &grid, Method::Full);
     let zero = VolumetricMaximum {
         max_mm: 0.0,
         at_mm: [0.0; 3],
     };
     let (mut after, mut positioning_only) = (zero, zero);
     let mut after_errors = errors.clone();
-    for direction in Direction::BOTH {
-        let positioned = compensated_errors(&errors, input.tables, &grid, direction)?;
-        let (max_mm, at_mm) = retest_machine
-            .error_map(&positioned, &grid, Method::Full)
-            .max_translation();
-        if max_mm >= positioning_only.max_mm {
-            positioning_only = VolumetricMaximum { max_mm, at_mm };
+    // Each table as the controller applies it, with the reversal the first
+    // test of its axis measured: the map of each direction keeps what the
+    // re-test of that direction keeps.
+    let mut applying = Vec::new();
+    for table in input.tables {
+        let axis = axis_named("a table", &table.axis)?;
+        let known = input
+            .measured
+            .iter()
+            .find(|m| axis_named("a measurement", m.measurement.axis()).ok() == Some(axis))
+            .and_then(|m| KnownError::from_evaluation(&evaluate(m.measurement)));
+        applying.push((table, known));
+    }
+    let mut before_map = zero;
+    let own: Vec<GeometricErrors> = Direction::BOTH
+        .into_iter()
+        .map(|direction| with_reversal(&errors, &applying, &grid, direction))
+        .collect::<Result<_, _>>()?;
+    let positioned: Vec<GeometricErrors> = Direction::BOTH
+        .into_iter()
+        .map(|direction| {
+            compensated_errors(&errors, &applying, input.backlash_set, &grid, direction)
+        })
+        .collect::<Result<_, _>>()?;
+    // The map is zero at the reference position; each direction's is taken
+    // from the reference reached as the two directions do on average, so
+    // what one direction keeps of the reversal stays in its map.
+    let reference = retest_machine.reference_mm();
+    let own_offsets = direction_offsets(&own, &applying, reference)?;
+    let offsets = direction_offsets(&positioned, &applying, reference)?;
+    for k in 0..2 {
+        let largest = |errors: &GeometricErrors, offset: [f64; 3]| {
+            let map = retest_machine.error_map(errors, &grid, Method::Full);
+            largest_with_offset(&map, offset)
+        };
+        let found = largest(&own[k], own_offsets[k]);
+        if found.max_mm >= before_map.max_mm {
+            before_map = found;
         }
-        let compensated = cross_compensated(&positioned, input.cross_tables, &grid)?;
-        let (max_mm, at_mm) = retest_machine
-            .error_map(&compensated, &grid, Method::Full)
-            .max_translation();
-        if max_mm >= after.max_mm {
-            after = VolumetricMaximum { max_mm, at_mm };
+        let found = largest(&positioned[k], offsets[k]);
+        if found.max_mm >= positioning_only.max_mm {
+            positioning_only = found;
+        }
+        let compensated = cross_compensated(&positioned[k], input.cross_tables, &grid)?;
+        let found = largest(&compensated, offsets[k]);
+        if found.max_mm >= after.max_mm {
+            after = found;
             after_errors = compensated;
         }
     }
     let shares = shares_at(&retest_machine, &after_errors, after.at_mm);
-    let (max_mm, at_mm) = before.max_translation();
     Ok(Prediction {
         standard: StandardUsed::of(input.standard),
         errors,
         retests,
-        volumetric_before: VolumetricMaximum { max_mm, at_mm },
+        volumetric_before: before_map,
         volumetric_after: after,
         volumetric_positioning_only: positioning_only,
         shares,
         grid_points: grid.len(),
     })
+}
+
+/// Per direction (↑, ↓), each table's axis' positioning error at the
+/// reference position less the two directions' mean there, mm, as a
+/// translation: what a map zeroed at the reference drops of a direction.
+fn direction_offsets(
+    directed: &[GeometricErrors],
+    applying: &[Applying<'_>],
+    reference_mm: [f64; 3],
+) -> Result<[[f64; 3]; 2], PredictError> {
+    let mut offsets = [[0.0; 3]; 2];
+    for (table, _) in applying {
+        let axis = axis_named("a table", &table.axis)?;
+        let name = positioning_error(axis);
+        let at = |errors: &GeometricErrors| {
+            errors
+                .function(name)
+                .map_or(0.0, |f| f.value_at(reference_mm[axis.index()]))
+        };
+        let (up, down) = (at(&directed[0]), at(&directed[1]));
+        let mean = 0.5 * (up + down);
+        offsets[0][axis.index()] = up - mean;
+        offsets[1][axis.index()] = down - mean;
+    }
+    Ok(offsets)
+}
+
+/// The largest ‖E + offset‖ over the map and where.
+fn largest_with_offset(map: &crate::model::ErrorMap, offset_mm: [f64; 3]) -> VolumetricMaximum {
+    let offset = nalgebra::Vector3::from(offset_mm);
+    let mut best = VolumetricMaximum {
+        max_mm: 0.0,
+        at_mm: map.grid.position_mm(0),
+    };
+    for (index, error) in map.errors.iter().enumerate() {
+        let norm = (error.translation_mm + offset).norm();
+        if norm > best.max_mm {
+            best = VolumetricMaximum {
+                max_mm: norm,
+                at_mm: map.grid.position_mm(index),
+            };
+        }
+    }
+    best
+}
+
+/// Refuses a test whose targets leave the model's stroke of its axis (by
+/// more than a micrometre: a stroke written to the mm holds its targets).
+fn within_stroke(machine: &Machine, measurement: &Measurement) -> Result<(), PredictError> {
+    let axis = axis_named("a measurement", measurement.axis())?;
+    let [low_mm, high_mm] = machine.axis(axis).stroke_mm;
+    let targets = measurement.targets_mm();
+    let (from_mm, to_mm) = (targets[0], targets[targets.len() - 1]);
+    let slack_mm = 1e-3;
+    if from_mm < low_mm - slack_mm || to_mm > high_mm + slack_mm {
+        return Err(PredictError::BeyondStroke {
+            axis,
+            from_mm,
+            to_mm,
+            low_mm,
+            high_mm,
+            machine: machine.name().to_string(),
+        });
+    }
+    Ok(())
 }
 
 /// The machine axis a measurement or table is for.
@@ -459,7 +578,7 @@ pub fn calibrate_positioning(
         given.push(name);
         let known = KnownError::from_evaluation(&evaluate(measured.measurement))
             .ok_or(PredictError::NoMeans(axis))?;
-        let machine = with_optics(machine, measured.optics_offset_mm)?;
+        let machine = machine.with_optics(&measured.optics)?;
         let sign = positioning_sign(&machine, axis)?;
         // The others' contribution on the measured line, with EAA still zero.
         let values: Vec<f64> = known
@@ -474,15 +593,6 @@ pub fn calibrate_positioning(
         errors.set(name, ErrorFunction::Table(table))?;
     }
     Ok(errors)
-}
-
-/// The machine as a test with optics `offset_mm` from the tool tip sees it.
-pub fn with_optics(machine: &Machine, offset_mm: [f64; 3]) -> Result<Machine, PredictError> {
-    if offset_mm == [0.0; 3] {
-        return Ok(machine.clone());
-    }
-    let tool = machine.tool_offset_mm();
-    Ok(machine.with_tool_offset([0, 1, 2].map(|i| tool[i] + offset_mm[i]))?)
 }
 
 /// An axis and the line its re-test runs on.
@@ -753,26 +863,64 @@ pub fn cross_axis_table_at(
     ))
 }
 
+/// A table and the first test of its axis, as its reversal is known.
+type Applying<'a> = (&'a CompensationTable, Option<KnownError>);
+
+/// The errors with each table's axis's positioning error in one direction:
+/// EAA(x) + r(x, d), r the reversal's share the first test of the axis
+/// measured (the geometric model has no direction; the test has), linear
+/// through the grid's positions and the test's targets.
+fn with_reversal(
+    errors: &GeometricErrors,
+    applying: &[Applying<'_>],
+    grid: &Grid,
+    direction: Direction,
+) -> Result<GeometricErrors, PredictError> {
+    let mut directed = errors.clone();
+    for (table, known) in applying {
+        let Some(known) = known else { continue };
+        let axis = axis_named("a table", &table.axis)?;
+        let name = positioning_error(axis);
+        let own = errors.function(name).cloned().unwrap_or_default();
+        let positions = merged_positions(grid.axis_mm(axis), known.positions_mm());
+        let values = positions
+            .iter()
+            .map(|&x| own.value_at(x) + known.reversal_share_at(x, direction))
+            .collect();
+        let function = ErrorTable::new(positions, values, Interpolation::Linear)?;
+        directed.set(name, ErrorFunction::Table(function))?;
+    }
+    Ok(directed)
+}
+
 /// The errors with each table applied to its axis's positioning error, for
-/// one direction: EAA_c(x) = EAA(x − v) − v, linear through the grid's
+/// one direction: EAA_c(x) = EAA(x − v) + r(x − v, d) − v, v the table's
+/// value (and the backlash parameter's share, when set) and r the reversal's
+/// share the first test of the axis measured; linear through the grid's
 /// positions and the table's points (exact at both).
 fn compensated_errors(
     errors: &GeometricErrors,
-    tables: &[CompensationTable],
+    applying: &[Applying<'_>],
+    backlash_set: bool,
     grid: &Grid,
     direction: Direction,
 ) -> Result<GeometricErrors, PredictError> {
     let mut compensated = errors.clone();
-    for table in tables {
+    for (table, known) in applying {
         let axis = axis_named("a table", &table.axis)?;
+        let applied = Applied::with_backlash(Some(table), known.as_ref(), backlash_set)
+            .map_err(|why| PredictError::Backlash { axis, why })?;
         let name = positioning_error(axis);
         let own = errors.function(name).cloned().unwrap_or_default();
         let positions = merged_positions(grid.axis_mm(axis), &table.positions_mm);
         let values = positions
             .iter()
             .map(|&x| {
-                let v = table.value_at(x, direction);
-                own.value_at(x - v) - v
+                let v = applied.value_at(x, direction);
+                let reversal = known
+                    .as_ref()
+                    .map_or(0.0, |k| k.reversal_share_at(x - v, direction));
+                own.value_at(x - v) + reversal - v
             })
             .collect();
         let function = ErrorTable::new(positions, values, Interpolation::Linear)?;

@@ -17,7 +17,16 @@
 //! errors = ["EYX", "EBX"]           # optional: the columns to take (default: all)
 //! line_mm = { y = 250.0, z = -275.0 }        # machine position of the line (default: reference)
 //! optics_offset_mm = { x = 0.0, y = 0.0, z = -60.0 }  # moving optics from the tool tip
+//! optics_on = "workpiece"           # optional: "tool" or "workpiece" (default: the body the axis moves)
 //! ```
+//!
+//! **Where the moving optic is.** It sits on the body `optics_on` names,
+//! by default the one the measured axis moves as the machine's chain says
+//! (on ZFYX: X and Y move the table, Z the tool), `optics_offset_mm` from
+//! the tool tip; the laser stands on the other body. The angles of the axes
+//! under that body take the offset into their Abbe arms
+//! ([`Machine::with_optics`]). [`MeasuredState::optics`] says where each
+//! test's optic was taken to be.
 //!
 //! **How each error is taken** (model units: mm, rad):
 //!
@@ -49,7 +58,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
-use super::{PredictError, axis_named, positioning_error, with_optics};
+use super::{PredictError, axis_named, positioning_error};
 use crate::error::ParseError;
 use crate::evaluate::straightness::{
     ReferenceLine, SquarenessConvention, Straightness, angle_excess, straightness,
@@ -57,7 +66,7 @@ use crate::evaluate::straightness::{
 use crate::measurement::{AxisSource, Measurement, Metadata, Run};
 use crate::model::{
     Axis, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Interpolation,
-    Machine, Method, ModelError, SquarenessPair,
+    Machine, Method, ModelError, Optics, OpticsBody, SquarenessPair,
 };
 
 /// Why a survey file is not valid: the model's error (TOML at a position, or
@@ -96,6 +105,9 @@ pub struct SurveyTest {
     pub line_mm: [Option<f64>; 3],
     /// Moving optics from the tool tip, mm.
     pub optics_offset_mm: [f64; 3],
+    /// The body that carries the moving optic, if the survey says
+    /// (otherwise the body the test's axis moves).
+    pub optics_on: Option<OpticsBody>,
 }
 
 #[derive(Deserialize)]
@@ -126,6 +138,7 @@ struct RawTest {
     errors: Option<Vec<String>>,
     line_mm: Option<RawPosition>,
     optics_offset_mm: Option<RawPosition>,
+    optics_on: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -246,6 +259,12 @@ impl Survey {
                 let p = p.unwrap_or_default();
                 [p.x, p.y, p.z]
             };
+            let optics_on = match &test.optics_on {
+                None => None,
+                Some(name) => Some(OpticsBody::from_name(name).ok_or_else(|| {
+                    invalid(what("optics_on"), "\"tool\" or \"workpiece\"", name)
+                })?),
+            };
             let line_mm = position(test.line_mm);
             let optics = position(test.optics_offset_mm);
             if let Some(bad) = line_mm
@@ -262,6 +281,7 @@ impl Survey {
                 errors,
                 line_mm,
                 optics_offset_mm: optics.map(|v| v.unwrap_or(0.0)),
+                optics_on,
             });
         }
         Ok(Survey {
@@ -342,8 +362,21 @@ pub struct PositioningTest {
     pub file: String,
     /// Machine position of the line, mm.
     pub line_mm: [f64; 3],
-    /// Moving optics from the tool tip, mm.
-    pub optics_offset_mm: [f64; 3],
+    /// Its moving optic, as taken.
+    pub optics: Optics,
+}
+
+/// Where a test's moving optic was taken to be.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TestOptics {
+    /// The file.
+    pub file: String,
+    /// The axis it measured.
+    pub axis: Axis,
+    /// The body and the offset.
+    pub optics: Optics,
+    /// Whether the survey named the body (else it is the one the axis moves).
+    pub body_stated: bool,
 }
 
 /// The machine's measured state: the 21 errors (positioning still to be
@@ -362,6 +395,8 @@ pub struct MeasuredState {
     pub squareness: Vec<SquarenessResult>,
     /// The survey's convention.
     pub convention: SquarenessConvention,
+    /// Each test's moving optic as taken, in the survey's order.
+    pub optics: Vec<TestOptics>,
 }
 
 /// One column of a test, taken.
@@ -371,7 +406,7 @@ struct Taken<'a> {
     test: &'a GeometryTest,
     column: &'a GeometryColumn,
     line_mm: [f64; 3],
-    optics_mm: [f64; 3],
+    optics: Optics,
 }
 
 /// Builds the measured state from a survey, the declared errors and each
@@ -405,6 +440,22 @@ pub fn assemble(
     let mut angles = Vec::new();
     let mut lines = Vec::new();
     let mut positioning = Vec::new();
+    let mut optics_taken = Vec::new();
+    let mut taken_optics = |axis: Axis, test: &SurveyTest| {
+        let optics = Optics {
+            body: test
+                .optics_on
+                .unwrap_or_else(|| machine.chain().body_moved_by(axis)),
+            offset_mm: test.optics_offset_mm,
+        };
+        optics_taken.push(TestOptics {
+            file: test.file.clone(),
+            axis,
+            optics,
+            body_stated: test.optics_on.is_some(),
+        });
+        optics
+    };
     for (test, file) in survey.tests.iter().zip(files) {
         let line_of = |axis: Axis| -> [f64; 3] {
             let mut line = [0, 1, 2].map(|i| test.line_mm[i].unwrap_or(reference[i]));
@@ -418,11 +469,12 @@ pub fn assemble(
                     None => axis_named("a positioning test", measurement.axis())?,
                 };
                 claim(positioning_error(axis), Source::Measured(test.file.clone()))?;
+                let optics = taken_optics(axis, test);
                 positioning.push(PositioningTest {
                     measurement: (**measurement).clone(),
                     file: test.file.clone(),
                     line_mm: line_of(axis),
-                    optics_offset_mm: test.optics_offset_mm,
+                    optics,
                 });
             }
             SurveyFile::Geometry(geometry) => {
@@ -446,6 +498,7 @@ pub fn assemble(
                         format!("the survey takes {missing}, the file has no {missing} column"),
                     ));
                 }
+                let optics = taken_optics(axis, test);
                 for column in &geometry.columns {
                     let name = ErrorName::from_name(&column.name).ok_or_else(|| {
                         PredictError::Internal(format!("column {} is no error name", column.name))
@@ -459,7 +512,7 @@ pub fn assemble(
                             measurement: positioning_measurement(geometry, column, &test.file)?,
                             file: test.file.clone(),
                             line_mm: line_of(axis),
-                            optics_offset_mm: test.optics_offset_mm,
+                            optics,
                         });
                         continue;
                     }
@@ -469,7 +522,7 @@ pub fn assemble(
                         test: geometry,
                         column,
                         line_mm: line_of(axis),
-                        optics_mm: test.optics_offset_mm,
+                        optics,
                     };
                     match column.quantity {
                         Quantity::Rotation(_) => angles.push(taken),
@@ -496,19 +549,17 @@ pub fn assemble(
     let mut straightness_results = Vec::new();
     let mut slopes: Vec<(ErrorName, f64, &Taken<'_>)> = Vec::new();
     for taken in &lines {
-        let ErrorComponent::Translation { axis, direction } = taken.name.component() else {
+        let ErrorComponent::Translation { direction, .. } = taken.name.component() else {
             continue;
         };
-        let test_machine = with_optics(machine, taken.optics_mm)?;
+        let test_machine = machine.with_optics(&taken.optics)?;
         let (positions, readings) = present_means(taken)?;
         let mut others = without_squareness.clone();
         others.set(taken.name, ErrorFunction::Constant(0.0))?;
         let corrected: Vec<f64> = positions
             .iter()
             .zip(&readings)
-            .map(|(&x, reading)| {
-                reading - along_line(&test_machine, &others, axis, direction, taken.line_mm, x)
-            })
+            .map(|(&x, reading)| reading - along_line(&test_machine, &others, taken, direction, x))
             .collect();
         let fit = straightness(&positions, &corrected, survey.reference_line);
         let table = ErrorTable::new(
@@ -599,6 +650,7 @@ pub fn assemble(
         straightness: straightness_results,
         squareness,
         convention: survey.convention,
+        optics: optics_taken,
     })
 }
 
@@ -635,16 +687,17 @@ fn present_means(taken: &Taken<'_>) -> Result<(Vec<f64>, Vec<f64>), PredictError
     Ok((positions, values))
 }
 
-/// The model's E_`direction` on `line_mm` with `axis` at `x_mm`, mm.
+/// The model's E_`direction` on the line of `taken` with its axis at
+/// `x_mm`, mm (`machine`: as its optic sees it).
 fn along_line(
     machine: &Machine,
     errors: &GeometricErrors,
-    axis: Axis,
+    taken: &Taken<'_>,
     direction: Axis,
-    line_mm: [f64; 3],
     x_mm: f64,
 ) -> f64 {
-    let mut p = line_mm;
+    let axis = axis_of(taken.name);
+    let mut p = taken.line_mm;
     p[axis.index()] = x_mm;
     machine
         .volumetric_error(errors, p, Method::Full)
@@ -665,16 +718,16 @@ fn squareness_gain(
     let mut errors = GeometricErrors::default();
     errors.squareness.set(pair, UNIT);
     let (a, b) = pair.axes();
-    let slope = |taken: &Taken<'_>, axis: Axis, direction: Axis| -> Result<f64, PredictError> {
-        let test_machine = with_optics(machine, taken.optics_mm)?;
+    let slope = |taken: &Taken<'_>, direction: Axis| -> Result<f64, PredictError> {
+        let test_machine = machine.with_optics(&taken.optics)?;
         let (positions, _) = present_means(taken)?;
         let values: Vec<f64> = positions
             .iter()
-            .map(|&x| along_line(&test_machine, &errors, axis, direction, taken.line_mm, x))
+            .map(|&x| along_line(&test_machine, &errors, taken, direction, x))
             .collect();
         Ok(straightness(&positions, &values, reference_line).slope)
     };
-    let gain = angle_excess(slope(taken_ab, a, b)?, slope(taken_ba, b, a)?) / UNIT;
+    let gain = angle_excess(slope(taken_ab, b)?, slope(taken_ba, a)?) / UNIT;
     check_gain(pair, gain)
 }
 
@@ -688,7 +741,13 @@ fn squareness_gain_nominal(machine: &Machine, pair: SquarenessPair) -> Result<f6
     let reference = machine.reference_mm();
     let slope = |axis: Axis, direction: Axis| {
         let [low, high] = machine.axis(axis).stroke_mm;
-        let at = |x| along_line(machine, &errors, axis, direction, reference, x);
+        let at = |x: f64| {
+            let mut p = reference;
+            p[axis.index()] = x;
+            machine
+                .volumetric_error(&errors, p, Method::Full)
+                .translation_mm[direction.index()]
+        };
         (at(high) - at(low)) / (high - low)
     };
     let gain = angle_excess(slope(a, b), slope(b, a)) / UNIT;

@@ -60,7 +60,7 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
     let measured = [MeasuredAxis {
         measurement: &before,
         line_mm: line,
-        optics_offset_mm: [0.0; 3],
+        optics: Optics::AT_TOOL_TIP,
     }];
     for mode in [TableMode::Mean, TableMode::Bidirectional] {
         let tables = [table(&before, mode)];
@@ -139,7 +139,7 @@ fn pitch_changes_the_reading_on_another_line_by_hand() {
     let measured = [MeasuredAxis {
         measurement: &before,
         line_mm: measured_line,
-        optics_offset_mm: [0.0; 3],
+        optics: Optics::AT_TOOL_TIP,
     }];
     let tables = [table(&before, TableMode::Mean)];
     let same = predict(&input(&machine, &errors, &measured, &tables, measured_line)).unwrap();
@@ -242,7 +242,7 @@ fn refusals() {
     let measured = [MeasuredAxis {
         measurement: &before,
         line_mm: [0.0; 3],
-        optics_offset_mm: [0.0; 3],
+        optics: Optics::AT_TOOL_TIP,
     }];
     let tables = [table(&before, TableMode::Mean)];
     let mut errors = GeometricErrors::default();

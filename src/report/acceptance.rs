@@ -264,11 +264,7 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
         if let Some(prediction) = prediction(&input.before, table.table, input.standard) {
             charts.push(NamedChart {
                 name: "predicted",
-                chart: prediction_chart(
-                    &prediction,
-                    table.table,
-                    input.after.map(|a| a.evaluation),
-                ),
+                chart: prediction_chart(&prediction, input.after.map(|a| a.evaluation)),
             });
         }
     }
@@ -563,11 +559,7 @@ fn plain_or_blank(axis: &str) -> &str {
 
 /// The predicted re-test, the uncompensated axis for comparison, and the
 /// re-test's measured means when there is one.
-fn prediction_chart(
-    prediction: &Prediction,
-    table: &CompensationTable,
-    after: Option<&Evaluation>,
-) -> Chart {
+fn prediction_chart(prediction: &Prediction, after: Option<&Evaluation>) -> Chart {
     let along = |values: &[f64]| -> Vec<(f64, f64)> {
         prediction
             .positions_mm
@@ -582,27 +574,33 @@ fn prediction_chart(
         Mark::Dashed(2),
         along(&prediction.uncompensated_um),
     )];
-    match table.values.mode() {
-        crate::compensate::TableMode::Mean => all.push(series(
+    // Both directions whenever they differ: a mean table leaves the reversal
+    // the first test measured, and one line would show ↓ as mispredicted.
+    let directional = prediction
+        .up_um
+        .iter()
+        .zip(&prediction.down_um)
+        .any(|(up, down)| up != down);
+    if directional {
+        all.push(series(
+            Some("predicted re-test ↑".into()),
+            UP,
+            Mark::Line(2),
+            along(&prediction.up_um),
+        ));
+        all.push(series(
+            Some("predicted re-test ↓".into()),
+            DOWN,
+            Mark::Line(2),
+            along(&prediction.down_um),
+        ));
+    } else {
+        all.push(series(
             Some("predicted re-test".into()),
             MODEL,
             Mark::Line(2),
             along(&prediction.up_um),
-        )),
-        crate::compensate::TableMode::Bidirectional => {
-            all.push(series(
-                Some("predicted re-test ↑".into()),
-                UP,
-                Mark::Line(2),
-                along(&prediction.up_um),
-            ));
-            all.push(series(
-                Some("predicted re-test ↓".into()),
-                DOWN,
-                Mark::Line(2),
-                along(&prediction.down_um),
-            ));
-        }
+        ));
     }
     if let Some(after) = after {
         for (direction, mark) in [(Direction::Up, Mark::Up), (Direction::Down, Mark::Down)] {
@@ -791,6 +789,8 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
                         &Line {
                             first_target_mm,
                             angle_urad: None,
+                            times_recorded: !diagnosis.time_assumed,
+                            run_h: diagnosis.run_h,
                         },
                     ),
                 )

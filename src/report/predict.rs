@@ -33,7 +33,11 @@
 //!     "straightness": [{"error": "EYX", "file": "X.csv", "reference_line": "least-squares",
 //!                       "straightness_um": …, "slope_urad": …}],
 //!     "squareness": [{"pair": "XY", "error": "EXOY", "convention": "right-handed",
-//!                     "value_urad": …, "angle_minus_90_urad": …, "model_urad": …}] } }
+//!                     "value_urad": …, "angle_minus_90_urad": …, "model_urad": …}],
+//!     "optics": [{"file": "X.csv", "axis": "X", "on": "workpiece" | "tool",
+//!                 "on_stated": true, "offset_mm": {"x", "y", "z"}}] } }
+//!                                             (each test's moving optic as taken; on_stated
+//!                                              false: the body the axis moves, by the chain)
 //! ```
 //!
 //! A straightness's `slope_urad` is its reference line's slope, kept apart
@@ -263,6 +267,23 @@ pub struct SurveyJson {
     pub straightness: Vec<StraightnessJson>,
     /// The squareness errors.
     pub squareness: Vec<SquarenessJson>,
+    /// Each test's moving optic as it was taken.
+    pub optics: Vec<OpticsJson>,
+}
+
+/// Where a survey test's moving optic was taken to be.
+#[derive(Clone, Debug, Serialize)]
+pub struct OpticsJson {
+    /// The test's file.
+    pub file: String,
+    /// The axis it measured.
+    pub axis: String,
+    /// The body that carries the optic: `tool` or `workpiece`.
+    pub on: &'static str,
+    /// Whether the survey named the body (else the one the axis moves).
+    pub on_stated: bool,
+    /// From the tool tip, mm.
+    pub offset_mm: PositionJson,
 }
 
 impl SurveyJson {
@@ -326,6 +347,17 @@ impl SurveyJson {
                     value_urad: rad_to_um_per_m(s.signed_rad),
                     angle_minus_90_urad: rad_to_um_per_m(s.excess_rad),
                     model_urad: rad_to_um_per_m(s.model_rad),
+                })
+                .collect(),
+            optics: state
+                .optics
+                .iter()
+                .map(|o| OpticsJson {
+                    file: o.file.clone(),
+                    axis: o.axis.to_string(),
+                    on: o.optics.body.name(),
+                    on_stated: o.body_stated,
+                    offset_mm: o.optics.offset_mm.into(),
                 })
                 .collect(),
         }
@@ -411,6 +443,23 @@ pub fn render(report: &PredictJson) -> String {
         um(Some(report.volumetric_max_um)),
         at(&report.volumetric_max_at_mm),
     );
+    // The map of each direction carries the reversal its first test measured.
+    let reversals: Vec<String> = report
+        .retest
+        .iter()
+        .chain(&report.also)
+        .filter_map(|r| {
+            r.measured_b_mean_um
+                .map(|b| format!("{} B̄ = {} µm", r.axis, um(Some(b))))
+        })
+        .collect();
+    if !reversals.is_empty() {
+        let _ = writeln!(
+            out,
+            "  (the worse of ↑ and ↓: each direction keeps what the tables leave of the reversal the first test measured, {})",
+            reversals.join(", ")
+        );
+    }
     // Without a positioning table that line would repeat "without the tables".
     if report.retest.is_some()
         && report.volumetric_max_positioning_only_um != report.volumetric_max_um
@@ -517,6 +566,19 @@ fn render_survey(out: &mut String, survey: &SurveyJson) {
             s.angle_minus_90_urad.abs(),
             s.error,
             s.model_urad
+        );
+    }
+    for o in &survey.optics {
+        let PositionJson { x, y, z } = o.offset_mm;
+        let why = if o.on_stated {
+            "as the survey says".to_string()
+        } else {
+            format!("the body {} moves", o.axis)
+        };
+        let _ = writeln!(
+            out,
+            "  optics of {} ({}): on the {} ({why}), x {x} y {y} z {z} mm from the tool tip; the laser on the other body",
+            o.file, o.axis, o.on
         );
     }
 }

@@ -769,6 +769,9 @@ struct RetestAnswer {
     residual_svg: Option<String>,
     /// The next table (`convert AFTER --existing TABLE --effects E.toml`), when a table was given.
     next: Option<ConvertAnswer>,
+    /// Every warning of the two tests, as `diagnose` prints them: the
+    /// readers', the evaluations' and the doubts of the pair, each naming its file.
+    warnings: Vec<String>,
 }
 
 async fn api_retest(multipart: Multipart) -> Result<axum::Json<RetestAnswer>, ApiError> {
@@ -789,7 +792,16 @@ async fn api_retest(multipart: Multipart) -> Result<axum::Json<RetestAnswer>, Ap
             standard,
             "",
         );
+        let warnings = [&retest.before, &retest.after]
+            .into_iter()
+            .zip([form.files("file"), form.files("after")])
+            .flat_map(|(test, files)| {
+                let label = file_label(files);
+                test.warnings.iter().map(move |w| format!("{label}: {w}"))
+            })
+            .collect();
         Ok(RetestAnswer {
+            warnings,
             residual_svg: svg_of(&input, "residual")?,
             next: next.as_ref().map(convert_answer).transpose()?,
             diagnosis: retest.report,

@@ -10,8 +10,10 @@
 //! (periods 400 … 1600 mm), tabulated every 5 mm.
 //!
 //! The tests ([`measure`]) read what the instruments would: on each axis's
-//! line with the optics offset, the model's volumetric error (full
-//! transforms, so every Abbe arm and squareness of the chain is in), the
+//! line, the model's volumetric error at the moving optic (full
+//! transforms, so every Abbe arm and squareness of the chain is in; the
+//! optic on the body the plan puts it on, by default the one the axis
+//! moves: [`Machine::with_optics`]), the
 //! straightness optics turned by one common small rotation of the laser's
 //! reference (the optical square keeps the pairs' reference common), an
 //! arbitrary zero for each straightness and angle, and Gaussian noise on
@@ -26,7 +28,7 @@ use crate::evaluate::straightness::{ReferenceLine, straightness};
 use crate::measurement::Direction;
 use crate::model::{
     Axis, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Interpolation,
-    Machine, Method, ModelError,
+    Machine, Method, ModelError, Optics, OpticsBody,
 };
 use crate::read::geometry::{ColumnUnit, GeometryColumn, GeometryRun, GeometryTest, Quantity};
 
@@ -47,6 +49,9 @@ pub struct GeometryPlan {
     pub lines_mm: [[f64; 3]; 3],
     /// The moving optics from the tool tip, mm, per axis's test.
     pub optics_offset_mm: [[f64; 3]; 3],
+    /// The body carrying each axis's moving optic; `None`: the body the
+    /// axis moves (the survey states the one taken).
+    pub optics_on: [Option<OpticsBody>; 3],
 }
 
 impl GeometryPlan {
@@ -71,6 +76,7 @@ impl GeometryPlan {
                 [100.0, 0.0, -150.0],
                 [-80.0, -120.0, 0.0],
             ],
+            optics_on: [None; 3],
         }
     }
 }
@@ -184,10 +190,13 @@ pub fn measure(
     );
     for axis in Axis::ALL {
         let k = axis.index();
-        let tool = machine.tool_offset_mm();
         let offset = plan.optics_offset_mm[k];
+        let optics = Optics {
+            body: plan.optics_on[k].unwrap_or_else(|| machine.chain().body_moved_by(axis)),
+            offset_mm: offset,
+        };
         let test_machine = machine
-            .with_tool_offset([0, 1, 2].map(|i| tool[i] + offset[i]))
+            .with_optics(&optics)
             .map_err(|e| SynthError::Truth(e.to_string()))?;
         let targets = targets(machine, axis, plan.step_mm);
         let own_at_reference = truth
@@ -271,7 +280,8 @@ pub fn measure(
         let [ox, oy, oz] = offset;
         survey.push_str(&format!(
             "\n[[test]]\nfile = \"{file}\"\nline_mm = {{ x = {lx:?}, y = {ly:?}, z = {lz:?} }}\n\
-             optics_offset_mm = {{ x = {ox:?}, y = {oy:?}, z = {oz:?} }}\n"
+             optics_offset_mm = {{ x = {ox:?}, y = {oy:?}, z = {oz:?} }}\noptics_on = \"{}\"\n",
+            optics.body.name()
         ));
         tests.push((file, crate::read::geometry::write(&test)));
     }

@@ -360,7 +360,9 @@ impl EffectSpec {
         Some(match *self {
             EffectSpec::Reversal { B_um, .. } => Effect::Reversal(Reversal { b_um: B_um }),
             EffectSpec::Scale { scale_um_per_m, .. } => Effect::Scale(Scale { scale_um_per_m }),
-            EffectSpec::Drift { rate_um_per_h, .. } => Effect::Drift(Drift { rate_um_per_h }),
+            EffectSpec::Drift { rate_um_per_h, .. } => {
+                Effect::Drift(Drift::PerHour { rate_um_per_h })
+            }
             EffectSpec::Periodic {
                 period_mm,
                 amplitude_um,

@@ -316,7 +316,7 @@ fn warm_up_drift_is_found_and_measured() {
             &d,
             &[(
                 "drift",
-                &|e| matches!(e, Effect::Drift(Drift { rate_um_per_h }) if within(*rate_um_per_h, 15.0)),
+                &|e| matches!(e, Effect::Drift(Drift::PerHour { rate_um_per_h }) if within(*rate_um_per_h, 15.0)),
             )],
             seed,
             sigma,
@@ -426,7 +426,7 @@ fn two_effects_at_once() {
             &d,
             &[
                 ("reversal", &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -3.0))),
-                ("drift", &|e| matches!(e, Effect::Drift(Drift { rate_um_per_h }) if within(*rate_um_per_h, 15.0))),
+                ("drift", &|e| matches!(e, Effect::Drift(Drift::PerHour { rate_um_per_h }) if within(*rate_um_per_h, 15.0))),
             ],
             seed,
             sigma,
@@ -676,7 +676,7 @@ fn at_higher_noise_every_kind_is_still_found() {
             "drift",
             after("kind = \"drift\"\nrate_um_per_h = 15.0"),
             false,
-            &|e| matches!(e, Effect::Drift(Drift { rate_um_per_h }) if within(*rate_um_per_h, 15.0)),
+            &|e| matches!(e, Effect::Drift(Drift::PerHour { rate_um_per_h }) if within(*rate_um_per_h, 15.0)),
         ),
         (
             "outlier-run",

@@ -135,7 +135,8 @@ fn scatter_um(m: &Measurement) -> f64 {
 fn value(effect: &Effect) -> f64 {
     match effect {
         Effect::Reversal(e) => e.b_um,
-        Effect::Drift(e) => e.rate_um_per_h,
+        Effect::Drift(Drift::PerHour { rate_um_per_h }) => *rate_um_per_h,
+        Effect::Drift(Drift::PerRun { rate_um_per_run }) => *rate_um_per_run,
         Effect::OutlierRun(e) => e.offset_um,
         Effect::Scale(e) => e.scale_um_per_m,
         Effect::Periodic(e) => e.amplitude_um,
@@ -162,16 +163,23 @@ fn found_like(d: &Diagnosis, put_in: &Effect) -> Option<Effect> {
 }
 
 /// The effects put in, sized to the file: a reversal and an outlier run of
-/// 10 s, a drift of 20 s over the test, a scale of 10 s over the span, and
+/// 10 s, a drift of 20 s over the test (per hour, or per run when the file records no times), a scale of 10 s over the span, and
 /// (with at least 9 targets) a periodic error of 5 s and a period of span/2.2 or 12 mm.
 fn effects_for(m: &Measurement, s_um: f64, duration_h: f64) -> Vec<Effect> {
     let targets = m.targets_mm();
     let span_mm = targets[targets.len() - 1] - targets[0];
     let mut effects = vec![
         Effect::Reversal(Reversal { b_um: -10.0 * s_um }),
-        Effect::Drift(Drift {
-            rate_um_per_h: 20.0 * s_um / duration_h,
-        }),
+        // The ecmc files record no times: the drift is per run (as diagnose gives it).
+        if m.metadata.duration_s().is_some() {
+            Effect::Drift(Drift::PerHour {
+                rate_um_per_h: 20.0 * s_um / duration_h,
+            })
+        } else {
+            Effect::Drift(Drift::PerRun {
+                rate_um_per_run: 20.0 * s_um / m.runs().len() as f64,
+            })
+        },
         Effect::OutlierRun(OutlierRun {
             run: 3,
             direction: Direction::Down,

@@ -622,3 +622,60 @@ fn the_retest_with_a_profile_is_what_diagnose_prints_with_it() {
             .contains("the screw lead the machine profile gives (15 mm)")
     );
 }
+
+/// The page's re-test refuses what `diagnose` refuses (a re-test of another
+/// stretch, tests against their recorded dates) and shows every warning of
+/// the two tests: the doubts of the pair and each test's own, naming its file.
+#[test]
+fn the_retest_refuses_and_warns_as_diagnose_does() {
+    let server = Server::start();
+    let demo = root().join("fixtures/demo");
+    let muts = crate::util::shared_data("ecmc/ecmc_target_muts_logger");
+    let b02 = read(&muts.join("b02__x__target_x.md_ISO230.dat"));
+    let ild50 = read(&muts.join("muts__data__week42_22__xyz__target_x_report_ILD50.md_ISO230.dat"));
+    let retest = |first: (&str, &[u8]), after: (&str, &[u8])| {
+        server.post(
+            "/api/retest",
+            Form::new()
+                .file("file", first.0, first.1)
+                .file("after", after.0, after.1),
+            &[],
+        )
+    };
+    let (before, after) = (
+        read(&demo.join("before.rtl")),
+        read(&demo.join("after.rtl")),
+    );
+    let elsewhere = retest(("b02.dat", &b02), ("after.rtl", &after));
+    assert_eq!(elsewhere.status, 400, "{}", elsewhere.text());
+    assert!(
+        elsewhere
+            .text()
+            .contains("only 3 % of the re-test lies where the first test measured"),
+        "{}",
+        elsewhere.text()
+    );
+    let swapped = retest(("after.rtl", &after), ("before.rtl", &before));
+    assert_eq!(swapped.status, 400, "{}", swapped.text());
+    assert!(
+        swapped
+            .text()
+            .contains("after.rtl was measured on 2026-11-20 10:00:00"),
+        "{}",
+        swapped.text()
+    );
+    // −20 … 20 mm then −4 … 4 mm: a doubt, shown with each test's warnings.
+    let doubtful = retest(("b02.dat", &b02), ("ild50.dat", &ild50));
+    assert_eq!(doubtful.status, 200, "{}", doubtful.text());
+    let warnings = doubtful.json()["warnings"].to_string();
+    for expected in [
+        "ild50.dat: b02.dat covers -20 … 20 mm, ild50.dat -4 … 4 mm: they overlap only in part",
+        "b02.dat: targets evenly spaced",
+        "ild50.dat: targets evenly spaced",
+    ] {
+        assert!(
+            warnings.contains(expected),
+            "{expected:?} not in {warnings}"
+        );
+    }
+}

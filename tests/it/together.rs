@@ -235,7 +235,13 @@ fn report_warns_when_the_files_were_written_in_different_units() {
     let dir = tempfile::tempdir().unwrap();
     let html = dir.path().join("report.html");
     let inch = shared_data("api-xd/example__8055__X Axis Forward.pos");
-    let result = run(&[&"report", &sample(), &"--after", &inch, &"-o", &html]);
+    // The API file is dated 2016-07-19: the sample, its first test here, dated before it.
+    let first = write(
+        dir.path(),
+        "sample-x.rtl",
+        &edited(&[("Date: 2026-11-20 09:14:00", "Date: 2015-11-20 09:14:00")]),
+    );
+    let result = run(&[&"report", &first, &"--after", &inch, &"-o", &html]);
     assert_eq!(result.code, 0, "{}", result.stderr);
     assert!(
         result.stderr.contains("was written in mm, "),

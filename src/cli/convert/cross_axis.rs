@@ -97,6 +97,7 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
                 .optics_offset
                 .unwrap_or([None; 3])
                 .map(|v| v.unwrap_or(0.0)),
+            optics_on: None,
         }],
     };
     let state = assemble(
@@ -213,6 +214,13 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
         "  straightness {:.2} µm ({} reference line); its slope {:.2} µrad is taken out and not compensated: it is the optics' alignment and, with the other test of the pair, squareness (predict --survey, which also takes the other axes' angles out of the slope)\n",
         report.straightness_um, report.reference_line, report.slope_urad
     ));
+    if let Some(taken) = state.optics.first() {
+        let [x, y, z] = taken.optics.offset_mm;
+        out.push_str(&format!(
+            "  moving optic on the {} (the body {axis} moves), x {x} y {y} z {z} mm from the tool tip: its offset is in the Abbe arms of the angles under that body\n",
+            taken.optics.body.name()
+        ));
+    }
     out.push_str(&format!(
         "  zero at {axis} = {} mm (the machine's reference position unless --reference)\n\n",
         report.reference_mm
