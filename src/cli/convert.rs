@@ -183,6 +183,7 @@ impl ConvertArgs {
             self.existing.as_deref(),
             self.effects.as_deref(),
             self.machine_file.machine.as_deref(),
+            self.machine_file.fanuc_parameters.as_deref(),
         ];
         let files = self.files.iter().map(PathBuf::as_path);
         files.chain(named.into_iter().flatten()).collect()

@@ -8,7 +8,7 @@ use anyhow::{Result, bail};
 use axcomp::compensate::cross_axis::CrossAxisTable;
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
-use axcomp::emit::{sinumerik840d, tnc640};
+use axcomp::emit::{Controller, sinumerik840d, tnc640};
 use axcomp::error::ParseError;
 use axcomp::measurement::Measurement;
 use axcomp::model::{GeometricErrors, Optics, read_error_description};
@@ -187,6 +187,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
             optics: *optics,
         })
         .collect();
+    check_one_machine(args, &measurements)?;
     let tables = args
         .table
         .iter()
@@ -346,6 +347,66 @@ fn load_table(
         .or(measurements.first().map(|(m, _)| m))
         .map_or(LengthUnit::Millimetre, |m| m.metadata.length_unit);
     Ok(read_table(Path::new(path), &axis, profile, linuxcnc_type, test_unit)?.1)
+}
+
+/// Refuses table files of one machine that would overwrite each other in
+/// the control: two Sinumerik programs writing the same CEC table number,
+/// or two TNC 640 tables of one table axis, which has one active table
+/// (MANUALplus 620 technical manual p.718).
+fn check_one_machine(args: &PredictArgs, measurements: &[(Measurement, [f64; 3])]) -> Result<()> {
+    // (file, the axis the table is a function of)
+    let mut files: Vec<(&str, String)> = Vec::new();
+    for spec in &args.table {
+        match spec.split_once('=') {
+            Some((axis, path)) if axis.len() == 1 => files.push((path, axis.to_ascii_uppercase())),
+            _ => {
+                if let [(only, _)] = measurements {
+                    files.push((spec, only.axis().to_string()));
+                }
+            }
+        }
+    }
+    for spec in &args.cross_table {
+        if let (Some(axis), Some(path)) = (spec.chars().nth(4), spec.get(7..)) {
+            files.push((path, axis.to_ascii_uppercase().to_string()));
+        }
+    }
+    let same_file = |a: &str, b: &str| {
+        a == b
+            || std::fs::canonicalize(a)
+                .ok()
+                .is_some_and(|a| std::fs::canonicalize(b).ok() == Some(a))
+    };
+    let mut seen: Vec<(&str, &str, Controller, Vec<usize>)> = Vec::new();
+    for (path, axis) in &files {
+        let Ok(text) = std::fs::read_to_string(path) else {
+            continue;
+        };
+        let Some(controller) = axcomp::emit::detect(&text) else {
+            continue;
+        };
+        let numbers = match controller {
+            Controller::Sinumerik840d => sinumerik840d::cec_tables(&text).unwrap_or_default(),
+            _ => Vec::new(),
+        };
+        for (other, other_axis, other_controller, other_numbers) in &seen {
+            if same_file(path, other) || *other_controller != controller {
+                continue;
+            }
+            if let Some(t) = numbers.iter().find(|t| other_numbers.contains(t)) {
+                bail!(
+                    "{other} and {path} both write Sinumerik CEC table {t}: loaded one after the other, the second overwrites the first in the control; write them again with convert, which numbers the tables of one machine from its profile (formats/sinumerik840d/README.md)"
+                );
+            }
+            if controller == Controller::Tnc640 && other_axis == axis {
+                bail!(
+                    "{other} and {path} are both tables of axis {axis}, and the TNC 640 has one active compensation table per axis (MANUALplus 620 technical manual p.718): put the columns into one table (convert STRAIGHTNESS --controller tnc640 --existing {other})"
+                );
+            }
+        }
+        seen.push((path, axis, controller, numbers));
+    }
+    Ok(())
 }
 
 /// `COLUMN=F(AXIS):FILE`: a cross-axis table from a TNC 640 `.COM` or a

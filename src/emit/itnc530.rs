@@ -214,7 +214,7 @@ mod tests {
             linuxcnc_type: 0,
             max_points: None,
             max_value_mm: None,
-            cec_first_table: 0,
+            provenance: None,
             cec_values_are_corrections: true,
             tnc640_columns: Vec::new(),
             kind: Default::default(),

@@ -29,6 +29,7 @@ pub mod profile;
 pub mod sinumerik840d;
 pub mod tnc640;
 
+use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::plan::Capabilities;
 use crate::compensate::{CompensationTable, TableMode, TableValues};
 use crate::error::ParseError;
@@ -283,8 +284,9 @@ pub struct EmitOptions {
     pub max_points: Option<usize>,
     /// Largest |value| the machine builder allows, mm.
     pub max_value_mm: Option<f64>,
-    /// Sinumerik CEC: index of the first table (the ↑ table; ↓ is the next).
-    pub cec_first_table: usize,
+    /// Where the table comes from, written as a comment where the format
+    /// has comments ([`Provenance`]); `None` writes none.
+    pub provenance: Option<Provenance>,
     /// Sinumerik CEC sign: `true` writes the correction (−error), the
     /// reconstructed convention; `false` writes the error.
     pub cec_values_are_corrections: bool,
@@ -311,7 +313,7 @@ impl EmitOptions {
             linuxcnc_type: 0,
             max_points: profile.controller.max_points,
             max_value_mm: profile.controller.max_value_mm,
-            cec_first_table: profile.controller.cec_first_table.unwrap_or(0),
+            provenance: None,
             cec_values_are_corrections: profile.controller.cec_values != Some(CecValues::Error),
             tnc640_columns: profile
                 .controller
@@ -340,6 +342,50 @@ impl EmitOptions {
             return false;
         };
         self.kind == AxisKind::Rotary && (last - first - FULL_TURN_DEG).abs() < 1e-9
+    }
+}
+
+/// What a table records of its source, where its format has comments
+/// (Sinumerik `;`): the measurement file, the date the file records (never
+/// the clock, so the same input gives the same bytes) and the axcomp version.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Provenance {
+    /// The measurement file(s) the table was made from, by file name.
+    pub source: String,
+    /// The test's date as the file records it; `None` when it records none.
+    pub recorded: Option<String>,
+}
+
+impl Provenance {
+    /// The provenance of a table made from `measurement`: its file's name
+    /// and the date it records.
+    pub fn of(measurement: &crate::measurement::Measurement) -> Provenance {
+        let metadata = &measurement.metadata;
+        Provenance {
+            source: metadata
+                .source_file
+                .as_ref()
+                .and_then(|path| path.file_name())
+                .map_or_else(
+                    || "a measurement without a file name".to_string(),
+                    |name| name.to_string_lossy().into_owned(),
+                ),
+            recorded: metadata.date.as_ref().map(|date| date.raw.clone()),
+        }
+    }
+
+    /// The lines to write, without the comment sign: `made by axcomp
+    /// 0.1.0 from X.rtl (measured 2024-03-05 10:12)`.
+    pub fn text(&self) -> String {
+        let date = match &self.recorded {
+            Some(date) => format!("measured {date}"),
+            None => "its date not recorded".to_string(),
+        };
+        format!(
+            "made by axcomp {} from {} ({date})",
+            env!("CARGO_PKG_VERSION"),
+            self.source
+        )
     }
 }
 
@@ -666,8 +712,9 @@ pub fn write(
     Ok(text)
 }
 
-/// The bytes of the file to hand out: [`write`]'s text, except that a Fagor
-/// 8065 table goes into `existing` (the `.mp` file that was active, when it
+/// The bytes of the file to hand out: [`write`]'s text, except that a TNC
+/// 640 table keeps the other filled columns of `existing` (the axis's one
+/// active `.COM`, [`tnc640::update`]) and a Fagor 8065 table goes into `existing` (the `.mp` file that was active, when it
 /// holds a leadscrew table) with every other line, the encoding, the
 /// byte-order mark and the line ends kept, or into a new UTF-16LE file.
 /// The result is read back like [`write`]'s.
@@ -677,6 +724,15 @@ pub fn write_bytes(
     options: &EmitOptions,
     existing: Option<&[u8]>,
 ) -> Result<Vec<u8>, EmitError> {
+    if controller == Controller::Tnc640
+        && let Some(old) = existing.and_then(|bytes| std::str::from_utf8(bytes).ok())
+    {
+        // One active table per axis: the axis's other columns stay.
+        check_table(controller, table, options)?;
+        let text = tnc640::update(old, table, options)?;
+        check_read_back(controller, table, &text, options)?;
+        return Ok(text.into_bytes());
+    }
     if controller == Controller::Fanuc {
         // A pitch file that was active gets the new points in place.
         let old = existing.and_then(|bytes| decode_table(bytes).ok());
@@ -826,6 +882,32 @@ pub fn read_any(
     Ok((controller, table))
 }
 
+/// The controller format of a table file, from its content.
+pub fn detect(text: &str) -> Option<Controller> {
+    let first = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty())
+        .unwrap_or("");
+    if fanuc::looks_like(text) {
+        Some(Controller::Fanuc)
+    } else if fagor8065::looks_like(text) {
+        Some(Controller::Fagor8065)
+    } else if fagor8055::looks_like(text) {
+        Some(Controller::Fagor8055)
+    } else if first.starts_with("BEGIN") && first.contains("DATUM") {
+        Some(Controller::Itnc530)
+    } else if first.starts_with("BEGIN") {
+        Some(Controller::Tnc640)
+    } else if first.starts_with('%') || text.contains("$AA_ENC_COMP") || text.contains("$AN_CEC") {
+        Some(Controller::Sinumerik840d)
+    } else if first.split_whitespace().count() == 3 {
+        Some(Controller::LinuxCnc)
+    } else {
+        None
+    }
+}
+
 /// How to activate a written table on its controller, in one or a few lines.
 pub fn activation(
     controller: Controller,
@@ -836,11 +918,86 @@ pub fn activation(
     match controller {
         Controller::Itnc530 => itnc530::activation(file_name, options),
         Controller::Tnc640 => tnc640::activation(file_name, options),
-        Controller::Sinumerik840d => sinumerik840d::activation(table, options),
+        Controller::Sinumerik840d => sinumerik840d::activation(table, file_name, options),
         Controller::LinuxCnc => linuxcnc::activation(file_name, options),
         Controller::Fagor8055 => fagor8055::activation(file_name, options),
         Controller::Fagor8065 => fagor8065::activation(file_name, options),
         Controller::Fanuc => fanuc::activation(file_name, table, options),
+    }
+}
+
+/// Writes a cross-axis table "`options.axes[0]` = F(`cross.table_axis`)"
+/// for `controller`, checked as every table is ([`check_table`]: the
+/// profile's point limit, spacing, value limits). TNC 640: the `.COM` of
+/// the table axis, holding the table axis's own column too (one active
+/// table per axis), `existing` its current `.COM` whose other columns are
+/// kept. Sinumerik: a CEC table numbered from the profile
+/// ([`MachineProfile::cec_table`]).
+pub fn write_cross_axis(
+    controller: Controller,
+    cross: &CrossAxisTable,
+    profile: &MachineProfile,
+    options: &EmitOptions,
+    existing: Option<&str>,
+) -> Result<String, EmitError> {
+    check_table(controller, &cross.table, options)?;
+    let input = profile.axis(&cross.table_axis)?;
+    let output = options.axes.first().ok_or_else(|| {
+        EmitError::Profile("a cross-axis table needs the axis it moves".to_string())
+    })?;
+    match controller {
+        Controller::Tnc640 => {
+            tnc640::write_cross_axis(cross, &input.tnc640_column, options, existing)
+        }
+        Controller::Sinumerik840d => {
+            let t = profile.cec_table(&cross.table_axis, &output.axis)?;
+            sinumerik840d::write_cross_axis(cross, &input.sinumerik_axis, t, options)
+        }
+        _ => Err(EmitError::Profile(format!(
+            "axcomp writes cross-axis tables for tnc640 and sinumerik840d, not {}",
+            controller.name()
+        ))),
+    }
+}
+
+/// How to activate a cross-axis table written by [`write_cross_axis`]
+/// (`existing`: into the table axis's existing table).
+pub fn cross_axis_activation(
+    controller: Controller,
+    cross: &CrossAxisTable,
+    profile: &MachineProfile,
+    (file_name, existing): (&str, bool),
+    options: &EmitOptions,
+) -> Result<String, EmitError> {
+    let input = profile.axis(&cross.table_axis)?;
+    let output = options.axes.first().ok_or_else(|| {
+        EmitError::Profile("a cross-axis table needs the axis it moves".to_string())
+    })?;
+    Ok(match controller {
+        Controller::Sinumerik840d => {
+            let t = profile.cec_table(&cross.table_axis, &output.axis)?;
+            sinumerik840d::cross_axis_activation(
+                cross,
+                (&input.sinumerik_axis, &output.sinumerik_axis),
+                t,
+                file_name,
+                options,
+            )
+        }
+        _ => tnc640::cross_axis_activation(
+            file_name,
+            (&input.tnc640_column, &output.tnc640_column),
+            existing,
+        ),
+    })
+}
+
+/// What a cross-axis file holds, times the table's error: −1 where a
+/// Sinumerik CEC holds corrections, else +1.
+pub fn cross_axis_file_sign(controller: Controller, options: &EmitOptions) -> f64 {
+    match controller {
+        Controller::Sinumerik840d if options.cec_values_are_corrections => -1.0,
+        _ => 1.0,
     }
 }
 
@@ -977,7 +1134,7 @@ mod tests {
             linuxcnc_type: 0,
             max_points: None,
             max_value_mm: None,
-            cec_first_table: 0,
+            provenance: None,
             cec_values_are_corrections: controller == Controller::Sinumerik840d,
             tnc640_columns: Vec::new(),
             kind: Default::default(),

@@ -8,7 +8,7 @@
 //! units = "mm"              # machine units (LinuxCNC writes these)
 //! max_points = 200          # Sinumerik MD38000 / MD18342, or any stricter limit
 //! max_value_mm = 0.1        # refuse tables with larger |values|
-//! cec_first_table = 0       # Sinumerik CEC table index for ↑ (↓ is the next)
+//! cec_first_table = 0       # Sinumerik: the first CEC table number of the machine
 //! cec_values = "correction" # or "error": the CEC sign, see formats/sinumerik840d
 //! tnc640_columns = ["X", "Y", "Z"]  # the machine's CfgAxes/axisList
 //! fanuc_parameters = "CNC-PARA.TXT" # a Fanuc control: its parameter backup
@@ -29,6 +29,14 @@
 //! Axes missing from the profile get defaults from their letter (X, Y, Z, A,
 //! B, C, U, V, W → iTNC columns 1–9, TNC 640 column = the letter, Sinumerik
 //! `X1`…, LinuxCNC joints 0–8), documented in README.md.
+//!
+//! Sinumerik CEC table numbers are allocated from the profile
+//! ([`MachineProfile::cec_table`]), so the files of one machine never load
+//! into the same table: the machine's axes are X, Y, Z and every other axis
+//! `[controller.axes]` names; with n of them, axis i has the pair
+//! `first + 2i` (↑) and `first + 2i + 1` (↓), and the cross-axis table
+//! "output = F(input)" the number `first + 2n + i·(n − 1) + j'`, where i is
+//! the input's index and j' the output's among the other axes.
 
 use std::collections::BTreeMap;
 
@@ -61,7 +69,7 @@ pub struct ControllerProfile {
     pub max_points: Option<usize>,
     /// Largest |value| allowed, mm.
     pub max_value_mm: Option<f64>,
-    /// Sinumerik CEC: first table index.
+    /// Sinumerik CEC: the machine's first table number (the allocation starts there).
     pub cec_first_table: Option<usize>,
     /// Sinumerik CEC sign: `correction` or `error`.
     #[serde(default, deserialize_with = "cec_values")]
@@ -167,6 +175,10 @@ pub struct AxisProfile {
     pub sinumerik_encoder: u32,
     /// LinuxCNC joint number.
     pub linuxcnc_joint: u32,
+    /// Sinumerik CEC: the number of the axis's own ↑ table (↓ is the next),
+    /// allocated from the profile; `None` for an axis the profile does not
+    /// name among the machine's axes ([`MachineProfile::cec_table`]).
+    pub cec_table: Option<usize>,
     /// Fanuc: the axis' pitch error compensation parameters, when the
     /// profile has a parameter backup.
     pub fanuc: Option<super::fanuc::AxisParameters>,
@@ -214,6 +226,52 @@ impl MachineProfile {
             })
     }
 
+    /// The machine's axes for the CEC table numbers: X, Y, Z, then every
+    /// other axis `[controller.axes]` names, in the letters' order (X Y Z A
+    /// B C U V W), other names after them alphabetically.
+    pub fn cec_axes(&self) -> Vec<String> {
+        let mut axes: Vec<String> = ["X", "Y", "Z"].map(String::from).to_vec();
+        let mut named: Vec<&String> = self.controller.axes.keys().collect();
+        named.sort_by_key(|name| {
+            let letter = AXIS_LETTERS
+                .iter()
+                .position(|l| l.eq_ignore_ascii_case(name));
+            (letter.unwrap_or(AXIS_LETTERS.len()), name.as_str())
+        });
+        for name in named {
+            if !axes.iter().any(|a| a.eq_ignore_ascii_case(name)) {
+                axes.push(name.clone());
+            }
+        }
+        axes
+    }
+
+    /// The Sinumerik CEC table number of "`output` = F(`input`)": for
+    /// `input == output` the axis's own ↑ table (↓ is the next), else the
+    /// cross-axis table (module doc). Distinct for every pair of the
+    /// machine's axes, so the files of one machine never overwrite each other.
+    pub fn cec_table(&self, input: &str, output: &str) -> Result<usize, EmitError> {
+        let axes = self.cec_axes();
+        let index = |axis: &str| {
+            axes.iter()
+                .position(|a| a.eq_ignore_ascii_case(axis))
+                .ok_or_else(|| {
+                    EmitError::Profile(format!(
+                        "axis {axis} has no Sinumerik CEC table number: the machine's axes are {} (name {axis} under [controller.axes.{axis}] in the machine profile, so every file of the machine numbers its tables alike)",
+                        axes.join(", ")
+                    ))
+                })
+        };
+        let first = self.controller.cec_first_table.unwrap_or(0);
+        let n = axes.len();
+        let (i, j) = (index(input)?, index(output)?);
+        Ok(match j.cmp(&i) {
+            std::cmp::Ordering::Equal => first + 2 * i,
+            std::cmp::Ordering::Less => first + 2 * n + i * (n - 1) + j,
+            std::cmp::Ordering::Greater => first + 2 * n + i * (n - 1) + j - 1,
+        })
+    }
+
     /// The resolved names of an axis: profile entries first, defaults from the letter.
     pub fn axis(&self, axis: &str) -> Result<AxisProfile, EmitError> {
         let entry = self.controller.axes.get(axis).cloned().unwrap_or_default();
@@ -243,6 +301,7 @@ impl MachineProfile {
                     .map(|i| i as u32)
                     .ok_or_else(|| need("linuxcnc_joint"))?,
             },
+            cec_table: self.cec_table(axis, axis).ok(),
             fanuc: match &self.fanuc {
                 Some(backup) => Some(backup.axis(axis).map_err(EmitError::Profile)?),
                 None => None,
@@ -289,6 +348,43 @@ mod tests {
         assert!(MachineProfile::from_toml_str("[controller]\nmax_pionts = 3\n").is_err());
         assert_eq!(profile.axis_periods("X"), AxisPeriods::default());
         assert!(MachineProfile::from_toml_str("[controller]\nunits = \"furlong\"\n").is_err());
+    }
+
+    #[test]
+    fn cec_tables_are_distinct_across_the_machine() {
+        // By hand for X, Y, Z: own pairs 0/1, 2/3, 4/5; then Y=F(X) 6,
+        // Z=F(X) 7, X=F(Y) 8, Z=F(Y) 9, X=F(Z) 10, Y=F(Z) 11.
+        let profile = MachineProfile::default();
+        let table = |i: &str, o: &str| profile.cec_table(i, o).unwrap();
+        assert_eq!(
+            (table("X", "X"), table("Y", "Y"), table("Z", "Z")),
+            (0, 2, 4)
+        );
+        assert_eq!((table("X", "Y"), table("X", "Z")), (6, 7));
+        assert_eq!((table("Y", "X"), table("Y", "Z")), (8, 9));
+        assert_eq!((table("Z", "X"), table("Z", "Y")), (10, 11));
+        assert!(profile.cec_table("C", "C").is_err());
+        assert_eq!(profile.axis("C").unwrap().cec_table, None);
+        // A profile naming C and starting at 10: n = 4.
+        let text =
+            "[controller]\ncec_first_table = 10\n\n[controller.axes.C]\nsinumerik_axis = \"C1\"\n";
+        let profile = MachineProfile::from_toml_str(text).unwrap();
+        assert_eq!(profile.cec_axes(), ["X", "Y", "Z", "C"]);
+        let table = |i: &str, o: &str| profile.cec_table(i, o).unwrap();
+        assert_eq!(
+            (table("C", "C"), table("X", "Y"), table("C", "Z")),
+            (16, 18, 29)
+        );
+        let mut all: Vec<usize> = ["X", "Y", "Z", "C"]
+            .iter()
+            .flat_map(|i| ["X", "Y", "Z", "C"].map(|o| (*i, o)))
+            .flat_map(|(i, o)| {
+                let t = table(i, o);
+                if i == o { vec![t, t + 1] } else { vec![t] }
+            })
+            .collect();
+        all.sort_unstable();
+        assert_eq!(all, (10..30).collect::<Vec<_>>());
     }
 
     #[test]

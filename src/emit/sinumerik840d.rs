@@ -23,7 +23,9 @@ use std::collections::BTreeMap;
 
 use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::{CompensationTable, TableValues};
-use crate::emit::{BacklashAdvice, BacklashParameter, EmitError, EmitOptions, minimal};
+use crate::emit::{
+    AxisProfile, BacklashAdvice, BacklashParameter, EmitError, EmitOptions, minimal,
+};
 use crate::error::ParseError;
 use crate::read::text::{self, Line};
 use crate::units::LengthUnit;
@@ -39,6 +41,37 @@ fn number(value: f64) -> String {
     } else {
         format!("{text}.0")
     }
+}
+
+/// The program's first lines: its name and, where the caller gives it, a
+/// comment with the table's source (`;` starts a comment in a Siemens part
+/// program; the K3 example programs comment every line).
+fn head(name: &str, options: &EmitOptions) -> String {
+    let mut out = format!("{name}\n");
+    if let Some(provenance) = &options.provenance {
+        out.push_str(&format!("; {}\n", provenance.text()));
+    }
+    out.push_str("CHANDATA(1)\n");
+    out
+}
+
+/// +1 or −1: what a CEC value is, times the table's error (corrections −error).
+fn cec_sign(options: &EmitOptions) -> f64 {
+    if options.cec_values_are_corrections {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+/// The axis's own ↑ CEC table number (↓ is the next), from the profile.
+fn own_cec_table(axis: &AxisProfile) -> Result<usize, EmitError> {
+    axis.cec_table.ok_or_else(|| {
+        EmitError::Profile(format!(
+            "axis {0} has no Sinumerik CEC table number: name it under [controller.axes.{0}] in the machine profile (the machine's axes get distinct tables, formats/sinumerik840d/README.md)",
+            axis.axis
+        ))
+    })
 }
 
 /// Writes LEC for a mean table, CEC for a bidirectional one.
@@ -58,8 +91,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     };
     match &table.values {
         TableValues::Mean(values) => {
-            line("%_N_AX_EEC_INI".to_string());
-            line("CHANDATA(1)".to_string());
+            line(head("%_N_AX_EEC_INI", options).trim_end().to_string());
             for axis in &options.axes {
                 let (e, name) = (axis.sinumerik_encoder, &axis.sinumerik_axis);
                 for (n, value) in values.iter().enumerate() {
@@ -72,16 +104,11 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
             }
         }
         TableValues::Bidirectional { up, down } => {
-            line("%_N_NC_CEC_INI".to_string());
-            line("CHANDATA(1)".to_string());
-            let sign = if options.cec_values_are_corrections {
-                -1.0
-            } else {
-                1.0
-            };
-            let mut t = options.cec_first_table;
+            line(head("%_N_NC_CEC_INI", options).trim_end().to_string());
+            let sign = cec_sign(options);
             for axis in &options.axes {
-                for (direction, values) in [(1, up), (-1, down)] {
+                let own = own_cec_table(axis)?;
+                for (t, direction, values) in [(own, 1, up), (own + 1, -1, down)] {
                     for (n, value) in values.iter().enumerate() {
                         line(format!("$AN_CEC[{t},{n}]={}", number(sign * value)));
                     }
@@ -94,7 +121,6 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
                     line(format!("$AN_CEC_DIRECTION[{t}]={direction}"));
                     line(format!("$AN_CEC_MULT_BY_TABLE[{t}]=0"));
                     line(format!("$AN_CEC_IS_MODULO[{t}]={modulo}"));
-                    t += 1;
                 }
             }
         }
@@ -103,14 +129,17 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     Ok(out)
 }
 
-/// Writes a cross-axis table as one CEC table: `$AN_CEC_INPUT_AXIS` the
-/// table axis (`input_axis`, its Sinumerik name), `$AN_CEC_OUTPUT_AXIS` the
-/// column axis (`options.axes[0]`), `$AN_CEC_DIRECTION` 0 (a straightness
-/// has no direction), values signed as `options.cec_values_are_corrections`
-/// says, as the axis's own CEC tables (K3 p.248, the sag example).
+/// Writes a cross-axis table as one CEC table, number `t` (the profile's
+/// [`MachineProfile::cec_table`](crate::emit::MachineProfile::cec_table) of
+/// the pair): `$AN_CEC_INPUT_AXIS` the table axis (`input_axis`, its
+/// Sinumerik name), `$AN_CEC_OUTPUT_AXIS` the column axis
+/// (`options.axes[0]`), `$AN_CEC_DIRECTION` 0 (a straightness has no
+/// direction), values signed as `options.cec_values_are_corrections` says,
+/// as the axis's own CEC tables (K3 p.248, the sag example).
 pub fn write_cross_axis(
     cross: &CrossAxisTable,
     input_axis: &str,
+    t: usize,
     options: &EmitOptions,
 ) -> Result<String, EmitError> {
     let table = &cross.table;
@@ -120,16 +149,11 @@ pub fn write_cross_axis(
     let output = options.axes.first().ok_or_else(|| {
         EmitError::Profile("a cross-axis table needs the axis it moves".to_string())
     })?;
-    let sign = if options.cec_values_are_corrections {
-        -1.0
-    } else {
-        1.0
-    };
-    let t = options.cec_first_table;
+    let sign = cec_sign(options);
     let values = table
         .values
         .for_direction(crate::measurement::Direction::Up);
-    let mut out = String::from("%_N_NC_CEC_INI\nCHANDATA(1)\n");
+    let mut out = head("%_N_NC_CEC_INI", options);
     for (n, value) in values.iter().enumerate() {
         out.push_str(&format!("$AN_CEC[{t},{n}]={}\n", number(sign * value)));
     }
@@ -149,6 +173,13 @@ pub fn write_cross_axis(
     }
     out.push_str("M17\n");
     Ok(out)
+}
+
+/// The CEC table numbers a program writes (`$AN_CEC…[t]`), in order: what
+/// must not clash with another program of the same machine.
+pub fn cec_tables(input: &str) -> Result<Vec<usize>, ParseError> {
+    let (_, cec) = raw_tables(input)?;
+    Ok(cec.keys().copied().collect())
 }
 
 /// Reads the CEC table with `$AN_CEC_INPUT_AXIS` = `input_axis` and
@@ -244,9 +275,18 @@ pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAd
 }
 
 /// What the machine needs before the program loads, and how to activate it.
-pub fn activation(table: &CompensationTable, options: &EmitOptions) -> String {
+///
+/// \[seen\] K3 03/2013: LEC p.237–242 (MD38000 ≥ points, load while MD32700
+/// = 0); CEC p.245 (MD32710 `$MA_CEC_ENABLE[<AXi>]` enables the sum of the
+/// axis's compensation relationships, SD41300 `$SN_CEC_TABLE_ENABLE[<t>]`
+/// the evaluation of table t), p.264 (MD18342 `$MN_MM_CEC_MAX_POINTS[t]`
+/// per table), p.237 (tables load only while MD32700 / MD32710 = 0; a
+/// changed MD18342 / MD38000 reformats the static memory at the next
+/// power on). The CEC sign is \[reconstructed\], so the text says how to
+/// check it with one move.
+pub fn activation(table: &CompensationTable, file_name: &str, options: &EmitOptions) -> String {
     let points = table.positions_mm.len();
-    match table.values {
+    match &table.values {
         TableValues::Mean(_) => {
             let axes: Vec<String> = options
                 .axes
@@ -258,14 +298,140 @@ pub fn activation(table: &CompensationTable, options: &EmitOptions) -> String {
                 axes.join(", ")
             )
         }
-        TableValues::Bidirectional { .. } => {
-            let last = options.cec_first_table + 2 * options.axes.len() - 1;
-            format!(
-                "needs the CEC option and MD18342 $MN_MM_CEC_MAX_POINTS[{}…{last}] ≥ {points}; load with MD32710 $MA_CEC_ENABLE = 0, then set $MA_CEC_TABLE_ENABLE for the tables and MD32710 to 1. Check the sign with one test move first (formats/sinumerik840d/README.md)",
-                options.cec_first_table
+        TableValues::Bidirectional { up, .. } => {
+            let tables: Vec<(usize, &str)> = options
+                .axes
+                .iter()
+                .filter_map(|a| a.cec_table.map(|t| (t, a.sinumerik_axis.as_str())))
+                .flat_map(|(t, axis)| [(t, axis), (t + 1, axis)])
+                .collect();
+            let axis = options
+                .axes
+                .first()
+                .map_or("X1", |a| a.sinumerik_axis.as_str());
+            let check = sign_check(
+                table,
+                up,
+                (axis, axis),
+                tables.first().map_or(0, |t| t.0),
+                options,
+            );
+            cec_activation(
+                file_name,
+                &tables,
+                points,
+                &format!(
+                    "tables {} (↑ DIRECTION 1, ↓ DIRECTION -1)",
+                    table_list(&tables)
+                ),
+                &check,
             )
         }
     }
+}
+
+/// The activation of a cross-axis CEC table `t`: "`output` = F(`input`)"
+/// (Sinumerik names), with the one-move check of its reconstructed sign.
+pub fn cross_axis_activation(
+    cross: &CrossAxisTable,
+    (input, output): (&str, &str),
+    t: usize,
+    file_name: &str,
+    options: &EmitOptions,
+) -> String {
+    let table = &cross.table;
+    let values = table
+        .values
+        .for_direction(crate::measurement::Direction::Up);
+    let check = sign_check(table, values, (input, output), t, options);
+    cec_activation(
+        file_name,
+        &[(t, output)],
+        table.positions_mm.len(),
+        &format!("table {t} ({output} = F({input}), both directions)"),
+        &check,
+    )
+}
+
+/// `0 and 1`, `6`.
+fn table_list(tables: &[(usize, &str)]) -> String {
+    let numbers: Vec<String> = tables.iter().map(|(t, _)| t.to_string()).collect();
+    match numbers.as_slice() {
+        [] => String::new(),
+        [one] => one.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+/// The CEC steps in the order the control needs them (K3 p.237, p.245, p.264).
+fn cec_activation(
+    file_name: &str,
+    tables: &[(usize, &str)],
+    points: usize,
+    what: &str,
+    check: &str,
+) -> String {
+    let mut axes: Vec<&str> = tables.iter().map(|(_, a)| *a).collect();
+    axes.dedup();
+    let per_table = |text: &str| {
+        tables
+            .iter()
+            .map(|(t, _)| format!("{text}[{t}]"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let enable = |text: &str| {
+        axes.iter()
+            .map(|a| format!("{text}[{a}]"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    format!(
+        "{file_name} writes CEC {what}; it needs the CEC option (alarm 8040 without it), then:\n\
+         1. MD18342 {} ≥ {points} (a changed value takes effect at the next power on, which reformats the static user memory);\n\
+         2. MD32710 {} = 0 while the program loads (tables load only then): run {file_name};\n\
+         3. SD41300 {} = 1 (evaluate the tables), then MD32710 {} = 1 and reset;\n\
+         4. {check}",
+        per_table("$MN_MM_CEC_MAX_POINTS"),
+        enable("$MA_CEC_ENABLE"),
+        per_table("$SN_CEC_TABLE_ENABLE"),
+        enable("$MA_CEC_ENABLE"),
+    )
+}
+
+/// "Check the sign with one test move" where the table's value is largest:
+/// with table `t` on and off the reading must move by the written value
+/// (toward the nominal); twice the error means the sign is reversed.
+fn sign_check(
+    table: &CompensationTable,
+    errors_mm: &[f64],
+    (input, output): (&str, &str),
+    t: usize,
+    options: &EmitOptions,
+) -> String {
+    let (position, error) = table
+        .positions_mm
+        .iter()
+        .zip(errors_mm)
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .map_or((0.0, 0.0), |(p, e)| (*p, *e));
+    let written = cec_sign(options) * error;
+    let approach = if input == output {
+        ", approaching in + (the ↑ table)"
+    } else {
+        ""
+    };
+    let other = if options.cec_values_are_corrections {
+        "error"
+    } else {
+        "correction"
+    };
+    format!(
+        "check the sign with one test move before use (the CEC sign is reconstructed, formats/sinumerik840d/README.md): move {input} to {} mm{approach}, where table {t} holds {} mm, and read {output} with SD41300 $SN_CEC_TABLE_ENABLE[{t}] = 0 and = 1: the reading must move by {} µm toward the nominal; if the error doubles instead, set cec_values = \"{other}\" in the machine profile and write the table again",
+        minimal(position, 4),
+        number(written),
+        minimal(crate::units::mm_to_um(error.abs()), 1),
+    )
 }
 
 /// One `$NAME[indices]=value` assignment.
@@ -501,7 +667,7 @@ mod tests {
             linuxcnc_type: 0,
             max_points: None,
             max_value_mm: None,
-            cec_first_table: 0,
+            provenance: None,
             cec_values_are_corrections: true,
             tnc640_columns: Vec::new(),
             kind: Default::default(),

@@ -19,7 +19,8 @@ use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::heidenhain::{BACKLASH_DECIMALS, BACKLASH_SIGN, Envelope, empty_cell};
 use crate::emit::{
-    BacklashAdvice, BacklashParameter, EmitError, EmitOptions, signed_fixed, signed_minimal,
+    BacklashAdvice, BacklashParameter, EmitError, EmitOptions, minimal, signed_fixed,
+    signed_minimal,
 };
 use crate::error::ParseError;
 use crate::measurement::Direction;
@@ -48,8 +49,121 @@ fn columns(options: &EmitOptions) -> Vec<String> {
     }
 }
 
-/// Writes the `.COM` table.
-pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String, EmitError> {
+/// A `.COM` table as its columns: AXISPOS, BACKLASH, and one column per
+/// axis, each cell a value or empty. What [`write`] renders, and what an
+/// update keeps of a machine's table (one active table per axis holds the
+/// axis's own column and its cross-axis columns together, MANUALplus 620
+/// TM p.718).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ComTable {
+    /// Compensation points, mm.
+    pub positions_mm: Vec<f64>,
+    /// BACKLASH per point (empty cells `None`).
+    pub backlash: Vec<Option<f64>>,
+    /// The axis columns: name and a cell per point.
+    pub columns: Vec<(String, Vec<Option<f64>>)>,
+}
+
+impl ComTable {
+    /// The column `name`, added empty after the others when missing.
+    fn column_mut(&mut self, name: &str) -> &mut Vec<Option<f64>> {
+        let index = match self
+            .columns
+            .iter()
+            .position(|(n, _)| n.eq_ignore_ascii_case(name))
+        {
+            Some(index) => index,
+            None => {
+                self.columns
+                    .push((name.to_string(), vec![None; self.positions_mm.len()]));
+                self.columns.len() - 1
+            }
+        };
+        &mut self.columns[index].1
+    }
+
+    /// The columns other than `written` that hold values.
+    fn filled_others(&self, written: &[String]) -> Vec<String> {
+        self.columns
+            .iter()
+            .filter(|(name, cells)| {
+                !written.iter().any(|w| w.eq_ignore_ascii_case(name))
+                    && cells.iter().any(Option::is_some)
+            })
+            .map(|(name, _)| name.clone())
+            .collect()
+    }
+
+    /// The columns in the machine's order (`tnc640_columns`) when given:
+    /// refused when a filled column is not the machine's.
+    fn in_machine_order(mut self, options: &EmitOptions) -> Result<ComTable, EmitError> {
+        if options.tnc640_columns.is_empty() {
+            return Ok(self);
+        }
+        let machine = &options.tnc640_columns;
+        if let Some((name, _)) = self
+            .columns
+            .iter()
+            .find(|(name, cells)| !machine.contains(name) && cells.iter().any(Option::is_some))
+        {
+            return Err(EmitError::Profile(format!(
+                "axis column {name:?} is not among the machine's TNC 640 columns {machine:?}"
+            )));
+        }
+        let n = self.positions_mm.len();
+        let columns = machine
+            .iter()
+            .map(|name| {
+                let cells = self
+                    .columns
+                    .iter()
+                    .position(|(c, _)| c == name)
+                    .map_or_else(|| vec![None; n], |i| std::mem::take(&mut self.columns[i].1));
+                (name.clone(), cells)
+            })
+            .collect();
+        self.columns = columns;
+        Ok(self)
+    }
+
+    /// The file's text: `BEGIN name MM`, the header, the rows, `[END]`, CRLF.
+    pub fn render(&self, name: &str) -> String {
+        let mut out = String::new();
+        let mut line = |text: String| {
+            out.push_str(text.trim_end());
+            out.push_str("\r\n");
+        };
+        line(format!("BEGIN {name} MM"));
+        let mut header = format!(
+            "{:<NR_WIDTH$}{:<COLUMN_WIDTH$}{:<COLUMN_WIDTH$}",
+            "NR", "AXISPOS", "BACKLASH"
+        );
+        for (column, _) in &self.columns {
+            header.push_str(&format!("{column:<COLUMN_WIDTH$}"));
+        }
+        line(header);
+        let cell = |value: Option<f64>| {
+            value.map_or_else(String::new, |v| signed_fixed(v, VALUE_DECIMALS))
+        };
+        for (index, position_mm) in self.positions_mm.iter().enumerate() {
+            let mut row = format!(
+                "{:<NR_WIDTH$}{:<COLUMN_WIDTH$}{:<COLUMN_WIDTH$}",
+                index,
+                signed_minimal(*position_mm, 4),
+                cell(self.backlash[index])
+            );
+            for (_, cells) in &self.columns {
+                row.push_str(&format!("{:<COLUMN_WIDTH$}", cell(cells[index])));
+            }
+            line(row);
+        }
+        line("[END]".to_string());
+        out
+    }
+}
+
+/// The `.COM` of `table` with the written axes' columns filled.
+fn com_table(table: &CompensationTable, options: &EmitOptions) -> Result<ComTable, EmitError> {
     let columns = columns(options);
     for axis in &options.axes {
         if !columns.contains(&axis.tnc640_column) {
@@ -59,46 +173,85 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
             )));
         }
     }
-    let mut out = String::new();
-    let mut line = |text: String| {
-        out.push_str(text.trim_end());
-        out.push_str("\r\n");
+    let up = table.values.for_direction(Direction::Up);
+    let backlash = match &table.values {
+        TableValues::Mean(_) => vec![None; up.len()],
+        TableValues::Bidirectional { down, .. } => down.iter().copied().map(Some).collect(),
     };
-    line(format!("BEGIN {} MM", options.table_name));
-    let mut header = format!(
-        "{:<NR_WIDTH$}{:<COLUMN_WIDTH$}{:<COLUMN_WIDTH$}",
-        "NR", "AXISPOS", "BACKLASH"
-    );
-    for column in &columns {
-        header.push_str(&format!("{column:<COLUMN_WIDTH$}"));
+    Ok(ComTable {
+        positions_mm: table.positions_mm.clone(),
+        backlash,
+        columns: columns
+            .into_iter()
+            .map(|column| {
+                let written = options.axes.iter().any(|a| a.tnc640_column == column);
+                let cells = up.iter().map(|v| written.then_some(*v)).collect();
+                (column, cells)
+            })
+            .collect(),
+    })
+}
+
+/// Writes the `.COM` table.
+pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String, EmitError> {
+    Ok(com_table(table, options)?.render(&options.table_name))
+}
+
+/// The new table of the axis in place of `existing` (the axis's `.COM` on
+/// the control): the axis's column and BACKLASH from `table`, every other
+/// filled column (a cross-axis column of the same table axis) kept. Those
+/// are functions of the same points, so the points must be the existing
+/// table's.
+pub fn update(
+    existing: &str,
+    table: &CompensationTable,
+    options: &EmitOptions,
+) -> Result<String, EmitError> {
+    let Ok(old) = parse(existing) else {
+        return write(table, options);
+    };
+    let written: Vec<String> = options
+        .axes
+        .iter()
+        .map(|a| a.tnc640_column.clone())
+        .collect();
+    let others = old.filled_others(&written);
+    if others.is_empty() {
+        return write(table, options);
     }
-    line(header);
-    for (index, position_mm) in table.positions_mm.iter().enumerate() {
-        let backlash = match &table.values {
-            TableValues::Mean(_) => String::new(),
-            TableValues::Bidirectional { down, .. } => signed_fixed(down[index], VALUE_DECIMALS),
-        };
-        let up = signed_fixed(
-            table.values.for_direction(Direction::Up)[index],
-            VALUE_DECIMALS,
-        );
-        let mut row = format!(
-            "{:<NR_WIDTH$}{:<COLUMN_WIDTH$}{:<COLUMN_WIDTH$}",
-            index,
-            signed_minimal(*position_mm, 4),
-            backlash
-        );
-        for column in &columns {
-            let written = options.axes.iter().any(|a| &a.tnc640_column == column);
-            row.push_str(&format!(
-                "{:<COLUMN_WIDTH$}",
-                if written { up.as_str() } else { "" }
-            ));
-        }
-        line(row);
+    same_points(&old.positions_mm, &table.positions_mm, &others)?;
+    let mut new = com_table(table, options)?;
+    for name in &others {
+        let cells = old
+            .columns
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, c)| c.clone());
+        *new.column_mut(name) = cells.unwrap_or_default();
     }
-    line("[END]".to_string());
-    Ok(out)
+    Ok(new.in_machine_order(options)?.render(&options.table_name))
+}
+
+/// Refuses a table whose points are not `old`'s: the kept columns `others` hold values at those.
+fn same_points(old: &[f64], new: &[f64], others: &[String]) -> Result<(), EmitError> {
+    let same = old.len() == new.len() && old.iter().zip(new).all(|(a, b)| (a - b).abs() < 0.5e-4);
+    if same {
+        return Ok(());
+    }
+    let range = |p: &[f64]| {
+        format!(
+            "{} points {}…{} mm",
+            p.len(),
+            minimal(p[0], 4),
+            minimal(p[p.len() - 1], 4)
+        )
+    };
+    Err(EmitError::Profile(format!(
+        "the existing table also holds column {} at its own points ({}), and the new table has {}: the TNC 640 has one active table per axis, so give the existing points (--start, --step, --count)",
+        others.join(", "),
+        range(old),
+        range(new)
+    )))
 }
 
 /// The `config.cma` line that activates the table: its file name entered in
@@ -151,11 +304,105 @@ pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAd
 /// whose .CMA column the .COM is entered)" (MANUALplus 620 TM p.716/718).
 /// The value is the column axis's error, not negated, as the axis's own
 /// column (module doc).
+///
+/// An axis has one active table (p.718), so the file is the table axis's
+/// whole table: `existing` (its `.COM` on the control) with every column
+/// kept and this one set, on its points; without it the table axis's own
+/// column (`table_column`) is 0 (no positioning compensation), never left out.
 pub fn write_cross_axis(
     cross: &CrossAxisTable,
+    table_column: &str,
     options: &EmitOptions,
+    existing: Option<&str>,
 ) -> Result<String, EmitError> {
-    write(&cross.table, options)
+    let output = options.axes.first().ok_or_else(|| {
+        EmitError::Profile("a cross-axis table needs the axis it moves".to_string())
+    })?;
+    let table = &cross.table;
+    let values = table.values.for_direction(Direction::Up);
+    let mut com = match existing {
+        Some(text) => {
+            let old =
+                parse(text).map_err(|e| EmitError::Profile(format!("the existing table: {e}")))?;
+            let others = old.filled_others(std::slice::from_ref(&output.tnc640_column));
+            same_points(&old.positions_mm, &table.positions_mm, &others)?;
+            old
+        }
+        None => ComTable {
+            positions_mm: table.positions_mm.clone(),
+            backlash: vec![None; values.len()],
+            columns: vec![(table_column.to_string(), vec![Some(0.0); values.len()])],
+        },
+    };
+    *com.column_mut(&output.tnc640_column) = values.iter().copied().map(Some).collect();
+    Ok(com.in_machine_order(options)?.render(&options.table_name))
+}
+
+/// The `.CMA` entry of a cross-axis `.COM`: in the table axis's column,
+/// the axis's one active table.
+pub fn cross_axis_activation(
+    file_name: &str,
+    (input, output): (&str, &str),
+    existing: bool,
+) -> String {
+    let own = if existing {
+        "as in the existing table"
+    } else {
+        "0 here: give the table on the control with --existing to keep it"
+    };
+    format!(
+        "enter {file_name} in the .CMA column of axis {input} (\"[axis in column] = F(axis in whose .CMA column the .COM is entered)\", MANUALplus 620 TM p.716/718): its {output} column moves {output} as a function of {input}. An axis has one active table (p.718): {file_name} is {input}'s whole table, its {input} column the positioning compensation ({own}); load it in place of {input}'s table, not beside it"
+    )
+}
+
+/// The points of a `.COM` table (its AXISPOS), for a table written on them.
+pub fn read_positions(input: &str) -> Result<Vec<f64>, ParseError> {
+    Ok(parse(input)?.positions_mm)
+}
+
+/// Every column of a `.COM` table.
+fn parse(input: &str) -> Result<ComTable, ParseError> {
+    let table = Envelope::split(input, "BEGIN <NAME>.COM MM")?;
+    let header = table.header;
+    let Some(axispos) = table.column("AXISPOS") else {
+        return Err(header.expected_at(header.text.trim_start(), "a header with AXISPOS"));
+    };
+    let backlash = table.column("BACKLASH");
+    let names: Vec<(usize, String)> = table
+        .offsets
+        .iter()
+        .enumerate()
+        .filter(|(i, (n, _))| {
+            *i != axispos && Some(*i) != backlash && !n.eq_ignore_ascii_case("NR")
+        })
+        .map(|(i, (n, _))| (i, n.clone()))
+        .collect();
+    let cell = |row, index: usize, what: &str| -> Result<Option<f64>, ParseError> {
+        let text = table.cell(row, index);
+        if text.is_empty() {
+            Ok(None)
+        } else {
+            Ok(Some(text::number(row, text, what)?))
+        }
+    };
+    let mut com = ComTable {
+        positions_mm: Vec::new(),
+        backlash: Vec::new(),
+        columns: names.iter().map(|(_, n)| (n.clone(), Vec::new())).collect(),
+    };
+    for row in &table.rows {
+        com.positions_mm
+            .push(text::number(row, table.cell(row, axispos), "AXISPOS")?);
+        com.backlash.push(match backlash {
+            Some(index) => cell(row, index, "BACKLASH value")?,
+            None => None,
+        });
+        for (k, (index, name)) in names.iter().enumerate() {
+            let value = cell(row, *index, name)?;
+            com.columns[k].1.push(value);
+        }
+    }
+    Ok(com)
 }
 
 /// Reads a cross-axis `.COM`: the values of `column_axis`'s column as a
@@ -166,8 +413,18 @@ pub fn read_cross_axis(
     table_axis: &str,
     column_axis: &str,
 ) -> Result<CrossAxisTable, ParseError> {
-    let table = read(input, column_axis)?;
-    if table.values.mode() != crate::compensate::TableMode::Mean {
+    let mut table = read(input, column_axis)?;
+    // A file with the table axis's own column is that axis's whole table
+    // (one active table per axis): its BACKLASH belongs to that column.
+    let own_column = parse(input).is_ok_and(|com| {
+        com.columns
+            .iter()
+            .any(|(n, _)| n.eq_ignore_ascii_case(table_axis))
+    });
+    if own_column {
+        let up = table.values.for_direction(Direction::Up).to_vec();
+        table = super::table_as_read(column_axis, table.positions_mm, TableValues::Mean(up));
+    } else if table.values.mode() != crate::compensate::TableMode::Mean {
         return Err(ParseError::new(
             2,
             1,
@@ -261,7 +518,7 @@ mod tests {
             linuxcnc_type: 0,
             max_points: None,
             max_value_mm: None,
-            cec_first_table: 0,
+            provenance: None,
             cec_values_are_corrections: true,
             tnc640_columns: Vec::new(),
             kind: Default::default(),

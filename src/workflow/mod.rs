@@ -214,7 +214,12 @@ pub fn convert(
     }
     let evaluation = evaluate(measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
-    let options = table.options;
+    // The file records its source where the format has comments.
+    let mut options = table.options.clone();
+    options
+        .provenance
+        .get_or_insert_with(|| emit::Provenance::of(measurement));
+    let options = &options;
     let only_direction = match Direction::BOTH.map(|d| measurement.run_count(d) > 0) {
         [true, false] => Some(Direction::Up),
         [false, true] => Some(Direction::Down),

@@ -313,7 +313,7 @@ fn read_options(case: &Case) -> EmitOptions {
         linuxcnc_type: if case.flags.contains(&"1") { 1 } else { 0 },
         max_points: None,
         max_value_mm: None,
-        cec_first_table: 0,
+        provenance: None,
         cec_values_are_corrections: true,
         tnc640_columns: Vec::new(),
         kind: if rotary {

@@ -38,21 +38,27 @@ fn eyx() -> CrossAxisTable {
 fn tnc640_dependent_column_round_trips() {
     let profile = MachineProfile::default();
     let options = EmitOptions::for_axis(&profile, "Y", "X.COM").unwrap();
-    let text = tnc640::write_cross_axis(&eyx(), &options).unwrap();
-    // The values sit in column Y of X.COM: Y = F(X), not negated.
+    let text = tnc640::write_cross_axis(&eyx(), "X", &options, None).unwrap();
+    // The values sit in column Y of X.COM: Y = F(X), not negated; X.COM is
+    // X's one table, so its X column is there too (0 without an existing table).
     assert!(text.starts_with("BEGIN X.COM MM\r\n"), "{text}");
     assert!(
-        text.contains("2    +300                        +0.0028\r\n"),
+        text.contains("2    +300                        +0.0000       +0.0028\r\n"),
         "{text}"
     );
     assert_golden(&text, &golden(0));
     let back = tnc640::read_cross_axis(&text, "X", "Y").unwrap();
     assert_eq!(back, eyx());
-    // A direction in BACKLASH is refused: a straightness has none.
-    let with_backlash = text.replace(
+    // A direction in BACKLASH of a file with only the dependent column is
+    // refused: a straightness has none.
+    let y_only = text
+        .replace("BACKLASH      X             Y", "BACKLASH      Y")
+        .replace("+0.0000       +", "+");
+    let with_backlash = y_only.replace(
         "2    +300                        +0.0028",
         "2    +300          +0.0001       +0.0028",
     );
+    assert_ne!(with_backlash, y_only);
     let error = tnc640::read_cross_axis(&with_backlash, "X", "Y").unwrap_err();
     assert!(error.message.contains("BACKLASH"), "{error}");
 }
@@ -63,17 +69,20 @@ fn sinumerik_cec_with_another_output_axis_round_trips() {
     let options = EmitOptions::for_axis(&profile, "Y", "CEC").unwrap();
     let input = profile.axis("X").unwrap().sinumerik_axis;
     let output = options.axes[0].sinumerik_axis.clone();
-    let text = sinumerik840d::write_cross_axis(&eyx(), &input, &options).unwrap();
+    // Y = F(X) is table 6 on an X, Y, Z machine: after the own pairs 0…5.
+    let t = profile.cec_table("X", "Y").unwrap();
+    assert_eq!(t, 6);
+    let text = sinumerik840d::write_cross_axis(&eyx(), &input, t, &options).unwrap();
     assert!(
-        text.contains(&format!("$AN_CEC_INPUT_AXIS[0]=({input})\n")),
+        text.contains(&format!("$AN_CEC_INPUT_AXIS[6]=({input})\n")),
         "{text}"
     );
     assert!(
-        text.contains(&format!("$AN_CEC_OUTPUT_AXIS[0]=({output})\n")),
+        text.contains(&format!("$AN_CEC_OUTPUT_AXIS[6]=({output})\n")),
         "{text}"
     );
     // Corrections (the profile's default): −error.
-    assert!(text.contains("$AN_CEC[0,2]=-0.0028\n"), "{text}");
+    assert!(text.contains("$AN_CEC[6,2]=-0.0028\n"), "{text}");
     assert_golden(&text, &golden(1));
     let back = sinumerik840d::read_cross_axis(&text, (&input, &output), ("X", "Y"), true).unwrap();
     assert_eq!(back, eyx());
@@ -148,17 +157,17 @@ mod convert {
         assert!(run.stdout.contains("not compensated"), "{}", run.stdout);
         let text = std::fs::read_to_string(&out).unwrap();
         for row in [
-            "0    +0                          +0.0000\r\n",
-            "1    +150                        +0.0016\r\n",
-            "2    +300                        +0.0026\r\n",
-            "3    +450                        +0.0027\r\n",
-            "4    +600                        +0.0017\r\n",
-            "5    +750                        -0.0001\r\n",
+            "0    +0                          +0.0000       +0.0000\r\n",
+            "1    +150                        +0.0000       +0.0016\r\n",
+            "2    +300                        +0.0000       +0.0026\r\n",
+            "3    +450                        +0.0000       +0.0027\r\n",
+            "4    +600                        +0.0000       +0.0017\r\n",
+            "5    +750                        +0.0000       -0.0001\r\n",
         ] {
             assert!(text.contains(row), "{row:?} in\n{text}");
         }
         assert!(
-            text.contains("NR   AXISPOS       BACKLASH      Y\r\n"),
+            text.contains("NR   AXISPOS       BACKLASH      X             Y\r\n"),
             "{text}"
         );
         // The library's writer on the table by hand gives the same bytes.
@@ -175,7 +184,10 @@ mod convert {
             0.0,
         );
         let options = EmitOptions::for_axis(&MachineProfile::default(), "Y", "X.COM").unwrap();
-        assert_eq!(text, tnc640::write_cross_axis(&by_hand, &options).unwrap());
+        assert_eq!(
+            text,
+            tnc640::write_cross_axis(&by_hand, "X", &options, None).unwrap()
+        );
         // Sinumerik: the same table as a CEC X → Y, read back.
         let cec = dir.path().join("X-Y.MPF");
         let run = convert(&file, "sinumerik840d", &cec, &[]);
@@ -213,7 +225,7 @@ mod convert {
         let positions: Vec<f64> = (0..16).map(|i| f64::from(i) * 50.0).collect();
         let expected = cross_axis_table_at(&state.errors, ErrorName::EYX, positions, 0.0).unwrap();
         let options = EmitOptions::for_axis(&MachineProfile::default(), "Y", "X-Y.COM").unwrap();
-        let expected_text = tnc640::write_cross_axis(&expected, &options).unwrap();
+        let expected_text = tnc640::write_cross_axis(&expected, "X", &options, None).unwrap();
         // The line and optics as the survey states them for X.csv.
         let out = geo.join("X-Y.COM");
         let run = convert(

@@ -29,6 +29,7 @@ mod generated_docs;
 mod http;
 mod injected;
 mod inputs;
+mod loadable;
 mod model;
 mod numbers;
 mod outputs;

@@ -170,7 +170,15 @@ fn cross_axis_tables_change_the_map_and_the_shares_add_up() {
         "formats/tnc640/golden/cross-Y-of-X.COM",
         "formats/sinumerik840d/golden/cross-Y-of-X-cec.MPF",
     ] {
-        let spec = format!("Y=F(X):{}", crate::util::root().join(golden).display());
+        let mut file = crate::util::root().join(golden);
+        if golden.ends_with(".COM") {
+            // The TNC 640 has one table per axis: X's (null) positioning
+            // column and Y = F(X) are one file, given as both.
+            let own = survey.with_file_name("X.COM");
+            std::fs::copy(&file, &own).unwrap();
+            file = own;
+        }
+        let spec = format!("Y=F(X):{}", file.display());
         let run = predict(&survey, &["--cross-table", &spec, "--json"]);
         assert_eq!(run.code, 0, "{}", run.stderr);
         let json: Value = serde_json::from_str(&run.stdout).unwrap();

@@ -13,7 +13,7 @@ use serde::Serialize;
 use axcomp::compensate::cross_axis::CrossAxisTable;
 use axcomp::compensate::plan::{PlanContext, Request, plan};
 use axcomp::compensate::{CompensateError, grid_positions};
-use axcomp::emit::{Controller, EmitOptions, MachineProfile, sinumerik840d, tnc640};
+use axcomp::emit::{self, Controller, EmitOptions, MachineProfile, Provenance, tnc640};
 use axcomp::model::{ErrorComponent, ErrorName, GeometricErrors, Machine};
 use axcomp::output::write_new;
 use axcomp::predict::cross_axis_table_at;
@@ -121,16 +121,48 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
         .zip(column.means())
         .filter_map(|(t, m)| m.map(|_| *t))
         .collect();
-    let table = build(args, &machine, &state.errors, name, &targets)?;
-    let options = emit_options(&profile, &direction.to_string(), &args.output)?;
-    let text = match args.controller {
-        Controller::Tnc640 => tnc640::write_cross_axis(&table, &options)?,
-        _ => sinumerik840d::write_cross_axis(
-            &table,
-            &profile.axis(&axis.to_string())?.sinumerik_axis,
-            &options,
-        )?,
+    // The TNC 640's one table per axis: the existing .COM's points and columns.
+    let existing = match &args.existing {
+        Some(path) => Some(
+            std::fs::read_to_string(path)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
+        ),
+        None => None,
     };
+    let existing_points = match &existing {
+        Some(text) => Some(tnc640::read_positions(text).map_err(|e| {
+            anyhow::anyhow!(
+                "{}:{e}",
+                args.existing
+                    .as_ref()
+                    .map_or_else(String::new, |p| p.display().to_string())
+            )
+        })?),
+        None => None,
+    };
+    let table = build(
+        args,
+        &machine,
+        &state.errors,
+        name,
+        &targets,
+        existing_points,
+    )?;
+    let mut options = emit_options(&profile, &direction.to_string(), &args.output)?;
+    options.max_points = args.max_points.or(options.max_points);
+    options.provenance = Some(Provenance {
+        source: file
+            .file_name()
+            .map_or_else(|| name_text.clone(), |n| n.to_string_lossy().into_owned()),
+        recorded: None,
+    });
+    let text = emit::write_cross_axis(
+        args.controller,
+        &table,
+        &profile,
+        &options,
+        existing.as_deref(),
+    )?;
     write_new(
         &args.output,
         text.as_bytes(),
@@ -142,19 +174,14 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
         |n| n.to_string_lossy().into_owned(),
     );
     // The value as in the file: the CEC holds −error when it holds corrections.
-    let sign = match args.controller {
-        Controller::Sinumerik840d if options.cec_values_are_corrections => -1.0,
-        _ => 1.0,
-    };
-    let activation = match args.controller {
-        Controller::Tnc640 => format!(
-            "enter {file_name} in the .CMA column of axis {axis} (\"[axis in column] = F(axis in whose .CMA column the .COM is entered)\", MANUALplus 620 TM p.716/718): its {direction} column moves {direction} as a function of {axis}"
-        ),
-        _ => format!(
-            "load {file_name} (CEC table {}: $AN_CEC_INPUT_AXIS {axis}, $AN_CEC_OUTPUT_AXIS {direction}, both directions), then set $MA_CEC_ENABLE for {direction} and reset",
-            options.cec_first_table
-        ),
-    };
+    let sign = emit::cross_axis_file_sign(args.controller, &options);
+    let activation = emit::cross_axis_activation(
+        args.controller,
+        &table,
+        &profile,
+        (&file_name, existing.is_some()),
+        &options,
+    )?;
     let report = CrossAxisJson {
         table: format!("{direction} = F({axis})"),
         error: name.as_str().to_string(),
@@ -227,13 +254,15 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
 fn refuse_positioning_flags(args: &ConvertArgs) -> Result<()> {
     let given: Vec<&str> = [
         ("--mode", args.mode.is_some()),
-        ("--existing", args.existing.is_some()),
+        (
+            "--existing (a cross-axis table goes into an existing table only on the tnc640)",
+            args.existing.is_some() && args.controller != Controller::Tnc640,
+        ),
         ("--effects", args.effects.is_some()),
         ("--also", !args.also.is_empty()),
         ("--axis", args.axis.is_some()),
         ("--exclude-run", !args.exclude_runs.is_empty()),
         ("--extrapolate", args.extrapolate.is_some()),
-        ("--max-points", args.max_points.is_some()),
     ]
     .into_iter()
     .filter_map(|(flag, set)| set.then_some(flag))
@@ -293,14 +322,15 @@ fn chosen_straightness(
 }
 
 /// The table on the grid of `--start`/`--step`/`--count` (default: the
-/// measured targets), inside the measured range, zero at `--reference` or
-/// the machine's reference position.
+/// measured targets) or on the points of the existing table, inside the
+/// measured range, zero at `--reference` or the machine's reference position.
 fn build(
     args: &ConvertArgs,
     machine: &Machine,
     errors: &GeometricErrors,
     name: ErrorName,
     targets: &[f64],
+    existing_points: Option<Vec<f64>>,
 ) -> Result<CrossAxisTable> {
     let capabilities = args.controller.capabilities(LengthUnit::Millimetre);
     let request = Request {
@@ -311,16 +341,28 @@ fn build(
         reference_mm: args.reference,
         extrapolate: None,
     };
-    let spec = plan(
-        targets,
-        &[],
-        &capabilities,
-        &request,
-        &PlanContext::default(),
-    )?
-    .options
-    .grid;
-    let positions = grid_positions(targets, spec)?;
+    let positions = match existing_points {
+        Some(points) => {
+            if args.step.is_some() {
+                bail!(
+                    "--step: the table goes into the existing table, on its points (the TNC 640 has one table per axis)"
+                );
+            }
+            points
+        }
+        None => grid_positions(
+            targets,
+            plan(
+                targets,
+                &[],
+                &capabilities,
+                &request,
+                &PlanContext::default(),
+            )?
+            .options
+            .grid,
+        )?,
+    };
     let (first_mm, last_mm) = (targets[0], targets[targets.len() - 1]);
     if let Some(&position_mm) = positions
         .iter()
