@@ -121,6 +121,12 @@ pub(super) trait Search {
     /// The fit of a design.
     fn fit(&self, design: &Design) -> Self::Fit;
 
+    /// The fit of `model` with the columns `extra` added: a search may keep
+    /// its work on `model` between the candidates that extend it.
+    fn fit_extended(&self, model: &Design, extra: &[Vec<f64>]) -> Self::Fit {
+        self.fit(&model.with(extra))
+    }
+
     /// What the best shape of a kind minimises (RSS or χ²).
     fn statistic(fit: &Self::Fit) -> f64;
 
@@ -161,7 +167,7 @@ pub(super) fn forward_selection<S: Search>(
             }
             for set in search.shape_sets(kind, &chosen) {
                 let Some((shape, _, trial_fit)) = best_of(&set, |shape| {
-                    let f = search.fit(&model.with(&search.columns(shape)));
+                    let f = search.fit_extended(&model, &search.columns(shape));
                     (S::statistic(&f), f)
                 }) else {
                     continue;
