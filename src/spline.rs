@@ -286,6 +286,41 @@ mod tests {
         }
     }
 
+    #[test]
+    fn sparse_basis_rows_are_the_basis_matrix() {
+        // 40 uneven knots; points on knots, between them and outside.
+        let knots: Vec<f64> = (0..40)
+            .map(|i| 10.0 * i as f64 + (i as f64 * 1.7).sin())
+            .collect();
+        let points = [
+            -5.0, knots[0], knots[7], 73.3, knots[20], 201.0, knots[39], 500.0,
+        ];
+        let rows = basis_rows(&knots, &points);
+        let dense = basis_matrix(&knots, &points);
+        // On a knot or outside: that knot alone, with weight 1.
+        for (p, knot) in [(0, 0), (1, 0), (2, 7), (4, 20), (6, 39), (7, 39)] {
+            assert_eq!(rows[p], [(knot, 1.0)], "point {p}");
+        }
+        for (p, row) in rows.iter().enumerate() {
+            let mut full = vec![0.0; knots.len()];
+            for (j, w) in row {
+                full[*j] = *w;
+            }
+            for (j, w) in full.iter().enumerate() {
+                assert!(
+                    (w - dense[p * knots.len() + j]).abs() < 1e-15,
+                    "point {p} knot {j}"
+                );
+            }
+        }
+        // Between knots the weights reach a few knots away, and fall below 1e-18 far away.
+        assert!(
+            rows[3].len() > 4 && rows[3].len() < knots.len(),
+            "{}",
+            rows[3].len()
+        );
+    }
+
     proptest! {
         #[test]
         fn interpolates_its_knots(

@@ -10,7 +10,7 @@
 //! smooth background (a regression spline with knots every span / 6), with the
 //! background's misfit counted as noise.
 
-use std::cell::RefCell;
+use std::sync::{Arc, Mutex};
 
 use nalgebra::{DMatrix, DVector};
 
@@ -173,7 +173,7 @@ pub(super) fn select_along_axis(
             .flatten(),
         min_periods,
         known,
-        base_fit: RefCell::new(None),
+        base_fit: Mutex::new(None),
     };
     let (mut chosen, mut model_fit) = forward_selection(&search, base.clone(), kinds, rejected);
     // Never the nearest kind: what is accepted along the axis must leave no
@@ -234,7 +234,7 @@ struct AlongAxis<'a> {
     min_periods: f64,
     known: &'a [KnownPeriod],
     /// The fit of the model the candidates extend, kept between them.
-    base_fit: RefCell<Option<GlsBase>>,
+    base_fit: Mutex<Option<Arc<GlsBase>>>,
 }
 
 impl AlongAxis<'_> {
@@ -304,11 +304,14 @@ impl Search for AlongAxis<'_> {
 
     /// The model's C⁻¹X is kept: a candidate costs a solve per column it adds.
     fn fit_extended(&self, model: &Design, extra: &[Vec<f64>]) -> WeightedFit {
-        let mut cached = self.base_fit.borrow_mut();
-        if !cached.as_ref().is_some_and(|b| b.is_of(&model.columns)) {
-            *cached = GlsBase::new(&model.columns, self.values, self.covariance);
-        }
-        match cached.as_ref() {
+        let base = {
+            let mut cached = self.base_fit.lock().unwrap_or_else(|e| e.into_inner());
+            if !cached.as_ref().is_some_and(|b| b.is_of(&model.columns)) {
+                *cached = GlsBase::new(&model.columns, self.values, self.covariance).map(Arc::new);
+            }
+            cached.clone()
+        };
+        match base {
             Some(base) => base.fit_with(extra, self.covariance),
             None => self.fit(&model.with(extra)),
         }

@@ -30,6 +30,8 @@ pub struct Covariance {
 
 #[derive(Clone, Debug)]
 enum Factor {
+    /// C is diagonal (no two rows share a variance): C⁻¹ element by element.
+    Diagonal(Vec<f64>),
     /// The Woodbury core, by band Cholesky.
     Woodbury(BandCholesky),
     /// A dense Cholesky factor of C: only when an own variance is not
@@ -98,6 +100,7 @@ impl Covariance {
     pub fn solve(&self, v: &[f64]) -> Option<Vec<f64>> {
         let mut x = match &self.factor {
             Factor::Singular => return None,
+            Factor::Diagonal(inverse) => v.iter().zip(inverse).map(|(v, i)| v * i).collect(),
             Factor::Dense(l) => {
                 let b = DVector::from_column_slice(v);
                 let z = l.solve_lower_triangular(&b)?;
@@ -151,6 +154,13 @@ impl Covariance {
 }
 
 fn factor(own: &[f64], weights: &[Vec<(usize, f64)>], shared: &[f64]) -> Factor {
+    if let Some(diagonal) = diagonal(own, weights, shared) {
+        return if diagonal.iter().all(|c| *c > 0.0 && c.is_finite()) {
+            Factor::Diagonal(diagonal.iter().map(|c| 1.0 / c).collect())
+        } else {
+            Factor::Singular
+        };
+    }
     if own.iter().all(|s| *s > 0.0 && s.is_finite()) {
         if let Some(core) = woodbury_core(own, weights, shared) {
             return Factor::Woodbury(core);
@@ -170,6 +180,22 @@ fn factor(own: &[f64], weights: &[Vec<(usize, f64)>], shared: &[f64]) -> Factor 
         Some(cholesky) => Factor::Dense(cholesky.l()),
         None => Factor::Singular,
     }
+}
+
+/// The diagonal of C when no two rows share a variance (a re-test at the
+/// first test's targets: each level draws on its own target's mean alone).
+fn diagonal(own: &[f64], weights: &[Vec<(usize, f64)>], shared: &[f64]) -> Option<Vec<f64>> {
+    let mut taken = vec![false; shared.len()];
+    let mut diagonal = own.to_vec();
+    for (row, c) in weights.iter().zip(&mut diagonal) {
+        for &(k, w) in row.iter().filter(|(k, _)| shared[*k] != 0.0) {
+            if std::mem::replace(&mut taken[k], true) {
+                return None;
+            }
+            *c += w * w * shared[k];
+        }
+    }
+    Some(diagonal)
 }
 
 /// D⁻¹ + WᵀS⁻¹W over the shared variances that are positive (the others
@@ -376,6 +402,22 @@ mod tests {
         for (a, b) in fast.iter().zip(&dense) {
             assert!((a - b).abs() < 1e-12 * b.abs().max(1.0), "{a} vs {b}");
         }
+    }
+
+    #[test]
+    fn rows_that_share_nothing_are_a_diagonal() {
+        // Each row its own shared variance: C = diag(1 + 0.25·2, 2 + 1·3) = diag(1.5, 5).
+        let c = Covariance::new(
+            vec![1.0, 2.0],
+            vec![vec![(1, 0.5)], vec![(0, 1.0)]],
+            vec![3.0, 2.0],
+        );
+        assert!(matches!(c.factor, Factor::Diagonal(_)));
+        let x = c.solve(&[3.0, 5.0]).unwrap();
+        assert!(
+            (x[0] - 2.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15,
+            "{x:?}"
+        );
     }
 
     #[test]
