@@ -161,10 +161,10 @@ fn factor(own: &[f64], weights: &[Vec<(usize, f64)>], shared: &[f64]) -> Factor 
             Factor::Singular
         };
     }
-    if own.iter().all(|s| *s > 0.0 && s.is_finite()) {
-        if let Some(core) = woodbury_core(own, weights, shared) {
-            return Factor::Woodbury(core);
-        }
+    if own.iter().all(|s| *s > 0.0 && s.is_finite())
+        && let Some(core) = woodbury_core(own, weights, shared)
+    {
+        return Factor::Woodbury(core);
     }
     // C itself, as a dense matrix (rows with a zero variance of their own).
     let m = own.len();
@@ -300,7 +300,8 @@ impl BandCholesky {
         Some(BandCholesky { l })
     }
 
-    /// A⁻¹ b: L z = b forward, then Lᵀ x = z backward.
+    /// A⁻¹ b: L z = b forward, then Lᵀ x = z backward (within the band).
+    #[allow(clippy::needless_range_loop)]
     fn solve(&self, mut b: Vec<f64>) -> Vec<f64> {
         let (n, p, l) = (self.l.size, self.l.band, &self.l);
         for i in 0..n {
