@@ -11,6 +11,8 @@ for f in "$shared"/api-xd/*.pos; do cp "$f" "corpus/read_api_pos/$(basename "$f"
 cp ../tests/data/bad/pos-* corpus/read_api_pos/
 cp ../tests/data/bad/csv-* corpus/read_csv/
 printf 'target_mm,run,direction,deviation_um\n0,1,up,0\n100,1,up,2.5\n0,1,down,1\n100,1,down,\n' > corpus/read_csv/good.csv
+mkdir -p corpus/read_fanuc
+cp "$shared"/fanuc/*.TXT ../formats/fanuc/golden/* corpus/read_fanuc/
 for f in ../formats/*/golden/*; do cp "$f" "corpus/read_tables/$(basename "$(dirname "$(dirname "$f")")")-$(basename "$f")"; done
 cp ../fixtures/demo/truth.toml ../fixtures/machines/*.toml corpus/read_inputs/
 printf '[[effect]]\nkind = "reversal"\nB_um = -3.0\n\n[[effect]]\nkind = "outlier-run"\nrun = 1\ndirection = "down"\noffset_um = 4.0\n' > corpus/read_inputs/effects.toml

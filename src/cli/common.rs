@@ -148,7 +148,13 @@ pub fn load_profile(path: Option<&Path>) -> Result<MachineProfile> {
     let Some(path) = path else {
         return Ok(MachineProfile::default());
     };
-    load(path, MachineProfile::from_toml_str)
+    let mut profile = load(path, MachineProfile::from_toml_str)?;
+    // A Fanuc control: its parameter backup, named relative to the profile.
+    if let Some(name) = &profile.controller.fanuc_parameters {
+        let backup = path.parent().unwrap_or(Path::new(".")).join(name);
+        profile.fanuc = Some(load_fanuc_parameters(&backup)?);
+    }
+    Ok(profile)
 }
 
 /// The effects a diagnosis wrote (`diagnose --write-effects`), for
@@ -362,6 +368,37 @@ pub struct MachineFile {
     /// [acceptance] the permissible values (README.md).
     #[arg(long, value_name = "M.toml", help_heading = "Machine")]
     pub machine: Option<PathBuf>,
+
+    /// Fanuc parameter backup (CNC-PARA.TXT): the axes' pitch error
+    /// compensation parameters (3620–3624) and detection unit (1013, 1820),
+    /// which a Fanuc PITCH.TXT is read and updated with (default: the
+    /// profile's controller.fanuc_parameters).
+    #[arg(
+        long = "fanuc-parameters",
+        value_name = "CNC-PARA.TXT",
+        help_heading = "Machine"
+    )]
+    pub fanuc_parameters: Option<PathBuf>,
+}
+
+impl MachineFile {
+    /// The profile's `[controller]` part ([`load_profile`]) with the Fanuc
+    /// parameter backup of `--fanuc-parameters`, when given.
+    pub fn profile(&self) -> Result<MachineProfile> {
+        let mut profile = load_profile(self.machine.as_deref())?;
+        if let Some(path) = &self.fanuc_parameters {
+            profile.fanuc = Some(load_fanuc_parameters(path)?);
+        }
+        Ok(profile)
+    }
+}
+
+/// A Fanuc parameter backup; errors name the file, line and column.
+pub fn load_fanuc_parameters(path: &Path) -> Result<axcomp::emit::fanuc::ParameterBackup> {
+    let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
+    let text = axcomp::read::decode(&bytes).map_err(|e| in_file(path, e))?;
+    let name = path.display().to_string();
+    axcomp::emit::fanuc::ParameterBackup::parse(&text, &name).map_err(|e| in_file(path, e))
 }
 
 /// `--equipment` and `--decision`: the measurement uncertainty and the rule

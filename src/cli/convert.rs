@@ -14,9 +14,9 @@ use axcomp::read;
 use axcomp::workflow::{self, Converted, TableRequest};
 
 use super::common::{
-    InputFormat, JsonOutput, MachineFile, Overwrite, Verbosity, load_effects, load_profile,
-    name_axis, parse_position, parse_run_selector, print_json, print_text, print_warnings,
-    read_active_table, recorded_axis,
+    InputFormat, JsonOutput, MachineFile, Overwrite, Verbosity, load_effects, name_axis,
+    parse_position, parse_run_selector, print_json, print_text, print_warnings, read_active_table,
+    recorded_axis,
 };
 use super::evaluate::check_selectors;
 
@@ -29,7 +29,7 @@ pub struct ConvertArgs {
     #[arg(required = true, num_args = 1..=2, value_name = "FILE")]
     pub files: Vec<PathBuf>,
 
-    /// The controller: itnc530, tnc640, sinumerik840d, linuxcnc, fagor8055 or fagor8065.
+    /// The controller: itnc530, tnc640, sinumerik840d, linuxcnc, fagor8055, fagor8065 or fanuc (with --fanuc-parameters: the control's points; --existing PITCH.TXT is updated in place).
     #[arg(long, value_name = "CONTROLLER", value_parser = parse_controller, help_heading = "Table")]
     pub controller: Controller,
 
@@ -208,7 +208,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
                 .join(" + ")
         );
     }
-    let profile = load_profile(args.machine_file.machine.as_deref())?;
+    let profile = args.machine_file.profile()?;
     let read::ReadResult {
         mut measurement,
         mut warnings,
@@ -260,20 +260,26 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         || args.output.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
+    let mut request = Request {
+        mode: args.mode,
+        step_mm: args.step,
+        start_mm: args.start,
+        count: args.count,
+        reference_mm: args.reference,
+        extrapolate: args.extrapolate,
+    };
+    if args.controller == Controller::Fanuc
+        && let Some(parameters) = &options.axes[0].fanuc
+    {
+        fanuc_grid(&mut request, parameters, measurement.targets_mm())?;
+    }
     let Converted { bytes, report, .. } = workflow::convert(
         &measurement,
         &mut warnings,
         &TableRequest {
             controller: args.controller,
             options: &options,
-            request: &Request {
-                mode: args.mode,
-                step_mm: args.step,
-                start_mm: args.start,
-                count: args.count,
-                reference_mm: args.reference,
-                extrapolate: args.extrapolate,
-            },
+            request: &request,
             effects: &effects,
             existing: existing_bytes.as_deref(),
             output: args.output.display().to_string(),
@@ -288,6 +294,29 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     } else {
         print_text(&report.summary())
     }
+}
+
+/// The grid of a Fanuc table: the control's points (3620–3624 of the
+/// parameter backup) inside the measured range, zero at its reference point.
+fn fanuc_grid(
+    request: &mut Request,
+    parameters: &axcomp::emit::fanuc::AxisParameters,
+    targets_mm: &[f64],
+) -> Result<()> {
+    if request.step_mm.is_some() || request.start_mm.is_some() || request.reference_mm.is_some() {
+        bail!(
+            "the Fanuc parameter backup fixes the compensation points and the reference ({}): leave out --step, --start, --count and --reference",
+            parameters.settings()
+        );
+    }
+    let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
+    let (start_mm, count) =
+        axcomp::emit::fanuc::points_in(parameters, first, last).map_err(anyhow::Error::msg)?;
+    request.step_mm = Some(parameters.interval);
+    request.start_mm = Some(start_mm);
+    request.count = Some(count);
+    request.reference_mm = Some(parameters.position(parameters.reference_point));
+    Ok(())
 }
 
 /// The name inside Heidenhain files: the output file name, upper case.

@@ -12,6 +12,7 @@ mod convert;
 mod demo;
 mod diagnose;
 mod evaluate;
+mod generate;
 mod predict;
 mod progress;
 mod report;
@@ -109,6 +110,10 @@ pub enum Command {
     /// and grid, download the table and the acceptance report. The same
     /// numbers and files as the commands; everything stays in memory.
     Serve(serve::ServeArgs),
+    /// Print the shell completion script (bash, zsh, fish, PowerShell, elvish).
+    Completions(generate::CompletionsArgs),
+    /// Print the manual page (roff) of axcomp or of one of its commands.
+    Man(generate::ManArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -204,6 +209,8 @@ fn run(args: Args) -> Result<()> {
         Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
         Command::Report(report_args) => report::run(&report_args),
         Command::Serve(serve_args) => serve::run(&serve_args),
+        Command::Completions(completions_args) => generate::completions(&completions_args),
+        Command::Man(man_args) => generate::man(&man_args),
     }
 }
 

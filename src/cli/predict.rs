@@ -21,8 +21,7 @@ use axcomp::units::{LengthUnit, mm_to_um};
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, StandardArg, Verbosity, load, load_effects,
-    load_machine, load_profile, name_axis, parse_position, print_json, print_text, print_warnings,
-    read_table,
+    load_machine, name_axis, parse_position, print_json, print_text, print_warnings, read_table,
 };
 
 /// Flags of `axcomp predict`.
@@ -126,7 +125,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         bail!("--grid must be a step > 0 mm, found {}", args.grid);
     }
     let machine = load_machine(args.machine_file.machine.as_deref())?;
-    let profile = load_profile(args.machine_file.machine.as_deref())?;
+    let profile = args.machine_file.profile()?;
     let mut errors = match &args.errors {
         Some(path) => load_errors(path)?,
         None => GeometricErrors::default(),

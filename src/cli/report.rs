@@ -23,8 +23,7 @@ use axcomp::workflow::Test;
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     AngleUnitArg, InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs,
-    Verbosity, load_equipment, load_profile, name_axis, print_text, print_warnings_in,
-    read_active_table,
+    Verbosity, load_equipment, name_axis, print_text, print_warnings_in, read_active_table,
 };
 
 /// Flags of `axcomp report`.
@@ -215,7 +214,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     }
     let table = match &args.table {
         Some(path) => {
-            let profile = load_profile(args.machine_file.machine.as_deref())?;
+            let profile = args.machine_file.profile()?;
             let (controller, table, doubts) = read_active_table(
                 path,
                 &before.measurement,

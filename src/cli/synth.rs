@@ -12,8 +12,7 @@ use axcomp::synth::{self, RotaryTruth, Truth};
 use axcomp::units::{LengthUnit, mm_to_um, rad_to_um_per_m};
 
 use super::common::{
-    LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_machine, load_profile, print_text,
-    read_table,
+    LinuxCncType, MachineFile, Overwrite, Verbosity, load, load_machine, print_text, read_table,
 };
 
 /// Flags of `axcomp synth`.
@@ -85,7 +84,7 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     let first_text = render(&first, output)?;
     let second = match (&args.table, &args.output2) {
         (Some(table_path), Some(output2)) => {
-            let profile = load_profile(args.machine_file.machine.as_deref())?;
+            let profile = args.machine_file.profile()?;
             let (_, table) = read_table(
                 table_path,
                 &truth.axis.name,

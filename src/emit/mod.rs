@@ -21,6 +21,7 @@
 mod fagor;
 pub mod fagor8055;
 pub mod fagor8065;
+pub mod fanuc;
 mod heidenhain;
 pub mod itnc530;
 pub mod linuxcnc;
@@ -52,17 +53,20 @@ pub enum Controller {
     Fagor8055,
     /// Fagor 8065 axis parameter file `<axis>.mp` (its `/LSCRWDATA` table).
     Fagor8065,
+    /// Fanuc pitch error compensation data (`PITCH.TXT`, punch format).
+    Fanuc,
 }
 
 impl Controller {
     /// Every controller, in the order they are listed to users.
-    pub const ALL: [Controller; 6] = [
+    pub const ALL: [Controller; 7] = [
         Controller::Itnc530,
         Controller::Tnc640,
         Controller::Sinumerik840d,
         Controller::LinuxCnc,
         Controller::Fagor8055,
         Controller::Fagor8065,
+        Controller::Fanuc,
     ];
 
     /// The `--controller` name.
@@ -74,6 +78,7 @@ impl Controller {
             Controller::LinuxCnc => "linuxcnc",
             Controller::Fagor8055 => "fagor8055",
             Controller::Fagor8065 => "fagor8065",
+            Controller::Fanuc => "fanuc",
         }
     }
 
@@ -87,6 +92,7 @@ impl Controller {
             Controller::LinuxCnc => format!("{}.comp", axis.to_ascii_lowercase()),
             Controller::Fagor8055 => format!("AL{axis}"),
             Controller::Fagor8065 => format!("{axis}.mp"),
+            Controller::Fanuc => "PITCH.TXT".to_string(),
         }
     }
 
@@ -110,7 +116,7 @@ impl Controller {
 
     /// Whether the format holds separate ↑ and ↓ values.
     pub fn supports_bidirectional(self) -> bool {
-        !matches!(self, Controller::Itnc530)
+        !matches!(self, Controller::Itnc530 | Controller::Fanuc)
     }
 
     /// What a table's plan needs to know of this controller
@@ -138,6 +144,7 @@ impl Controller {
             Controller::LinuxCnc => linuxcnc::backlash_parameter(backlash_mm, options),
             Controller::Fagor8055 => fagor8055::backlash_parameter(backlash_mm, options),
             Controller::Fagor8065 => fagor8065::backlash_parameter(backlash_mm, options),
+            Controller::Fanuc => fanuc::backlash_parameter(backlash_mm, options),
         }
     }
 
@@ -149,6 +156,7 @@ impl Controller {
             // LinuxCNC motion.h: EMCMOT_COMP_SIZE 256.
             Controller::LinuxCnc => Some(256),
             Controller::Fagor8055 => Some(fagor8055::MAX_POINTS),
+            Controller::Fanuc => Some(fanuc::MAX_POINTS),
             // TNC 640: not documented publicly; Sinumerik: MD38000,
             // machine-specific; Fagor 8065: no public limit found.
             Controller::Tnc640 | Controller::Sinumerik840d | Controller::Fagor8065 => None,
@@ -447,6 +455,9 @@ fn format_limits_mm(
         Controller::Fagor8055 | Controller::Fagor8065 => {
             (fagor::LIMIT_MM, ("Fagor", fagor::LIMIT_MM))
         }
+        // [reconstructed] 3624 and 1240 hold ±99 999.999 mm (IS-B); each
+        // point's own limit is checked by `fanuc` in its units.
+        Controller::Fanuc => (99_999.999, ("Fanuc", 99_999.999)),
     }
 }
 
@@ -555,7 +566,9 @@ fn check_rotary(
             });
         }
         Controller::Sinumerik840d => {}
-        Controller::Itnc530 | Controller::Tnc640 | Controller::LinuxCnc => return Ok(()),
+        Controller::Itnc530 | Controller::Tnc640 | Controller::LinuxCnc | Controller::Fanuc => {
+            return Ok(());
+        }
     }
     let (first, last) = (
         table.positions_mm[0],
@@ -601,6 +614,7 @@ pub fn write(
         Controller::LinuxCnc => linuxcnc::write(table, options),
         Controller::Fagor8055 => fagor8055::write(table, options),
         Controller::Fagor8065 => fagor8065::write(table, options),
+        Controller::Fanuc => fanuc::write(table, options),
     }?;
     check_read_back(controller, table, &text, options)?;
     Ok(text)
@@ -617,6 +631,16 @@ pub fn write_bytes(
     options: &EmitOptions,
     existing: Option<&[u8]>,
 ) -> Result<Vec<u8>, EmitError> {
+    if controller == Controller::Fanuc {
+        // A pitch file that was active gets the new points in place.
+        let old = existing.and_then(|bytes| decode_table(bytes).ok());
+        if let Some((old_text, encoding)) = old.filter(|(text, _)| fanuc::looks_like(text)) {
+            check_table(controller, table, options)?;
+            let text = fanuc::update(&old_text, table, options)?;
+            fanuc::check_read_back(&text, table, options)?;
+            return Ok(encode_table(&text, encoding));
+        }
+    }
     if controller != Controller::Fagor8065 {
         return Ok(write(controller, table, options)?.into_bytes());
     }
@@ -639,6 +663,9 @@ fn check_read_back(
     text: &str,
     options: &EmitOptions,
 ) -> Result<(), EmitError> {
+    if controller == Controller::Fanuc {
+        return fanuc::check_read_back(text, table, options);
+    }
     let (_, back) = read_any(text, options, Some(options.linuxcnc_type)).map_err(|error| {
         EmitError::Internal(format!(
             "the written {} table does not read back: {error}",
@@ -681,6 +708,9 @@ pub fn resolution_mm(controller: Controller, machine_unit: LengthUnit) -> f64 {
             machine_unit.to_mm(10f64.powi(-(fagor8055::decimals(machine_unit) as i32)))
         }
         Controller::Fagor8065 => 1e-4,
+        // [manual] IS-B: least input increment 0.001 mm (B-63943EN-1/02
+        // p.109), the resolution of the interval 3624.
+        Controller::Fanuc => 1e-3,
     }
 }
 
@@ -702,7 +732,22 @@ pub fn read_any(
         .map(str::trim)
         .find(|l| !l.is_empty())
         .unwrap_or("");
-    let (controller, mut table) = if fagor8065::looks_like(text) {
+    let (controller, mut table) = if fanuc::looks_like(text) {
+        let Some(parameters) = &axis.fanuc else {
+            return Err(ParseError::new(
+                1,
+                1,
+                "a Fanuc pitch error compensation file counts in units the parameter backup gives (3620–3624, 1820): give it with --fanuc-parameters CNC-PARA.TXT",
+            ));
+        };
+        (Controller::Fanuc, fanuc::read(text, parameters)?)
+    } else if fanuc::looks_like_parameters(text) {
+        return Err(ParseError::new(
+            1,
+            1,
+            "this is a Fanuc parameter backup (N…Q1 lines), not the pitch error compensation data: give it with --fanuc-parameters and the pitch file (PITCH.TXT, N1…Q0 lines) as the table",
+        ));
+    } else if fagor8065::looks_like(text) {
         (Controller::Fagor8065, fagor8065::read(text, &axis.axis)?)
     } else if fagor8055::looks_like(text) {
         let table = fagor8055::read(text, &axis.axis, options.machine_unit)?;
@@ -728,7 +773,7 @@ pub fn read_any(
         return Err(ParseError::new(
             1,
             1,
-            "unknown compensation table format: expected a Heidenhain .COM (BEGIN …), a Sinumerik .MPF (%_N_…), a LinuxCNC COMP_FILE (nominal forward reverse), a Fagor 8055 AL<axis> (P0001 X … EX … EX …) or a Fagor 8065 .mp (/LSCRWDATA/…)",
+            "unknown compensation table format: expected a Heidenhain .COM (BEGIN …), a Sinumerik .MPF (%_N_…), a LinuxCNC COMP_FILE (nominal forward reverse), a Fagor 8055 AL<axis> (P0001 X … EX … EX …), a Fagor 8065 .mp (/LSCRWDATA/…) or a Fanuc pitch file (%, N10000Q0P…)",
         ));
     };
     table.axis = axis.axis.clone();
@@ -749,6 +794,7 @@ pub fn activation(
         Controller::LinuxCnc => linuxcnc::activation(file_name, options),
         Controller::Fagor8055 => fagor8055::activation(file_name, options),
         Controller::Fagor8065 => fagor8065::activation(file_name, options),
+        Controller::Fanuc => fanuc::activation(file_name, table, options),
     }
 }
 
@@ -873,7 +919,8 @@ mod tests {
         for controller in Controller::ALL {
             assert_eq!(Controller::from_name(controller.name()), Some(controller));
         }
-        assert_eq!(Controller::from_name("fanuc"), None);
+        assert_eq!(Controller::from_name("fanuc"), Some(Controller::Fanuc));
+        assert_eq!(Controller::from_name("heidenhain"), None);
     }
 
     fn options(controller: Controller, unit: LengthUnit) -> EmitOptions {
@@ -1012,7 +1059,9 @@ mod tests {
         #[test]
         fn every_controller_reads_back_what_it_writes((table, both) in arbitrary_table(), inch in any::<bool>()) {
             for controller in Controller::ALL {
-                if both && !controller.supports_bidirectional() {
+                // Fanuc points hold ±127 units each, which arbitrary values
+                // exceed; its round trip is tested in `fanuc`.
+                if (both && !controller.supports_bidirectional()) || controller == Controller::Fanuc {
                     continue;
                 }
                 let unit = if inch && controller == Controller::LinuxCnc { LengthUnit::Inch } else { LengthUnit::Millimetre };

@@ -11,6 +11,7 @@
 //! cec_first_table = 0       # Sinumerik CEC table index for ↑ (↓ is the next)
 //! cec_values = "correction" # or "error": the CEC sign, see formats/sinumerik840d
 //! tnc640_columns = ["X", "Y", "Z"]  # the machine's CfgAxes/axisList
+//! fanuc_parameters = "CNC-PARA.TXT" # a Fanuc control: its parameter backup
 //!
 //! [controller.axes.X]
 //! itnc530_column = 1        # iTNC 530: the N of the N=F() column
@@ -43,6 +44,10 @@ pub struct MachineProfile {
     /// Controller settings.
     #[serde(default)]
     pub controller: ControllerProfile,
+    /// The Fanuc parameter backup (`controller.fanuc_parameters` or
+    /// `--fanuc-parameters`), read by the caller.
+    #[serde(skip)]
+    pub fanuc: Option<super::fanuc::ParameterBackup>,
 }
 
 /// The `[controller]` table.
@@ -63,6 +68,8 @@ pub struct ControllerProfile {
     pub cec_values: Option<CecValues>,
     /// TNC 640: the machine's axis columns, in order.
     pub tnc640_columns: Option<Vec<String>>,
+    /// Fanuc: the parameter backup (`CNC-PARA.TXT`), relative to the profile.
+    pub fanuc_parameters: Option<String>,
     /// Per-axis names and numbers.
     #[serde(default)]
     pub axes: BTreeMap<String, AxisProfileToml>,
@@ -160,6 +167,9 @@ pub struct AxisProfile {
     pub sinumerik_encoder: u32,
     /// LinuxCNC joint number.
     pub linuxcnc_joint: u32,
+    /// Fanuc: the axis' pitch error compensation parameters, when the
+    /// profile has a parameter backup.
+    pub fanuc: Option<super::fanuc::AxisParameters>,
 }
 
 /// The letters whose position gives the default numbers.
@@ -230,6 +240,10 @@ impl MachineProfile {
                 None => index
                     .map(|i| i as u32)
                     .ok_or_else(|| need("linuxcnc_joint"))?,
+            },
+            fanuc: match &self.fanuc {
+                Some(backup) => Some(backup.axis(axis).map_err(EmitError::Profile)?),
+                None => None,
             },
         })
     }

@@ -200,6 +200,11 @@ pub fn convert(
         warning_texts,
     );
     report.effects = plan.notes;
+    if table.controller == Controller::Fanuc {
+        report
+            .effects
+            .extend(emit::fanuc::notes(&compensation, options));
+    }
     if measurement.kind() == AxisKind::Linear {
         report.file_unit = options.machine_unit.as_str();
     }

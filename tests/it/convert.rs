@@ -395,7 +395,8 @@ fn every_golden_file_has_a_case() {
             .join("golden");
         for entry in std::fs::read_dir(&folder).unwrap() {
             let name = entry.unwrap().file_name().into_string().unwrap();
-            let cross_axis = crate::cross_axis::GOLDENS.contains(&(controller.name(), &name));
+            let cross_axis = crate::cross_axis::GOLDENS.contains(&(controller.name(), &name))
+                || crate::fanuc::GOLDENS.contains(&name.as_str());
             assert!(
                 cross_axis || names.contains(&(controller.name().to_string(), name.clone())),
                 "{}/{name} is not produced by any case",
@@ -570,8 +571,8 @@ fn what_the_controllers_would_reject_is_refused() {
         "bidirectional tables need runs in both directions",
     );
     refused(
-        &[SAMPLE, "--controller", "fanuc"],
-        "unknown controller \"fanuc\"; supported: itnc530, tnc640, sinumerik840d, linuxcnc",
+        &[SAMPLE, "--controller", "mazak"],
+        "unknown controller \"mazak\"; supported: itnc530, tnc640, sinumerik840d, linuxcnc",
     );
     refused(
         &[SAMPLE, "--controller", "tnc640", "--also", "Q"],

@@ -131,7 +131,7 @@ fn negative_values_elsewhere_get_a_value_error_not_an_unexpected_argument() {
 #[test]
 fn quiet_is_documented_the_same_in_every_command() {
     let commands = subcommands();
-    assert_eq!(commands.len(), 10, "{commands:?}");
+    assert_eq!(commands.len(), 12, "{commands:?}");
     for command in &commands {
         let help = axcomp([command.as_str(), "--help"]);
         assert_eq!(help.code, 0, "{command}");
