@@ -93,6 +93,51 @@ pub fn basis_matrix(knots: &[f64], points: &[f64]) -> Vec<f64> {
     basis
 }
 
+/// The rows of [`basis_matrix`] as (knot index, weight) pairs, without the
+/// weights below 1e-18 (smaller than the rounding of any value the spline
+/// gives: the weights of a not-a-knot spline decay by about 0.27 a knot away
+/// from the point).
+///
+/// A point on a knot (or outside the knots) takes that knot's value alone:
+/// one weight of 1, in time independent of the number of knots; only the
+/// points between knots need the knots' splines.
+pub fn basis_rows(knots: &[f64], points: &[f64]) -> Vec<Vec<(usize, f64)>> {
+    let n_knots = knots.len();
+    let on_knot = |x: f64| -> Option<usize> {
+        if x <= knots[0] {
+            return Some(0);
+        }
+        if x >= knots[n_knots - 1] {
+            return Some(n_knots - 1);
+        }
+        let i = knots.partition_point(|knot| *knot < x);
+        (knots[i] == x).then_some(i)
+    };
+    let mut rows: Vec<Vec<(usize, f64)>> = points
+        .iter()
+        .map(|&x| on_knot(x).map_or_else(Vec::new, |i| vec![(i, 1.0)]))
+        .collect();
+    let between: Vec<usize> = (0..points.len())
+        .filter(|&p| on_knot(points[p]).is_none())
+        .collect();
+    if between.is_empty() {
+        return rows;
+    }
+    let mut unit = vec![0.0; n_knots];
+    for column in 0..n_knots {
+        unit.fill(0.0);
+        unit[column] = 1.0;
+        let spline = CubicSpline::new(knots, &unit);
+        for &p in &between {
+            let weight = spline.value_at(points[p]);
+            if weight.abs() >= 1e-18 {
+                rows[p].push((column, weight));
+            }
+        }
+    }
+    rows
+}
+
 /// The second derivatives at the knots of the not-a-knot spline.
 ///
 /// Interior knots i = 1 … n−2 satisfy the C² conditions
@@ -239,6 +284,41 @@ mod tests {
                 .sum();
             assert!((dot - spline.value_at(*point)).abs() < 1e-14);
         }
+    }
+
+    #[test]
+    fn sparse_basis_rows_are_the_basis_matrix() {
+        // 40 uneven knots; points on knots, between them and outside.
+        let knots: Vec<f64> = (0..40)
+            .map(|i| 10.0 * i as f64 + (i as f64 * 1.7).sin())
+            .collect();
+        let points = [
+            -5.0, knots[0], knots[7], 73.3, knots[20], 201.0, knots[39], 500.0,
+        ];
+        let rows = basis_rows(&knots, &points);
+        let dense = basis_matrix(&knots, &points);
+        // On a knot or outside: that knot alone, with weight 1.
+        for (p, knot) in [(0, 0), (1, 0), (2, 7), (4, 20), (6, 39), (7, 39)] {
+            assert_eq!(rows[p], [(knot, 1.0)], "point {p}");
+        }
+        for (p, row) in rows.iter().enumerate() {
+            let mut full = vec![0.0; knots.len()];
+            for (j, w) in row {
+                full[*j] = *w;
+            }
+            for (j, w) in full.iter().enumerate() {
+                assert!(
+                    (w - dense[p * knots.len() + j]).abs() < 1e-15,
+                    "point {p} knot {j}"
+                );
+            }
+        }
+        // Between knots the weights reach a few knots away, and fall below 1e-18 far away.
+        assert!(
+            rows[3].len() > 4 && rows[3].len() < knots.len(),
+            "{}",
+            rows[3].len()
+        );
     }
 
     proptest! {

@@ -10,9 +10,12 @@
 //! smooth background (a regression spline with knots every span / 6), with the
 //! background's misfit counted as noise.
 
+use std::sync::{Arc, Mutex};
+
 use nalgebra::{DMatrix, DVector};
 
-use super::fit::{Design, WeightedFit, fit_gls};
+use super::covariance::Covariance;
+use super::fit::{Design, GlsBase, WeightedFit, fit_gls};
 use super::gates::{period_range, rotary_orders, set_rejection};
 use super::levels::{Fold, Level};
 use super::periodogram::{aliases, frequency_uncertainty, period_sets};
@@ -28,25 +31,15 @@ use crate::units::DeviationUnit;
 /// Covariance of the per-target levels, µm²: each level's own scatter on the
 /// diagonal, plus the prediction's, which targets share when they interpolate
 /// the same points of the first test: C = diag(s²) + W D Wᵀ.
-pub(super) fn level_covariance(problem: &Problem, levels: &[Level]) -> DMatrix<f64> {
-    let m = levels.len();
-    let mut covariance = DMatrix::zeros(m, m);
-    for (a, la) in levels.iter().enumerate() {
-        covariance[(a, a)] += la.scatter_variance_um2;
-        for (b, lb) in levels.iter().enumerate() {
-            let shared: f64 = problem.prediction_weights[la.target_index]
-                .iter()
-                .flat_map(|(ka, wa)| {
-                    problem.prediction_weights[lb.target_index]
-                        .iter()
-                        .filter(move |(kb, _)| kb == ka)
-                        .map(move |(_, wb)| wa * wb * problem.first_test_variance_um2[*ka])
-                })
-                .sum();
-            covariance[(a, b)] += shared;
-        }
-    }
-    covariance
+pub(super) fn level_covariance(problem: &Problem, levels: &[Level]) -> Covariance {
+    Covariance::new(
+        levels.iter().map(|l| l.scatter_variance_um2).collect(),
+        levels
+            .iter()
+            .map(|l| problem.prediction_weights[l.target_index].clone())
+            .collect(),
+        problem.first_test_variance_um2.clone(),
+    )
 }
 
 /// What the effects along the axis are fitted against.
@@ -153,16 +146,14 @@ pub(super) fn select_along_axis(
 ) -> AlongAxisSelection {
     let m = levels.len();
     let values: Vec<f64> = levels.iter().map(|l| l.value_um).collect();
-    let base = Design {
-        columns: background_columns(background, levels, None),
-    };
+    let base = Design::of_columns(background_columns(background, levels, None));
     let mut covariance = level_covariance(problem, levels);
     if background == Background::Smooth {
         // The smooth curve only approximates the test's own systematic error:
         // its misfit counts as noise (the variance scaled by χ²/dof when > 1).
         let fit = fit_gls(&base, &values, &covariance, None);
         let dof = m.saturating_sub(fit.rank).max(1) as f64;
-        covariance *= (fit.chi2 / dof).max(1.0);
+        covariance = covariance.scaled((fit.chi2 / dof).max(1.0));
     }
     let min_periods = match background {
         Background::Constant => super::MIN_PERIODS_IN_SPAN,
@@ -182,6 +173,7 @@ pub(super) fn select_along_axis(
             .flatten(),
         min_periods,
         known,
+        base_fit: Mutex::new(None),
     };
     let (mut chosen, mut model_fit) = forward_selection(&search, base.clone(), kinds, rejected);
     // Never the nearest kind: what is accepted along the axis must leave no
@@ -215,7 +207,7 @@ pub(super) fn select_along_axis(
             };
             aliases(found, range, search.span_mm(), |p| {
                 search
-                    .fit(&others.with(&search.columns(Shape::Period(p, tests))))
+                    .fit_extended(&others, &search.columns(Shape::Period(p, tests)))
                     .chi2
             })
         }
@@ -237,10 +229,12 @@ struct AlongAxis<'a> {
     reversal_b: f64,
     background: Background,
     values: &'a [f64],
-    covariance: &'a DMatrix<f64>,
+    covariance: &'a Covariance,
     periods: Option<(f64, f64)>,
     min_periods: f64,
     known: &'a [KnownPeriod],
+    /// The fit of the model the candidates extend, kept between them.
+    base_fit: Mutex<Option<Arc<GlsBase>>>,
 }
 
 impl AlongAxis<'_> {
@@ -308,6 +302,21 @@ impl Search for AlongAxis<'_> {
         fit_gls(design, self.values, self.covariance, None)
     }
 
+    /// The model's C⁻¹X is kept: a candidate costs a solve per column it adds.
+    fn fit_extended(&self, model: &Design, extra: &[Vec<f64>]) -> WeightedFit {
+        let base = {
+            let mut cached = self.base_fit.lock().unwrap_or_else(|e| e.into_inner());
+            if !cached.as_ref().is_some_and(|b| b.is_of(&model.columns)) {
+                *cached = GlsBase::new(&model.columns, self.values, self.covariance).map(Arc::new);
+            }
+            cached.clone()
+        };
+        match base {
+            Some(base) => base.fit_with(extra, self.covariance),
+            None => self.fit(&model.with(extra)),
+        }
+    }
+
     fn statistic(fit: &WeightedFit) -> f64 {
         fit.chi2
     }
@@ -355,7 +364,7 @@ fn inconsistent_along_axis(
     problem: &Problem,
     levels: &[Level],
     values: &[f64],
-    covariance: &DMatrix<f64>,
+    covariance: &Covariance,
     background: Background,
     shape: Shape,
 ) -> Option<String> {
@@ -371,9 +380,7 @@ fn inconsistent_along_axis(
         if rows.iter().filter(|r| **r).count() < k + 6 {
             return None;
         }
-        let design = Design {
-            columns: background_columns(background, levels, Some(&rows)),
-        };
+        let design = Design::of_columns(background_columns(background, levels, Some(&rows)));
         let first = design.parameters();
         let fitted = fit_gls(&design.with(&columns), values, covariance, Some(&rows));
         if fitted.rank < first + k {
@@ -400,9 +407,7 @@ fn inconsistent_along_axis(
         // 2π·δf·(the half's centre), so the halves' (a, b) differ by 2π·δf·Δc·(−b, a) even
         // when the error is the same along the axis: a period the whole span determines
         // well is not rejected for what its halves cannot (σ_f from χ²'s curvature).
-        let base = Design {
-            columns: background_columns(background, levels, None),
-        };
+        let base = Design::of_columns(background_columns(background, levels, None));
         let whole = |p: f64| {
             fit_gls(
                 &base.with(&level_columns(problem, levels, Shape::Period(p, tests))),
@@ -466,20 +471,25 @@ pub(super) fn along_axis_cv(
     reversal_b: f64,
 ) -> f64 {
     let (mut sum, mut count) = (0.0, 0usize);
+    let targets = problem.targets_mm.len();
+    let mut row_of_target = vec![None; targets];
+    for (row, l) in levels.iter().enumerate() {
+        row_of_target[l.target_index].get_or_insert(row);
+    }
     for fold in folds {
         // The design's columns are over `levels`; take the rows of the fold's levels (same targets).
         let index: Vec<usize> = fold
             .levels
             .iter()
-            .filter_map(|l| levels.iter().position(|m| m.target_index == l.target_index))
+            .filter_map(|l| row_of_target[l.target_index])
             .collect();
-        let columns = Design {
-            columns: design
+        let columns = Design::of_columns(
+            design
                 .columns
                 .iter()
                 .map(|c| index.iter().map(|&i| c[i]).collect())
                 .collect(),
-        };
+        );
         let values: Vec<f64> = fold.levels.iter().map(|l| l.value_um).collect();
         let fitted = fit_gls(
             &columns,
@@ -487,8 +497,12 @@ pub(super) fn along_axis_cv(
             &level_covariance(problem, &fold.levels),
             None,
         );
+        let mut fold_row = vec![None; targets];
+        for (row, l) in fold.levels.iter().enumerate() {
+            fold_row[l.target_index].get_or_insert(row);
+        }
         for (target, direction, value) in &fold.held_out {
-            if let Some(at) = fold.levels.iter().position(|l| l.target_index == *target) {
+            if let Some(at) = fold_row[*target] {
                 let half = direction.reversal_share(reversal_b);
                 sum += (value - fitted.fitted[at] - half).powi(2);
                 count += 1;

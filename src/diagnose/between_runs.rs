@@ -3,6 +3,7 @@
 //! on those cell levels. No position-dependent error can pose as one of them:
 //! every cell has its own level.
 
+use super::covariance::Covariance;
 use super::fit::{self, Design, Fit, bic, leave_one_run_out_rmse};
 use super::gates::{predicts_better, set_rejection, strong_evidence};
 use super::levels::{Cell, Fold, reversals};
@@ -10,7 +11,6 @@ use super::problem::Problem;
 use super::selection::{Chosen, Search, ShapeSet, forward_selection, shapes};
 use super::stats::{chi2_p, partial_f_p};
 use super::{Evidence, Kind, LACK_OF_FIT_P, RejectedEffect, Shape};
-use nalgebra::{DMatrix, DVector};
 
 use crate::effects::deviation_text;
 use crate::measurement::Run;
@@ -127,26 +127,34 @@ fn runs_of(problem: &Problem) -> Vec<Run> {
 /// first test as many independent ones.
 fn constant_reversal(problem: &Problem, differences: &[(usize, f64, f64)]) -> (f64, f64, f64, f64) {
     let m = differences.len();
-    let covariance = DMatrix::from_fn(m, m, |a, b| {
-        if a == b {
-            differences[a].2.max(1e-300)
-        } else {
-            problem.shared_reversal_variance_um2(differences[a].0, differences[b].0)
-        }
-    });
-    let d = DVector::from_iterator(m, differences.iter().map(|(_, d, _)| *d));
-    let ones = DVector::from_element(m, 1.0);
-    let Some(cholesky) = covariance.cholesky() else {
+    // Each difference's variance less what it shares (the diagonal of W R Wᵀ), plus W R Wᵀ.
+    let covariance = Covariance::new(
+        differences
+            .iter()
+            .map(|(t, _, v)| v.max(1e-300) - problem.reversal_prediction_variance_um2(*t))
+            .collect(),
+        differences
+            .iter()
+            .map(|(t, _, _)| problem.prediction_weights[*t].clone())
+            .collect(),
+        problem.first_test_reversal_variance_um2.clone(),
+    );
+    let d: Vec<f64> = differences.iter().map(|(_, d, _)| *d).collect();
+    let (Some(inverse_d), Some(inverse_ones)) =
+        (covariance.solve(&d), covariance.solve(&vec![1.0; m]))
+    else {
         // Not positive definite only if the variances are degenerate: treat them as independent.
         return independent_constant_reversal(differences);
     };
-    let inverse_d = cholesky.solve(&d);
-    let inverse_ones = cholesky.solve(&ones);
-    let weight = ones.dot(&inverse_ones);
-    let mean = ones.dot(&inverse_d) / weight;
-    let about_zero = d.dot(&inverse_d);
-    let residual = &d - &ones * mean;
-    let about_mean = residual.dot(&cholesky.solve(&residual));
+    let weight: f64 = inverse_ones.iter().sum();
+    let mean = inverse_d.iter().sum::<f64>() / weight;
+    let about_zero: f64 = d.iter().zip(&inverse_d).map(|(a, b)| a * b).sum();
+    // C⁻¹(d − 1·mean) = C⁻¹d − mean · C⁻¹1.
+    let about_mean: f64 = d
+        .iter()
+        .zip(inverse_d.iter().zip(&inverse_ones))
+        .map(|(d, (id, io))| (d - mean) * (id - mean * io))
+        .sum();
     (mean, (1.0 / weight).sqrt(), about_zero, about_mean)
 }
 

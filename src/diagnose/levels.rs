@@ -51,12 +51,14 @@ pub(super) fn cell_levels(problem: &Problem, fitted: &Fit) -> Vec<Cell> {
 
 /// The per-target difference ↑ − ↓ of the cell levels and its variance.
 pub(super) fn reversals(cells: &[Cell]) -> Vec<(usize, f64, f64)> {
+    let targets = cells.iter().map(|c| c.target_index + 1).max().unwrap_or(0);
+    let mut down_at = vec![None; targets];
+    for c in cells.iter().filter(|c| c.direction == Direction::Down) {
+        down_at[c.target_index].get_or_insert(c);
+    }
     let mut list = Vec::new();
     for up in cells.iter().filter(|c| c.direction == Direction::Up) {
-        if let Some(down) = cells
-            .iter()
-            .find(|c| c.direction == Direction::Down && c.target_index == up.target_index)
-        {
+        if let Some(down) = down_at[up.target_index] {
             list.push((
                 up.target_index,
                 up.value_um - down.value_um,
@@ -94,15 +96,12 @@ pub(super) fn cross_validation_folds(
         let fitted = fit::fit(between_model, y, Some(&training));
         let cells = cell_levels(problem, &fitted);
         let levels = target_levels(problem, &cells);
+        let effects = problem.between_runs_um(between, &fitted.coefficients);
         let held: Vec<(usize, Direction, f64)> = (0..y.len())
             .filter(|&i| run_of[i] == held_out)
             .map(|i| {
-                let effects: f64 = between
-                    .iter()
-                    .map(|c| problem.contribution(c, &fitted.coefficients, i))
-                    .sum();
                 let r = &problem.readings[i];
-                (r.target_index, r.direction, y[i] - effects)
+                (r.target_index, r.direction, y[i] - effects[i])
             })
             .collect();
         folds.push(Fold {
@@ -117,9 +116,12 @@ pub(super) fn cross_validation_folds(
 /// The per-target levels: both directions pooled (their mean), with the
 /// variance of the scatter and of the prediction.
 pub(super) fn target_levels(problem: &Problem, cells: &[Cell]) -> Vec<Level> {
+    let mut at_target: Vec<Vec<&Cell>> = vec![Vec::new(); problem.targets_mm.len()];
+    for c in cells {
+        at_target[c.target_index].push(c);
+    }
     let mut levels = Vec::new();
-    for t in 0..problem.targets_mm.len() {
-        let here: Vec<&Cell> = cells.iter().filter(|c| c.target_index == t).collect();
+    for (t, here) in at_target.iter().enumerate() {
         if here.is_empty() {
             continue;
         }

@@ -34,6 +34,7 @@
 mod along_axis;
 mod angular_profile;
 mod between_runs;
+mod covariance;
 mod findings;
 pub mod fit;
 pub mod friction;
@@ -432,14 +433,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         };
     }
     let half_reversal = |d: Direction| d.reversal_share(reversal_b);
-    let between_um: Vec<f64> = (0..n)
-        .map(|i| {
-            between
-                .iter()
-                .map(|c| problem.contribution(c, &between_fit.coefficients, i))
-                .sum()
-        })
-        .collect();
+    let between_um = problem.between_runs_um(&between, &between_fit.coefficients);
     let scatter: Vec<f64> = y
         .iter()
         .zip(&between_fit.fitted)

@@ -31,6 +31,8 @@
 //!
 //! It does not look for two periodic errors at once.
 
+use rayon::prelude::*;
+
 use super::selection::ShapeSet;
 use super::{KnownPeriod, MIN_DELTA_BIC};
 use crate::effects::{PeriodicIn, Shape};
@@ -126,7 +128,7 @@ pub(super) fn aliases(
     found_mm: f64,
     range: (f64, f64),
     span_mm: f64,
-    chi2: impl Fn(f64) -> f64,
+    chi2: impl Fn(f64) -> f64 + Sync,
 ) -> Vec<f64> {
     let (shortest, longest) = range;
     let at_found = chi2(found_mm);
@@ -137,7 +139,7 @@ pub(super) fn aliases(
             _ => None,
         })
         .collect();
-    let values: Vec<f64> = periods.iter().map(|&p| chi2(p)).collect();
+    let values: Vec<f64> = periods.par_iter().map(|&p| chi2(p)).collect();
     let mut found: Vec<(f64, f64)> = Vec::new();
     for i in 1..values.len().saturating_sub(1) {
         let (left, middle, right) = (values[i - 1], values[i], values[i + 1]);

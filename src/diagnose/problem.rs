@@ -2,7 +2,9 @@
 //! at each and its covariance (from the first test's scatter), the times of
 //! the readings, and the design of one level per cell.
 
-use super::fit::Design;
+use std::sync::Arc;
+
+use super::fit::{Design, Groups};
 use super::selection::Chosen;
 use super::{DiagnoseError, DiagnoseInput};
 use crate::compensate::retest::{
@@ -47,7 +49,7 @@ pub(super) struct Problem {
     pub(super) angle_urad: Option<Vec<f64>>,
     /// The cells (target, direction) that have readings, in column order.
     pub(super) cells: Vec<(usize, Direction)>,
-    /// One column per cell: the ISO 230-2 systematic model x̄_i↑, x̄_i↓.
+    /// One level per cell: the ISO 230-2 systematic model x̄_i↑, x̄_i↓.
     pub(super) cell_design: Design,
 }
 
@@ -95,14 +97,18 @@ impl Problem {
         self.readings.iter().map(|r| r.run_index).collect()
     }
 
-    /// The contribution of a between-runs effect (drift, outlier run) to reading `i`.
-    pub(super) fn contribution(&self, chosen: &Chosen, coefficients: &[f64], i: usize) -> f64 {
-        let columns = self.columns(chosen.shape);
-        columns
-            .iter()
-            .enumerate()
-            .map(|(j, column)| column[i] * coefficients[chosen.first_column + j])
-            .sum()
+    /// What the between-runs effects (drift, outlier runs) add to each reading.
+    pub(super) fn between_runs_um(&self, chosen: &[Chosen], coefficients: &[f64]) -> Vec<f64> {
+        let mut sum = vec![0.0; self.readings.len()];
+        for c in chosen {
+            for (j, column) in self.columns(c.shape).iter().enumerate() {
+                let coefficient = coefficients[c.first_column + j];
+                for (s, v) in sum.iter_mut().zip(column) {
+                    *s += v * coefficient;
+                }
+            }
+        }
+        sum
     }
 }
 
@@ -182,11 +188,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         first_test_reversal_variance_um2,
     ) = match &first {
         Some((_, variances)) => (
-            after
-                .targets_mm()
-                .iter()
-                .map(|&x| interpolation_weights(&variances.positions_mm, x))
-                .collect(),
+            interpolation_weights(&variances.positions_mm, after.targets_mm()),
             variances.positions_mm.clone(),
             variances.mean_um2.clone(),
             variances.reversal_um2.clone(),
@@ -198,27 +200,31 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
             Vec::new(),
         ),
     };
+    // The cells in column order (target, then ↑ before ↓), and each reading's.
+    let direction_index = |d: Direction| usize::from(d != Direction::BOTH[0]);
+    let mut cell_of = vec![[None; 2]; after.targets_mm().len()];
+    for r in &readings {
+        cell_of[r.target_index][direction_index(r.direction)] = Some(0);
+    }
     let mut cells: Vec<(usize, Direction)> = Vec::new();
-    for t in 0..after.targets_mm().len() {
+    for (t, here) in cell_of.iter_mut().enumerate() {
         for direction in Direction::BOTH {
-            if readings
-                .iter()
-                .any(|r| r.target_index == t && r.direction == direction)
-            {
+            let slot = &mut here[direction_index(direction)];
+            if slot.is_some() {
+                *slot = Some(cells.len());
                 cells.push((t, direction));
             }
         }
     }
     let cell_design = Design {
-        columns: cells
-            .iter()
-            .map(|(t, d)| {
-                readings
-                    .iter()
-                    .map(|r| f64::from(u8::from(r.target_index == *t && r.direction == *d)))
-                    .collect()
-            })
-            .collect(),
+        groups: Some(Arc::new(Groups {
+            of_row: readings
+                .iter()
+                .map(|r| cell_of[r.target_index][direction_index(r.direction)].unwrap_or(0))
+                .collect(),
+            count: cells.len(),
+        })),
+        columns: Vec::new(),
     };
     let angle_urad = input.angular.map(|profile| {
         after
@@ -298,13 +304,9 @@ pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
     variances
 }
 
-/// The weights with which the prediction at `x` combines the first test's
-/// means: a row of the not-a-knot spline basis (as `KnownError::at`
-/// interpolates), as (index, weight) pairs.
-pub(super) fn interpolation_weights(positions: &[f64], x: f64) -> Vec<(usize, f64)> {
-    crate::spline::basis_matrix(positions, &[x])
-        .into_iter()
-        .enumerate()
-        .filter(|(_, w)| *w != 0.0)
-        .collect()
+/// The weights with which the prediction at each of `points` combines the
+/// first test's means: rows of the not-a-knot spline basis (as
+/// `KnownError::at` interpolates), as (index, weight) pairs.
+pub(super) fn interpolation_weights(positions: &[f64], points: &[f64]) -> Vec<Vec<(usize, f64)>> {
+    crate::spline::basis_rows(positions, points)
 }

@@ -2,6 +2,8 @@
 //! them, and the one loop that adds effects while the evidence is strong
 //! (used between runs and along the axis).
 
+use rayon::prelude::*;
+
 use super::fit::Design;
 use super::gates::{predicts_better, set_rejection, strong_evidence};
 use super::{Evidence, RejectedEffect};
@@ -61,19 +63,27 @@ pub(super) fn shapes(kind: Kind, runs: &[Run], chosen: &[Chosen]) -> Vec<Shape> 
     }
 }
 
-/// Tries every shape of the set and returns the one with the lowest score; a
-/// period of a scan is refined around the best, within its range.
-pub(super) fn best_of<T>(
+/// Tries every shape of the set and returns the one with the lowest score
+/// (the first of equal ones); a period of a scan is refined around the best,
+/// within its range. The shapes are scored in parallel (rayon), chosen in order.
+pub(super) fn best_of<T: Send>(
     set: &ShapeSet,
-    mut score: impl FnMut(Shape) -> (f64, T),
+    score: impl Fn(Shape) -> (f64, T) + Sync,
 ) -> Option<(Shape, f64, T)> {
-    let mut best: Option<(Shape, f64, T)> = None;
-    for shape in &set.shapes {
-        let (value, extra) = score(*shape);
-        if best.as_ref().is_none_or(|b| value < b.1) {
-            best = Some((*shape, value, extra));
-        }
-    }
+    let lowest = |shapes: Vec<Shape>, best: Option<(Shape, f64, T)>| {
+        let scored: Vec<(f64, T)> = shapes.par_iter().map(|s| score(*s)).collect();
+        shapes
+            .into_iter()
+            .zip(scored)
+            .fold(best, |best, (shape, (value, extra))| {
+                if best.as_ref().is_none_or(|b| value < b.1) {
+                    Some((shape, value, extra))
+                } else {
+                    best
+                }
+            })
+    };
+    let best = lowest(set.shapes.clone(), None);
     if let (
         Some((Shape::Period(period, tests), _, _)),
         Some((shortest, longest)),
@@ -82,17 +92,12 @@ pub(super) fn best_of<T>(
     {
         let step = (1.0 / b - 1.0 / a).abs();
         let (centre, tests) = (1.0 / period, *tests);
-        for k in -10..=10 {
-            let frequency = centre + f64::from(k) * step / 10.0;
-            if frequency < 1.0 / longest || frequency > 1.0 / shortest {
-                continue;
-            }
-            let shape = Shape::Period(1.0 / frequency, tests);
-            let (value, extra) = score(shape);
-            if best.as_ref().is_none_or(|b| value < b.1) {
-                best = Some((shape, value, extra));
-            }
-        }
+        let refined: Vec<Shape> = (-10..=10)
+            .map(|k| centre + f64::from(k) * step / 10.0)
+            .filter(|f| *f >= 1.0 / longest && *f <= 1.0 / shortest)
+            .map(|f| Shape::Period(1.0 / f, tests))
+            .collect();
+        return lowest(refined, best);
     }
     best
 }
@@ -102,9 +107,9 @@ pub(super) fn best_of<T>(
 /// squares and judged by its residual sum of squares (partial F); along the
 /// axis it is fitted to the per-target levels by generalised least squares
 /// with their known covariance and judged by χ².
-pub(super) trait Search {
+pub(super) trait Search: Sync {
     /// A fit of a design.
-    type Fit;
+    type Fit: Send;
 
     /// Whether to try `kind` now, given what is chosen.
     fn tries(&self, kind: Kind, chosen: &[Chosen]) -> bool;
@@ -120,6 +125,12 @@ pub(super) trait Search {
 
     /// The fit of a design.
     fn fit(&self, design: &Design) -> Self::Fit;
+
+    /// The fit of `model` with the columns `extra` added: a search may keep
+    /// its work on `model` between the candidates that extend it.
+    fn fit_extended(&self, model: &Design, extra: &[Vec<f64>]) -> Self::Fit {
+        self.fit(&model.with(extra))
+    }
 
     /// What the best shape of a kind minimises (RSS or χ²).
     fn statistic(fit: &Self::Fit) -> f64;
@@ -161,7 +172,7 @@ pub(super) fn forward_selection<S: Search>(
             }
             for set in search.shape_sets(kind, &chosen) {
                 let Some((shape, _, trial_fit)) = best_of(&set, |shape| {
-                    let f = search.fit(&model.with(&search.columns(shape)));
+                    let f = search.fit_extended(&model, &search.columns(shape));
                     (S::statistic(&f), f)
                 }) else {
                     continue;
