@@ -18,6 +18,7 @@ mod report;
 mod serve;
 mod servo_sim;
 mod synth;
+mod thermal;
 mod tolerance;
 
 use std::any::TypeId;
@@ -109,6 +110,12 @@ pub enum Command {
     /// and grid, download the table and the acceptance report. The same
     /// numbers and files as the commands; everything stays in memory.
     Serve(serve::ServeArgs),
+    /// ISO 230-3 thermal tests and a drift model from temperatures (evaluate, fit, apply).
+    ///
+    /// Reads thermal logs (CSV: time, drift, temperatures), gives the ISO
+    /// 230-3 view, fits a model of the drift from sensors through first-order
+    /// lags that a control can run, and runs a model over a log.
+    Thermal(thermal::ThermalArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -204,6 +211,7 @@ fn run(args: Args) -> Result<()> {
         Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
         Command::Report(report_args) => report::run(&report_args),
         Command::Serve(serve_args) => serve::run(&serve_args),
+        Command::Thermal(thermal_args) => thermal::run(&thermal_args),
     }
 }
 
