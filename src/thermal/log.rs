@@ -356,7 +356,7 @@ fn cell_value(
         Role::Drift(factor) => {
             let um = number(line, token, "drift")? * factor;
             if um.abs() > 1e6 {
-                return Err(line.error_at(token, format!("a drift of {um} µm is beyond ±1 m")));
+                return Err(line.error_at(token, format!("a drift of {um:.0} µm is beyond ±1 m")));
             }
             Ok(um)
         }
@@ -365,7 +365,7 @@ fn cell_value(
             if !(-100.0..=500.0).contains(&celsius) {
                 return Err(line.error_at(
                     token,
-                    format!("a temperature of {celsius} °C is outside −100…500 °C"),
+                    format!("a temperature of {celsius:.2} °C is outside −100…500 °C"),
                 ));
             }
             Ok(celsius)

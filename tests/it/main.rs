@@ -32,6 +32,7 @@ mod serve;
 mod servo;
 mod standards;
 mod survey;
+mod thermal;
 mod together;
 mod util;
 mod verdict;
