@@ -34,7 +34,7 @@ fn bench(c: &mut Criterion) {
     let axis = Axis::bundled("mcfv5050-x").unwrap();
     let cycle = full_cycle();
     let options = IsoOptions {
-        compliance_n_per_um: Some(100.0),
+        stiffness_n_per_um: Some(100.0),
         stepping: Stepping::DEFAULT,
     };
     let mut group = c.benchmark_group("iso230_2_cycle_21_targets_5_runs");

@@ -60,19 +60,25 @@ pub struct DiagnoseArgs {
     /// The axis's servo description, to read a reversal found as friction.
     ///
     /// A bundled axis (mcfv5050-x, mcfv5050-y) or an axis TOML file as
-    /// servo-sim takes it; with --compliance-n-um the reversal B found is
+    /// servo-sim takes it; with --stiffness-n-per-um the reversal B found is
     /// reported as the force F_res = −B·k_c/2 held against friction
     /// (B̄ = B̄_scale − 2·F_res/k_c), in the terminal and as "friction" in JSON.
-    #[arg(long = "servo-axis", value_name = "AXIS", requires = "compliance_n_um")]
+    #[arg(
+        long = "servo-axis",
+        value_name = "AXIS",
+        requires = "stiffness_n_per_um"
+    )]
     pub servo_axis: Option<String>,
 
     /// Structural stiffness k_c between the drive's force line and the laser, N/µm.
     #[arg(
-        long = "compliance-n-um",
+        long = "stiffness-n-per-um",
+        // The name it had before 0.2 (CHANGELOG.md).
+        alias = "compliance-n-um",
         value_name = "N_PER_UM",
         requires = "servo_axis"
     )]
-    pub compliance_n_um: Option<f64>,
+    pub stiffness_n_per_um: Option<f64>,
 
     /// Save the accepted effects (TOML) for predict --effects and convert --effects.
     #[arg(long = "write-effects", value_name = "E.toml")]
@@ -183,9 +189,9 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         args.table.as_deref().map(name),
         angle,
     );
-    if let (Some(servo_axis), Some(compliance)) = (&args.servo_axis, args.compliance_n_um) {
+    if let (Some(servo_axis), Some(compliance)) = (&args.servo_axis, args.stiffness_n_per_um) {
         if !(compliance.is_finite() && compliance > 0.0) {
-            bail!("--compliance-n-um: expected a number > 0, found {compliance}");
+            bail!("--stiffness-n-per-um: expected a number > 0, found {compliance}");
         }
         let axis = load_axis(servo_axis)?;
         report.set_friction(

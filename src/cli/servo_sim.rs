@@ -18,7 +18,7 @@ use axcomp::servo::friction::FrictionKind;
 use axcomp::servo::friction_fit::{
     axis_with_friction, identify, parse_constant_velocity, parse_following_error,
 };
-use axcomp::servo::iso_cycle::{DEFAULT_COMPLIANCE_N_PER_UM, IsoCycle, IsoOptions, run_iso_cycle};
+use axcomp::servo::iso_cycle::{DEFAULT_STIFFNESS_N_PER_UM, IsoCycle, IsoOptions, run_iso_cycle};
 use axcomp::servo::simulate::{ForceStep, Stepping};
 use axcomp::servo::trajectory::{Circle, CircleAxis, MoveLimits};
 use axcomp::units::{mm_to_m, um_to_mm};
@@ -244,8 +244,14 @@ pub struct IsoFlags {
     /// so the measured point lags the scale by F/k_c. The default (100 N/µm)
     /// is illustrative, not from the thesis. 0 means rigid: the laser reads
     /// the scale.
-    #[arg(long = "compliance-n-um", value_name = "N_PER_UM", default_value_t = DEFAULT_COMPLIANCE_N_PER_UM)]
-    pub compliance_n_um: f64,
+    // `alias`: the name it had before 0.2 (CHANGELOG.md).
+    #[arg(
+        long = "stiffness-n-per-um",
+        alias = "compliance-n-um",
+        value_name = "N_PER_UM",
+        default_value_t = DEFAULT_STIFFNESS_N_PER_UM
+    )]
+    pub stiffness_n_per_um: f64,
 }
 
 fn parse_friction(name: &str) -> Result<FrictionKind, String> {
@@ -382,9 +388,10 @@ pub fn run(args: &ServoSimArgs) -> Result<()> {
                 overrun_m: mm_to_m(args.iso.overrun_mm),
                 limits: move_limits(&args.motion, 2.0)?,
             };
-            let compliance = (args.iso.compliance_n_um != 0.0).then_some(args.iso.compliance_n_um);
+            let compliance =
+                (args.iso.stiffness_n_per_um != 0.0).then_some(args.iso.stiffness_n_per_um);
             let options = IsoOptions {
-                compliance_n_per_um: compliance,
+                stiffness_n_per_um: compliance,
                 stepping,
             };
             let result = run_iso_cycle(&axis, friction, &cycle, options, &mut report_progress)
@@ -578,7 +585,7 @@ mod tests {
             (args.iso.targets, args.iso.runs, args.iso.dwell_s),
             (21, 5, 1.0)
         );
-        assert_eq!(args.iso.compliance_n_um, 100.0);
+        assert_eq!(args.iso.stiffness_n_per_um, 100.0);
         assert!(!args.reference);
     }
 

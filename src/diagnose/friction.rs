@@ -42,7 +42,7 @@ pub struct ReversalFriction {
     /// What one position increment of the scale's own reversal would be worth, ± N.
     pub scale_part_n: f64,
     /// k_c, N/µm.
-    pub compliance_n_per_um: f64,
+    pub stiffness_n_per_um: f64,
     /// The servo description's F_C, N.
     pub axis_coulomb_n: f64,
     /// The reversal the description's F_C would give through k_c,
@@ -58,7 +58,7 @@ pub struct ReversalFriction {
 pub fn friction_behind_reversal(
     diagnosis: &Diagnosis,
     axis: &Axis,
-    compliance_n_per_um: f64,
+    stiffness_n_per_um: f64,
 ) -> Option<ReversalFriction> {
     let accepted = diagnosis
         .accepted
@@ -77,7 +77,7 @@ pub fn friction_behind_reversal(
         .find(|(key, _)| *key == "B_um")
         .map_or(0.0, |(_, u)| *u);
     // B = −2·F/k_c: the force is the inverse of the (negative) reversal.
-    let friction_n = friction_from_reversal_n(-reversal.b_um, compliance_n_per_um);
+    let friction_n = friction_from_reversal_n(-reversal.b_um, stiffness_n_per_um);
     let increment_um = m_to_um(axis.position_loop.increment_m);
     let axis_coulomb_n = axis.friction.coulomb_n;
     Some(ReversalFriction {
@@ -85,11 +85,11 @@ pub fn friction_behind_reversal(
         reversal_uncertainty_um: uncertainty_um,
         change_since_first_test: change,
         friction_n,
-        friction_uncertainty_n: friction_from_reversal_n(uncertainty_um, compliance_n_per_um),
-        scale_part_n: friction_from_reversal_n(increment_um, compliance_n_per_um),
-        compliance_n_per_um,
+        friction_uncertainty_n: friction_from_reversal_n(uncertainty_um, stiffness_n_per_um),
+        scale_part_n: friction_from_reversal_n(increment_um, stiffness_n_per_um),
+        stiffness_n_per_um,
         axis_coulomb_n,
-        expected_reversal_um: -reversal_from_friction_um(axis_coulomb_n, compliance_n_per_um),
+        expected_reversal_um: -reversal_from_friction_um(axis_coulomb_n, stiffness_n_per_um),
         start_coulomb_n: if change {
             (axis_coulomb_n + friction_n).max(0.0)
         } else {

@@ -25,7 +25,7 @@
 //!   "friction": {"servo_axis": "mcfv5050-x", "B_um": -3.3, "B_uncertainty_um": 0.1,
 //!                "change_since_first_test": false, "friction_n": 165.0,
 //!                "friction_uncertainty_n": 5.0, "scale_part_n": 50.0,
-//!                "compliance_n_per_um": 100.0, "axis_coulomb_n": 90.0, "expected_reversal_um": -1.8,
+//!                "stiffness_n_per_um": 100.0, "axis_coulomb_n": 90.0, "expected_reversal_um": -1.8,
 //!                "start_coulomb_n": 165.0, "servo_sim": "axcomp servo-sim …"} }
 //!                                            (only with --servo-axis and a reversal found)
 //! ```
@@ -349,6 +349,9 @@ pub struct FrictionJson {
     /// ± N that one position increment of the scale's own reversal is worth.
     pub scale_part_n: f64,
     /// k_c, N/µm.
+    pub stiffness_n_per_um: f64,
+    /// The same k_c under the key it had before 0.2 (a stiffness, misnamed;
+    /// CHANGELOG.md), kept for scripts that read it.
     pub compliance_n_per_um: f64,
     /// The description's F_C, N.
     pub axis_coulomb_n: f64,
@@ -371,13 +374,14 @@ impl FrictionJson {
             friction_n: f.friction_n,
             friction_uncertainty_n: f.friction_uncertainty_n,
             scale_part_n: f.scale_part_n,
-            compliance_n_per_um: f.compliance_n_per_um,
+            stiffness_n_per_um: f.stiffness_n_per_um,
+            compliance_n_per_um: f.stiffness_n_per_um,
             axis_coulomb_n: f.axis_coulomb_n,
             expected_reversal_um: f.expected_reversal_um,
             start_coulomb_n: f.start_coulomb_n,
             servo_sim: format!(
-                "axcomp servo-sim --axis {servo_axis} --friction lugre --test iso230-2 --coulomb-n {:.1} --compliance-n-um {}",
-                f.start_coulomb_n, f.compliance_n_per_um
+                "axcomp servo-sim --axis {servo_axis} --friction lugre --test iso230-2 --coulomb-n {:.1} --stiffness-n-per-um {}",
+                f.start_coulomb_n, f.stiffness_n_per_um
             ),
         }
     }
@@ -398,7 +402,7 @@ impl FrictionJson {
         vec![
             format!(
                 "friction: B̄ = B̄_scale − 2·F_res/k_c with k_c = {} N/µm ({}): {what}, ±{:.1} N more from the scale's own part (one position increment); the F_C of {} ({:.1} N) would give B = {:.2} µm",
-                self.compliance_n_per_um,
+                self.stiffness_n_per_um,
                 self.servo_axis,
                 self.scale_part_n,
                 self.servo_axis,

@@ -19,7 +19,7 @@
 //!   "constant_velocity": {"feed_m_min": …, "mean_current_a": …, "mean_friction_n": …,
 //!                         "steady_friction_n": …, "mean_following_error_um": …},
 //!   "iso230_2": {"targets_mm": […], "runs": 5, "dwell_s": 1, "overrun_mm": 5, "feed_m_min": 2,
-//!                "compliance_n_per_um": 100 | null,
+//!                "stiffness_n_per_um": 100 | null,
 //!                "figures_um": {"A", "A_up", …, "B", "B_mean"},   (as in `evaluate --json`)
 //!                "residual_friction_n": {"up": 89.7, "down": -89.7},
 //!                "reversal_from_friction_um": 1.79,
@@ -178,6 +178,9 @@ pub struct IsoJson {
     /// Feed, m/min.
     pub feed_m_min: f64,
     /// k_c, N/µm; null for a rigid path.
+    pub stiffness_n_per_um: Option<f64>,
+    /// The same k_c under the key it had before 0.2 (a stiffness, misnamed;
+    /// CHANGELOG.md), kept for scripts that read it.
     pub compliance_n_per_um: Option<f64>,
     /// The ISO 230-2 figures of the readings, µm.
     pub figures_um: FiguresJson,
@@ -285,7 +288,7 @@ impl ConstantVelocityJson {
 
 impl IsoJson {
     /// From a simulated cycle.
-    pub fn new(cycle: &IsoCycle, compliance_n_per_um: Option<f64>, result: &IsoResult) -> IsoJson {
+    pub fn new(cycle: &IsoCycle, stiffness_n_per_um: Option<f64>, result: &IsoResult) -> IsoJson {
         let residual = result.residual_friction();
         IsoJson {
             targets_mm: cycle.targets_m.iter().map(|m| m_to_mm(*m)).collect(),
@@ -293,13 +296,14 @@ impl IsoJson {
             dwell_s: cycle.dwell_s,
             overrun_mm: m_to_mm(cycle.overrun_m),
             feed_m_min: cycle.limits.feed_m_per_s * 60.0,
-            compliance_n_per_um,
+            stiffness_n_per_um,
+            compliance_n_per_um: stiffness_n_per_um,
             figures_um: FiguresJson::from_figures(&result.evaluation.figures),
             residual_friction_n: ResidualJson {
                 up: residual.up_n,
                 down: residual.down_n,
             },
-            reversal_from_friction_um: compliance_n_per_um.map(|k| residual.reversal_um(k)),
+            reversal_from_friction_um: stiffness_n_per_um.map(|k| residual.reversal_um(k)),
             readings: result
                 .readings
                 .iter()
@@ -380,7 +384,7 @@ pub fn text(report: &ServoSimJson) -> String {
 
 fn iso_text(out: &mut String, iso: &IsoJson) {
     let compliance = iso
-        .compliance_n_per_um
+        .stiffness_n_per_um
         .map_or("rigid (laser reads the scale)".to_string(), |k| {
             format!("{k} N/µm")
         });

@@ -23,7 +23,7 @@
 //! structural mode, √(k_c/m) ≈ 670 rad/s for k_c = 100 N/µm and 225 kg, is
 //! well above the velocity loop's bandwidth (≈ 40 Hz); readings after a
 //! dwell do not depend on it. The thesis gives no such compliance (notes
-//! §6.2): [`DEFAULT_COMPLIANCE_N_PER_UM`] is illustrative. With `None` the
+//! §6.2): [`DEFAULT_STIFFNESS_N_PER_UM`] is illustrative. With `None` the
 //! laser reads the scale position.
 //!
 //! The readings make a [`Measurement`] (mm, as everywhere in axcomp), so
@@ -42,7 +42,7 @@ use crate::units::m_to_mm;
 /// The structural stiffness between the motor's force line and the measured
 /// point used when none is given, N/µm: illustrative (notes §6.2's example),
 /// a plausible order for a machine-tool table; not from the thesis.
-pub const DEFAULT_COMPLIANCE_N_PER_UM: f64 = 100.0;
+pub const DEFAULT_STIFFNESS_N_PER_UM: f64 = 100.0;
 
 /// The test.
 #[derive(Clone, Debug, PartialEq)]
@@ -63,7 +63,7 @@ pub struct IsoCycle {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IsoOptions {
     /// k_c, N/µm; `None` for a rigid path (the laser reads the scale).
-    pub compliance_n_per_um: Option<f64>,
+    pub stiffness_n_per_um: Option<f64>,
     /// How time is stepped.
     pub stepping: Stepping,
 }
@@ -228,7 +228,7 @@ impl IsoCycle {
 ///     overrun_m: 0.002,
 ///     limits: MoveLimits { feed_m_per_s: 0.05, acceleration_m_per_s2: 1.0, jerk_m_per_s3: 20.0 },
 /// };
-/// let options = IsoOptions { compliance_n_per_um: Some(100.0), stepping: Stepping::DEFAULT };
+/// let options = IsoOptions { stiffness_n_per_um: Some(100.0), stepping: Stepping::DEFAULT };
 /// let result = run_iso_cycle(&axis, axis.friction(FrictionKind::Classic), &cycle, options, &mut |_| {})
 ///     .unwrap();
 /// // Classic friction holds about F_C = 90 N after each approach: B ≈ 2·90/100 = 1.8 µm.
@@ -243,7 +243,7 @@ pub fn run_iso_cycle(
     progress: &mut dyn FnMut(f64),
 ) -> Result<IsoResult, ServoError> {
     cycle.check()?;
-    if let Some(k) = options.compliance_n_per_um
+    if let Some(k) = options.stiffness_n_per_um
         && !(k.is_finite() && k > 0.0)
     {
         return Err(ServoError::Invalid(
@@ -255,7 +255,7 @@ pub fn run_iso_cycle(
         Trajectory::Profile(profile) => profile.end_s(),
         _ => 0.0,
     };
-    let compliance_m_per_n = options.compliance_n_per_um.map_or(0.0, |k| 1.0 / (k * 1e6));
+    let compliance_m_per_n = options.stiffness_n_per_um.map_or(0.0, |k| 1.0 / (k * 1e6));
     let mut simulator = Simulator::new(axis, friction, &trajectory, options.stepping, None);
     let macro_s = simulator.macro_step_s();
     let mut readings = Vec::with_capacity(plan.len());

@@ -16,10 +16,12 @@
 //! `[[A, B, 0, 0, 0], [0, 0, I, 0, 0], [0, 0, 0, I, 0], [0, 0, 0, 0, I], [0; 5]]`
 //! (Van Loan's construction; the augmented state carries u and its first three
 //! derivatives). The exponential is taken once per step length when a
-//! simulation starts, by scaling and squaring a Taylor series; it is not in
-//! the inner loop.
+//! simulation starts, by nalgebra's `exp` (scaling and squaring with a Padé
+//! approximant, Higham 2005); it is not in the inner loop.
 //!
 //! This module knows nothing about friction or control; `simulate` does.
+
+use nalgebra::SMatrix;
 
 /// States of the axis: position, velocity, current, velocity-PI state, current-PI state.
 pub const N_STATES: usize = 5;
@@ -28,114 +30,10 @@ pub const N_INPUTS: usize = 4;
 /// Polynomial degree of the inputs within one step, plus one.
 pub const N_COEFFS: usize = 4;
 
-/// A small dense square matrix, row-major; only used when a simulation is set up.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Dense {
-    n: usize,
-    values: Vec<f64>,
-}
-
-impl Dense {
-    /// The n × n zero matrix.
-    pub fn zeros(n: usize) -> Dense {
-        Dense {
-            n,
-            values: vec![0.0; n * n],
-        }
-    }
-
-    /// The n × n identity.
-    pub fn identity(n: usize) -> Dense {
-        let mut m = Dense::zeros(n);
-        for i in 0..n {
-            m.set(i, i, 1.0);
-        }
-        m
-    }
-
-    /// Size n.
-    pub fn size(&self) -> usize {
-        self.n
-    }
-
-    /// Entry (row, column).
-    pub fn get(&self, row: usize, column: usize) -> f64 {
-        self.values[row * self.n + column]
-    }
-
-    /// Sets entry (row, column).
-    pub fn set(&mut self, row: usize, column: usize, value: f64) {
-        self.values[row * self.n + column] = value;
-    }
-
-    fn scaled(&self, factor: f64) -> Dense {
-        Dense {
-            n: self.n,
-            values: self.values.iter().map(|v| v * factor).collect(),
-        }
-    }
-
-    fn add(&self, other: &Dense) -> Dense {
-        Dense {
-            n: self.n,
-            values: self
-                .values
-                .iter()
-                .zip(&other.values)
-                .map(|(a, b)| a + b)
-                .collect(),
-        }
-    }
-
-    fn mul(&self, other: &Dense) -> Dense {
-        let n = self.n;
-        let mut out = Dense::zeros(n);
-        for i in 0..n {
-            for k in 0..n {
-                let a = self.values[i * n + k];
-                if a == 0.0 {
-                    continue;
-                }
-                for j in 0..n {
-                    out.values[i * n + j] += a * other.values[k * n + j];
-                }
-            }
-        }
-        out
-    }
-
-    /// Largest absolute row sum (the ∞-norm).
-    fn norm_inf(&self) -> f64 {
-        (0..self.n)
-            .map(|i| (0..self.n).map(|j| self.get(i, j).abs()).sum::<f64>())
-            .fold(0.0, f64::max)
-    }
-
-    /// The matrix exponential e^M, by scaling and squaring a Taylor series.
-    ///
-    /// M is scaled by 2^-s until its norm is below 1/2, where 24 Taylor terms
-    /// leave a truncation error below 1e-30 relative; the result is squared s
-    /// times (Moler and Van Loan, "Nineteen dubious ways…", 2003, method 3).
-    pub fn exp(&self) -> Dense {
-        let norm = self.norm_inf();
-        let squarings = if norm > 0.5 {
-            (norm / 0.5).log2().ceil() as i32
-        } else {
-            0
-        };
-        let scaled = self.scaled(0.5f64.powi(squarings));
-        let mut sum = Dense::identity(self.n);
-        let mut term = Dense::identity(self.n);
-        for k in 1..=24 {
-            term = term.mul(&scaled).scaled(1.0 / f64::from(k));
-            sum = sum.add(&term);
-        }
-        for _ in 0..squarings {
-            sum = sum.mul(&sum);
-        }
-        sum
-    }
-}
+/// The augmented matrix of Van Loan's construction: the states, then the
+/// inputs' polynomial coefficients.
+type Augmented =
+    SMatrix<f64, { N_STATES + N_INPUTS * N_COEFFS }, { N_STATES + N_INPUTS * N_COEFFS }>;
 
 /// The linear system `s' = A s + B u`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -160,24 +58,22 @@ pub struct StepMap {
 impl LinearSystem {
     /// The exact map over a step of `h_s` seconds for inputs that are cubic in τ.
     pub fn step_map(&self, h_s: f64) -> StepMap {
-        let size = N_STATES + N_INPUTS * N_COEFFS;
-        let mut m = Dense::zeros(size);
+        let mut m = Augmented::zeros();
         for i in 0..N_STATES {
             for j in 0..N_STATES {
-                m.set(i, j, self.a[i][j] * h_s);
+                m[(i, j)] = self.a[i][j] * h_s;
             }
             for j in 0..N_INPUTS {
-                m.set(i, N_STATES + j, self.b[i][j] * h_s);
+                m[(i, N_STATES + j)] = self.b[i][j] * h_s;
             }
         }
         // The input chain: d/dτ of coefficient block k is block k + 1.
         for k in 0..N_COEFFS - 1 {
             for j in 0..N_INPUTS {
-                m.set(
+                m[(
                     N_STATES + k * N_INPUTS + j,
                     N_STATES + (k + 1) * N_INPUTS + j,
-                    h_s,
-                );
+                )] = h_s;
             }
         }
         // Time is scaled by h (σ = τ/h), so every block carries one factor h
@@ -190,11 +86,11 @@ impl LinearSystem {
         };
         for i in 0..N_STATES {
             for j in 0..N_STATES {
-                map.phi[i][j] = e.get(i, j);
+                map.phi[i][j] = e[(i, j)];
             }
             for k in 0..N_COEFFS {
                 for j in 0..N_INPUTS {
-                    map.gamma[i][j * N_COEFFS + k] = e.get(i, N_STATES + k * N_INPUTS + j);
+                    map.gamma[i][j * N_COEFFS + k] = e[(i, N_STATES + k * N_INPUTS + j)];
                 }
             }
         }
@@ -272,14 +168,12 @@ mod tests {
     #[test]
     fn exponential_of_a_rotation_is_cos_and_sin() {
         // e^{[[0, −θ], [θ, 0]]} = [[cos θ, −sin θ], [sin θ, cos θ]] (closed form).
-        let theta = 7.3;
-        let mut m = Dense::zeros(2);
-        m.set(0, 1, -theta);
-        m.set(1, 0, theta);
+        let theta: f64 = 7.3;
+        let m = nalgebra::Matrix2::new(0.0, -theta, theta, 0.0);
         let e = m.exp();
-        assert!((e.get(0, 0) - theta.cos()).abs() < 1e-13);
-        assert!((e.get(1, 0) - theta.sin()).abs() < 1e-13);
-        assert!((e.get(0, 1) + theta.sin()).abs() < 1e-13);
+        assert!((e[(0, 0)] - theta.cos()).abs() < 1e-13);
+        assert!((e[(1, 0)] - theta.sin()).abs() < 1e-13);
+        assert!((e[(0, 1)] + theta.sin()).abs() < 1e-13);
     }
 
     #[test]

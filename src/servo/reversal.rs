@@ -34,8 +34,8 @@
 /// // 90 N held against a 100 N/µm structure: 1.8 µm.
 /// assert!((reversal_from_friction_um(90.0, 100.0) - 1.8).abs() < 1e-12);
 /// ```
-pub fn reversal_from_friction_um(residual_force_n: f64, compliance_stiffness_n_per_um: f64) -> f64 {
-    2.0 * residual_force_n / compliance_stiffness_n_per_um
+pub fn reversal_from_friction_um(residual_force_n: f64, stiffness_n_per_um: f64) -> f64 {
+    2.0 * residual_force_n / stiffness_n_per_um
 }
 
 /// The inverse: F_res ≈ B·k_c/2, N, for a reversal in µm and a stiffness in N/µm.
@@ -47,17 +47,17 @@ pub fn reversal_from_friction_um(residual_force_n: f64, compliance_stiffness_n_p
 /// let force = 37.0;
 /// assert!((friction_from_reversal_n(reversal_from_friction_um(force, 40.0), 40.0) - force).abs() < 1e-12);
 /// ```
-pub fn friction_from_reversal_n(reversal_um: f64, compliance_stiffness_n_per_um: f64) -> f64 {
-    reversal_um * compliance_stiffness_n_per_um / 2.0
+pub fn friction_from_reversal_n(reversal_um: f64, stiffness_n_per_um: f64) -> f64 {
+    reversal_um * stiffness_n_per_um / 2.0
 }
 
 /// The stiffness that turns a residual force into a reversal: k_c ≈ 2·F_res/B, N/µm.
 ///
 /// # Example
 /// ```
-/// use axcomp::servo::reversal::compliance_from_reversal_n_per_um;
-/// assert!((compliance_from_reversal_n_per_um(1.8, 90.0) - 100.0).abs() < 1e-12);
+/// use axcomp::servo::reversal::stiffness_from_reversal_n_per_um;
+/// assert!((stiffness_from_reversal_n_per_um(1.8, 90.0) - 100.0).abs() < 1e-12);
 /// ```
-pub fn compliance_from_reversal_n_per_um(reversal_um: f64, residual_force_n: f64) -> f64 {
+pub fn stiffness_from_reversal_n_per_um(reversal_um: f64, residual_force_n: f64) -> f64 {
     2.0 * residual_force_n / reversal_um
 }

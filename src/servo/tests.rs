@@ -182,7 +182,7 @@ fn adaptive_matches_uniform(kind: FrictionKind) {
     let cycle = short_cycle();
     let run = |stepping| {
         let options = IsoOptions {
-            compliance_n_per_um: Some(100.0),
+            stiffness_n_per_um: Some(100.0),
             stepping,
         };
         run_iso_cycle(&axis, axis.friction(kind), &cycle, options, &mut |_| {}).unwrap()
@@ -237,7 +237,7 @@ fn iso_reversal_is_the_held_friction_through_the_compliance() {
     let cycle = short_cycle();
     let run = |kind, k| {
         let options = IsoOptions {
-            compliance_n_per_um: k,
+            stiffness_n_per_um: k,
             stepping: Stepping::DEFAULT,
         };
         run_iso_cycle(&axis, axis.friction(kind), &cycle, options, &mut |_| {}).unwrap()

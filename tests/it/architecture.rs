@@ -9,7 +9,7 @@
 //!   circle (a parent `mod.rs` and its own children are one unit: Rust's
 //!   `pub use` of a child and a child's `use super::Type` are not a circle).
 //!
-//! Test code is exempt (`tests.rs` files and what follows `#[cfg(test)]`),
+//! Test code is exempt (`tests.rs` files and each item under `#[cfg(test)]`),
 //! and so are comments. The checker works on text in memory, so the tests
 //! below also show that it fails on an upward import and on a pair of files
 //! that import each other.
@@ -68,22 +68,63 @@ fn module_path(relative: &Path) -> ModulePath {
     parts
 }
 
-/// The code of a file without comments and without its tests.
+/// The code of a file without comments and without its tests: the item
+/// after each `#[cfg(test)]` (a `mod tests;` line, or an item up to the `}`
+/// that closes it) is left out, and reading goes on after it.
 fn code_of(text: &str) -> String {
     let mut code = String::new();
+    let mut test_item: Option<TestItem> = None;
     for line in text.lines() {
         let trimmed = line.trim_start();
-        if trimmed.starts_with("#[cfg(test)]") {
-            break;
-        }
         if trimmed.starts_with("//") {
             continue;
         }
         let line = line.split(" //").next().unwrap_or_default();
+        if let Some(item) = &mut test_item {
+            if item.ends_with(line) {
+                test_item = None;
+            }
+            continue;
+        }
+        if trimmed.starts_with("#[cfg(test)]") {
+            test_item = Some(TestItem::default());
+            continue;
+        }
         code.push_str(line);
         code.push('\n');
     }
     code
+}
+
+/// Where a `#[cfg(test)]` item ends: its braces balanced once opened, or a
+/// `;` before any brace (`mod tests;`, `use …;`). Braces in strings are
+/// counted too, which test code rarely has unbalanced.
+#[derive(Default)]
+struct TestItem {
+    depth: usize,
+    opened: bool,
+}
+
+impl TestItem {
+    /// Takes the next line of the item; true when the item ends on it.
+    fn ends_with(&mut self, line: &str) -> bool {
+        let trimmed = line.trim_start();
+        if !self.opened && trimmed.starts_with("#[") {
+            return false;
+        }
+        for c in line.chars() {
+            match c {
+                '{' => {
+                    self.depth += 1;
+                    self.opened = true;
+                }
+                '}' => self.depth = self.depth.saturating_sub(1),
+                ';' if !self.opened => return true,
+                _ => {}
+            }
+        }
+        self.opened && self.depth == 0
+    }
 }
 
 /// Every path the code names from `crate::`, `super::` or `self::`, as
@@ -435,5 +476,25 @@ fn a_stage_missing_from_the_layers_is_named() {
     assert_eq!(
         violations(&layers(), &files),
         ["src/servo/mod.rs: stage `servo` is on no layer of ARCHITECTURE.md"]
+    );
+}
+
+/// Code after a `#[cfg(test)]` item is read again: an upward import below a
+/// test-only function (as `evaluate/mod.rs` has one in its `impl`) or below
+/// a `mod tests;` line is caught.
+#[test]
+fn code_after_a_test_item_is_read() {
+    let files = tree(&[
+        (
+            "units.rs",
+            "pub struct Mm;\nimpl Mm {\n    #[cfg(test)]\n    pub(crate) fn of(\n        a: f64,\n    ) -> Mm {\n        if a > 0.0 { Mm } else { Mm }\n    }\n}\n#[cfg(test)]\nmod tests;\nuse crate::diagnose::Effect;",
+        ),
+        ("diagnose/mod.rs", "pub struct Effect;"),
+    ]);
+    assert_eq!(
+        violations(&layers(), &files),
+        [
+            "src/units.rs: `units` (layer 0) imports crate::diagnose::Effect (layer 2): a dependency that does not point down"
+        ]
     );
 }

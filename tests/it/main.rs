@@ -1,4 +1,8 @@
-//! axcomp integration tests: one binary (see Cargo.toml `autotests = false`).
+//! axcomp integration tests that need only Rust (`cargo test`): the CLI
+//! through the binary, the web app over HTTP on the loopback, the library's
+//! stages end to end. One binary (see Cargo.toml `autotests = false`). The
+//! tests that need LinuxCNC, Chromium or Wine are the `system` target
+//! (tests/system/), which `scripts/test` runs too.
 //!
 //! Real third-party data is read by path from `../shared/data` (never copied
 //! into the repository); small inputs and expected outputs live in `tests/data`.
@@ -7,7 +11,6 @@ mod architecture;
 mod axis_identity;
 mod backlash;
 mod bad_input;
-mod browser;
 mod cli;
 mod close_loop;
 mod conformance;
@@ -21,14 +24,17 @@ mod fagor;
 mod flags;
 mod http;
 mod injected;
-mod linuxcnc;
 mod model;
 mod outputs;
+mod page;
+mod pixels;
 mod predict;
 mod read_api_pos;
 mod report;
+mod retest_case;
 mod rotary;
 mod serve;
+mod server;
 mod servo;
 mod standards;
 mod survey;
@@ -36,4 +42,3 @@ mod thermal;
 mod together;
 mod util;
 mod verdict;
-mod windows;

@@ -1,94 +1,17 @@
 //! `axcomp serve`, the local web app: its API answers with what the CLI
 //! prints and writes (the same JSON, the same bytes), refuses what it must
 //! (other origins, other host names, oversized uploads, bad files with the
-//! CLI's `file:line:col` message), and the page works in a real headless
-//! browser (upload, change the controller, download, see an error), with a
-//! screenshot of each step.
+//! CLI's `file:line:col` message). The page in a real headless browser is
+//! the `system` target's (tests/system/web_page.rs).
 //!
 //! Every test starts its own server on a free port (`--port 0`), so they run
 //! in parallel.
 
-use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 
-use crate::browser::{Pixels, WebDriver, artefacts};
 use crate::http::{Form, Response, request};
+use crate::server::{Server, cli_in, read, sample};
 use crate::util::{root, without_time};
-
-/// A running `axcomp serve --port 0 --no-open`, stopped when dropped.
-struct Server {
-    child: Child,
-    /// `127.0.0.1:PORT`.
-    host: String,
-}
-
-impl Server {
-    fn start() -> Server {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_axcomp"))
-            .args(["serve", "--port", "0", "--no-open"])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("start axcomp serve");
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap())
-            .read_line(&mut line)
-            .unwrap();
-        // "axcomp serve: http://127.0.0.1:PORT/ (Ctrl-C stops it)"
-        let host = line
-            .split("http://")
-            .nth(1)
-            .and_then(|rest| rest.split('/').next())
-            .unwrap_or_else(|| panic!("no address in {line:?}"))
-            .to_string();
-        assert!(host.starts_with("127.0.0.1:"), "{line}");
-        Server { child, host }
-    }
-
-    fn url(&self) -> String {
-        format!("http://{}/", self.host)
-    }
-
-    /// A POST of `form` to `path` with extra `headers`.
-    fn post(&self, path: &str, form: Form, headers: &[(&str, &str)]) -> Response {
-        let (content_type, body) = form.finish();
-        let mut all = vec![("Content-Type", content_type.as_str())];
-        all.extend_from_slice(headers);
-        request(&self.host, "POST", path, &all, body)
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn sample() -> PathBuf {
-    root().join("fixtures/sample-x.rtl")
-}
-
-fn read(path: &Path) -> Vec<u8> {
-    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-/// Runs the CLI in `dir` (so that a file named by its base name is shown
-/// as the app shows an upload) and returns its stdout.
-fn cli_in(dir: &Path, args: &[&str]) -> Vec<u8> {
-    let output = Command::new(env!("CARGO_BIN_EXE_axcomp"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "axcomp {args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    output.stdout
-}
 
 #[test]
 fn evaluate_answers_with_the_json_evaluate_prints() {
@@ -434,144 +357,6 @@ fn the_page_loads_nothing_from_elsewhere() {
             assert!(!text.contains(outside), "{path} has {outside}");
         }
     }
-}
-
-/// A screenshot of the page with something on it: at least `inked` of it
-/// not white (the start page is about 0.015), and in `expect_blue` steps
-/// the deviation plot's blue ↑ runs and bands (the start page's blue drop
-/// zone alone is about 0.002).
-fn check_screenshot(browser: &WebDriver, name: &str, inked: f64, expect_blue: bool) -> PathBuf {
-    let path = artefacts().join(format!("serve-{name}.png"));
-    browser.screenshot(&path);
-    let pixels = Pixels::read(&path);
-    // The window less the browser's own bars.
-    assert!(
-        pixels.size.0 == 1200 && pixels.size.1 > 1000,
-        "{name}: {:?}",
-        pixels.size
-    );
-    eprintln!(
-        "{name}: {:.4} inked, {:.4} blue",
-        pixels.inked(),
-        pixels.blue()
-    );
-    assert!(
-        pixels.inked() > inked,
-        "{name}: {:.3} inked",
-        pixels.inked()
-    );
-    if expect_blue {
-        assert!(pixels.blue() > 0.004, "{name}: {:.4} blue", pixels.blue());
-    }
-    path
-}
-
-/// The engineer's steps in a real browser: open the page, pick the sample,
-/// change the controller, download the table (equal to the CLI's), then
-/// pick a malformed file and read the error.
-#[test]
-fn the_page_works_in_a_real_browser() {
-    let server = Server::start();
-    let browser = WebDriver::start((1200, 1400));
-    browser.goto(&server.url());
-    browser.wait_for(
-        "return document.body.dataset.ready === 'yes'",
-        "the page to load",
-    );
-    // The start page is mostly white: a heading, the drop zone, the settings.
-    check_screenshot(&browser, "1-start", 0.01, false);
-
-    let input = browser.find("#file");
-    browser.send_keys(&input, &sample().display().to_string());
-    browser.wait_for(
-        "return document.body.dataset.converted === 'tnc640:X.COM' && document.body.dataset.busy === '0'",
-        "the sample's figures and table",
-    );
-    let figures = browser.execute("return document.getElementById('figures').innerText");
-    assert!(figures.as_str().unwrap().contains("13.19"), "{figures}");
-    // The plot at the bottom of the window, the figures above it.
-    browser.execute("document.getElementById('deviation').scrollIntoView(false); return true");
-    check_screenshot(&browser, "2-evaluated", 0.05, true);
-    // The Edlén check as evaluate --json has it: −0.01 ppm at the start.
-    let edlen = browser.execute("return document.getElementById('edlen').innerText");
-    assert!(edlen.as_str().unwrap().contains("-0.01 ✓"), "{edlen}");
-
-    // A limit of 12 µm on A (the sample's A is 13.19 µm): FAIL, as
-    // `evaluate --limit A=12` says.
-    browser.click(&browser.find("#limit-A"));
-    browser.send_keys(&browser.find("#limit-A"), "12\u{E007}");
-    browser.wait_for(
-        "return document.body.dataset.verdict === 'fail' && document.body.dataset.busy === '0'",
-        "the verdict on A = 12 µm",
-    );
-    let verdict = browser.execute("return document.getElementById('verdict').innerText");
-    assert_eq!(
-        verdict.as_str().unwrap(),
-        "FAIL (simple acceptance): A not within the limits"
-    );
-    let checks = browser.execute("return document.getElementById('checks').innerText");
-    assert!(
-        checks
-            .as_str()
-            .unwrap()
-            .starts_with("A 13.19 µm against 12.00 µm"),
-        "{checks}"
-    );
-    browser.execute("document.getElementById('figures').scrollIntoView(); return true");
-    check_screenshot(&browser, "2b-verdict", 0.02, false);
-
-    browser.click(&browser.find("#controller option[value='linuxcnc']"));
-    browser.click(&browser.find("#step"));
-    browser.send_keys(&browser.find("#step"), "50\u{E007}");
-    browser.wait_for(
-        "return document.body.dataset.converted === 'linuxcnc:x.comp' && document.body.dataset.busy === '0' \
-         && /^50(\\.0+)? /m.test(document.getElementById('preview').textContent)",
-        "the LinuxCNC table on a 50 mm step",
-    );
-    browser.execute("document.getElementById('step-table').scrollIntoView(); return true");
-    // The table's plot is black and grey: ink, not blue.
-    check_screenshot(&browser, "3-linuxcnc", 0.05, false);
-
-    browser.click(&browser.find("#download"));
-    let downloaded = browser.downloaded("x.comp");
-    let work = tempfile::tempdir().unwrap();
-    let cli_table = work.path().join("x.comp");
-    cli_in(
-        &root(),
-        &[
-            "convert",
-            &sample().display().to_string(),
-            "--controller",
-            "linuxcnc",
-            "--step",
-            "50",
-            "-o",
-            &cli_table.display().to_string(),
-        ],
-    );
-    assert_eq!(downloaded, read(&cli_table));
-
-    let bad = root().join("tests/data/bad/junk-in-text.rtl");
-    // A file input keeps what it was given: empty it, as a new pick does.
-    browser
-        .execute("document.getElementById('file').value = ''; window.scrollTo(0, 0); return true");
-    browser.send_keys(&browser.find("#file"), &bad.display().to_string());
-    browser.wait_for(
-        "return !document.getElementById('error').hidden && document.body.dataset.busy === '0'",
-        "the error of the malformed file",
-    );
-    let error = browser.execute("return document.getElementById('error').innerText");
-    assert!(
-        error
-            .as_str()
-            .unwrap()
-            .starts_with("junk-in-text.rtl:23:10: expected text"),
-        "{error}"
-    );
-    let shot = check_screenshot(&browser, "4-error", 0.01, false);
-    // The error box's red is on the page.
-    let red = Pixels::read(&shot).fraction(|r, g, b| r > 150 && g < 60 && b < 60);
-    assert!(red > 0.0005, "{red:.4} red");
 }
 
 /// A machine profile with acceptance limits and a screw lead for X.

@@ -387,7 +387,7 @@ mod identify_cli {
             &path("after.rtl"),
             "-q",
         ]);
-        let servo = ["--servo-axis", "mcfv5050-x", "--compliance-n-um", "100"];
+        let servo = ["--servo-axis", "mcfv5050-x", "--stiffness-n-per-um", "100"];
         let (after, before, table) = (path("after.rtl"), path("before.rtl"), path("X.COM"));
         let mut args = vec!["diagnose", "--after", &after];
         args.extend(["--before", &before, "--table", &table, "--json"]);
@@ -401,6 +401,18 @@ mod identify_cli {
         assert_eq!(friction["scale_part_n"].as_f64().unwrap(), 50.0);
         // The start value: the description's 90 N plus the change.
         assert!((friction["start_coulomb_n"].as_f64().unwrap() - (90.0 + force)).abs() < 1e-9);
+        // k_c is a stiffness, under its own key; the key and the flag it had
+        // before 0.2 still work (CHANGELOG.md).
+        assert_eq!(friction["stiffness_n_per_um"].as_f64(), Some(100.0));
+        assert_eq!(friction["compliance_n_per_um"].as_f64(), Some(100.0));
+        let mut old_flag = args.clone();
+        let at = old_flag
+            .iter()
+            .position(|a| *a == "--stiffness-n-per-um")
+            .unwrap();
+        old_flag[at] = "--compliance-n-um";
+        let old: Value = serde_json::from_str(&ok(&old_flag)).unwrap();
+        assert_eq!(old["friction"], json["friction"]);
 
         let text = ok(&[
             "diagnose",
@@ -408,7 +420,7 @@ mod identify_cli {
             &after,
             "--servo-axis",
             "mcfv5050-x",
-            "--compliance-n-um",
+            "--stiffness-n-per-um",
             "100",
         ]);
         assert!(

@@ -308,10 +308,9 @@ fn predict_diagnose_and_report_give_the_standards_figures_of_one_prediction() {
 /// The report names the chosen standard with its coverage, shows VDI's own
 /// table and says the definitions are reconstructed; every number it shows
 /// is the one in its embedded JSON (the ISO table of a VDI report under
-/// `figures_iso230_2_um`), and the page renders in Chromium.
+/// `figures_iso230_2_um`); the `system` target renders it in Chromium.
 #[test]
 fn the_report_names_the_chosen_standard() {
-    use crate::browser::{BrowserOutput, Pixels, artefacts, open_in_browser};
     use crate::report::{check_against_json, embedded_data};
 
     let directory = tempfile::tempdir().unwrap();
@@ -365,13 +364,5 @@ fn the_report_names_the_chosen_standard() {
             assert!(html.contains("data-key=\"before.figures_um.P\""));
             assert!(html.contains("data-key=\"after.figures_iso230_2_um.A\""));
         }
-        let screenshot = artefacts().join(format!(
-            "standard-{}.png",
-            standard.replace([':', '/'], "-")
-        ));
-        let browser = open_in_browser(&page, (1280, 2400), BrowserOutput::Screenshot(&screenshot));
-        assert!(browser.console.is_empty(), "console: {:?}", browser.console);
-        let shot = Pixels::read(&screenshot);
-        assert!(shot.inked() > 0.05, "{}: blank", screenshot.display());
     }
 }

@@ -146,17 +146,6 @@ pub fn synth_loop(
     (before, table, after)
 }
 
-/// The first of `names` on PATH: a program the tests need (Debian's
-/// chromium, chromedriver, wine; `scripts/test` installs them). Missing is a
-/// failure that says `how` to get it, never a skip.
-pub fn program_on_path(names: &[&str], how: &str) -> PathBuf {
-    let path = std::env::var_os("PATH").unwrap_or_default();
-    std::env::split_paths(&path)
-        .flat_map(|directory| names.iter().map(move |name| directory.join(name)))
-        .find(|candidate| candidate.is_file())
-        .unwrap_or_else(|| panic!("{} not found on PATH: {how}", names.join(" or ")))
-}
-
 /// A report page without the line that says when it was made (two runs
 /// may straddle a minute).
 pub fn without_time(page: &str) -> String {

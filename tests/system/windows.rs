@@ -35,7 +35,7 @@ fn windows_exe() -> PathBuf {
 }
 
 fn wine() -> PathBuf {
-    crate::util::program_on_path(
+    crate::program_on_path(
         &["wine"],
         "the Windows build is checked under Wine; install Debian's wine and wine64, or run the \
          tests with scripts/test, which installs them",
@@ -96,7 +96,7 @@ fn prefix() -> PathBuf {
         );
     }
     if !dll.is_file() {
-        let gcc = crate::util::program_on_path(
+        let gcc = crate::program_on_path(
             &["x86_64-w64-mingw32-gcc"],
             "install Debian's gcc-mingw-w64-x86-64 (scripts/test does)",
         );

@@ -1,70 +1,16 @@
-//! Opening pages in a real browser (Debian's chromium, headless) and reading
-//! PNGs: shared by the report and demo tests; driving a page over WebDriver
-//! (chromedriver) for the web app's tests (`serve.rs`).
+//! Opening pages in a real browser (Debian's chromium, headless) for the
+//! report and demo pages; driving a page over WebDriver (chromedriver) for
+//! the web app (`web_page.rs`). Screenshots are read with `crate::pixels`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus};
 use std::time::{Duration, Instant};
 
-/// Where screenshots and PDFs are kept for a person to look at.
-pub fn artefacts() -> PathBuf {
-    let directory = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("report");
-    std::fs::create_dir_all(&directory).unwrap();
-    directory
-}
-
-/// A decoded PNG: width, height, and its pixels as RGB(A) rows.
-pub struct Pixels {
-    pub size: (u32, u32),
-    channels: usize,
-    data: Vec<u8>,
-}
-
-impl Pixels {
-    pub fn read(path: &Path) -> Pixels {
-        let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
-            .read_info()
-            .unwrap();
-        let mut data = vec![0; reader.output_buffer_size().unwrap()];
-        let info = reader.next_frame(&mut data).unwrap();
-        data.truncate(info.buffer_size());
-        Pixels {
-            size: (info.width, info.height),
-            channels: info.color_type.samples(),
-            data,
-        }
-    }
-
-    /// The fraction of pixels for which `test(r, g, b)` holds.
-    pub fn fraction(&self, test: impl Fn(u8, u8, u8) -> bool) -> f64 {
-        let total = self.data.len() / self.channels;
-        let hits = self
-            .data
-            .chunks(self.channels)
-            .filter(|p| match p {
-                [r, g, b, ..] => test(*r, *g, *b),
-                [grey, ..] => test(*grey, *grey, *grey),
-                [] => false,
-            })
-            .count();
-        hits as f64 / total as f64
-    }
-
-    /// The fraction that is not (nearly) white.
-    pub fn inked(&self) -> f64 {
-        self.fraction(|r, g, b| r.min(g).min(b) < 235)
-    }
-
-    /// The fraction in the plots' blues (↑ runs, bands): a plot is drawn, not only text.
-    pub fn blue(&self) -> f64 {
-        self.fraction(|r, _, b| i32::from(b) > i32::from(r) + 60)
-    }
-}
+use base64::Engine as _;
 
 /// Debian's chromium; `scripts/test` installs it. Missing is a failure, not a skip.
 pub fn chromium() -> PathBuf {
-    crate::util::program_on_path(
+    crate::program_on_path(
         &["chromium", "chromium-browser"],
         "the report is tested in a real browser; install Debian's chromium (apt-get install \
          chromium), or run the tests with scripts/test, which installs it",
@@ -160,7 +106,7 @@ pub fn wait_with_timeout(
 /// Debian's chromedriver (package `chromium-driver`; `scripts/test`
 /// installs it). Missing is a failure, not a skip.
 pub fn chromedriver() -> PathBuf {
-    crate::util::program_on_path(
+    crate::program_on_path(
         &["chromedriver"],
         "the web app is tested in a real browser; install Debian's chromium-driver (apt-get \
          install chromium-driver), or run the tests with scripts/test, which installs it",
@@ -333,7 +279,10 @@ impl WebDriver {
     /// The visible part of the page as a PNG in `path`.
     pub fn screenshot(&self, path: &Path) {
         let encoded = self.session_call("GET", "/screenshot", serde_json::Value::Null);
-        let bytes = base64_decode(encoded.as_str().expect("a base64 screenshot"));
+        // Standard base64 (RFC 4648 §4), as WebDriver sends screenshots.
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(encoded.as_str().expect("a base64 screenshot"))
+            .expect("a base64 screenshot");
         std::fs::write(path, bytes).unwrap();
     }
 
@@ -370,32 +319,4 @@ impl Drop for WebDriver {
         let _ = self.driver.kill();
         let _ = self.driver.wait();
     }
-}
-
-/// Standard base64 (RFC 4648 §4), as WebDriver sends screenshots.
-fn base64_decode(text: &str) -> Vec<u8> {
-    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut bytes = Vec::with_capacity(text.len() * 3 / 4);
-    let (mut buffer, mut bits) = (0u32, 0);
-    for c in text
-        .bytes()
-        .filter(|c| !c.is_ascii_whitespace() && *c != b'=')
-    {
-        let value = ALPHABET.iter().position(|a| *a == c).expect("base64") as u32;
-        buffer = (buffer << 6) | value;
-        bits += 6;
-        if bits >= 8 {
-            bits -= 8;
-            bytes.push((buffer >> bits) as u8);
-            buffer &= (1 << bits) - 1;
-        }
-    }
-    bytes
-}
-
-#[test]
-fn base64_decodes_the_rfc_4648_examples() {
-    assert_eq!(base64_decode("Zm9vYmFy"), b"foobar");
-    assert_eq!(base64_decode("Zm9vYg=="), b"foob");
-    assert_eq!(base64_decode("Zm9vYmE="), b"fooba");
 }
