@@ -34,6 +34,33 @@ pub enum ThermalCommand {
     /// Run a model over a thermal log: the predicted drift at each row and,
     /// where the log has the drift, the residual before and after.
     Apply(ApplyArgs),
+    /// Write a model as a LinuxCNC HAL file: lowpass, scale and sum2
+    /// components computing the model every servo period, feeding the axis'
+    /// external offset (eoffset-counts at 1 nm).
+    Hal(HalArgs),
+}
+
+/// Flags of `axcomp thermal hal`.
+#[derive(Debug, clap::Args)]
+pub struct HalArgs {
+    /// The model file (from `axcomp thermal fit`).
+    #[arg(value_name = "MODEL.toml")]
+    pub model: PathBuf,
+    /// The axis whose external offset takes the drift out (x, y, z, …).
+    #[arg(long, value_name = "AXIS")]
+    pub axis: String,
+    /// The period of the thread the components run in, s (the servo thread's, 0.001 by default).
+    #[arg(long, value_name = "S", default_value_t = 0.001)]
+    pub period: f64,
+    /// The thread the components are added to.
+    #[arg(long, value_name = "NAME", default_value = "servo-thread")]
+    pub thread: String,
+    /// The HAL file to write.
+    #[arg(short = 'o', long = "output", value_name = "FILE.hal")]
+    pub output: PathBuf,
+    /// `--force`.
+    #[command(flatten)]
+    pub overwrite: Overwrite,
 }
 
 /// How to read a thermal log (the same in every thermal command).
@@ -168,6 +195,7 @@ pub fn run(args: &ThermalArgs) -> Result<()> {
         ThermalCommand::Evaluate(a) => evaluate(a),
         ThermalCommand::Fit(a) => fit(a),
         ThermalCommand::Apply(a) => apply(a),
+        ThermalCommand::Hal(a) => hal(a),
     }
 }
 
@@ -290,5 +318,22 @@ fn write_plot(
         );
     };
     write_new(path, &chart(&make(), format)?, force)?;
+    Ok(())
+}
+
+fn hal(args: &HalArgs) -> Result<()> {
+    let model = load(&args.model, ThermalModel::from_toml)?;
+    if !(args.period.is_finite() && args.period > 0.0) {
+        bail!("--period {}: expected a period above 0 s", args.period);
+    }
+    if args.axis.len() != 1 || !"xyzabcuvw".contains(args.axis.to_ascii_lowercase().as_str()) {
+        bail!(
+            "--axis {}: expected one of x, y, z, a, b, c, u, v, w",
+            args.axis
+        );
+    }
+    let text =
+        axcomp::emit::linuxcnc_thermal::write_hal(&model, &args.axis, args.period, &args.thread);
+    write_new(&args.output, text.as_bytes(), args.overwrite.force)?;
     Ok(())
 }

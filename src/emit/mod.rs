@@ -24,6 +24,7 @@ pub mod fagor8065;
 mod heidenhain;
 pub mod itnc530;
 pub mod linuxcnc;
+pub mod linuxcnc_thermal;
 pub mod profile;
 pub mod sinumerik840d;
 pub mod tnc640;
