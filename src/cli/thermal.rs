@@ -61,6 +61,9 @@ pub struct HalArgs {
     /// `--force`.
     #[command(flatten)]
     pub overwrite: Overwrite,
+    /// `-q` (the same in every command; hal prints no warnings).
+    #[command(flatten)]
+    pub verbosity: Verbosity,
 }
 
 /// How to read a thermal log (the same in every thermal command).
