@@ -12,6 +12,7 @@ mod convert;
 mod demo;
 mod diagnose;
 mod evaluate;
+mod generate;
 mod predict;
 mod progress;
 mod report;
@@ -116,6 +117,10 @@ pub enum Command {
     /// 230-3 view, fits a model of the drift from sensors through first-order
     /// lags that a control can run, and runs a model over a log.
     Thermal(thermal::ThermalArgs),
+    /// Print the shell completion script (bash, zsh, fish, PowerShell, elvish).
+    Completions(generate::CompletionsArgs),
+    /// Print the manual page (roff) of axcomp or of one of its commands.
+    Man(generate::ManArgs),
 }
 
 /// Parses, runs, and maps the outcome to an exit code.
@@ -212,6 +217,8 @@ fn run(args: Args) -> Result<()> {
         Command::Report(report_args) => report::run(&report_args),
         Command::Serve(serve_args) => serve::run(&serve_args),
         Command::Thermal(thermal_args) => thermal::run(&thermal_args),
+        Command::Completions(completions_args) => generate::completions(&completions_args),
+        Command::Man(man_args) => generate::man(&man_args),
     }
 }
 
