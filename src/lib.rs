@@ -66,6 +66,7 @@ pub mod serve;
 pub mod servo;
 pub mod spline;
 pub mod synth;
+pub mod thermal;
 pub mod together;
 pub mod units;
 pub mod workflow;

@@ -19,6 +19,7 @@ mod report;
 mod serve;
 mod servo_sim;
 mod synth;
+mod thermal;
 mod tolerance;
 
 use std::any::TypeId;
@@ -110,6 +111,12 @@ pub enum Command {
     /// and grid, download the table and the acceptance report. The same
     /// numbers and files as the commands; everything stays in memory.
     Serve(serve::ServeArgs),
+    /// ISO 230-3 thermal tests and a drift model from temperatures (evaluate, fit, apply).
+    ///
+    /// Reads thermal logs (CSV: time, drift, temperatures), gives the ISO
+    /// 230-3 view, fits a model of the drift from sensors through first-order
+    /// lags that a control can run, and runs a model over a log.
+    Thermal(thermal::ThermalArgs),
     /// Print the shell completion script (bash, zsh, fish, PowerShell, elvish).
     Completions(generate::CompletionsArgs),
     /// Print the manual page (roff) of axcomp or of one of its commands.
@@ -209,6 +216,7 @@ fn run(args: Args) -> Result<()> {
         Command::ServoSim(servo_args) => servo_sim::run(&servo_args),
         Command::Report(report_args) => report::run(&report_args),
         Command::Serve(serve_args) => serve::run(&serve_args),
+        Command::Thermal(thermal_args) => thermal::run(&thermal_args),
         Command::Completions(completions_args) => generate::completions(&completions_args),
         Command::Man(man_args) => generate::man(&man_args),
     }

@@ -25,6 +25,7 @@ pub mod fanuc;
 mod heidenhain;
 pub mod itnc530;
 pub mod linuxcnc;
+pub mod linuxcnc_thermal;
 pub mod profile;
 pub mod sinumerik840d;
 pub mod tnc640;

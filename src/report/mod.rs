@@ -26,6 +26,7 @@ pub mod plot;
 pub mod predict;
 pub mod servo;
 pub mod terminal;
+pub mod thermal;
 pub mod tolerance;
 pub mod uncertainty;
 pub mod update;

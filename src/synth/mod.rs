@@ -26,6 +26,7 @@
 
 pub mod geometry;
 pub mod rotary;
+pub mod thermal;
 pub mod truth;
 
 use chrono::{Duration, NaiveDateTime, Timelike};

@@ -46,6 +46,7 @@ mod servo;
 mod standards;
 mod survey;
 mod survey_optics;
+mod thermal;
 mod together;
 mod util;
 mod verdict;

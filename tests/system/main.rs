@@ -35,6 +35,7 @@ mod util;
 
 mod browser;
 mod linuxcnc;
+mod linuxcnc_thermal;
 mod pages;
 mod web_page;
 mod windows;

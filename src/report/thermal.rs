@@ -1,0 +1,401 @@
+//! The thermal stage's outputs: the model file (TOML), the `--json` of
+//! `thermal evaluate` and `thermal apply`, their terminal reports, and the
+//! plots of drift and temperatures against time.
+
+use serde::Serialize;
+
+use crate::report::chart::{Chart, Mark, Rgb, Series};
+use crate::thermal::{Application, Iso230_3, ThermalLog, ThermalModel};
+
+/// The model file: `[fit]` (what it was fitted on) and one `[[term]]` per
+/// lagged sensor; `thermal::ThermalModel::from_toml` reads it back.
+#[derive(Serialize)]
+struct ModelFile<'a> {
+    fit: FitFile<'a>,
+    term: Vec<TermFile<'a>>,
+}
+
+#[derive(Serialize)]
+struct FitFile<'a> {
+    drift: &'a str,
+    first_row: usize,
+    last_row: usize,
+    from_s: f64,
+    to_s: f64,
+    candidates: &'a [String],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reference: Option<&'a str>,
+    blocks: usize,
+    cv_rms_um: f64,
+    fit_rms_um: f64,
+}
+
+#[derive(Serialize)]
+struct TermFile<'a> {
+    sensor: &'a str,
+    tau_s: f64,
+    coefficient_um_per_k: f64,
+    reference_c: f64,
+}
+
+/// The model as its TOML file, with a comment saying what it computes.
+pub fn model_toml(model: &ThermalModel) -> String {
+    let f = &model.fit;
+    let file = ModelFile {
+        fit: FitFile {
+            drift: &f.drift,
+            first_row: f.first_row,
+            last_row: f.last_row,
+            from_s: f.from_s,
+            to_s: f.to_s,
+            candidates: &f.candidates,
+            reference: f.reference.as_deref(),
+            blocks: f.blocks,
+            cv_rms_um: f.cv_rms_um,
+            fit_rms_um: f.fit_rms_um,
+        },
+        term: model
+            .terms
+            .iter()
+            .map(|t| TermFile {
+                sensor: &t.sensor,
+                tau_s: t.tau_s,
+                coefficient_um_per_k: t.coefficient_um_per_k,
+                reference_c: t.reference_c,
+            })
+            .collect(),
+    };
+    let body = toml::to_string(&file).unwrap_or_default();
+    format!(
+        "# axcomp thermal model: drift_um(t) = sum over terms of\n\
+         #   coefficient_um_per_k * (lag(sensor, tau_s)(t) - reference_c),\n\
+         # each lag a first-order low-pass started at the log's first row.\n\
+         # cv_rms_um is the prediction's standard uncertainty (time-blocked cross-validation).\n{body}"
+    )
+}
+
+/// rms and largest size of a set of values, µm.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Spread {
+    /// Root mean square, µm.
+    pub rms_um: f64,
+    /// Largest absolute value, µm.
+    pub max_um: f64,
+    /// How many rows.
+    pub rows: usize,
+}
+
+impl Spread {
+    /// Of `values` (none: zeros).
+    pub fn of(values: &[f64]) -> Spread {
+        let rows = values.len();
+        let sum: f64 = values.iter().map(|v| v * v).sum();
+        Spread {
+            rms_um: if rows == 0 {
+                0.0
+            } else {
+                (sum / rows as f64).sqrt()
+            },
+            max_um: values.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+            rows,
+        }
+    }
+}
+
+/// Before (the drift) and after (the residual) over a set of rows.
+#[derive(Serialize)]
+pub struct BeforeAfter {
+    /// The measured drift from the first row.
+    pub before: Spread,
+    /// Measured minus predicted.
+    pub after: Spread,
+}
+
+/// `thermal apply --json`.
+#[derive(Serialize)]
+pub struct ApplyJson {
+    /// The time of each row, s from the first.
+    pub time_s: Vec<f64>,
+    /// The model's drift at each row, µm.
+    pub predicted_um: Vec<f64>,
+    /// Measured minus predicted, where the log has the drift column.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual_um: Option<Vec<f64>>,
+    /// Over every row.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub all_rows: Option<BeforeAfter>,
+    /// Over the rows outside the model's fitted rows (the held-out rows,
+    /// when the log is the one it was fitted on).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outside_fit_rows: Option<BeforeAfter>,
+}
+
+/// The JSON of a model run over a log.
+pub fn apply_json(model: &ThermalModel, log: &ThermalLog, applied: &Application) -> ApplyJson {
+    let residual = applied.residual_um();
+    let figures = |keep: &dyn Fn(usize) -> bool| {
+        let measured = applied.measured_um.as_ref()?;
+        let residual = residual.as_ref()?;
+        let pick = |v: &[f64]| -> Vec<f64> {
+            v.iter()
+                .enumerate()
+                .filter(|(i, _)| keep(*i))
+                .map(|(_, x)| *x)
+                .collect()
+        };
+        Some(BeforeAfter {
+            before: Spread::of(&pick(measured)),
+            after: Spread::of(&pick(residual)),
+        })
+    };
+    let fitted = model.fit.first_row - 1..model.fit.last_row;
+    let outside = figures(&|i| !fitted.contains(&i)).filter(|f| f.after.rows > 0);
+    ApplyJson {
+        time_s: log.times_s.clone(),
+        predicted_um: applied.predicted_um.clone(),
+        all_rows: figures(&|_| true),
+        outside_fit_rows: outside,
+        residual_um: residual,
+    }
+}
+
+/// The apply report for the terminal.
+pub fn apply_text(model: &ThermalModel, json: &ApplyJson) -> String {
+    let mut text = format!(
+        "Thermal model: {} term(s), fitted on rows {}–{} ({:.0}–{:.0} min); prediction uncertainty {:.2} µm (1σ, time-blocked cross-validation)\n",
+        model.terms.len(),
+        model.fit.first_row,
+        model.fit.last_row,
+        model.fit.from_s / 60.0,
+        model.fit.to_s / 60.0,
+        model.fit.cv_rms_um
+    );
+    for (label, figures) in [
+        ("all rows", &json.all_rows),
+        ("rows not fitted on", &json.outside_fit_rows),
+    ] {
+        if let Some(f) = figures {
+            text.push_str(&format!(
+                "  {label} ({}): drift rms {:.2} µm, max {:.2} µm; after compensation rms {:.2} µm, max {:.2} µm\n",
+                f.before.rows, f.before.rms_um, f.before.max_um, f.after.rms_um, f.after.max_um
+            ));
+        }
+    }
+    if json.all_rows.is_none() {
+        text.push_str(&format!(
+            "  the log has no {:?} column: predictions only (--json)\n",
+            model.fit.drift
+        ));
+    }
+    text
+}
+
+/// The fit report for the terminal.
+pub fn fit_text(model: &ThermalModel) -> String {
+    let f = &model.fit;
+    let mut text = format!(
+        "Thermal model of {:?} from rows {}–{} ({:.0}–{:.0} min), chosen from {} by {}-block time-blocked cross-validation{}\n",
+        f.drift,
+        f.first_row,
+        f.last_row,
+        f.from_s / 60.0,
+        f.to_s / 60.0,
+        f.candidates.join(", "),
+        f.blocks,
+        f.reference
+            .as_deref()
+            .map(|r| format!(" as rises over {r}"))
+            .unwrap_or_default()
+    );
+    for t in &model.terms {
+        text.push_str(&format!(
+            "  {:<8} lag τ = {:>5.0} min  {:>+8.3} µm/K  from {:.2} °C\n",
+            t.sensor,
+            t.tau_s / 60.0,
+            t.coefficient_um_per_k,
+            t.reference_c
+        ));
+    }
+    text.push_str(&format!(
+        "  fit rms {:.2} µm; cross-validated rms {:.2} µm (the prediction's standard uncertainty)\n",
+        f.fit_rms_um, f.cv_rms_um
+    ));
+    text
+}
+
+/// One sensor in `thermal evaluate --json`.
+#[derive(Serialize)]
+pub struct SensorJson {
+    /// Column name.
+    pub name: String,
+    /// At the first row, °C.
+    pub start_c: f64,
+    /// At the last row, °C.
+    pub end_c: f64,
+    /// Largest minus smallest, K.
+    pub range_k: f64,
+    /// Largest rise over the start, K.
+    pub max_rise_k: f64,
+    /// When, min from the start.
+    pub max_rise_at_min: f64,
+}
+
+/// `thermal evaluate --json`.
+#[derive(Serialize)]
+pub struct EvaluateJson {
+    /// The ISO 230-3 test, as the user states it (`null`: not stated).
+    pub test_type: Option<&'static str>,
+    /// Rows.
+    pub rows: usize,
+    /// Duration, min.
+    pub duration_min: f64,
+    /// The largest drift from the start (signed), µm.
+    pub max_drift_um: Option<f64>,
+    /// When it occurred, min from the start.
+    pub max_drift_at_min: Option<f64>,
+    /// Largest minus smallest drift, µm.
+    pub drift_range_um: Option<f64>,
+    /// Each temperature.
+    pub sensors: Vec<SensorJson>,
+}
+
+/// The JSON of an ISO 230-3 view.
+pub fn evaluate_json(iso: &Iso230_3) -> EvaluateJson {
+    EvaluateJson {
+        test_type: iso.test_type.map(|t| t.title()),
+        rows: iso.rows,
+        duration_min: iso.duration_s / 60.0,
+        max_drift_um: iso.max_drift.map(|d| d.0),
+        max_drift_at_min: iso.max_drift.map(|d| d.1 / 60.0),
+        drift_range_um: iso.drift_range_um,
+        sensors: iso
+            .sensors
+            .iter()
+            .map(|s| SensorJson {
+                name: s.name.clone(),
+                start_c: s.start_c,
+                end_c: s.end_c,
+                range_k: s.range_k,
+                max_rise_k: s.max_rise_k,
+                max_rise_at_min: s.max_rise_at_s / 60.0,
+            })
+            .collect(),
+    }
+}
+
+/// The ISO 230-3 view for the terminal.
+pub fn evaluate_text(json: &EvaluateJson) -> String {
+    let mut text = format!(
+        "ISO 230-3 thermal test: {}\n  duration {:.0} min, {} rows\n",
+        json.test_type
+            .unwrap_or("type not stated (--test etve, spindle or linear-axis)"),
+        json.duration_min,
+        json.rows
+    );
+    match (
+        json.max_drift_um,
+        json.max_drift_at_min,
+        json.drift_range_um,
+    ) {
+        (Some(d), Some(at), Some(range)) => text.push_str(&format!(
+            "  largest drift from the start {d:+.2} µm at {at:.0} min; range {range:.2} µm\n"
+        )),
+        _ => text.push_str("  drift: not recorded (name its column with --drift)\n"),
+    }
+    text.push_str("  sensor       start °C   end °C  range K  largest rise K  at min\n");
+    for s in &json.sensors {
+        text.push_str(&format!(
+            "  {:<10} {:>9.2} {:>8.2} {:>8.2} {:>15.2} {:>7.0}\n",
+            s.name, s.start_c, s.end_c, s.range_k, s.max_rise_k, s.max_rise_at_min
+        ));
+    }
+    text
+}
+
+const PALETTE: [Rgb; 8] = [
+    Rgb(31, 95, 170),
+    Rgb(200, 82, 0),
+    Rgb(40, 140, 60),
+    Rgb(170, 40, 40),
+    Rgb(120, 80, 160),
+    Rgb(130, 90, 60),
+    Rgb(200, 90, 170),
+    Rgb(110, 110, 110),
+];
+
+/// The drift against time; with a model run, the prediction and the residual.
+pub fn drift_chart(log: &ThermalLog, applied: Option<&Application>) -> Chart {
+    let minutes: Vec<f64> = log.times_s.iter().map(|t| t / 60.0).collect();
+    let line = |label: &str, color: Rgb, mark: Mark, values: &[f64]| Series {
+        label: Some(label.to_string()),
+        color,
+        mark,
+        points: minutes
+            .iter()
+            .copied()
+            .zip(values.iter().copied())
+            .collect(),
+    };
+    let mut series = Vec::new();
+    if let Some(drift) = &log.drift {
+        let start = drift.um[0];
+        let measured: Vec<f64> = drift.um.iter().map(|v| v - start).collect();
+        series.push(line("measured drift", PALETTE[0], Mark::Line(2), &measured));
+    }
+    if let Some(applied) = applied {
+        series.push(line(
+            "model",
+            PALETTE[1],
+            Mark::Dashed(2),
+            &applied.predicted_um,
+        ));
+        if let Some(residual) = applied.residual_um() {
+            series.push(line(
+                "after compensation",
+                PALETTE[2],
+                Mark::Line(1),
+                &residual,
+            ));
+        }
+    }
+    Chart {
+        title: "Thermal drift".to_string(),
+        x_label: "time [min]".to_string(),
+        y_label: "drift [µm]".to_string(),
+        series,
+        y_range: None,
+        polar: None,
+    }
+}
+
+/// The temperatures against time.
+pub fn temperature_chart(log: &ThermalLog) -> Chart {
+    let minutes: Vec<f64> = log.times_s.iter().map(|t| t / 60.0).collect();
+    let series = log
+        .sensors
+        .iter()
+        .enumerate()
+        .map(|(k, s)| Series {
+            label: Some(s.name.clone()),
+            color: PALETTE[k % PALETTE.len()],
+            mark: if k < PALETTE.len() {
+                Mark::Line(1)
+            } else {
+                Mark::Dashed(1)
+            },
+            points: minutes
+                .iter()
+                .copied()
+                .zip(s.celsius.iter().copied())
+                .collect(),
+        })
+        .collect();
+    Chart {
+        title: "Temperatures".to_string(),
+        x_label: "time [min]".to_string(),
+        y_label: "temperature [°C]".to_string(),
+        series,
+        y_range: None,
+        polar: None,
+    }
+}

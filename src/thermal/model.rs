@@ -1,0 +1,540 @@
+//! The compensation model: the drift as a sum of sensors through first-order
+//! lags, `d(t) = Σ cᵢ·(Lτᵢ[Tᵢ](t) − Tᵢ,ref)`, with no constant term (at the
+//! reference temperatures the drift is zero, as it is at the log's start).
+//!
+//! Fitting ([`fit`]) chooses the sensors and their time constants by forward
+//! selection on time-blocked cross-validation: the rows given are cut into
+//! contiguous blocks, each block is predicted by the fit on the others, and a
+//! sensor (with the time constant from the grid that predicts best) is added
+//! only while it lowers the cross-validated rms by a set fraction. Blocks,
+//! not a random split: neighbouring rows of a thermal log are nearly equal,
+//! and a random split would score interpolation, not prediction (Arlot and
+//! Celisse 2010, §8.1). Only the rows given are used; rows after them are
+//! never seen. The cross-validated rms is the prediction's uncertainty.
+//!
+//! With a reference sensor (the other end of the measuring loop: the table,
+//! the air) each chosen sensor enters as its rise over the reference,
+//! `cᵢ·(Lτᵢ[Tᵢ] − Lτr[Tr])`: a uniform change of the whole loop's
+//! temperature moves both ends alike. One time constant of the reference
+//! is chosen for all; the file stores the reference as one more term whose
+//! coefficient is minus the sum of the others, so a control runs one sum.
+//!
+//! Applying ([`apply`]) starts every lag at the log's first row.
+
+use nalgebra::{DMatrix, DVector};
+use serde::Deserialize;
+
+use crate::error::ParseError;
+
+use super::{ThermalError, ThermalLog, lag};
+
+/// One term of the model: a sensor through a lag, times a coefficient.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Term {
+    /// The sensor (the log's column name).
+    pub sensor: String,
+    /// The lag's time constant, s (0: no lag).
+    pub tau_s: f64,
+    /// µm of drift per K of the lagged temperature.
+    pub coefficient_um_per_k: f64,
+    /// The temperature at which the term is zero, °C.
+    pub reference_c: f64,
+}
+
+/// What the fit was made from, and how well it predicts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitSummary {
+    /// The drift column fitted.
+    pub drift: String,
+    /// The rows fitted on, 1-based data rows, first and last (inclusive).
+    pub first_row: usize,
+    /// The last row fitted on (inclusive).
+    pub last_row: usize,
+    /// Time of the first and last row fitted on, s from the log's start.
+    pub from_s: f64,
+    /// Time of the last row fitted on.
+    pub to_s: f64,
+    /// The sensors the selection could choose from.
+    pub candidates: Vec<String>,
+    /// The reference sensor, when each term is a rise over it.
+    pub reference: Option<String>,
+    /// The number of contiguous blocks of the cross-validation.
+    pub blocks: usize,
+    /// The cross-validated rms (each block predicted from the others), µm:
+    /// the prediction's standard uncertainty.
+    pub cv_rms_um: f64,
+    /// The rms of the fit on all rows fitted on, µm.
+    pub fit_rms_um: f64,
+}
+
+/// A fitted model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThermalModel {
+    /// The terms, summed.
+    pub terms: Vec<Term>,
+    /// How it was fitted.
+    pub fit: FitSummary,
+}
+
+/// How to fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// The rows to fit on, 0-based, end exclusive.
+    pub rows: std::ops::Range<usize>,
+    /// The sensors to choose from (empty: every sensor of the log).
+    pub sensors: Vec<String>,
+    /// Sensors never to use.
+    pub exclude: Vec<String>,
+    /// The reference sensor (each term a rise over it).
+    pub reference: Option<String>,
+    /// The time constants to try, s (0: no lag).
+    pub taus_s: Vec<f64>,
+    /// Contiguous blocks of the cross-validation.
+    pub blocks: usize,
+    /// At most this many sensors (the reference aside).
+    pub max_sensors: usize,
+    /// A sensor is added only if it lowers the cross-validated rms by this fraction.
+    pub min_gain: f64,
+}
+
+impl FitOptions {
+    /// The defaults over `rows`: the time-constant grid of [`tau_grid_s`],
+    /// five blocks, up to four sensors, each gaining 5 %.
+    pub fn over(rows: std::ops::Range<usize>) -> FitOptions {
+        FitOptions {
+            rows,
+            sensors: Vec::new(),
+            exclude: Vec::new(),
+            reference: None,
+            taus_s: tau_grid_s(),
+            blocks: 5,
+            max_sensors: 4,
+            min_gain: 0.05,
+        }
+    }
+}
+
+/// The time constants tried: none, and 5 min doubling to 640 min (a
+/// spindle's bearings take minutes, its housing and a machine's structure
+/// hours).
+pub fn tau_grid_s() -> Vec<f64> {
+    let mut taus = vec![0.0];
+    taus.extend((0..8).map(|k| 300.0 * f64::from(1u32 << k)));
+    taus
+}
+
+/// The lagged temperatures' Gram matrices, one per block, over every
+/// candidate feature (sensor × time constant) and the reference's.
+struct Problem {
+    /// Per block: X'X, X'y, y'y, rows.
+    blocks: Vec<(DMatrix<f64>, DVector<f64>, f64, usize)>,
+    /// Feature index of (candidate k, tau j) is k·taus + j; the reference's
+    /// features follow the candidates'.
+    taus: usize,
+    candidates: usize,
+}
+
+/// A choice: candidate features and, with a reference, its feature.
+#[derive(Clone, Debug, PartialEq)]
+struct Choice {
+    features: Vec<usize>,
+    reference: Option<usize>,
+}
+
+impl Problem {
+    fn build(
+        log: &ThermalLog,
+        drift: &[f64],
+        columns: &[&[f64]],
+        taus_s: &[f64],
+        options: &FitOptions,
+    ) -> Problem {
+        let end = options.rows.end;
+        let times = &log.times_s[..end];
+        let mut features: Vec<Vec<f64>> = Vec::new();
+        let mut lagged = Vec::new();
+        for column in columns {
+            for &tau in taus_s {
+                lag(&column[..end], times, tau, &mut lagged);
+                let start = column[0];
+                features.push(lagged.iter().map(|v| v - start).collect());
+            }
+        }
+        let rows = options.rows.clone();
+        let count = rows.len();
+        let blocks = (0..options.blocks)
+            .map(|b| {
+                let lo = rows.start + b * count / options.blocks;
+                let hi = rows.start + (b + 1) * count / options.blocks;
+                let x = DMatrix::from_fn(hi - lo, features.len(), |r, f| features[f][lo + r]);
+                let y = DVector::from_fn(hi - lo, |r, _| drift[lo + r] - drift[0]);
+                (x.transpose() * &x, x.transpose() * &y, y.dot(&y), hi - lo)
+            })
+            .collect();
+        Problem {
+            blocks,
+            taus: taus_s.len(),
+            candidates: columns.len() - usize::from(options.reference.is_some()),
+        }
+    }
+
+    /// The normal equations of a choice over the blocks `use_block` keeps.
+    fn normal(
+        &self,
+        choice: &Choice,
+        use_block: impl Fn(usize) -> bool,
+    ) -> (DMatrix<f64>, DVector<f64>) {
+        let k = choice.features.len();
+        let mut a = DMatrix::zeros(k, k);
+        let mut v = DVector::zeros(k);
+        for (b, (g, h, _, _)) in self.blocks.iter().enumerate() {
+            if !use_block(b) {
+                continue;
+            }
+            let (ga, ha) = self.restricted(choice, g, h);
+            a += ga;
+            v += ha;
+        }
+        (a, v)
+    }
+
+    /// One block's Gram matrix and X'y for a choice (the rises over the reference, with one).
+    fn restricted(
+        &self,
+        choice: &Choice,
+        g: &DMatrix<f64>,
+        h: &DVector<f64>,
+    ) -> (DMatrix<f64>, DVector<f64>) {
+        let f = &choice.features;
+        let k = f.len();
+        let mut a = DMatrix::from_fn(k, k, |i, j| g[(f[i], f[j])]);
+        let mut v = DVector::from_fn(k, |i, _| h[f[i]]);
+        if let Some(r) = choice.reference {
+            for i in 0..k {
+                for j in 0..k {
+                    a[(i, j)] += -g[(f[i], r)] - g[(r, f[j])] + g[(r, r)];
+                }
+                v[i] -= h[r];
+            }
+        }
+        (a, v)
+    }
+
+    /// The sum of squared residuals of coefficients `c` on block `b`.
+    fn sse(&self, choice: &Choice, c: &DVector<f64>, b: usize) -> f64 {
+        let (g, h, yy, _) = &self.blocks[b];
+        let (a, v) = self.restricted(choice, g, h);
+        (yy - 2.0 * c.dot(&v) + (a * c).dot(c)).max(0.0)
+    }
+
+    fn rows(&self) -> usize {
+        self.blocks.iter().map(|b| b.3).sum()
+    }
+
+    /// Each block predicted by the fit on the others: the rms, µm
+    /// (infinite when a fit is singular).
+    fn cv_rms(&self, choice: &Choice) -> f64 {
+        if choice.features.is_empty() {
+            let total: f64 = self.blocks.iter().map(|b| b.2).sum();
+            return (total / self.rows() as f64).sqrt();
+        }
+        let mut total = 0.0;
+        for held in 0..self.blocks.len() {
+            let (a, v) = self.normal(choice, |b| b != held);
+            let Some(c) = solve(a, v) else {
+                return f64::INFINITY;
+            };
+            total += self.sse(choice, &c, held);
+        }
+        (total / self.rows() as f64).sqrt()
+    }
+
+    /// Forward selection for one reference feature (or none).
+    fn forward(&self, reference: Option<usize>, options: &FitOptions) -> (Choice, f64) {
+        let mut choice = Choice {
+            features: Vec::new(),
+            reference,
+        };
+        let mut score = self.cv_rms(&choice);
+        while choice.features.len() < options.max_sensors {
+            let mut best: Option<(f64, usize)> = None;
+            for candidate in 0..self.candidates {
+                if choice.features.iter().any(|f| f / self.taus == candidate) {
+                    continue;
+                }
+                for t in 0..self.taus {
+                    let feature = candidate * self.taus + t;
+                    let mut trial = choice.clone();
+                    trial.features.push(feature);
+                    let trial_score = self.cv_rms(&trial);
+                    if best.is_none_or(|(s, _)| trial_score < s) {
+                        best = Some((trial_score, feature));
+                    }
+                }
+            }
+            match best {
+                Some((s, feature)) if s < score * (1.0 - options.min_gain) => {
+                    choice.features.push(feature);
+                    score = s;
+                }
+                _ => break,
+            }
+        }
+        (choice, score)
+    }
+}
+
+fn solve(a: DMatrix<f64>, v: DVector<f64>) -> Option<DVector<f64>> {
+    let c = a.cholesky()?.solve(&v);
+    c.iter().all(|x| x.is_finite()).then_some(c)
+}
+
+/// Fits a model of `log`'s drift on `options.rows`.
+pub fn fit(log: &ThermalLog, options: &FitOptions) -> Result<ThermalModel, ThermalError> {
+    let drift = log.drift.as_ref().ok_or_else(|| {
+        ThermalError::Request("the log has no drift column to fit (--drift)".to_string())
+    })?;
+    let rows = options.rows.clone();
+    if rows.end > log.len() || rows.len() < 2 * options.blocks.max(1) {
+        return Err(ThermalError::Request(format!(
+            "cannot fit on rows {}–{}: the log has {} rows, and each of the {} blocks needs at least two",
+            rows.start + 1,
+            rows.end,
+            log.len(),
+            options.blocks
+        )));
+    }
+    for name in options
+        .sensors
+        .iter()
+        .chain(&options.exclude)
+        .chain(&options.reference)
+    {
+        if log.sensor(name).is_none() {
+            return Err(ThermalError::Request(format!(
+                "the log has no temperature column {name:?}"
+            )));
+        }
+    }
+    let candidates: Vec<&str> = log
+        .sensors
+        .iter()
+        .map(|s| s.name.as_str())
+        .filter(|name| options.sensors.is_empty() || options.sensors.iter().any(|s| s == name))
+        .filter(|name| !options.exclude.iter().any(|s| s == name))
+        .filter(|name| options.reference.as_deref() != Some(*name))
+        .collect();
+    if candidates.is_empty() {
+        return Err(ThermalError::Request(
+            "no sensor is left to choose from".to_string(),
+        ));
+    }
+    let mut columns: Vec<&[f64]> = candidates
+        .iter()
+        .filter_map(|name| log.sensor(name))
+        .map(|s| s.celsius.as_slice())
+        .collect();
+    let reference_sensor = options
+        .reference
+        .as_deref()
+        .and_then(|name| log.sensor(name));
+    if let Some(sensor) = reference_sensor {
+        columns.push(&sensor.celsius);
+    }
+    let taus = &options.taus_s;
+    let problem = Problem::build(log, &drift.um, &columns, taus, options);
+    let references: Vec<Option<usize>> = match reference_sensor {
+        None => vec![None],
+        Some(_) => (0..taus.len())
+            .map(|t| Some(candidates.len() * taus.len() + t))
+            .collect(),
+    };
+    let mut best: Option<(Choice, f64)> = None;
+    for reference in references {
+        let (choice, score) = problem.forward(reference, options);
+        if best.as_ref().is_none_or(|(_, s)| score < *s) {
+            best = Some((choice, score));
+        }
+    }
+    let (choice, cv_rms_um) = best.expect("at least one reference choice");
+    let (a, v) = problem.normal(&choice, |_| true);
+    let coefficients = if choice.features.is_empty() {
+        DVector::zeros(0)
+    } else {
+        solve(a, v)
+            .ok_or_else(|| ThermalError::Request("the chosen sensors are collinear".to_string()))?
+    };
+    let sse: f64 = (0..options.blocks)
+        .map(|b| problem.sse(&choice, &coefficients, b))
+        .sum();
+    let fit_rms_um = (sse / rows.len() as f64).sqrt();
+    let mut terms: Vec<Term> = choice
+        .features
+        .iter()
+        .zip(coefficients.iter())
+        .map(|(&feature, &c)| {
+            let name = candidates[feature / taus.len()];
+            Term {
+                sensor: name.to_string(),
+                tau_s: taus[feature % taus.len()],
+                coefficient_um_per_k: c,
+                reference_c: log.sensor(name).map_or(0.0, |s| s.celsius[0]),
+            }
+        })
+        .collect();
+    if let (Some(r), Some(sensor)) = (choice.reference, reference_sensor)
+        && !terms.is_empty()
+    {
+        terms.push(Term {
+            sensor: sensor.name.clone(),
+            tau_s: taus[r % taus.len()],
+            coefficient_um_per_k: -coefficients.sum(),
+            reference_c: sensor.celsius[0],
+        });
+    }
+    Ok(ThermalModel {
+        terms,
+        fit: FitSummary {
+            drift: drift.name.clone(),
+            first_row: rows.start + 1,
+            last_row: rows.end,
+            from_s: log.times_s[rows.start],
+            to_s: log.times_s[rows.end - 1],
+            candidates: candidates.iter().map(|s| s.to_string()).collect(),
+            reference: reference_sensor.map(|s| s.name.clone()),
+            blocks: options.blocks,
+            cv_rms_um,
+            fit_rms_um,
+        },
+    })
+}
+
+/// A model run over a log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Application {
+    /// The predicted drift at each row, µm.
+    pub predicted_um: Vec<f64>,
+    /// The measured drift from the first row (where the log has the model's
+    /// drift column), µm.
+    pub measured_um: Option<Vec<f64>>,
+}
+
+impl Application {
+    /// Measured minus predicted at each row, µm (where the log has the drift).
+    pub fn residual_um(&self) -> Option<Vec<f64>> {
+        let measured = self.measured_um.as_ref()?;
+        Some(
+            measured
+                .iter()
+                .zip(&self.predicted_um)
+                .map(|(m, p)| m - p)
+                .collect(),
+        )
+    }
+}
+
+/// Runs `model` over `log`, every lag starting at the log's first row.
+pub fn apply(model: &ThermalModel, log: &ThermalLog) -> Result<Application, ThermalError> {
+    let mut predicted_um = vec![0.0; log.len()];
+    let mut lagged = Vec::with_capacity(log.len());
+    for term in &model.terms {
+        let sensor = log.sensor(&term.sensor).ok_or_else(|| {
+            ThermalError::Request(format!(
+                "the log has no temperature column {:?}, which the model uses",
+                term.sensor
+            ))
+        })?;
+        lag(&sensor.celsius, &log.times_s, term.tau_s, &mut lagged);
+        for (p, l) in predicted_um.iter_mut().zip(&lagged) {
+            *p += term.coefficient_um_per_k * (l - term.reference_c);
+        }
+    }
+    let measured_um = log
+        .drift
+        .as_ref()
+        .filter(|d| d.name == model.fit.drift)
+        .map(|d| d.um.iter().map(|v| v - d.um[0]).collect());
+    Ok(Application {
+        predicted_um,
+        measured_um,
+    })
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelFile {
+    fit: FitFile,
+    #[serde(default)]
+    term: Vec<TermFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FitFile {
+    drift: String,
+    first_row: usize,
+    last_row: usize,
+    from_s: f64,
+    to_s: f64,
+    candidates: Vec<String>,
+    reference: Option<String>,
+    blocks: usize,
+    cv_rms_um: f64,
+    fit_rms_um: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TermFile {
+    sensor: String,
+    tau_s: f64,
+    coefficient_um_per_k: f64,
+    reference_c: f64,
+}
+
+impl ThermalModel {
+    /// Reads a model file (`report::thermal::model_toml` writes it).
+    pub fn from_toml(text: &str) -> Result<ThermalModel, ParseError> {
+        let file: ModelFile = toml::from_str(text).map_err(|e| ParseError::from_toml(text, &e))?;
+        let mut terms = Vec::new();
+        for term in file.term {
+            let finite = [term.tau_s, term.coefficient_um_per_k, term.reference_c]
+                .iter()
+                .all(|v| v.is_finite());
+            if !finite || term.tau_s < 0.0 {
+                let at = text.find(&format!("\"{}\"", term.sensor)).unwrap_or(0);
+                let line = text[..at].matches('\n').count() + 1;
+                return Err(ParseError::new(
+                    line,
+                    1,
+                    format!(
+                        "term {:?}: expected finite values and tau_s ≥ 0",
+                        term.sensor
+                    ),
+                ));
+            }
+            terms.push(Term {
+                sensor: term.sensor,
+                tau_s: term.tau_s,
+                coefficient_um_per_k: term.coefficient_um_per_k,
+                reference_c: term.reference_c,
+            });
+        }
+        let f = file.fit;
+        Ok(ThermalModel {
+            terms,
+            fit: FitSummary {
+                drift: f.drift,
+                first_row: f.first_row,
+                last_row: f.last_row,
+                from_s: f.from_s,
+                to_s: f.to_s,
+                candidates: f.candidates,
+                reference: f.reference,
+                blocks: f.blocks,
+                cv_rms_um: f.cv_rms_um,
+                fit_rms_um: f.fit_rms_um,
+            },
+        })
+    }
+}
