@@ -135,10 +135,11 @@ fn angular_moves(seed: u64) -> Vec<(String, Direction)> {
 
 /// Writes the config for `joint` into `dir` and runs LinuxCNC there, making
 /// `moves`; returns result.json.
-/// One LinuxCNC at a time: two instances on one machine share its HAL
-/// shared memory and NML channels and break each other ("move to … timed
-/// out"), and cargo runs the linear and the rotary test in parallel.
-static ONE_LINUXCNC: std::sync::Mutex<()> = std::sync::Mutex::new(());
+/// One LinuxCNC (or halrun) at a time: two instances on one machine share
+/// its HAL shared memory and NML channels and break each other ("move to …
+/// timed out"), and cargo runs the linear, the rotary and the thermal
+/// (`linuxcnc_thermal.rs`) test in parallel.
+pub static ONE_LINUXCNC: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 fn run_linuxcnc(
     dir: &Path,

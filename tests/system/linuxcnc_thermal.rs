@@ -206,6 +206,10 @@ fn linuxcnc_hal_offset_equals_thermal_apply_at_every_step() {
     } else {
         Command::new(halrun)
     };
+    // A test that failed while holding the lock has already said why.
+    let _one = crate::linuxcnc::ONE_LINUXCNC
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let output = command
         .current_dir(dir.path())
         .arg("-f")

@@ -121,6 +121,8 @@ fn windows(dir: &Path, args: &[&str]) -> Output {
 /// relative names give the same output.
 fn folders() -> (tempfile::TempDir, tempfile::TempDir) {
     let sample = std::fs::read(root().join("fixtures/sample-x.rtl")).unwrap();
+    // The Fagor 8065 table is an update of the axis' exported .mp (UTF-16).
+    let parameters = std::fs::read(root().join("fixtures/fagor8065/X.mp")).unwrap();
     let crlf = String::from_utf8(sample.clone())
         .unwrap()
         .replace("\r\n", "\n")
@@ -130,6 +132,7 @@ fn folders() -> (tempfile::TempDir, tempfile::TempDir) {
         std::fs::write(dir.join("sample-x.rtl"), &sample).unwrap();
         std::fs::write(dir.join("sample-crlf.rtl"), &crlf).unwrap();
         std::fs::write(dir.join("Maß-prüfung-é.rtl"), &sample).unwrap();
+        std::fs::write(dir.join("exported-X.mp"), &parameters).unwrap();
         std::fs::create_dir(dir.join("tables")).unwrap();
     }
     folders
@@ -174,7 +177,7 @@ fn the_windows_binary_under_wine_writes_what_the_linux_binary_writes() {
         ("fagor8065", "X.mp"),
     ] {
         let output = format!("tables/{name}");
-        let args = [
+        let mut args = vec![
             "convert",
             "sample-x.rtl",
             "--controller",
@@ -184,6 +187,9 @@ fn the_windows_binary_under_wine_writes_what_the_linux_binary_writes() {
             "-o",
             &output,
         ];
+        if controller == "fagor8065" {
+            args.extend(["--existing", "exported-X.mp"]);
+        }
         let (a, b) = (linux(l, &args), windows(w, &args));
         assert_eq!(b.stdout, a.stdout, "{args:?}");
         let (file_l, file_w) = (
