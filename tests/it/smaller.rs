@@ -1,0 +1,48 @@
+//! Smaller findings of one review, each through the binary: what the
+//! engineer reads must name the right axis, point and precision.
+
+use crate::util::{axcomp, root};
+
+const SAMPLE: &str = "fixtures/sample-x.rtl";
+
+/// A 100 mm step on the 0 … 750 mm test reaches 0 + 7·100 = 700 mm; the
+/// 50 mm beyond it are left out of the table, and convert says so.
+#[test]
+fn convert_says_where_a_step_that_does_not_divide_the_range_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("X.COM");
+    let run = axcomp([
+        "convert",
+        root().join(SAMPLE).to_str().unwrap(),
+        "--controller",
+        "itnc530",
+        "--axis",
+        "X",
+        "--step",
+        "100",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let said = format!("{}{}", run.stdout, run.stderr);
+    assert!(
+        said.contains("the table ends at 700 mm, its last compensation point, short of the measured end 750 mm"),
+        "{said}"
+    );
+    assert!(said.contains("give a step that divides 750 mm"), "{said}");
+    // A step that divides the range ends at the measured end: no note.
+    let run = axcomp([
+        "convert",
+        root().join(SAMPLE).to_str().unwrap(),
+        "--controller",
+        "itnc530",
+        "--axis",
+        "X",
+        "--step",
+        "150",
+        "-o",
+        dir.path().join("X2.COM").to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(!format!("{}{}", run.stdout, run.stderr).contains("the table ends at"));
+}
