@@ -46,3 +46,36 @@ fn convert_says_where_a_step_that_does_not_divide_the_range_ends() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(!format!("{}{}", run.stdout, run.stderr).contains("the table ends at"));
 }
+
+/// A TNC 640 table of axis Y given for the X test: the error names both axes.
+#[test]
+fn a_y_table_for_an_x_test_says_which_axis_each_is_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("Y.COM");
+    let sample = root().join(SAMPLE);
+    let run = axcomp([
+        "convert",
+        sample.to_str().unwrap(),
+        "--controller",
+        "tnc640",
+        "--axis",
+        "Y",
+        "-o",
+        table.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let run = axcomp([
+        "predict",
+        "--measured",
+        &format!("X={}", sample.display()),
+        "--table",
+        &format!("X={}", table.display()),
+    ]);
+    assert_eq!(run.code, 2, "{}{}", run.stdout, run.stderr);
+    assert!(
+        run.stderr
+            .contains("Y.COM:2:1: the table is for axis Y (its value column), the test for axis X"),
+        "{}",
+        run.stderr
+    );
+}
