@@ -79,3 +79,41 @@ fn a_y_table_for_an_x_test_says_which_axis_each_is_for() {
         run.stderr
     );
 }
+
+/// The Fagor 8055 inch table on the terminal shows what the file holds
+/// (5 decimals), row for row: 0.000008 in is written 0.00001 in the file.
+#[test]
+fn the_fagor_8055_inch_table_prints_as_the_file_has() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ALX");
+    let run = axcomp([
+        "convert",
+        crate::util::shared_data("api-xd/example__8055__X Axis Forward.pos")
+            .to_str()
+            .unwrap(),
+        "--controller",
+        "fagor8055",
+        "--axis",
+        "X",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let file = std::fs::read_to_string(&out).unwrap();
+    let file_values: Vec<f64> = file
+        .lines()
+        .filter(|l| l.trim_start().starts_with('P'))
+        .map(|l| l.split_whitespace().nth(4).unwrap().parse().unwrap())
+        .collect();
+    let printed: Vec<f64> = run
+        .stdout
+        .lines()
+        .skip_while(|l| !l.contains("value in"))
+        .skip(1)
+        .take_while(|l| !l.trim().is_empty())
+        .map(|l| l.split_whitespace().nth(2).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(printed.len(), 27, "{}", run.stdout);
+    assert_eq!(printed, file_values, "{}", run.stdout);
+    assert!(run.stdout.contains("  0.00001  "), "{}", run.stdout);
+}
