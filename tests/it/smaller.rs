@@ -117,3 +117,55 @@ fn the_fagor_8055_inch_table_prints_as_the_file_has() {
     assert_eq!(printed, file_values, "{}", run.stdout);
     assert!(run.stdout.contains("  0.00001  "), "{}", run.stdout);
 }
+
+/// diagnose's terminal shows a periodic effect's phase with 4 decimals (as
+/// the effects file writes it), the JSON's full value rounded.
+#[test]
+fn diagnose_prints_the_phase_with_four_decimals() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let case = crate::diagnose_periodic::case(15.0, 3, true);
+    std::fs::write(path("truth.toml"), &case.truth).unwrap();
+    crate::util::synth_loop_files(
+        dir.path(),
+        dir.path().join("truth.toml").as_path(),
+        Some("3"),
+    );
+    let profile = root().join("fixtures/machines/vc1810.toml");
+    let args = |json: bool| {
+        let mut args = vec![
+            "diagnose".to_string(),
+            "--after".into(),
+            path("after.rtl"),
+            "--before".into(),
+            path("before.rtl"),
+            "--table".into(),
+            path("X.COM"),
+            "--machine".into(),
+            profile.to_str().unwrap().to_string(),
+        ];
+        if json {
+            args.push("--json".into());
+        }
+        args
+    };
+    let run = axcomp(args(true));
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let phase = json["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["kind"] == "periodic")
+        .unwrap()["params"]["phase_rad"]
+        .as_f64()
+        .unwrap();
+    let run = axcomp(args(false));
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let shown = format!("phase_rad = {phase:.4}");
+    assert!(
+        run.stdout.contains(&format!("{shown},")) || run.stdout.contains(&format!("{shown} ")),
+        "{}",
+        run.stdout
+    );
+}
