@@ -169,3 +169,29 @@ fn diagnose_prints_the_phase_with_four_decimals() {
         run.stdout
     );
 }
+
+/// A one-run ↑ test has E↑ but neither M (bidirectional) nor A (needs s):
+/// the uncertainty line names U(E) only; a full test names all three.
+#[test]
+fn the_uncertainty_line_names_only_the_figures_evaluated() {
+    let one_run = axcomp([
+        "evaluate",
+        crate::util::shared_data("api-xd/example__8055__X Axis Forward.pos")
+            .to_str()
+            .unwrap(),
+    ]);
+    assert_eq!(one_run.code, 0, "{}", one_run.stderr);
+    let line = one_run
+        .stdout
+        .lines()
+        .find(|l| l.starts_with("U("))
+        .unwrap_or_else(|| panic!("{}", one_run.stdout));
+    assert!(line.starts_with("U(E) = 8.13 µm (k = 2"), "{line}");
+    let full = axcomp(["evaluate", root().join(SAMPLE).to_str().unwrap()]);
+    assert_eq!(full.code, 0, "{}", full.stderr);
+    assert!(
+        full.stdout.contains("\nU(E) = U(M) = U(A) = "),
+        "{}",
+        full.stdout
+    );
+}
