@@ -195,3 +195,50 @@ fn the_uncertainty_line_names_only_the_figures_evaluated() {
         full.stdout
     );
 }
+
+/// `report` of an evenly spaced test and re-test says the even-spacing
+/// warning once for each file, naming it (it printed the same line twice).
+#[test]
+fn report_says_each_files_even_spacing_once_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    // 17 targets 0 … 800 mm without jitter: every 50 mm.
+    std::fs::write(
+        path("truth.toml"),
+        "[cycle]\nstart_mm = 0.0\nend_mm = 800.0\ncount = 17\njitter_mm = 0.0\nruns = 5\nstart = \"2026-11-20 09:00:00\"\n\n\
+         [error]\nscale_um_per_m = 9.5\n\n[noise]\nsigma_um = 0.4\n",
+    )
+    .unwrap();
+    crate::util::synth_loop_files(
+        dir.path(),
+        dir.path().join("truth.toml").as_path(),
+        Some("3"),
+    );
+    let run = axcomp([
+        "report",
+        &path("before.rtl"),
+        "--after",
+        &path("after.rtl"),
+        "--table",
+        &path("X.COM"),
+        "-o",
+        &path("r.html"),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let even: Vec<&str> = run
+        .stderr
+        .lines()
+        .filter(|l| l.contains("targets evenly spaced every 50 mm"))
+        .collect();
+    assert_eq!(even.len(), 2, "{}", run.stderr);
+    assert!(
+        even[0].starts_with(&format!("axcomp: warning: {}: ", path("before.rtl"))),
+        "{}",
+        run.stderr
+    );
+    assert!(
+        even[1].starts_with(&format!("axcomp: warning: {}: ", path("after.rtl"))),
+        "{}",
+        run.stderr
+    );
+}
