@@ -522,7 +522,16 @@ pub fn print_test_warnings(path: &Path, measurement: &Measurement, quiet: bool, 
     if quiet {
         return;
     }
-    for warning in axcomp::evaluate::evaluate(measurement).warnings {
+    let warnings = axcomp::evaluate::evaluate(measurement).warnings;
+    print_file_warnings(path, &warnings, quiet, angle);
+}
+
+/// Prints a file's warnings to stderr, each naming the file, unless `quiet`.
+pub fn print_file_warnings(path: &Path, warnings: &[Warning], quiet: bool, angle: AngleUnit) {
+    if quiet {
+        return;
+    }
+    for warning in warnings {
         eprintln!(
             "axcomp: warning: {}: {}",
             path.display(),

@@ -23,7 +23,8 @@ use axcomp::workflow::Test;
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
     AngleUnitArg, InputFormat, LinuxCncType, MachineFile, Overwrite, StandardArg, UncertaintyArgs,
-    Verbosity, load_equipment, name_axis, print_text, print_warnings_in, read_active_table,
+    Verbosity, load_equipment, name_axis, print_file_warnings, print_text, print_warnings_in,
+    read_active_table,
 };
 
 /// Flags of `axcomp report`.
@@ -293,8 +294,14 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         }
         return Err(error.into());
     }
-    for test in std::iter::once(&before).chain(&after) {
-        print_warnings_in(&test.warnings, args.verbosity.quiet, angle);
+    // With a re-test each test's warnings name its file: the same warning of
+    // both is said once for each, not twice alike.
+    let paths = std::iter::once(&args.file).chain(&args.after);
+    for (test, path) in std::iter::once(&before).chain(&after).zip(paths) {
+        match after {
+            Some(_) => print_file_warnings(path, &test.warnings, args.verbosity.quiet, angle),
+            None => print_warnings_in(&test.warnings, args.verbosity.quiet, angle),
+        }
     }
     let mut summary = format!("Wrote {}\n", args.output.display());
     for (path, _) in files.iter().skip(1) {

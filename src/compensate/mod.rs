@@ -531,12 +531,16 @@ pub fn grid_positions(targets_mm: &[f64], grid: GridSpec) -> Result<Vec<f64>, Co
                     "start must be a number, found {start_mm}"
                 )));
             }
-            // start + k·step, rounded to 1e-9 mm so that e.g. 0.1·3 prints as 0.3.
             Ok((0..count)
-                .map(|k| ((start_mm + k as f64 * step_mm) * 1e9).round() / 1e9)
+                .map(|k| round_nm(start_mm + k as f64 * step_mm))
                 .collect())
         }
     }
+}
+
+/// A grid position rounded to 1e-9 mm, so that e.g. 0.1·3 prints as 0.3.
+fn round_nm(mm: f64) -> f64 {
+    (mm * 1e9).round() / 1e9
 }
 
 /// Interpolates a source curve onto the points, applying the extrapolation rule.

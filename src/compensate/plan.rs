@@ -98,7 +98,7 @@ pub fn plan(
 ) -> Result<Plan, CompensateError> {
     let mut notes = Vec::new();
     let mode = mode(effects, controller, request, &mut notes);
-    let table_notes = one_direction(mode, controller, context)?;
+    let mut table_notes = one_direction(mode, controller, context)?;
     let update = match context.existing {
         Some(_) if request.extrapolate.is_some() => {
             return Err(CompensateError::ExtrapolateUpdate);
@@ -112,7 +112,7 @@ pub fn plan(
             notes.push(note);
         }
     }
-    let grid = grid(targets_mm, controller, request, step_mm)?;
+    let grid = grid(targets_mm, controller, request, step_mm, &mut table_notes)?;
     if let Some(update) = &update {
         check_update_grid(update, targets_mm, grid, controller)?;
     }
@@ -256,6 +256,7 @@ fn grid(
     controller: &Capabilities,
     request: &Request,
     effects_step: Option<f64>,
+    notes: &mut Vec<String>,
 ) -> Result<GridSpec, CompensateError> {
     let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
     let Some(step_mm) = effects_step.or(request.step_mm) else {
@@ -282,6 +283,17 @@ fn grid(
         Some(count) => count,
         None => ((last - start_mm) / step_mm + 1e-9).floor().max(0.0) as usize + 1,
     };
+    let end_mm = start_mm + (count - 1) as f64 * step_mm;
+    // The user's step is said where it falls short; the effects' fine step ends within it.
+    if request.count.is_none() && request.step_mm == Some(step_mm) && end_mm < last - 1e-9 {
+        notes.push(format!(
+            "the table ends at {end} mm, its last compensation point, short of the measured end \
+             {last} mm ({start_mm} mm + whole steps of {step_mm} mm): to include {last} mm give a \
+             step that divides {length} mm",
+            end = super::round_nm(end_mm),
+            length = super::round_nm(last - start_mm),
+        ));
+    }
     Ok(GridSpec::Regular {
         start_mm,
         step_mm,

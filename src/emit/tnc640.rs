@@ -456,6 +456,25 @@ pub fn read(input: &str, column: &str) -> Result<CompensationTable, ParseError> 
     let header = table.header;
     let (Some(axispos), Some(value_column)) = (table.column("AXISPOS"), table.column(column))
     else {
+        let axes: Vec<&str> = table
+            .offsets
+            .iter()
+            .map(|(name, _)| name.as_str())
+            .filter(|name| {
+                !["NR", "AXISPOS", "BACKLASH"]
+                    .iter()
+                    .any(|n| n.eq_ignore_ascii_case(name))
+            })
+            .collect();
+        if table.column("AXISPOS").is_some() && !axes.is_empty() {
+            return Err(header.error_at(
+                header.text.trim_start(),
+                format!(
+                    "the table is for axis {} (its value column), the test for axis {column}: give the table of axis {column}",
+                    axes.join(", ")
+                ),
+            ));
+        }
         return Err(header.expected_at(
             header.text.trim_start(),
             &format!("a header with AXISPOS and an axis column {column}"),

@@ -33,7 +33,7 @@ use serde::Serialize;
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::BacklashAdvice;
 use crate::measurement::AxisKind;
-use crate::report::format::{inch_text, um};
+use crate::report::format::{inch_text_places, um};
 use crate::units::{LengthUnit, deg_to_arcsec, mm_to_um, um_to_mm};
 
 /// The table's values, µm.
@@ -122,6 +122,8 @@ pub struct ConvertJson {
     pub update: Option<super::update::UpdateJson>,
     /// Warnings from reading and evaluating.
     pub warnings: Vec<String>,
+    /// The decimals of the file's lengths (an inch table is shown with them).
+    pub file_decimals: usize,
 }
 
 impl ConvertJson {
@@ -173,6 +175,7 @@ impl ConvertJson {
             notes: Vec::new(),
             update: None,
             warnings,
+            file_decimals: 6,
         }
     }
 
@@ -326,7 +329,7 @@ impl ConvertJson {
     /// The table of an inch file: positions and values in inches, as the
     /// file holds them and the controller shows them, beside the µm.
     fn inch_table(&self, mut out: String) -> String {
-        let inch = |mm: f64| inch_text(LengthUnit::Inch.from_mm(mm));
+        let inch = |mm: f64| inch_text_places(LengthUnit::Inch.from_mm(mm), self.file_decimals);
         let _ = writeln!(
             out,
             "The file is in inches (the controller's unit); µm beside them."

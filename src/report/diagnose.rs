@@ -516,6 +516,8 @@ pub fn render(report: &DiagnoseJson) -> String {
                         units.key(key),
                         u.as_f64().unwrap_or(f64::NAN)
                     ),
+                    // A number without an uncertainty (a phase): 4 decimals, as the effects file.
+                    (Some(v), None) if value.is_f64() => format!("{} = {v:.4}", units.key(key)),
                     _ => format!("{} = {value}", units.key(key)),
                 },
             )

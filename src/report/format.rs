@@ -170,7 +170,12 @@ pub fn inch_beside(length_unit: &str, values_mm: &[f64]) -> String {
 
 /// Inches with at most six decimals (0.025 µm), no trailing zeros.
 pub fn inch_text(value_in: f64) -> String {
-    let text = format!("{value_in:.6}");
+    inch_text_places(value_in, 6)
+}
+
+/// An inch value with at most `places` decimals, as a file of that many shows it.
+pub fn inch_text_places(value_in: f64, places: usize) -> String {
+    let text = format!("{value_in:.places$}");
     let text = text.trim_end_matches('0').trim_end_matches('.');
     if text == "-0" {
         "0".to_string()

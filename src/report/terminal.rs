@@ -43,7 +43,21 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     }
     out.push('\n');
     if let Some(uncertainty) = &report.uncertainty_um {
-        out.push_str(&crate::report::uncertainty::terminal(uncertainty));
+        // A figure is evaluated when any of its directions has a value (E↑ of a one-direction test).
+        let evaluated: Vec<&str> = ["E", "M", "A"]
+            .into_iter()
+            .filter(|figure| {
+                report.figures().values.iter().any(|(key, value)| {
+                    value.is_some()
+                        && (key == figure
+                            || key.strip_prefix(figure).is_some_and(|d| d.starts_with('_')))
+                })
+            })
+            .collect();
+        out.push_str(&crate::report::uncertainty::terminal(
+            uncertainty,
+            &evaluated,
+        ));
     }
     if !report.outliers.is_empty() {
         out.push_str("\nSuspected outlier runs (included; exclude with --exclude-run RUN:DIRECTION only if you know why)\n");

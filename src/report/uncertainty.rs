@@ -93,17 +93,28 @@ impl UncertaintyJson {
         }
     }
 
-    /// The title line: `U(E) = U(M) = U(A) = 3.49 µm (k = 2, u_c = 1.75 µm, equipment: …)`.
-    pub fn summary(&self) -> String {
+    /// The title line: `U(E) = U(M) = U(A) = 3.49 µm (k = 2, u_c = 1.75 µm, equipment: …)`,
+    /// naming only the figures of `evaluated` (`E`, `M`, `A`) the test has.
+    pub fn summary(&self, evaluated: &[&str]) -> String {
+        let named: Vec<String> = ["E", "M", "A"]
+            .into_iter()
+            .filter(|f| evaluated.contains(f))
+            .map(|f| format!("U({f}) = "))
+            .collect();
+        let named = if named.is_empty() {
+            "U = ".to_string()
+        } else {
+            named.concat()
+        };
         format!(
-            "U(E) = U(M) = U(A) = {:.2} µm (k = {}, u_c = {:.3} µm; equipment: {})",
+            "{named}{:.2} µm (k = {}, u_c = {:.3} µm; equipment: {})",
             self.E, self.k, self.u_c, self.equipment
         )
     }
 }
 
 /// The budget table of `evaluate`, largest contributor first.
-pub fn terminal(uncertainty: &UncertaintyJson) -> String {
+pub fn terminal(uncertainty: &UncertaintyJson, evaluated: &[&str]) -> String {
     use tabled::builder::Builder;
     use tabled::settings::object::Columns;
     use tabled::settings::{Alignment, Style};
@@ -125,7 +136,7 @@ pub fn terminal(uncertainty: &UncertaintyJson) -> String {
     let _ = writeln!(
         out,
         "\nMeasurement uncertainty (ISO 230-2:2014 Annex A, ISO/TR 230-9; README, Measurement uncertainty)\n{}\n{table}\n{}.",
-        uncertainty.summary(),
+        uncertainty.summary(evaluated),
         NOT_EVALUATED_NOTE
     );
     out

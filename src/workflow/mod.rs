@@ -269,7 +269,11 @@ pub fn convert(
             .extend(emit::fanuc::notes(&compensation, options));
     }
     if measurement.kind() == AxisKind::Linear {
-        report.file_unit = table.controller.file_unit(options.machine_unit).as_str();
+        let file_unit = table.controller.file_unit(options.machine_unit);
+        report.file_unit = file_unit.as_str();
+        let resolution =
+            file_unit.from_mm(emit::resolution_mm(table.controller, options.machine_unit));
+        report.file_decimals = (-resolution.log10()).round().max(0.0) as usize;
     }
     report.update = update.map(|summary| UpdateJson::new(&summary, report.file_unit));
     if let Some(backlash_mm) = compensation.suggested_backlash_mm {

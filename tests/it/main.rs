@@ -43,6 +43,7 @@ mod rotary;
 mod serve;
 mod server;
 mod servo;
+mod smaller;
 mod standards;
 mod survey;
 mod survey_optics;
