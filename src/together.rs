@@ -415,7 +415,7 @@ mod tests {
         )
     }
 
-    /// Issue 14: a rotary axis' ranges are said in degrees, not mm.
+    /// A rotary axis' ranges are said in degrees, not mm.
     #[test]
     fn a_rotary_axis_ranges_are_in_degrees() {
         let rotary =

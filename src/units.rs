@@ -79,7 +79,7 @@ impl LengthUnit {
 
 /// The unit a rotary axis' deviations are reported in: arc-seconds (″, the
 /// default, as the rotary laser vendors and ISO 230-2's tables quote them) or
-/// microradians (µrad, on request, issue 14). Inside they stay degrees.
+/// microradians (µrad, on request). Inside they stay degrees.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum AngleUnit {
     /// Arc-seconds, ″.

@@ -488,8 +488,8 @@ pub fn load_equipment(args: &UncertaintyArgs) -> Result<Option<Equipment>> {
 }
 
 /// Refuses a rotary axis where a command handles linear axes only
-/// (prediction is µm and mm throughout, on the volumetric model; rotary axes
-/// there are issue 14's later part).
+/// (prediction is µm and mm throughout, on the volumetric model, which has
+/// no rotary axes yet).
 pub fn linear_only(measurement: &Measurement, command: &str) -> Result<()> {
     if measurement.kind() == AxisKind::Rotary {
         anyhow::bail!(

@@ -117,7 +117,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let angle = args.angle_unit.for_axis(&after.measurement)?;
     print_test_warnings(&args.after, &after.measurement, args.verbosity.quiet, angle);
     if after.measurement.kind() == AxisKind::Rotary {
-        // Issue 14: a rotary re-test is diagnosed in ″ (per-revolution
+        // A rotary re-test is diagnosed in ″ (per-revolution
         // harmonics, reversal, outlier runs); its effects file and an Abbe
         // profile are lengths, for linear axes only so far.
         for (given, flag) in [

@@ -244,8 +244,8 @@ mod tests {
         command().debug_assert();
     }
 
-    /// Every flag with a numeric value takes a negative one (issue 11:
-    /// `convert --step -50` was parsed as a flag).
+    /// Every flag with a numeric value takes a negative one (otherwise
+    /// `convert --step -50` is parsed as a flag).
     #[test]
     fn every_numeric_flag_takes_a_negative_value() {
         let command = command();

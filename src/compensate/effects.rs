@@ -1,5 +1,5 @@
 //! A table that accounts for the effects a diagnosis found (`convert
-//! --effects`, issue 6): what the geometric curve of a test misses.
+//! --effects`): what the geometric curve of a test misses.
 //!
 //! - **periodic**: the test's targets (and a table at them, linear in
 //!   between) cannot follow a short period. The periodic error is taken out of

@@ -22,7 +22,7 @@ pub(super) fn applicable_kinds(
     for &kind in Kind::ALL {
         let reason = match kind {
             // A rotary axis' errors are per-revolution harmonics and the
-            // reversal (issue 14); these kinds are lengths and times.
+            // reversal; these kinds are lengths and times.
             Kind::Scale | Kind::Drift | Kind::Abbe if rotary => Some(
                 "not looked for on a rotary axis: modelled for linear axes only so far".to_string(),
             ),

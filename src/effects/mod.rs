@@ -1,5 +1,5 @@
 //! The effects: parametric models of what a re-test shows beyond the
-//! geometric model (issue 6), each in its own file, below every stage that
+//! geometric model, each in its own file, below every stage that
 //! closes the loop. `diagnose` fits them, `compensate` and `predict` account
 //! for them, `report` shows them, `synth` plants them; all through this
 //! module, which depends only on `measurement` and `units` (and the full

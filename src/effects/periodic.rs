@@ -1,5 +1,5 @@
 //! Periodic error in position: `amplitude · sin(2πx/period + phase)` (a screw
-//! lead, a scale period). On a rotary axis (issue 14) the period is 360°/k,
+//! lead, a scale period). On a rotary axis the period is 360°/k,
 //! a whole order k per revolution (once from eccentricity, twice from the
 //! encoder's mounting, a worm gear's tooth count), and the sentences say so
 //! in ° and ″ ([`Periodic::per_revolution`]).

@@ -1,6 +1,6 @@
 //! Prediction after compensation (`axcomp predict`): what a re-test of a
 //! compensated axis will show along its laser line, and what the table leaves
-//! in the work volume, from the volumetric model (issue 4).
+//! in the work volume, from the volumetric model.
 //!
 //! **The errors.** The 21 errors come from an error description
 //! ([`crate::model::read_error_description`]) and from measured files: a

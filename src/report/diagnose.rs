@@ -39,7 +39,7 @@
 //! `down`) and `offset_um`. `residual_before_um` is the model's error before
 //! the effects are added, `residual_after_um` with them.
 //!
-//! A rotary axis (issue 14) adds `"axis_kind": "rotary"` and carries its
+//! A rotary axis adds `"axis_kind": "rotary"` and carries its
 //! units in the same keys: every `_um` key is `_arcsec` (″), every `_mm` key
 //! `_deg` (`residual_before_arcsec`, `figures_arcsec`, `noise_arcsec`,
 //! `unexplained.where_deg`, `evidence.cv_rmse_with_arcsec`, a periodic

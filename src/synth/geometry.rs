@@ -1,5 +1,5 @@
 //! A synthetic machine with known 21 errors, "measured" into geometry test
-//! files and a survey, for the tests of `predict::survey` (issue 15).
+//! files and a survey, for the tests of `predict::survey`.
 //!
 //! The truth ([`random_truth`]) is in the survey's own form, because a line
 //! measurement can tell nothing else: each straightness has no
@@ -55,7 +55,7 @@ pub struct GeometryPlan {
 }
 
 impl GeometryPlan {
-    /// The plan of the tests of issue 15 on the bundled MCV 754 Quick:
+    /// The plan of the survey tests on the bundled MCV 754 Quick:
     /// 25 mm targets, 2 runs each way, 0.1 µm and 0.1 µrad of noise a
     /// reading, the laser's reference turned by tens of µrad, each axis on
     /// a line away from the reference with optics 120–150 mm from the tool.

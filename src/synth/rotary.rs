@@ -1,4 +1,4 @@
-//! A rotary axis' truth and its synthetic test (issue 14): the errors a
+//! A rotary axis' truth and its synthetic test: the errors a
 //! rotary axis has, in degrees and arc-seconds (`../shared/spec/standards.md`
 //! §6), for tests with a known answer.
 //!

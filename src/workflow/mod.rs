@@ -87,7 +87,7 @@ pub fn evaluation_report(
     } = options;
     warnings.extend(evaluation.warnings.iter().cloned());
     // The budget is the laser's, for lengths, and limits are µm: a rotary
-    // axis has neither yet (issue 14's later part).
+    // axis has neither yet.
     let budget = match measurement.kind() {
         AxisKind::Rotary if !limits.is_empty() => {
             return Err(WorkflowError::RotaryLimits {

@@ -67,7 +67,7 @@ fn seed_15(machine: &Machine, convention: &str) -> (GeometricErrors, Survey, Vec
 
 #[test]
 fn a_synthetic_machine_is_predicted_off_the_measured_lines() {
-    // Issue 15's done-when: 20 random points off the lines within 0.5 µm.
+    // 20 random points off the lines within 0.5 µm.
     let machine = Machine::bundled();
     let (truth, survey, files) = seed_15(&machine, "right-handed");
     let state = assemble(&machine, &survey, &GeometricErrors::default(), &files).unwrap();
@@ -91,7 +91,7 @@ fn a_synthetic_machine_is_predicted_off_the_measured_lines() {
 
 #[test]
 fn squareness_equals_the_truth_in_both_conventions() {
-    // Issue 15's done-when: to 1 µrad with both sign conventions. Expected
+    // To 1 µrad with both sign conventions. Expected
     // from the notes' §2.5 expansion of the thesis chain (ZFYX), not from
     // the model: EXOY adds EXOY·Y to E_x and EXOY·X to E_y, so the angle
     // X–Y is 90° − 2·EXOY; EXOZ adds EXOZ·Z to E_x only: 90° − EXOZ;
@@ -222,7 +222,7 @@ fn survey_file_errors_name_the_key() {
 
 #[test]
 fn the_residual_after_cross_axis_tables_is_the_truth_minus_the_tables() {
-    // Issue 15's done-when: the six straightness tables built from the
+    // The six straightness tables built from the
     // survey, applied as the controller does (`predict`), against a direct
     // evaluation of the truth with each table's value taken off its column
     // axis at its table axis's position.
