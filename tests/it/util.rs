@@ -68,6 +68,15 @@ pub fn evaluate_json(files: &[&Path]) -> serde_json::Value {
     serde_json::from_str(&run.stdout).expect("evaluate --json prints one JSON object")
 }
 
+/// `evaluate --json` with extra arguments (limits, a profile, a decision rule).
+pub fn evaluate_json_with(args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["evaluate", "--json"];
+    all.extend_from_slice(args);
+    let run = axcomp(all);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    serde_json::from_str(&run.stdout).unwrap()
+}
+
 /// Compares a text with a golden file; `AXCOMP_UPDATE_GOLDEN=1` rewrites it.
 /// A missing golden file is a failure, not a silent pass.
 pub fn assert_golden(actual: &str, golden: &Path) {

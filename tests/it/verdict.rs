@@ -10,18 +10,9 @@ use std::path::{Path, PathBuf};
 use serde_json::{Value, json};
 
 use crate::report::{check_against_json, embedded_data};
-use crate::util::axcomp;
+use crate::util::{axcomp, evaluate_json_with};
 
 const SAMPLE: &str = "fixtures/sample-x.rtl";
-
-/// `evaluate --json` with extra arguments (limits, a profile).
-pub fn evaluate_json_with(args: &[&str]) -> Value {
-    let mut all = vec!["evaluate", "--json"];
-    all.extend_from_slice(args);
-    let run = axcomp(all);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    serde_json::from_str(&run.stdout).unwrap()
-}
 
 /// A first test over 0–200 mm, 2 runs each way (µm):
 /// ↑ 0 4 8 / 2 6 10, ↓ 2 6 10 / 4 8 12. By hand: x̄↑ = 1, 5, 9; x̄↓ = 3, 7, 11;

@@ -9,24 +9,13 @@
 
 use std::path::Path;
 
-use serde_json::Value;
-
 use crate::browser::{BrowserOutput, open_in_browser};
 use crate::page::{check_against_json, embedded_data};
 use crate::pixels::{Pixels, artefacts};
 use crate::retest_case::RetestCase;
-use crate::util::{axcomp, evaluate_json};
+use crate::util::{axcomp, evaluate_json, evaluate_json_with};
 
 const SAMPLE: &str = "fixtures/sample-x.rtl";
-
-/// `evaluate --json` with more arguments (limits, a decision rule).
-fn evaluate_json_with(args: &[&str]) -> Value {
-    let mut all = vec!["evaluate", "--json"];
-    all.extend_from_slice(args);
-    let run = axcomp(all);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    serde_json::from_str(&run.stdout).unwrap()
-}
 
 #[test]
 fn the_sample_report_opens_in_chromium_without_errors_and_is_not_blank() {
