@@ -125,8 +125,8 @@ fn run_block(examples: &[Example]) -> Result<usize, String> {
     Ok(examples.len())
 }
 
-/// README.md and every Markdown file under docs/.
-fn documents() -> Vec<PathBuf> {
+/// Every Markdown file under `folder`, at any depth, sorted.
+pub fn markdown_under(folder: &Path) -> Vec<PathBuf> {
     fn walk(folder: &Path, found: &mut Vec<PathBuf>) {
         let Ok(entries) = std::fs::read_dir(folder) else {
             return;
@@ -140,9 +140,16 @@ fn documents() -> Vec<PathBuf> {
             }
         }
     }
-    let mut found = vec![root().join("README.md")];
-    walk(&root().join("docs"), &mut found);
+    let mut found = Vec::new();
+    walk(folder, &mut found);
     found.sort();
+    found
+}
+
+/// README.md and every Markdown file under docs/.
+fn documents() -> Vec<PathBuf> {
+    let mut found = vec![root().join("README.md")];
+    found.extend(markdown_under(&root().join("docs")));
     found
 }
 
