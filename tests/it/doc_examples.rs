@@ -206,3 +206,21 @@ fn the_example_check_can_fail() {
     let other = console_blocks("doc.md", "```console\n$ ls\n```\n").unwrap_err();
     assert_eq!(other, "doc.md:2: only `$ axcomp …` is run here: ls");
 }
+
+/// A real example of the README, one figure changed by hand as a careless
+/// edit would, no longer passes.
+#[test]
+fn a_readme_example_changed_by_hand_fails() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let blocks = console_blocks("README.md", &readme).unwrap();
+    let mut block = blocks
+        .into_iter()
+        .find(|block| block.iter().any(|e| e.output.contains("13.19 ± 1.82")))
+        .expect("README shows the sample's A, 13.19 ± 1.82 µm");
+    assert_eq!(run_block(&block), Ok(block.len()));
+    for example in &mut block {
+        example.output = example.output.replace("13.19 ± 1.82", "13.18 ± 1.82");
+    }
+    let failure = run_block(&block).unwrap_err();
+    assert!(failure.contains("the output differs"), "{failure}");
+}
