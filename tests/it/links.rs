@@ -177,3 +177,23 @@ fn the_link_check_can_fail() {
     assert_eq!(broken(&file, "https://example.com/x"), None);
     assert_eq!(anchor(" Valášek (2021), and why"), "valášek-2021-and-why");
 }
+
+/// README.md is the front page: install, set-up, the demo, the workflow and
+/// where to go next, in at most 300 lines; the rest belongs in the guide.
+#[test]
+fn the_readme_stays_a_front_page() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let lines = readme.lines().count();
+    assert!(
+        lines <= 300,
+        "README.md has {lines} lines; move detail into docs/src"
+    );
+    for (what, needle) in [
+        ("install", "cargo install --path ."),
+        ("the demo", "$ axcomp demo"),
+        ("the tests", "scripts/test"),
+        ("the guide", "docs/src/SUMMARY.md"),
+    ] {
+        assert!(readme.contains(needle), "README.md lacks {what} ({needle})");
+    }
+}
