@@ -60,7 +60,7 @@ use crate::evaluate::standard::{Vdi3441, vdi_figure_name};
 use crate::evaluate::verdict::Figure;
 use crate::evaluate::{Standard, StandardUsed};
 use crate::measurement::{AxisKind, Direction, Measurement, StartEnd};
-use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts, prediction};
+use crate::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
 use crate::report::chart::chart;
 use crate::report::format::{SourcedUm, inch_beside, inch_text, um};
 use crate::report::json::source_notes;
@@ -82,7 +82,7 @@ use crate::units::{AngleUnit, DeviationUnit, LengthUnit, mm_to_um, um_to_mm};
 /// let (measurement, warnings) = read::parse_str(csv, SourceFormat::Csv).unwrap();
 /// let evaluation = evaluate(&measurement);
 /// let before = TestRecord { measurement: &measurement, evaluation: &evaluation, warnings: &warnings, budget: None };
-/// let input = ReportInput { before, after: None, table: None, diagnosis: None, limits: &[],
+/// let input = ReportInput { before, after: None, table: None, prediction: None, diagnosis: None, limits: &[],
 ///     decision: Default::default(), standard: &ISO_230_2, angle: Default::default(),
 ///     generator: "axcomp" };
 /// let html = axcomp::report::html::render(&input).unwrap();
@@ -1199,7 +1199,7 @@ fn table_view(
     plot: &dyn Fn(&str) -> Option<Plot>,
 ) -> TableView {
     let table = record.table;
-    let prediction = prediction(&input.before, table, input.standard).map(|predicted| {
+    let prediction = input.prediction.map(|predicted| {
         let iso_family = iso_keys(&predicted.figures);
         PredictionView {
             range_um: um(Some(predicted.range_um())),
