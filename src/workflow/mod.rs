@@ -2,7 +2,8 @@
 //! `evaluate`, `convert` (and the next table), the table that was active
 //! ([`table`]), the diagnosis of a re-test with the profile's known periods
 //! ([`retest`]), the acceptance report with its predicted re-test
-//! ([`report`]), and what a rotary axis supports ([`rotary`]). The CLI
+//! ([`report`]), the cross-axis table of a straightness test
+//! ([`cross_axis`]), and what a rotary axis supports ([`rotary`]). The CLI
 //! (`src/cli/`), the local web app (`serve`) and the demo all call these, so
 //! the page shows the very JSON that `--json` prints and downloads the very
 //! bytes `convert` writes.
@@ -11,6 +12,7 @@
 //! takes a measurement that is read and named (and runs left out) and the
 //! settings already parsed.
 
+pub mod cross_axis;
 pub mod report;
 pub mod retest;
 pub mod rotary;
@@ -63,6 +65,12 @@ pub enum WorkflowError {
         /// Where and why.
         error: ParseError,
     },
+    /// A cross-axis table's model.
+    #[error(transparent)]
+    Predict(#[from] crate::predict::PredictError),
+    /// Input refused, with what was expected (the message names the file).
+    #[error("{0}")]
+    Refused(String),
     /// Inputs that do not belong together.
     #[error(transparent)]
     NotTogether(#[from] crate::together::NotTogether),
