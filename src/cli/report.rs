@@ -17,7 +17,7 @@ use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::workflow::Test;
-use axcomp::workflow::report::{Report, ReportParts};
+use axcomp::workflow::report::{Report, ReportParts, generator};
 use axcomp::workflow::retest::{DiagnoseSettings, diagnosis};
 use axcomp::workflow::rotary::{self, ReportAsks};
 
@@ -217,11 +217,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         ),
         _ => None,
     };
-    let generator = format!(
-        "axcomp {} on {}",
-        env!("CARGO_PKG_VERSION"),
-        chrono::Local::now().format("%Y-%m-%d %H:%M")
-    );
+    let generator = generator(chrono::Local::now());
     let report = Report::new(ReportParts {
         after: after.as_ref(),
         table: table.as_ref().map(|(file, active)| TableRecord {

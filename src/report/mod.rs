@@ -33,3 +33,4 @@ pub mod tolerance;
 pub mod uncertainty;
 pub mod update;
 pub mod verdict;
+pub mod web;

@@ -3,8 +3,8 @@
 
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
-use serde::Serialize;
 
+use crate::report::web::ErrorJson;
 use crate::{emit, read, workflow};
 
 /// A refused request: its status and the message the page shows.
@@ -46,13 +46,9 @@ impl ApiError {
 
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
-        #[derive(Serialize)]
-        struct Body {
-            error: String,
-        }
         (
             self.status,
-            axum::Json(Body {
+            axum::Json(ErrorJson {
                 error: self.message,
             }),
         )

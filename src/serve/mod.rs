@@ -20,10 +20,15 @@
 //! its axis settings for the tables, its `[acceptance]` for the verdict, its
 //! screw lead and scale period for the diagnosis.
 //!
+//! A rotary axis gets what the CLI gives it (`workflow::rotary`): its
+//! re-test is diagnosed (in ″; no effects file, so its next table has no
+//! effects, and no residual plot, which is in µm), and the report refuses
+//! what `axcomp report` refuses.
+//!
 //! The work is the CLI's own ([`crate::workflow`]); this module only reads
 //! the form (`form.rs`, `inputs.rs`), calls the workflow (`steps.rs`, one
-//! handler per step) and answers (`present.rs`, `error.rs`). Its limits: uploads of at most [`UPLOAD_LIMIT`]
-//! bytes, kept in memory and named by their base name (no path a client
+//! handler per step) and answers (`present.rs`, `error.rs`). Its limits:
+//! uploads of at most [`UPLOAD_LIMIT`] bytes, kept in memory and named by their base name (no path a client
 //! names is ever opened, no file is written), and only requests addressed to
 //! the app from its own page ([`origin`]). Bad input is a 400 whose `error`
 //! is the CLI's message (`file:line:col: …`).

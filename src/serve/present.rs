@@ -1,56 +1,21 @@
-//! What the app answers: the JSON objects the page shows (each the CLI's
-//! own object with the plots beside it) and the downloads.
+//! What the app answers: the JSON objects the page shows
+//! (`report::web`, each the CLI's own object with the plots beside it)
+//! filled in, and the downloads.
 
 use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::{IntoResponse, Response};
 use percent_encoding::{AsciiSet, NON_ALPHANUMERIC, utf8_percent_encode};
-use serde::Serialize;
 
-use crate::emit;
+use crate::emit::{self, Controller};
+use crate::evaluate;
 use crate::report::acceptance::{ReportInput, TableRecord, charts};
 use crate::report::chart::chart;
-use crate::report::convert::ConvertJson;
-use crate::report::diagnose::DiagnoseJson;
-use crate::report::json::EvaluationJson;
 use crate::report::plot::PlotFormat;
+use crate::report::web::ConvertAnswer;
 use crate::workflow::report::{Report, ReportParts};
 use crate::workflow::{Converted, Test};
-use crate::{emit::Controller, evaluate};
 
 use super::error::ApiError;
-
-/// What the page offers to choose from.
-#[derive(Serialize)]
-pub struct OptionsJson {
-    controllers: Vec<&'static str>,
-    standards: Vec<StandardJson>,
-    upload_limit_bytes: usize,
-    version: &'static str,
-}
-
-#[derive(Serialize)]
-struct StandardJson {
-    key: &'static str,
-    name: &'static str,
-}
-
-impl OptionsJson {
-    /// The controllers, the standards, the upload limit and the version.
-    pub fn new(upload_limit_bytes: usize) -> OptionsJson {
-        OptionsJson {
-            controllers: Controller::ALL.iter().map(|c| c.name()).collect(),
-            standards: evaluate::SUPPORTED
-                .iter()
-                .map(|s| StandardJson {
-                    key: s.key(),
-                    name: s.name(),
-                })
-                .collect(),
-            upload_limit_bytes,
-            version: env!("CARGO_PKG_VERSION"),
-        }
-    }
-}
 
 /// The SVG of the chart named `name` that the report draws for `input`, if it draws one.
 pub fn svg_of(input: &ReportInput<'_>, name: &str) -> Result<Option<String>, ApiError> {
@@ -59,15 +24,6 @@ pub fn svg_of(input: &ReportInput<'_>, name: &str) -> Result<Option<String>, Api
     };
     let bytes = chart(&named.chart, PlotFormat::Svg)?;
     Ok(Some(String::from_utf8_lossy(&bytes).into_owned()))
-}
-
-/// `/api/evaluate`'s answer.
-#[derive(Serialize)]
-pub struct EvaluateAnswer {
-    /// `evaluate --json`'s object.
-    pub evaluation: EvaluationJson,
-    /// The report's deviation plot.
-    pub deviation_svg: Option<String>,
 }
 
 /// The table the page asks for: its bytes, its name, the JSON.
@@ -82,57 +38,26 @@ pub struct Table {
     pub controller: Controller,
 }
 
-/// `/api/convert`'s answer (and the next table of `/api/retest`).
-#[derive(Serialize)]
-pub struct ConvertAnswer {
-    /// `convert --json`'s object.
-    convert: ConvertJson,
-    /// The name the download gets.
-    file_name: String,
-    /// The file as text, for the preview.
-    text: String,
-    /// The report's plot of the table.
-    table_svg: Option<String>,
-}
-
-impl ConvertAnswer {
-    /// The answer for `table`.
-    pub fn new(table: &Table) -> Result<ConvertAnswer, ApiError> {
-        let text = match emit::decode_table(&table.converted.bytes) {
-            Ok((text, _)) => text,
-            Err(_) => String::from_utf8_lossy(&table.converted.bytes).into_owned(),
-        };
-        let report = Report::new(ReportParts {
-            table: Some(TableRecord {
-                table: &table.converted.table,
-                file: &table.file_name,
-                controller: table.controller,
-            }),
-            ..ReportParts::of(&table.before, &evaluate::ISO_230_2)
-        });
-        Ok(ConvertAnswer {
-            convert: table.converted.report.clone(),
-            file_name: table.file_name.clone(),
-            text,
-            table_svg: svg_of(&report.input(), "table")?,
-        })
-    }
-}
-
-/// `/api/retest`'s answer.
-#[derive(Serialize)]
-pub struct RetestAnswer {
-    /// `diagnose --json`'s object.
-    pub diagnosis: DiagnoseJson,
-    /// What `diagnose --write-effects` writes (`null` where it writes none: a rotary axis).
-    pub effects_toml: Option<String>,
-    /// The report's plot of the residual (`null` where the report has none: a rotary axis).
-    pub residual_svg: Option<String>,
-    /// The next table (`convert AFTER --existing TABLE --effects E.toml`), when a table was given.
-    pub next: Option<ConvertAnswer>,
-    /// Every warning of the two tests, as `diagnose` prints them: the
-    /// readers', the evaluations' and the doubts of the pair, each naming its file.
-    pub warnings: Vec<String>,
+/// The answer for `table`: `convert --json`, the file's text, the table's plot.
+pub fn convert_answer(table: &Table) -> Result<ConvertAnswer, ApiError> {
+    let text = match emit::decode_table(&table.converted.bytes) {
+        Ok((text, _)) => text,
+        Err(_) => String::from_utf8_lossy(&table.converted.bytes).into_owned(),
+    };
+    let report = Report::new(ReportParts {
+        table: Some(TableRecord {
+            table: &table.converted.table,
+            file: &table.file_name,
+            controller: table.controller,
+        }),
+        ..ReportParts::of(&table.before, &evaluate::ISO_230_2)
+    });
+    Ok(ConvertAnswer {
+        convert: table.converted.report.clone(),
+        file_name: table.file_name.clone(),
+        text,
+        table_svg: svg_of(&report.input(), "table")?,
+    })
 }
 
 /// What a file name keeps in `filename*` (RFC 5987's attr-char less a few):

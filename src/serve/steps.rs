@@ -11,9 +11,10 @@ use crate::effects::Effect;
 use crate::report::acceptance::TableRecord;
 use crate::report::diagnose::DiagnoseJson;
 use crate::report::html;
+use crate::report::web::{ConvertAnswer, EvaluateAnswer, OptionsJson, RetestAnswer};
 use crate::together::{Input, Pairing, check_together};
 use crate::units::AngleUnit;
-use crate::workflow::report::{Report, ReportParts};
+use crate::workflow::report::{Report, ReportParts, generator};
 use crate::workflow::retest::{DiagnoseSettings, diagnosis, effects_file};
 use crate::workflow::rotary::{self, ReportAsks, Use};
 use crate::workflow::table::{WriteAs, recorded_axis, write_options};
@@ -26,9 +27,7 @@ use super::inputs::{
     active_table, controller, decision, file_label, grid, limits, linuxcnc_type, measurement,
     profile, standard, test,
 };
-use super::present::{
-    ConvertAnswer, EvaluateAnswer, OptionsJson, RetestAnswer, Table, attachment, svg_of,
-};
+use super::present::{Table, attachment, convert_answer, svg_of};
 
 /// Runs the blocking work off the async threads (a large test takes a
 /// while) and reads the form first.
@@ -140,7 +139,7 @@ fn table_of(form: &Form, field: &str, effects: &[Effect]) -> Result<Table, ApiEr
 /// `POST /api/convert`: `convert --json`, the file's text and the table's plot.
 pub async fn api_convert(multipart: Multipart) -> Result<axum::Json<ConvertAnswer>, ApiError> {
     answer(multipart, |form| {
-        ConvertAnswer::new(&table_of(&form, "file", &[])?)
+        convert_answer(&table_of(&form, "file", &[])?)
     })
     .await
     .map(axum::Json)
@@ -273,7 +272,7 @@ pub async fn api_retest(multipart: Multipart) -> Result<axum::Json<RetestAnswer>
         Ok(RetestAnswer {
             warnings,
             residual_svg,
-            next: next.as_ref().map(ConvertAnswer::new).transpose()?,
+            next: next.as_ref().map(convert_answer).transpose()?,
             diagnosis: retest.report,
             effects_toml: retest.effects.map(|(text, _)| text),
         })
@@ -338,11 +337,7 @@ pub async fn api_report(multipart: Multipart) -> Result<Response, ApiError> {
         let file = table
             .as_ref()
             .map(|((name, _), _)| name.display().to_string());
-        let generator = format!(
-            "axcomp {} on {}",
-            env!("CARGO_PKG_VERSION"),
-            chrono::Local::now().format("%Y-%m-%d %H:%M")
-        );
+        let generator = generator(chrono::Local::now());
         let report = Report::new(ReportParts {
             after: after.as_ref(),
             table: table

@@ -122,14 +122,13 @@ pub fn evaluation_report(
     // The budget is the laser's, for lengths, and limits are µm: a rotary
     // axis has neither yet.
     rotary::check(measurement, &[(rotary::Use::Limits, !limits.is_empty())])?;
-    let budget = match measurement.kind() {
-        AxisKind::Rotary => None,
-        AxisKind::Linear => budget_of(measurement, equipment, warnings)?,
+    let budget = match rotary::allows(measurement, rotary::Use::Uncertainty) {
+        true => budget_of(measurement, equipment, warnings)?,
+        false => None,
     };
-    let verdict = match measurement.kind() {
-        AxisKind::Rotary => None,
-        AxisKind::Linear => verdict::judge(&evaluation, limits, decision, budget.as_ref()),
-    };
+    let verdict = rotary::allows(measurement, rotary::Use::Limits)
+        .then(|| verdict::judge(&evaluation, limits, decision, budget.as_ref()))
+        .flatten();
     let mut report =
         EvaluationJson::from_evaluation(measurement, evaluation, exclude_runs, warnings, angle);
     report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
@@ -339,9 +338,9 @@ impl Test {
     ) -> Result<Test, WorkflowError> {
         let evaluation = evaluate_with(&measurement, standard);
         warnings.extend(evaluation.warnings.iter().cloned());
-        let budget = match measurement.kind() {
-            AxisKind::Linear => budget_of(&measurement, equipment, &mut warnings)?,
-            AxisKind::Rotary => None,
+        let budget = match rotary::allows(&measurement, rotary::Use::Uncertainty) {
+            true => budget_of(&measurement, equipment, &mut warnings)?,
+            false => None,
         };
         Ok(Test {
             measurement,

@@ -87,6 +87,16 @@ impl<'a> Report<'a> {
     }
 }
 
+/// The report's "made by" line: axcomp's version and `when` (the caller
+/// reads the clock; the library reads none).
+pub fn generator(when: chrono::DateTime<chrono::Local>) -> String {
+    format!(
+        "axcomp {} on {}",
+        env!("CARGO_PKG_VERSION"),
+        when.format("%Y-%m-%d %H:%M")
+    )
+}
+
 /// Points at which the prediction is sampled: fine enough that linear
 /// interpolation between table points shows as it is.
 const PREDICTION_SAMPLES: usize = 600;

@@ -131,6 +131,12 @@ pub fn supports(what: Use) -> bool {
     refusal(what).is_none()
 }
 
+/// Whether `measurement` may have `what`: a linear axis always, a rotary
+/// axis where [`ROTARY`] says so.
+pub fn allows(measurement: &Measurement, what: Use) -> bool {
+    measurement.kind() == AxisKind::Linear || supports(what)
+}
+
 fn refusal(what: Use) -> Option<&'static str> {
     ROTARY
         .iter()

@@ -447,6 +447,61 @@ fn a_report_assembled_in_the_web_app_is_caught() {
     );
 }
 
+/// Where a file outside `src/report/` derives `Serialize`: the wire
+/// structs (whose keys are a promise to scripts) live in `report`
+/// (ARCHITECTURE.md, "Serialisation"). Reading a file (`Deserialize`) is
+/// anyone's.
+fn wire_structs_outside_report(files: &[(PathBuf, String)]) -> Vec<String> {
+    let mut found = Vec::new();
+    for (path, text) in files {
+        if path.starts_with("report") {
+            continue;
+        }
+        let derives_serialize = code_of(text).lines().any(|line| {
+            line.trim_start()
+                .strip_prefix("#[derive(")
+                .is_some_and(|list| {
+                    list.trim_end_matches(")]")
+                        .split(',')
+                        .any(|name| matches!(name.trim(), "Serialize" | "serde::Serialize"))
+                })
+        });
+        if derives_serialize {
+            found.push(format!(
+                "src/{}: derives Serialize; wire structs live in src/report/",
+                path.display()
+            ));
+        }
+    }
+    found
+}
+
+#[test]
+fn only_report_derives_serialize() {
+    let found = wire_structs_outside_report(&source_tree());
+    assert!(found.is_empty(), "\n{}", found.join("\n"));
+}
+
+#[test]
+fn a_wire_struct_outside_report_is_caught() {
+    let files = tree(&[
+        (
+            "serve/mod.rs",
+            "#[derive(Debug, Serialize)]\nstruct Answer {}",
+        ),
+        ("emit/profile.rs", "#[derive(Deserialize)]\nstruct File {}"),
+        (
+            "report/web.rs",
+            "#[derive(Serialize)]\npub struct Answer {}",
+        ),
+        ("cli/mod.rs", "// #[derive(Serialize)]\nfn f() {}"),
+    ]);
+    assert_eq!(
+        wire_structs_outside_report(&files),
+        ["src/serve/mod.rs: derives Serialize; wire structs live in src/report/"]
+    );
+}
+
 fn layers() -> BTreeMap<String, usize> {
     layers_from(
         "<!-- layers -->\n- 0: `units`\n- 1: `compensate`, `model`: peers\n- 2: `diagnose`\n<!-- /layers -->",

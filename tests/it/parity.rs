@@ -27,7 +27,7 @@ fn cli(dir: &Path, args: &[&str]) -> crate::util::Run {
 }
 
 /// The CLI's JSON on stdout; the run must succeed.
-fn cli_json(dir: &Path, args: &[&str]) -> serde_json::Value {
+pub(crate) fn cli_json(dir: &Path, args: &[&str]) -> serde_json::Value {
     let run = cli(dir, args);
     assert_eq!(run.code, 0, "axcomp {args:?}: {}", run.stderr);
     serde_json::from_str(&run.stdout).unwrap_or_else(|e| panic!("{e}: {}", run.stdout))
@@ -48,7 +48,7 @@ fn ok(answer: &Response, what: &str) {
 }
 
 /// The files of `dir` named `names`, as a form's `field` each.
-fn form_of(dir: &Path, fields: &[(&str, &str)]) -> Form {
+pub(crate) fn form_of(dir: &Path, fields: &[(&str, &str)]) -> Form {
     fields.iter().fold(Form::new(), |form, (field, name)| {
         form.file(field, name, &read(&dir.join(name)))
     })
@@ -239,27 +239,26 @@ fn the_report_of_a_rotary_axis_refuses_alike() {
     );
 }
 
-/// One re-test, one diagnosis: `diagnose --machine`, `report --diagnose
-/// --machine` and the web app's report with the profile all search the
-/// profile's screw lead first and find the planted 15 mm lead error there
-/// (seed 001's VC1810, Tab. 7; `diagnose_periodic`'s seed 3). The report
-/// passed no known periods before, and found the error off the lead.
-#[test]
-fn a_retest_gets_one_diagnosis_with_the_profiles_screw_lead() {
-    let app = App::new();
-    let work = tempfile::tempdir().unwrap();
+/// The note a diagnosis gives a periodic error found at the profile's lead.
+pub(crate) const LEAD_NOTE: &str = "the screw lead the machine profile gives (15 mm)";
+
+/// Into `dir`: a first test, its TNC 640 table `X.COM` and a re-test with a
+/// planted 15 mm lead error (`diagnose_periodic`'s seed 3), and seed 001's
+/// VC1810 profile `vc1810.toml`, whose lead is 15 mm on every axis (Tab. 7).
+pub(crate) fn screw_lead_retest(dir: &Path) {
     let case = crate::diagnose_periodic::case(15.0, 3, true);
-    let truth = work.path().join("truth.toml");
+    let truth = dir.join("truth.toml");
     std::fs::write(&truth, &case.truth).unwrap();
-    crate::util::synth_loop_files(work.path(), &truth, Some("3"));
-    std::fs::copy(
-        root().join("fixtures/machines/vc1810.toml"),
-        work.path().join("vc1810.toml"),
-    )
-    .unwrap();
-    let note = "the screw lead the machine profile gives (15 mm)";
+    crate::util::synth_loop_files(dir, &truth, Some("3"));
+    let profile = root().join("fixtures/machines/vc1810.toml");
+    std::fs::copy(profile, dir.join("vc1810.toml")).unwrap();
+}
+
+/// `diagnose --json` of [`screw_lead_retest`] with the profile, and its
+/// periodic effect, which must be found at the lead with [`LEAD_NOTE`].
+pub(crate) fn diagnose_with_the_lead(dir: &Path) -> serde_json::Value {
     let diagnosis = cli_json(
-        work.path(),
+        dir,
         &[
             "diagnose",
             "--after",
@@ -280,7 +279,21 @@ fn a_retest_gets_one_diagnosis_with_the_profiles_screw_lead() {
         .find(|e| e["kind"] == "periodic")
         .unwrap_or_else(|| panic!("{diagnosis:#}"));
     assert_eq!(periodic["params"]["period_mm"], 15.0);
-    assert!(periodic["warnings"].to_string().contains(note));
+    assert!(periodic["warnings"].to_string().contains(LEAD_NOTE));
+    diagnosis
+}
+
+/// One re-test, one diagnosis: `diagnose --machine`, `report --diagnose
+/// --machine` and the web app's report with the profile all search the
+/// profile's screw lead first and find the planted 15 mm lead error there.
+/// The report passed no known periods before, and found the error off the
+/// lead, without the note.
+#[test]
+fn a_retest_gets_one_diagnosis_with_the_profiles_screw_lead() {
+    let app = App::new();
+    let work = tempfile::tempdir().unwrap();
+    screw_lead_retest(work.path());
+    diagnose_with_the_lead(work.path());
     let run = cli(
         work.path(),
         &[
@@ -300,7 +313,7 @@ fn a_retest_gets_one_diagnosis_with_the_profiles_screw_lead() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     let page = std::fs::read_to_string(work.path().join("r.html")).unwrap();
     assert!(
-        page.contains(note),
+        page.contains(LEAD_NOTE),
         "report --diagnose --machine: no screw lead"
     );
     let answer = app.post(

@@ -19,6 +19,7 @@ use crate::util::{root, without_time};
 #[test]
 fn the_server_starts_and_answers_on_its_port() {
     let server = Server::start();
+    assert_eq!(server.url(), format!("http://{}/", server.host));
     let page = request(&server.host, "GET", "/", &[], Vec::new());
     assert_eq!(page.status, 200);
     assert!(page.text().contains("<script src=\"/app.js\""));
@@ -594,53 +595,26 @@ fn a_bad_profile_is_refused_with_its_position() {
 fn the_retest_with_a_profile_is_what_diagnose_prints_with_it() {
     let server = App::new();
     let work = tempfile::tempdir().unwrap();
-    let case = crate::diagnose_periodic::case(15.0, 3, true);
-    let truth = work.path().join("truth.toml");
-    std::fs::write(&truth, &case.truth).unwrap();
-    crate::util::synth_loop_files(work.path(), &truth, Some("3"));
-    let profile = root().join("fixtures/machines/vc1810.toml");
-    std::fs::copy(&profile, work.path().join("vc1810.toml")).unwrap();
-    let file = |name: &str| read(&work.path().join(name));
+    crate::parity::screw_lead_retest(work.path());
     let answer = server.post(
         "/api/retest",
-        Form::new()
-            .file("file", "before.rtl", &file("before.rtl"))
-            .file("after", "after.rtl", &file("after.rtl"))
-            .file("table", "X.COM", &file("X.COM"))
-            .file("machine", "vc1810.toml", &read(&profile)),
+        crate::parity::form_of(
+            work.path(),
+            &[
+                ("file", "before.rtl"),
+                ("after", "after.rtl"),
+                ("table", "X.COM"),
+                ("machine", "vc1810.toml"),
+            ],
+        ),
         &[],
     );
     assert_eq!(answer.status, 200, "{}", answer.text());
-    let cli: serde_json::Value = serde_json::from_slice(&cli_in(
-        work.path(),
-        &[
-            "diagnose",
-            "--after",
-            "after.rtl",
-            "--before",
-            "before.rtl",
-            "--table",
-            "X.COM",
-            "--machine",
-            "vc1810.toml",
-            "--json",
-        ],
-    ))
-    .unwrap();
+    // The CLI's diagnosis finds the lead error at exactly 15 mm and says
+    // it is the profile's lead (`parity::diagnose_with_the_lead`).
+    let cli = crate::parity::diagnose_with_the_lead(work.path());
     let diagnosis = &answer.json()["diagnosis"];
     assert_eq!(*diagnosis, cli);
-    let periodic = diagnosis["effects"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["kind"] == "periodic")
-        .unwrap_or_else(|| panic!("{diagnosis:#}"));
-    assert_eq!(periodic["params"]["period_mm"], 15.0);
-    assert!(
-        periodic["warnings"]
-            .to_string()
-            .contains("the screw lead the machine profile gives (15 mm)")
-    );
 }
 
 /// The page's re-test refuses what `diagnose` refuses (a re-test of another
