@@ -16,7 +16,12 @@ use axcomp::measurement::Direction;
 use crate::util::{assert_golden, axcomp, root, shared_data};
 
 /// The golden files `golden_files_read_back` writes (`formats/fanuc/golden/`).
-pub const GOLDENS: &[&str] = &["synth-x-HM100TS.TXT", "sample-mean.TXT"];
+pub const GOLDENS: &[&str] = &[
+    "synth-x-HM100TS.TXT",
+    "sample-mean.TXT",
+    "synth-x-bidirectional.TXT",
+    "synth-x-HM100TS-rescaled.TXT",
+];
 
 pub(crate) fn data(name: &str) -> String {
     shared_data(&format!("fanuc/HM100TS__{name}"))

@@ -11,7 +11,7 @@ use std::path::Path;
 use axcomp::measurement::{Direction, Measurement};
 
 use crate::fanuc::{absolute, data, increments, ok, truth, update_x};
-use crate::util::axcomp;
+use crate::util::{axcomp, root};
 
 /// The mean reading of `direction` (all directions: `None`) at target `i`, µm.
 fn mean_um(m: &Measurement, i: usize, direction: Option<Direction>) -> f64 {
@@ -352,4 +352,115 @@ fn a_rotary_axis_turn_sums_to_zero_and_its_backlash_is_in_degrees() {
     // The real file's own B turn sums to zero (10 at 310, −10 at 311).
     let real = increments(&std::fs::read_to_string(data("PITCH.TXT")).unwrap());
     assert_eq!((301..=312).map(|n| real[&n]).sum::<i64>(), 0);
+}
+
+/// The golden files of the new output forms (`formats/fanuc/golden/`),
+/// each read back: the bidirectional table in axcomp's numbering, and the
+/// synthetic X at HM100TS's points rescaled to 3623 = 1.
+#[test]
+fn the_new_golden_files_read_back() {
+    use axcomp::emit::fanuc::AxisParameters;
+    use axcomp::emit::{EmitOptions, MachineProfile};
+    let directory = tempfile::tempdir().unwrap();
+    let path = |name: &str| directory.path().join(name).display().to_string();
+    ok(&[
+        "synth",
+        "--truth",
+        &truth(),
+        "-o",
+        &path("x.rtl"),
+        "--seed",
+        "30",
+    ]);
+    // Bidirectional without a backup: X's 26 targets −1000 … 0 mm are
+    // points 0 … 25 (3620 = 0 at −1000 mm, 3621 = 1, 3622 = 25), the ↓
+    // table right after (3626 = 26 … 50), 1 µm units (0.001 mm, 3623 = 1).
+    let out = path("BIDIR.TXT");
+    let run = ok(&[
+        "convert",
+        &path("x.rtl"),
+        "--controller",
+        "fanuc",
+        "--mode",
+        "bidirectional",
+        "-o",
+        &out,
+        "--json",
+        "-q",
+    ]);
+    let written = std::fs::read_to_string(&out).unwrap();
+    crate::util::assert_golden(
+        &written,
+        &root().join("formats/fanuc/golden/synth-x-bidirectional.TXT"),
+    );
+    let values = increments(&written);
+    assert_eq!(values.len(), 51);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let activation = json["activation"].as_str().unwrap();
+    let at_reference: i64 = activation
+        .split("3627 = ")
+        .nth(1)
+        .and_then(|rest| rest.split([',', ' ', ')']).next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{activation}"));
+    assert!(activation.contains("3605#0 = 1, 3626 = 26"), "{activation}");
+    let mut options = EmitOptions::for_axis(&MachineProfile::default(), "X", "").unwrap();
+    let mut p = AxisParameters::default_for("X", 26, 40.0, 0, -1000.0);
+    p.bidirectional = true;
+    p.negative_first = 26;
+    p.reference_negative = at_reference;
+    options.axes[0].fanuc = Some(p);
+    let (_, table) = axcomp::emit::read_any(&written, &options, None).unwrap();
+    // The ↓ curve at −1000 mm is 3627 units of 1 µm from the ↑ one: the
+    // ↓ absolute compensation there is 3627 (its error, −3627 µm).
+    let gap = table.value_at(-1000.0, Direction::Down) - table.value_at(-1000.0, Direction::Up);
+    assert!((gap * 1000.0 + at_reference as f64).abs() < 1e-9, "{gap}");
+    // By hand from the file: the ↓ absolute at point 25 is 3627 + Σ 26 … 50.
+    let down_25 = at_reference + (26..=50).map(|n| values[&n]).sum::<i64>();
+    assert!((table.value_at(0.0, Direction::Down) * 1000.0 + down_25 as f64).abs() < 1e-9);
+    // Rescaled, with HM100TS's parameters (no --existing: a new file):
+    // X's points 0 … 41 in units of 0.0001 mm (3623 = 1).
+    let (coarse, fine) = (path("PITCH.TXT"), path("FINE.TXT"));
+    let run = ok(&[
+        "convert",
+        &path("x.rtl"),
+        "--controller",
+        "fanuc",
+        "--fanuc-parameters",
+        &data("CNC-PARA.TXT"),
+        "-o",
+        &coarse,
+        "--fanuc-rescaled",
+        &fine,
+    ]);
+    assert!(
+        run.stdout.contains("set 3623 of axis X to 1"),
+        "{}",
+        run.stdout
+    );
+    let written = std::fs::read_to_string(&fine).unwrap();
+    crate::util::assert_golden(
+        &written,
+        &root().join("formats/fanuc/golden/synth-x-HM100TS-rescaled.TXT"),
+    );
+    // Read back at 3623 = 1, it is the golden at 3623 = 10 to half its unit.
+    let backup = std::fs::read_to_string(data("CNC-PARA.TXT")).unwrap();
+    let backup = axcomp::emit::fanuc::ParameterBackup::parse(&backup, "CNC-PARA.TXT").unwrap();
+    let x = backup.axis("X").unwrap();
+    let x_fine = AxisParameters {
+        magnification: 1,
+        ..x.clone()
+    };
+    let a = axcomp::emit::fanuc::read(&std::fs::read_to_string(&coarse).unwrap(), &x).unwrap();
+    let b = axcomp::emit::fanuc::read(&written, &x_fine).unwrap();
+    assert_eq!(a.positions_mm, b.positions_mm);
+    let up =
+        |t: &axcomp::compensate::CompensationTable| t.values.for_direction(Direction::Up).to_vec();
+    for (x, y) in up(&a).iter().zip(up(&b)) {
+        assert!((x - y).abs() <= 0.0005 + 1e-12, "{x} {y}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(&coarse).unwrap(),
+        std::fs::read_to_string(root().join("formats/fanuc/golden/synth-x-HM100TS.TXT")).unwrap()
+    );
 }

@@ -128,6 +128,8 @@ pub fn activation(file_name: &str, table: &CompensationTable, options: &EmitOpti
 
 #[cfg(test)]
 mod tests {
+    use proptest::prelude::Just;
+
     use super::*;
     use crate::compensate::TableValues;
 
@@ -315,6 +317,93 @@ mod tests {
         options.axes[0].fanuc = Some(AxisParameters::default_for("X", 3, 100.0, 0, 0.0));
         let error = write(&t, &options).unwrap_err().to_string();
         assert!(error.contains("set 3605#0 = 1 and 3626"), "{error}");
+    }
+
+    /// What `fuzz/fuzz_targets/read_fanuc.rs` asks of any input, on
+    /// backups and pitch files built from arbitrary numbers (cargo-fuzz
+    /// mutates bytes; this reaches the arithmetic on parsed values): no
+    /// panic; a pitch file that reads takes its own table back with
+    /// `update`, and `rescaled` of it does not panic.
+    fn fuzz_body(backup: &str, pitch: &str) {
+        if let Ok(backup) = ParameterBackup::parse(backup, "fuzz") {
+            for (_, name) in backup.axis_names() {
+                if let Ok(p) = backup.axis(&name) {
+                    round_trip(pitch, &p);
+                }
+            }
+        }
+    }
+
+    fn round_trip(pitch: &str, p: &AxisParameters) {
+        let Ok(table) = read(pitch, p) else { return };
+        let mut options = EmitOptions::for_axis(&Default::default(), "X", "").unwrap();
+        options.axes[0].fanuc = Some(p.clone());
+        if let Ok(updated) = update(pitch, &table, &options) {
+            let back = read(&updated, p).expect("an updated file reads back");
+            assert_eq!(back.positions_mm, table.positions_mm);
+        }
+        let _ = rescaled(Some(pitch), &table, &options, None);
+    }
+
+    fn parameter_line(number: u32, value: &str) -> String {
+        format!("N{number:05}Q1A1P{value}\n")
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+        #[test]
+        fn the_fuzz_body_holds_on_arbitrary_numbers(
+            points in proptest::collection::vec(-3i64..1600, 6),
+            magnification in proptest::prop_oneof![Just(10i64), -2i64..200, proptest::num::i64::ANY],
+            interval in proptest::prop_oneof![Just("40.0".to_string()), "-?[0-9]{1,3}(\\.[0-9]{1,3})?", "[0-9]{20,40}"],
+            cmr in 0i64..130,
+            bits in "[01]{8}",
+            extreme in proptest::prop_oneof![Just(i64::MIN), Just(i64::MAX), -5i64..5],
+            values in proptest::collection::vec(proptest::prop_oneof![-200i64..200, Just(99_999_999i64), Just(i64::MIN)], 0..140),
+        ) {
+            let mut backup = String::from("%\n");
+            backup.push_str(&parameter_line(1020, "88"));
+            backup.push_str(&parameter_line(1820, &cmr.to_string()));
+            backup.push_str(&parameter_line(1013, "00000000"));
+            backup.push_str("N01001Q1L1P00000000\n");
+            backup.push_str(&parameter_line(1006, &bits));
+            backup.push_str(&parameter_line(3605, &bits));
+            for (k, number) in [3620u32, 3621, 3622, 3626, 3627].iter().enumerate() {
+                let value = if k == 4 { extreme } else { points[k] };
+                backup.push_str(&parameter_line(*number, &value.to_string()));
+            }
+            backup.push_str(&parameter_line(3623, &magnification.to_string()));
+            backup.push_str(&parameter_line(3624, &interval));
+            backup.push_str(&parameter_line(3625, &points[5].to_string()));
+            backup.push_str(&parameter_line(1240, "0.0"));
+            backup.push_str(&parameter_line(1851, &extreme.to_string()));
+            backup.push_str(&parameter_line(1852, "0"));
+            backup.push('%');
+            let mut pitch = String::from("%\n");
+            for (n, v) in values.iter().enumerate() {
+                pitch.push_str(&data_line(n as i64, *v));
+                pitch.push('\n');
+            }
+            pitch.push('%');
+            fuzz_body(&backup, &pitch);
+            // And the bounds the reader has for any number in a parameter.
+            let extreme_backup = backup.replace(&parameter_line(3621, &points[1].to_string()), &parameter_line(3621, &extreme.to_string()));
+            fuzz_body(&extreme_backup, &pitch);
+        }
+    }
+
+    #[test]
+    fn the_smallest_integer_is_refused_not_negated() {
+        // Found running the fuzz target's body: |i64::MIN| overflowed.
+        let error = parse_pitch("%\nN10000Q0P-9223372036854775808\n%").unwrap_err();
+        assert_eq!((error.position.line, error.position.column), (2, 10));
+        let backup = "%\nN01020Q1A1P88\nN03621Q1A1P-9223372036854775808\n%";
+        let backup = ParameterBackup::parse(backup, "P").unwrap();
+        let error = backup.integer(3621, Some(('A', 1))).unwrap_err();
+        assert!(
+            error.contains("P:3:12: parameter 3621: expected an integer of at most 8 digits"),
+            "{error}"
+        );
     }
 
     fn increments_of(text: &str) -> Vec<(i64, i64)> {

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use super::MAX_POINT;
+use super::{MAX_POINT, READ_LIMIT};
 use crate::error::ParseError;
 use crate::measurement::Direction;
 use crate::read::text::{self, Line};
@@ -214,14 +214,21 @@ impl ParameterBackup {
             })
     }
 
-    fn integer(&self, number: u32, index: Option<(char, usize)>) -> Result<i64, String> {
+    /// An integer parameter: \[reconstructed\] at most 8 digits, as every
+    /// one of the real backup (beyond, the point arithmetic would overflow).
+    pub(super) fn integer(&self, number: u32, index: Option<(char, usize)>) -> Result<i64, String> {
         let entry = self.value(number, index)?;
-        entry.value.parse().map_err(|_| {
-            format!(
-                "{}:{}:{}: parameter {number:04}: expected an integer, found {:?}",
-                self.source, entry.line, entry.column, entry.value
-            )
-        })
+        entry
+            .value
+            .parse()
+            .ok()
+            .filter(|v: &i64| v.unsigned_abs() <= READ_LIMIT as u64)
+            .ok_or_else(|| {
+                format!(
+                    "{}:{}:{}: parameter {number:04}: expected an integer of at most 8 digits, found {:?}",
+                    self.source, entry.line, entry.column, entry.value
+                )
+            })
     }
 
     fn real(&self, number: u32, index: Option<(char, usize)>) -> Result<f64, String> {

@@ -55,7 +55,7 @@ pub(super) fn parse_pitch(
         let value: i64 = value_text
             .parse()
             .ok()
-            .filter(|v: &i64| v.abs() <= READ_LIMIT)
+            .filter(|v: &i64| v.unsigned_abs() <= READ_LIMIT as u64)
             .ok_or_else(|| line.expected_at(value_text, "an integer value of at most 8 digits"))?;
         if number < DATA_NUMBER_OFFSET {
             return Err(line.error_at(
