@@ -24,6 +24,16 @@ fn mean_um(m: &Measurement, i: usize, direction: Option<Direction>) -> f64 {
     readings.iter().sum::<f64>() / readings.len() as f64 * 1000.0
 }
 
+/// The 3627 the activation line says to set.
+fn setting_3627(activation: &str) -> i64 {
+    activation
+        .split("3627 = ")
+        .nth(1)
+        .and_then(|rest| rest.split([',', ' ', ')']).next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{activation}"))
+}
+
 fn read(path: &str) -> Measurement {
     axcomp::read::read_path(Path::new(path), None)
         .unwrap()
@@ -86,12 +96,7 @@ fn bidirectional_compensation_needs_3605_and_goes_to_3626() {
     let (after, run) = update_x(directory.path(), &parameters, "31", &flags);
     let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
     let activation = json["activation"].as_str().unwrap();
-    let reference_negative: i64 = activation
-        .split("3627 = ")
-        .nth(1)
-        .and_then(|rest| rest.split([',', ' ', ')']).next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("{activation}"));
+    let reference_negative = setting_3627(activation);
     assert!(activation.contains("3605#0 = 1, 3626 = 50"), "{activation}");
     assert!(
         activation.contains("leave them as they were"),
@@ -397,12 +402,7 @@ fn the_new_golden_files_read_back() {
     assert_eq!(values.len(), 51);
     let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
     let activation = json["activation"].as_str().unwrap();
-    let at_reference: i64 = activation
-        .split("3627 = ")
-        .nth(1)
-        .and_then(|rest| rest.split([',', ' ', ')']).next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("{activation}"));
+    let at_reference = setting_3627(activation);
     assert!(activation.contains("3605#0 = 1, 3626 = 26"), "{activation}");
     let mut options = EmitOptions::for_axis(&MachineProfile::default(), "X", "").unwrap();
     let mut p = AxisParameters::default_for("X", 26, 40.0, 0, -1000.0);
