@@ -35,6 +35,7 @@ mod model;
 mod numbers;
 mod outputs;
 mod page;
+mod parity;
 mod pixels;
 mod predict;
 mod read_api_pos;
