@@ -24,6 +24,7 @@ mod evaluate_ecmc;
 mod fagor;
 mod fagor_update;
 mod fanuc;
+mod fanuc_modes;
 mod flags;
 mod generated_docs;
 mod http;
