@@ -82,6 +82,7 @@ impl LogArgs {
         let options = LogOptions {
             drift: self.drift.clone(),
             sample_interval_s: self.sample_interval,
+            drift_optional: false,
         };
         load(path, |text| thermal::parse_log(text, &options))
     }
@@ -260,19 +261,13 @@ fn fit(args: &FitArgs) -> Result<()> {
 
 fn apply(args: &ApplyArgs) -> Result<()> {
     let model = load(&args.model, ThermalModel::from_toml)?;
-    let log_args = LogArgs {
+    // A log without the model's drift column is run for the prediction alone.
+    let options = LogOptions {
         drift: Some(model.fit.drift.clone()),
-        sample_interval: args.sample_interval,
+        sample_interval_s: args.sample_interval,
+        drift_optional: true,
     };
-    let log = match log_args.read(&args.log) {
-        Ok(log) => log,
-        // A log without the drift column is run for the prediction alone.
-        Err(_) => LogArgs {
-            drift: None,
-            sample_interval: args.sample_interval,
-        }
-        .read(&args.log)?,
-    };
+    let log = load(&args.log, |text| thermal::parse_log(text, &options))?;
     let applied = thermal::apply(&model, &log).map_err(|e| in_file_thermal(&args.log, e))?;
     write_plot(
         args.plot.as_deref(),

@@ -18,3 +18,22 @@ fn lag_is_the_exact_first_order_step() {
     lag(&values, &times, 0.0, &mut out);
     assert_eq!(out, values);
 }
+
+#[test]
+fn drift_column_optional_reads_a_log_without_it_once() {
+    let text = "time [s],T1\n0,20\n60,20.5\n";
+    let mut options = LogOptions {
+        drift: Some("d".to_string()),
+        sample_interval_s: None,
+        drift_optional: false,
+    };
+    let refused = parse_log(text, &options).unwrap_err();
+    assert_eq!((refused.position.line, refused.position.column), (1, 1));
+    options.drift_optional = true;
+    let log = parse_log(text, &options).unwrap();
+    assert_eq!(log.drift, None);
+    assert_eq!(log.sensors[0].celsius, [20.0, 20.5]);
+    // With the column present, it is the drift.
+    let log = parse_log("time [s],d,T1\n0,0,20\n60,1.5,20.5\n", &options).unwrap();
+    assert_eq!(log.drift.unwrap().um, [0.0, 1.5]);
+}
