@@ -31,6 +31,7 @@
 
 mod form;
 pub mod origin;
+mod thermal;
 
 use std::net::{SocketAddr, TcpListener};
 use std::sync::Arc;
@@ -115,6 +116,7 @@ pub fn app(addr: SocketAddr) -> Router {
         .route("/api/table", post(api_table))
         .route("/api/retest", post(api_retest))
         .route("/api/report", post(api_report))
+        .route("/thermal", get(thermal::form).post(thermal::submit))
         .layer(DefaultBodyLimit::max(UPLOAD_LIMIT))
         .layer(middleware::from_fn_with_state(allowed, guard))
 }
