@@ -145,12 +145,18 @@ pub struct FitArgs {
     pub exclude: Vec<String>,
     /// The reference sensor: each term is a sensor's rise over it (the
     /// measuring loop's other end, e.g. the table), so a uniform change of
-    /// the loop's temperature moves nothing.
+    /// the loop's temperature moves nothing. `auto`: each sensor tried as
+    /// the reference (and none), the one that predicts best kept.
     #[arg(long, value_name = "SENSOR")]
     pub reference: Option<String>,
     /// At most this many sensors (the reference aside).
     #[arg(long = "max-sensors", value_name = "N", default_value_t = 4)]
     pub max_sensors: usize,
+    /// How the cross-validation predicts its blocks: blocked (each from all
+    /// the others) or forward (each from the blocks before it only: what
+    /// the model does on the machine, predicting the hours after its fit).
+    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = ["blocked", "forward"])]
+    pub validation: String,
     /// Write the drift, the model and the residual against time (.svg or .png).
     #[arg(long = "plot", value_name = "FILE", help_heading = "Output")]
     pub plot: Option<PathBuf>,
@@ -238,8 +244,12 @@ fn fit(args: &FitArgs) -> Result<()> {
     let mut options = FitOptions::over(rows);
     options.sensors = args.sensors.clone();
     options.exclude = args.exclude.clone();
-    options.reference = args.reference.clone();
+    options.auto_reference = args.reference.as_deref() == Some("auto");
+    options.reference = args.reference.clone().filter(|r| r != "auto");
     options.max_sensors = args.max_sensors;
+    if args.validation == "forward" {
+        options.validation = thermal::Validation::Forward;
+    }
     let model = thermal::fit(&log, &options).map_err(|e| in_file_thermal(&args.log, e))?;
     write_new(
         &args.output,

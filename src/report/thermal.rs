@@ -10,7 +10,7 @@ use crate::diagnose::thermal::{RecordedChange, ThermalShare};
 use crate::report::chart::{Chart, Mark, Rgb, Series, chart};
 use crate::report::format::esc;
 use crate::report::plot::{PlotError, PlotFormat};
-use crate::thermal::{Application, Iso230_3, Study, ThermalLog, ThermalModel};
+use crate::thermal::{Application, Iso230_3, Study, ThermalLog, ThermalModel, Validation};
 
 /// The model file: `[fit]` (what it was fitted on) and one `[[term]]` per
 /// lagged sensor; `thermal::ThermalModel::from_toml` reads it back.
@@ -31,6 +31,7 @@ struct FitFile<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     reference: Option<&'a str>,
     blocks: usize,
+    validation: &'static str,
     cv_rms_um: f64,
     fit_rms_um: f64,
 }
@@ -56,6 +57,7 @@ pub fn model_toml(model: &ThermalModel) -> String {
             candidates: &f.candidates,
             reference: f.reference.as_deref(),
             blocks: f.blocks,
+            validation: f.validation.name(),
             cv_rms_um: f.cv_rms_um,
             fit_rms_um: f.fit_rms_um,
         },
@@ -195,11 +197,19 @@ pub fn apply_text(model: &ThermalModel, json: &ApplyJson) -> String {
     text
 }
 
+/// How a summary says the validation: nothing for the blocked k-fold (the default).
+fn validation_words(validation: Validation) -> &'static str {
+    match validation {
+        Validation::Blocked => "",
+        Validation::Forward => " (each block predicted from the blocks before it)",
+    }
+}
+
 /// The fit report for the terminal.
 pub fn fit_text(model: &ThermalModel) -> String {
     let f = &model.fit;
     let mut text = format!(
-        "Thermal model of {:?} from rows {}–{} ({:.0}–{:.0} min), chosen from {} by {}-block time-blocked cross-validation{}\n",
+        "Thermal model of {:?} from rows {}–{} ({:.0}–{:.0} min), chosen from {} by {}-block time-blocked cross-validation{}{}\n",
         f.drift,
         f.first_row,
         f.last_row,
@@ -207,6 +217,7 @@ pub fn fit_text(model: &ThermalModel) -> String {
         f.to_s / 60.0,
         f.candidates.join(", "),
         f.blocks,
+        validation_words(f.validation),
         f.reference
             .as_deref()
             .map(|r| format!(" as rises over {r}"))
@@ -460,9 +471,10 @@ pub fn section_html(study: &Study, share: Option<&ShareView>) -> Result<String, 
 fn model_html(model: &ThermalModel, json: &ApplyJson) -> String {
     let f = &model.fit;
     let mut html = format!(
-        "<h3>Model of the drift from the temperatures</h3>\n<p>Each term is a sensor through a first-order lag (time constant τ), times a coefficient; chosen from {} by {}-block time-blocked cross-validation on rows {}–{} ({:.0}–{:.0} min){}.</p>\n",
+        "<h3>Model of the drift from the temperatures</h3>\n<p>Each term is a sensor through a first-order lag (time constant τ), times a coefficient; chosen from {} by {}-block time-blocked cross-validation{} on rows {}–{} ({:.0}–{:.0} min){}.</p>\n",
         esc(&f.candidates.join(", ")),
         f.blocks,
+        validation_words(f.validation),
         f.first_row,
         f.last_row,
         f.from_s / 60.0,
