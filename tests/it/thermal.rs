@@ -507,6 +507,8 @@ fn web_thermal_page_fits_as_the_cli_does() {
     let get = crate::http::request(&server.host, "GET", "/thermal", &[], Vec::new());
     assert_eq!(get.status, 200);
     assert!(get.text().contains("name=\"log\""));
+    let index = crate::http::request(&server.host, "GET", "/", &[], Vec::new());
+    assert!(index.text().contains("<a href=\"/thermal\">"));
     let log = std::fs::read(shared_data(REAL)).unwrap();
     let form = Form::new()
         .file("log", "spindle.csv", &log)
