@@ -490,7 +490,7 @@ fn report_has_the_thermal_section() {
     assert!(!out2.exists());
 }
 
-/// The web app's thermal page: the real log uploaded with the physical
+/// The web app's thermal page (in process): the real log uploaded with the physical
 /// sensor set fitted on the warm-up shows the same model and held-out
 /// figures as `thermal fit` and `thermal apply --json` (one piece of work
 /// behind both); a bad log is a 400 naming its line and column.
@@ -503,11 +503,11 @@ fn web_thermal_page_fits_as_the_cli_does() {
         "front.toml",
         &["--sensors", "T0,T1,T2,T3,T4", "--reference", "T14"],
     );
-    let server = crate::server::Server::start();
-    let get = crate::http::request(&server.host, "GET", "/thermal", &[], Vec::new());
+    let app = crate::server::App::new();
+    let get = app.get("/thermal", &[]);
     assert_eq!(get.status, 200);
     assert!(get.text().contains("name=\"log\""));
-    let index = crate::http::request(&server.host, "GET", "/", &[], Vec::new());
+    let index = app.get("/", &[]);
     assert!(index.text().contains("<a href=\"/thermal\">"));
     let log = std::fs::read(shared_data(REAL)).unwrap();
     let form = Form::new()
@@ -517,7 +517,7 @@ fn web_thermal_page_fits_as_the_cli_does() {
         .text("rows", "1-1500")
         .text("sensors", "T0,T1,T2,T3,T4")
         .text("reference", "T14");
-    let answer = server.post("/thermal", form, &[]);
+    let answer = app.post("/thermal", form, &[]);
     assert_eq!(answer.status, 200, "{}", answer.text());
     let page = answer.text();
     let expected = json["outside_fit_rows"]["after"]["rms_um"]
@@ -542,7 +542,7 @@ fn web_thermal_page_fits_as_the_cli_does() {
     let bad = Form::new()
         .file("log", "bad.csv", b"time [s],d,T1\n0,0,20\n60,0.1,warm\n")
         .text("drift", "d");
-    let refused = server.post("/thermal", bad, &[]);
+    let refused = app.post("/thermal", bad, &[]);
     assert_eq!(refused.status, 400);
     assert!(
         refused.text().contains("bad.csv:3:8: "),
