@@ -463,14 +463,7 @@ pub fn print_with_share<T: serde::Serialize>(
         let Some(share) = share else {
             return print_json(report);
         };
-        // The report's own keys first, in its order, then "thermal".
-        #[derive(serde::Serialize)]
-        struct WithShare<'a, T> {
-            #[serde(flatten)]
-            report: &'a T,
-            thermal: report::ShareView,
-        }
-        print_json(&WithShare {
+        print_json(&report::WithShare {
             report,
             thermal: share,
         })

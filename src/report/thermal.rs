@@ -572,6 +572,17 @@ pub struct ShareView {
     pub text: String,
 }
 
+/// A command's JSON with the thermal share added: the report's own keys
+/// first, in its order, then `"thermal"`.
+#[derive(Serialize)]
+pub struct WithShare<'a, T> {
+    /// The command's JSON.
+    #[serde(flatten)]
+    pub report: &'a T,
+    /// The share.
+    pub thermal: ShareView,
+}
+
 impl ShareView {
     /// Of a computed share.
     pub fn of(share: &ThermalShare) -> ShareView {
