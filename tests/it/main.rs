@@ -29,6 +29,8 @@ mod generated_docs;
 mod http;
 mod injected;
 mod inputs;
+mod json_reference;
+mod links;
 mod loadable;
 mod model;
 mod numbers;
