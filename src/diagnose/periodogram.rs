@@ -428,6 +428,28 @@ mod tests {
             .collect();
         assert!(!kept.is_empty() && kept.len() <= 2, "{kept:?}");
         assert!((kept[0] - 37.0).abs() < 0.5, "{kept:?}");
+        // The best of the scan, refined, is the one every period fitted exactly finds.
+        let set = ShapeSet {
+            shapes: periods
+                .iter()
+                .map(|p| Shape::Period(*p, PeriodicIn::ReTest))
+                .collect(),
+            trials: 1.0,
+            refine: Some((10.0, span / 2.0)),
+        };
+        let score = |shape: Shape| {
+            let Shape::Period(p, _) = shape else {
+                unreachable!()
+            };
+            (exact(p), ())
+        };
+        let screened_best = crate::diagnose::selection::best_of(&set, Some(&marks), score);
+        let every_best = crate::diagnose::selection::best_of(&set, None, score);
+        let (Some((a, chi2_a, _)), Some((b, chi2_b, _))) = (screened_best, every_best) else {
+            panic!("no best")
+        };
+        assert_eq!(a, b);
+        assert_eq!(chi2_a, chi2_b);
     }
 
     #[test]
