@@ -212,7 +212,7 @@ pub(super) fn diagonal_gls_chi2(
                 let det = cc * ss - cs * cs;
                 // Either column nearly in the span of the others: the exact fit's rank decides.
                 let smallest = (cc + ss) / 2.0 - (((cc - ss) / 2.0).powi(2) + cs * cs).sqrt();
-                if !(smallest > 1e-8 * total_weight) || !det.is_finite() {
+                if smallest.is_nan() || smallest <= 1e-8 * total_weight || !det.is_finite() {
                     return f64::NEG_INFINITY;
                 }
                 let (bc, bs) = (data[k].re, data[k].im);
@@ -232,7 +232,7 @@ pub(super) fn may_be_lowest(screened: &[f64]) -> Vec<bool> {
         .filter(|v| v.is_finite())
         .fold(f64::INFINITY, f64::min);
     let bound = lowest + SCREEN_MARGIN * (lowest.abs() + 1.0);
-    screened.iter().map(|v| !(*v > bound)).collect()
+    screened.iter().map(|v| v.is_nan() || *v <= bound).collect()
 }
 
 /// The periods of the scan of `range`, mm (every shape of [`scan`] is a period).
@@ -288,7 +288,7 @@ pub(super) fn aliases(
             let bound = at_found + MIN_DELTA_BIC + SCREEN_MARGIN * (at_found.abs() + 1.0);
             let mut exact = vec![false; values.len()];
             for (i, v) in values.iter().enumerate() {
-                if !(*v > bound) {
+                if v.is_nan() || *v <= bound {
                     exact[i.saturating_sub(1)..(i + 2).min(values.len())].fill(true);
                 }
             }

@@ -45,7 +45,9 @@ pub fn trig_sums(
     }
     // t_j = 2π·Δf·(x_j − origin) in [0, 2π): the frequency index k is the Fourier mode.
     let t: Vec<f64> = positions.iter().map(|x| TAU * df * (x - origin)).collect();
-    if !t.iter().all(|t| t.is_finite() && *t >= 0.0 && *t < TAU) || !(f0.is_finite() && df > 0.0) {
+    let valid =
+        t.iter().all(|t| t.is_finite() && *t >= 0.0 && *t < TAU) && f0.is_finite() && df > 0.0;
+    if !valid {
         return None;
     }
     // Modes −M/2 … M/2 − 1 hold k − M/2 for k < count ≤ M; the grid has M_r = R·M points.
