@@ -45,6 +45,7 @@ mod problem;
 mod selection;
 mod stats;
 pub mod thermal;
+mod trig_sums;
 mod unexplained;
 
 pub use angular_profile::AngularProfile;
