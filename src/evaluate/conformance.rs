@@ -146,7 +146,7 @@ pub struct TestConformance {
 ///     does not meet ISO 230-2's 5 runs, 5 targets and 5 targets per metre");
 /// ```
 pub fn check_test(measurement: &Measurement) -> TestConformance {
-    let targets_mm = measurement.targets_mm();
+    let targets_mm = measurement.targets();
     let runs_up = measurement.run_count(Direction::Up);
     let runs_down = measurement.run_count(Direction::Down);
     let length_mm = match (targets_mm.first(), targets_mm.last()) {

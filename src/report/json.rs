@@ -77,12 +77,14 @@ use serde::Serialize;
 use crate::error::Warning;
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
 use crate::evaluate::{
-    AxisFigures, Evaluation, StandardFigure, SuspectedOutlier, TargetStats, TestConformance,
+    AxisFigures, Evaluation, OutlierIn, StandardFigure, SuspectedOutlier, TargetIn, TargetStats,
+    TestConformance,
 };
 use crate::measurement::{
-    AxisKind, AxisSource, Environment, Measurement, RunSelector, SourceFormat, StartEnd, TestSetup,
+    AxisKind, AxisSource, ByKind, Environment, Measurement, RunSelector, SourceFormat, StartEnd,
+    TestSetup,
 };
-use crate::units::{AngleUnit, DeviationUnit, opt_mm_to_um};
+use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, opt_mm_to_um};
 
 /// The whole `evaluate --json` object.
 #[derive(Clone, Debug, Serialize)]
@@ -101,12 +103,9 @@ pub struct EvaluationJson {
     /// Length unit of the source file (`mm` or `inch`; `deg` on a rotary
     /// axis); all values here are mm or µm (° or ″).
     pub length_unit: &'static str,
-    /// Targets, mm (empty, and absent, on a rotary axis).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub targets_mm: Vec<f64>,
-    /// Targets, ° (empty, and absent, on a linear axis).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub targets_deg: Vec<f64>,
+    /// Targets: `targets_mm`, or `targets_deg` on a rotary axis.
+    #[serde(flatten)]
+    pub targets: TargetsJson,
     /// Runs per direction, after exclusions.
     pub runs: RunCountsJson,
     /// Runs left out by `--exclude-run`, as `3`, `3:up` or `3:down`.
@@ -118,21 +117,15 @@ pub struct EvaluationJson {
     /// Whether its definitions are reconstructed from public sources
     /// (`../shared/spec/standards.md`), not read in the standard.
     pub definitions_reconstructed: bool,
-    /// That standard's axis figures, µm, under its keys (empty, and absent,
-    /// on a rotary axis).
-    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
-    pub figures_um: FiguresJson,
+    /// That standard's axis figures under its keys: `figures_um`, or
+    /// `figures_arcsec` (`figures_urad`) on a rotary axis.
+    #[serde(flatten)]
+    pub figures: FiguresByUnit,
     /// The ISO 230-2:2014 figures too, µm, when the standard's keys are
-    /// others (VDI 3441): the report shows both; absent otherwise.
+    /// others (VDI 3441) on a linear axis: the report shows both; absent
+    /// otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub figures_iso230_2_um: Option<FiguresJson>,
-    /// The same in ″ on a rotary axis (empty, and absent, on a linear one).
-    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
-    pub figures_arcsec: FiguresJson,
-    /// The same in µrad on a rotary axis with `--angle-unit urad` (empty,
-    /// and absent, otherwise).
-    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
-    pub figures_urad: FiguresJson,
     /// The unit of every deviation here (µm, ″ or µrad); the keys say it.
     #[serde(skip)]
     pub deviation: DeviationUnit,
@@ -208,14 +201,84 @@ pub struct ConformanceJson {
     pub title: String,
     /// Whether every requirement (not the recommendations) is met.
     pub meets_iso230_2: bool,
-    /// Travel, mm (absent on a rotary axis).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub length_mm: Option<f64>,
-    /// Range, ° (a rotary axis only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub length_deg: Option<f64>,
+    /// Travel: `length_mm`, or the range `length_deg` on a rotary axis.
+    #[serde(flatten)]
+    pub length: LengthJson,
     /// Every check.
     pub checks: Vec<CheckJson>,
+}
+
+/// A travel in its unit, the key saying which.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum LengthJson {
+    /// A linear axis' travel, mm.
+    #[serde(rename = "length_mm")]
+    Mm(Mm),
+    /// A rotary axis' range, °.
+    #[serde(rename = "length_deg")]
+    Deg(Deg),
+}
+
+/// The targets in their unit, the key saying which.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum TargetsJson {
+    /// A linear axis' targets, mm.
+    #[serde(rename = "targets_mm")]
+    Mm(Vec<Mm>),
+    /// A rotary axis' targets, °.
+    #[serde(rename = "targets_deg")]
+    Deg(Vec<Deg>),
+}
+
+impl TargetsJson {
+    /// The targets of `measurement`, typed by its axis' kind.
+    pub fn of(measurement: &Measurement) -> TargetsJson {
+        let positions = measurement.positions();
+        match measurement.kind() {
+            AxisKind::Linear => TargetsJson::Mm(positions.filter_map(ByKind::linear).collect()),
+            AxisKind::Rotary => TargetsJson::Deg(positions.filter_map(ByKind::rotary).collect()),
+        }
+    }
+}
+
+/// A standard's figures in the unit they are reported in, the key saying
+/// which: `figures_um` on a linear axis, `figures_arcsec` or `figures_urad`
+/// on a rotary one.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum FiguresByUnit {
+    /// µm.
+    #[serde(rename = "figures_um")]
+    Um(FiguresJson),
+    /// ″.
+    #[serde(rename = "figures_arcsec")]
+    Arcsec(FiguresJson),
+    /// µrad.
+    #[serde(rename = "figures_urad")]
+    Urad(FiguresJson),
+}
+
+impl FiguresByUnit {
+    /// A standard's figures of an axis of `kind`, an angle's in `angle`.
+    pub fn of(figures: &[StandardFigure], kind: AxisKind, angle: AngleUnit) -> FiguresByUnit {
+        match (kind, angle) {
+            (AxisKind::Linear, _) => FiguresByUnit::Um(FiguresJson::from_standard(figures)),
+            (AxisKind::Rotary, AngleUnit::Arcsec) => {
+                FiguresByUnit::Arcsec(FiguresJson::from_standard_deg(figures, angle))
+            }
+            (AxisKind::Rotary, AngleUnit::Urad) => {
+                FiguresByUnit::Urad(FiguresJson::from_standard_deg(figures, angle))
+            }
+        }
+    }
+
+    /// The figures, in their unit.
+    pub fn values(&self) -> &FiguresJson {
+        match self {
+            FiguresByUnit::Um(figures)
+            | FiguresByUnit::Arcsec(figures)
+            | FiguresByUnit::Urad(figures) => figures,
+        }
+    }
 }
 
 /// One check of the test.
@@ -239,8 +302,10 @@ impl ConformanceJson {
         ConformanceJson {
             title: c.title(),
             meets_iso230_2: c.meets_iso230_2(),
-            length_mm: (c.kind == AxisKind::Linear).then_some(c.length_mm),
-            length_deg: (c.kind == AxisKind::Rotary).then_some(c.length_mm),
+            length: match c.kind.position(c.length_mm) {
+                ByKind::Linear(length_mm) => LengthJson::Mm(length_mm),
+                ByKind::Rotary(length_deg) => LengthJson::Deg(length_deg),
+            },
             checks: c
                 .checks
                 .iter()
@@ -410,40 +475,120 @@ impl Serialize for FiguresJson {
     }
 }
 
-/// Statistics at one target, µm; on a rotary axis (`kind`) the same fields
-/// hold ° and ″ (or µrad, `deviation`) and serialise as `target_deg`,
-/// `mean_up_arcsec` (`mean_up_urad`), …
-#[allow(non_snake_case)]
-#[derive(Clone, Copy, Debug)]
-pub struct PerTargetJson {
-    /// Linear or rotary: the unit of the target and its JSON key.
-    pub kind: AxisKind,
-    /// The unit of every deviation and of its JSON keys.
-    pub deviation: DeviationUnit,
-    /// Target, mm.
-    pub target_mm: f64,
-    /// Readings ↑.
-    pub n_up: usize,
-    /// Readings ↓.
-    pub n_down: usize,
-    /// x̄_i↑.
-    pub mean_up_um: Option<f64>,
-    /// x̄_i↓.
-    pub mean_down_um: Option<f64>,
-    /// x̄_i.
-    pub mean_um: Option<f64>,
-    /// s_i↑.
-    pub s_up_um: Option<f64>,
-    /// s_i↓.
-    pub s_down_um: Option<f64>,
-    /// B_i (signed).
-    pub B_um: Option<f64>,
-    /// R_i↑.
-    pub R_up_um: Option<f64>,
-    /// R_i↓.
-    pub R_down_um: Option<f64>,
-    /// R_i.
-    pub R_um: Option<f64>,
+/// Declares the wire form of one target's statistics in one pair of units:
+/// each field's name is its JSON key, its type the unit the key names.
+macro_rules! per_target_json {
+    (
+        $(#[$doc:meta])*
+        $name:ident<$position:ty, $deviation:ty> {
+            $target:ident, $mean_up:ident, $mean_down:ident, $mean:ident, $s_up:ident,
+            $s_down:ident, $b:ident, $r_up:ident, $r_down:ident, $r:ident $(,)?
+        }
+    ) => {
+        $(#[$doc])*
+        #[allow(non_snake_case)]
+        #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+        pub struct $name {
+            /// Target P_i.
+            pub $target: $position,
+            /// Readings ↑.
+            pub n_up: usize,
+            /// Readings ↓.
+            pub n_down: usize,
+            /// x̄_i↑.
+            pub $mean_up: Option<$deviation>,
+            /// x̄_i↓.
+            pub $mean_down: Option<$deviation>,
+            /// x̄_i.
+            pub $mean: Option<$deviation>,
+            /// s_i↑.
+            pub $s_up: Option<$deviation>,
+            /// s_i↓.
+            pub $s_down: Option<$deviation>,
+            /// B_i (signed).
+            pub $b: Option<$deviation>,
+            /// R_i↑.
+            pub $r_up: Option<$deviation>,
+            /// R_i↓.
+            pub $r_down: Option<$deviation>,
+            /// R_i.
+            pub $r: Option<$deviation>,
+        }
+
+        impl From<TargetIn<$position, $deviation>> for $name {
+            fn from(t: TargetIn<$position, $deviation>) -> $name {
+                $name {
+                    $target: t.target,
+                    n_up: t.n_up,
+                    n_down: t.n_down,
+                    $mean_up: t.mean_up,
+                    $mean_down: t.mean_down,
+                    $mean: t.mean,
+                    $s_up: t.s_up,
+                    $s_down: t.s_down,
+                    $b: t.reversal,
+                    $r_up: t.repeatability_up,
+                    $r_down: t.repeatability_down,
+                    $r: t.repeatability,
+                }
+            }
+        }
+
+        impl $name {
+            /// The deviations with their JSON keys, in the order written.
+            fn cells(&self) -> [(&'static str, Option<f64>); 9] {
+                [
+                    (stringify!($mean_up), self.$mean_up.map(|v| v.0)),
+                    (stringify!($mean_down), self.$mean_down.map(|v| v.0)),
+                    (stringify!($mean), self.$mean.map(|v| v.0)),
+                    (stringify!($s_up), self.$s_up.map(|v| v.0)),
+                    (stringify!($s_down), self.$s_down.map(|v| v.0)),
+                    (stringify!($b), self.$b.map(|v| v.0)),
+                    (stringify!($r_up), self.$r_up.map(|v| v.0)),
+                    (stringify!($r_down), self.$r_down.map(|v| v.0)),
+                    (stringify!($r), self.$r.map(|v| v.0)),
+                ]
+            }
+        }
+    };
+}
+
+per_target_json!(
+    /// One target of a linear axis: the target in mm, deviations in µm.
+    LinearTargetJson<Mm, Um> {
+        target_mm, mean_up_um, mean_down_um, mean_um, s_up_um, s_down_um, B_um, R_up_um,
+        R_down_um, R_um,
+    }
+);
+
+per_target_json!(
+    /// One target of a rotary axis: the target in °, deviations in ″.
+    ArcsecTargetJson<Deg, Arcsec> {
+        target_deg, mean_up_arcsec, mean_down_arcsec, mean_arcsec, s_up_arcsec,
+        s_down_arcsec, B_arcsec, R_up_arcsec, R_down_arcsec, R_arcsec,
+    }
+);
+
+per_target_json!(
+    /// One target of a rotary axis: the target in °, deviations in µrad.
+    UradTargetJson<Deg, Urad> {
+        target_deg, mean_up_urad, mean_down_urad, mean_urad, s_up_urad, s_down_urad,
+        B_urad, R_up_urad, R_down_urad, R_urad,
+    }
+);
+
+/// Statistics at one target in the units of its axis and of `--angle-unit`;
+/// each form's keys name its units (`target_mm`, `mean_up_um`;
+/// `target_deg`, `mean_up_arcsec` or `mean_up_urad`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum PerTargetJson {
+    /// A linear axis: mm and µm.
+    Linear(LinearTargetJson),
+    /// A rotary axis: ° and ″.
+    Arcsec(ArcsecTargetJson),
+    /// A rotary axis: ° and µrad.
+    Urad(UradTargetJson),
 }
 
 impl PerTargetJson {
@@ -454,109 +599,160 @@ impl PerTargetJson {
 
     /// Converts one target's statistics to µm, or `angle` (″, µrad) on a rotary axis.
     pub fn from_stats_of(t: &TargetStats, kind: AxisKind, angle: AngleUnit) -> PerTargetJson {
-        let deviation = kind.deviation_unit(angle);
-        let shown = |value: f64| deviation.from_internal(value);
-        PerTargetJson {
-            kind,
-            deviation,
-            target_mm: t.target_mm,
-            n_up: t.up.n,
-            n_down: t.down.n,
-            mean_up_um: t.up.mean_mm.map(shown),
-            mean_down_um: t.down.mean_mm.map(shown),
-            mean_um: t.mean_mm.map(shown),
-            s_up_um: t.up.s_mm.map(shown),
-            s_down_um: t.down.s_mm.map(shown),
-            B_um: t.reversal_mm.map(shown),
-            R_up_um: t.repeatability_up_mm.map(shown),
-            R_down_um: t.repeatability_down_mm.map(shown),
-            R_um: t.repeatability_mm.map(shown),
+        match (t.typed(kind), angle) {
+            (ByKind::Linear(t), _) => PerTargetJson::Linear(t.map_deviations(Mm::to_um).into()),
+            (ByKind::Rotary(t), AngleUnit::Arcsec) => {
+                PerTargetJson::Arcsec(t.map_deviations(Deg::to_arcsec).into())
+            }
+            (ByKind::Rotary(t), AngleUnit::Urad) => {
+                PerTargetJson::Urad(t.map_deviations(Deg::to_urad).into())
+            }
+        }
+    }
+
+    /// The target, in its unit (mm, or ° on a rotary axis).
+    pub fn target(&self) -> f64 {
+        match self {
+            PerTargetJson::Linear(t) => t.target_mm.0,
+            PerTargetJson::Arcsec(t) => t.target_deg.0,
+            PerTargetJson::Urad(t) => t.target_deg.0,
+        }
+    }
+
+    /// Readings ↑ and ↓.
+    pub fn readings(&self) -> (usize, usize) {
+        match self {
+            PerTargetJson::Linear(t) => (t.n_up, t.n_down),
+            PerTargetJson::Arcsec(t) => (t.n_up, t.n_down),
+            PerTargetJson::Urad(t) => (t.n_up, t.n_down),
+        }
+    }
+
+    /// The nine deviations with their JSON keys, in the order written:
+    /// x̄↑, x̄↓, x̄, s↑, s↓, B, R↑, R↓, R, in µm (″, µrad).
+    pub fn cells(&self) -> [(&'static str, Option<f64>); 9] {
+        match self {
+            PerTargetJson::Linear(t) => t.cells(),
+            PerTargetJson::Arcsec(t) => t.cells(),
+            PerTargetJson::Urad(t) => t.cells(),
         }
     }
 }
 
-/// The key suffix of a position: `mm`, or `deg` on a rotary axis.
-fn position_key(kind: AxisKind) -> &'static str {
-    match kind {
-        AxisKind::Linear => "mm",
-        AxisKind::Rotary => "deg",
-    }
-}
-
-impl Serialize for PerTargetJson {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let (position, deviation) = (position_key(self.kind), self.deviation.key());
-        let mut map = serializer.serialize_map(Some(13))?;
-        map.serialize_entry(&format!("target_{position}"), &self.target_mm)?;
-        map.serialize_entry("n_up", &self.n_up)?;
-        map.serialize_entry("n_down", &self.n_down)?;
-        let values = [
-            ("mean_up", self.mean_up_um),
-            ("mean_down", self.mean_down_um),
-            ("mean", self.mean_um),
-            ("s_up", self.s_up_um),
-            ("s_down", self.s_down_um),
-            ("B", self.B_um),
-            ("R_up", self.R_up_um),
-            ("R_down", self.R_down_um),
-            ("R", self.R_um),
-        ];
-        for (stem, value) in values {
-            map.serialize_entry(&format!("{stem}_{deviation}"), &value)?;
+/// Declares the wire form of a suspected outlier run in one pair of units:
+/// each field's name is its JSON key, its type the unit the key names.
+macro_rules! outlier_json {
+    (
+        $(#[$doc:meta])*
+        $name:ident<$position:ty, $deviation:ty> { $worst_target:ident, $offset:ident $(,)? }
+    ) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+        pub struct $name {
+            /// Run number within its direction.
+            pub run: u32,
+            /// `up` or `down`.
+            pub direction: &'static str,
+            /// Largest standardised difference from the other runs.
+            pub score: f64,
+            /// Where it differs most.
+            pub $worst_target: $position,
+            /// How much it differs there from the mean of the other runs.
+            pub $offset: $deviation,
         }
-        map.end()
-    }
+
+        impl From<OutlierIn<$position, $deviation>> for $name {
+            fn from(o: OutlierIn<$position, $deviation>) -> $name {
+                $name {
+                    run: o.run,
+                    direction: o.direction.as_str(),
+                    score: o.score,
+                    $worst_target: o.worst_target,
+                    $offset: o.offset,
+                }
+            }
+        }
+
+        impl $name {
+            fn shown(&self) -> OutlierShown {
+                OutlierShown {
+                    run: self.run,
+                    direction: self.direction,
+                    score: self.score,
+                    worst_target: self.$worst_target.0,
+                    offset: self.$offset.0,
+                }
+            }
+        }
+    };
 }
 
-/// A suspected outlier run; on a rotary axis (`kind`) the position is ° and
-/// the offset ″ (or µrad), serialised as `worst_target_deg` and
-/// `offset_arcsec` (`offset_urad`).
-#[derive(Clone, Copy, Debug)]
-pub struct OutlierJson {
-    /// Linear or rotary.
-    pub kind: AxisKind,
-    /// The unit of the offset.
-    pub deviation: DeviationUnit,
+outlier_json!(
+    /// A suspected outlier run of a linear axis: mm and µm.
+    LinearOutlierJson<Mm, Um> { worst_target_mm, offset_um }
+);
+
+outlier_json!(
+    /// A suspected outlier run of a rotary axis: ° and ″.
+    ArcsecOutlierJson<Deg, Arcsec> { worst_target_deg, offset_arcsec }
+);
+
+outlier_json!(
+    /// A suspected outlier run of a rotary axis: ° and µrad.
+    UradOutlierJson<Deg, Urad> { worst_target_deg, offset_urad }
+);
+
+/// A suspected outlier run in the units of its axis and of `--angle-unit`,
+/// the keys naming them (`worst_target_mm`, `offset_um`; `worst_target_deg`,
+/// `offset_arcsec` or `offset_urad`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum OutlierJson {
+    /// A linear axis: mm and µm.
+    Linear(LinearOutlierJson),
+    /// A rotary axis: ° and ″.
+    Arcsec(ArcsecOutlierJson),
+    /// A rotary axis: ° and µrad.
+    Urad(UradOutlierJson),
+}
+
+/// A suspected outlier run as a report prints it: the position in its unit
+/// (mm or °), the offset in the deviations' (µm, ″ or µrad).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutlierShown {
     /// Run number within its direction.
     pub run: u32,
     /// `up` or `down`.
     pub direction: &'static str,
     /// Largest standardised difference from the other runs.
     pub score: f64,
-    /// Where it differs most, mm.
-    pub worst_target_mm: f64,
-    /// How much it differs there from the mean of the other runs, µm.
-    pub offset_um: f64,
+    /// Where it differs most.
+    pub worst_target: f64,
+    /// How much it differs there from the mean of the other runs.
+    pub offset: f64,
 }
 
 impl OutlierJson {
     /// Converts a flagged run of an axis of `kind`, an angle's offset to `angle`.
     pub fn from_outlier(o: &SuspectedOutlier, kind: AxisKind, angle: AngleUnit) -> OutlierJson {
-        let deviation = kind.deviation_unit(angle);
-        OutlierJson {
-            kind,
-            deviation,
-            run: o.run,
-            direction: o.direction.as_str(),
-            score: o.score,
-            worst_target_mm: o.worst_target_mm,
-            offset_um: deviation.from_internal(o.offset_mm),
+        match (o.typed(kind), angle) {
+            (ByKind::Linear(o), _) => OutlierJson::Linear(o.map_offset(Mm::to_um).into()),
+            (ByKind::Rotary(o), AngleUnit::Arcsec) => {
+                OutlierJson::Arcsec(o.map_offset(Deg::to_arcsec).into())
+            }
+            (ByKind::Rotary(o), AngleUnit::Urad) => {
+                OutlierJson::Urad(o.map_offset(Deg::to_urad).into())
+            }
         }
     }
-}
 
-impl Serialize for OutlierJson {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let (position, deviation) = (position_key(self.kind), self.deviation.key());
-        let mut map = serializer.serialize_map(Some(5))?;
-        map.serialize_entry("run", &self.run)?;
-        map.serialize_entry("direction", self.direction)?;
-        map.serialize_entry("score", &self.score)?;
-        map.serialize_entry(&format!("worst_target_{position}"), &self.worst_target_mm)?;
-        map.serialize_entry(&format!("offset_{deviation}"), &self.offset_um)?;
-        map.end()
+    /// The run as a report prints it, in its units.
+    pub fn shown(&self) -> OutlierShown {
+        match self {
+            OutlierJson::Linear(o) => o.shown(),
+            OutlierJson::Arcsec(o) => o.shown(),
+            OutlierJson::Urad(o) => o.shown(),
+        }
     }
 }
 
@@ -704,21 +900,16 @@ pub struct MetadataJson {
 
 impl EvaluationJson {
     /// The targets, in their unit (mm, or ° on a rotary axis).
-    pub fn targets(&self) -> &[f64] {
-        if self.targets_deg.is_empty() {
-            &self.targets_mm
-        } else {
-            &self.targets_deg
+    pub fn targets(&self) -> Vec<f64> {
+        match &self.targets {
+            TargetsJson::Mm(targets) => targets.iter().map(|target| target.0).collect(),
+            TargetsJson::Deg(targets) => targets.iter().map(|target| target.0).collect(),
         }
     }
 
     /// The figures, in their unit (µm, or ″ or µrad on a rotary axis).
     pub fn figures(&self) -> &FiguresJson {
-        match self.deviation {
-            DeviationUnit::Micrometre => &self.figures_um,
-            DeviationUnit::Angle(AngleUnit::Arcsec) => &self.figures_arcsec,
-            DeviationUnit::Angle(AngleUnit::Urad) => &self.figures_urad,
-        }
+        self.figures.values()
     }
 
     /// How a deviation's unit is printed: `µm`, or `″` or `µrad` on a rotary axis.
@@ -792,23 +983,6 @@ impl EvaluationJson {
         let kind = measurement.kind();
         let deviation = kind.deviation_unit(angle);
         let rotary = kind == AxisKind::Rotary;
-        let targets = measurement.targets_mm().to_vec();
-        let (targets_mm, targets_deg) = if rotary {
-            (Vec::new(), targets)
-        } else {
-            (targets, Vec::new())
-        };
-        // One of the three is filled, in the unit of `deviation`.
-        let (mut figures_um, mut figures_arcsec, mut figures_urad) = Default::default();
-        *match deviation {
-            DeviationUnit::Micrometre => &mut figures_um,
-            DeviationUnit::Angle(AngleUnit::Arcsec) => &mut figures_arcsec,
-            DeviationUnit::Angle(AngleUnit::Urad) => &mut figures_urad,
-        } = if rotary {
-            FiguresJson::from_standard_deg(&evaluation.standard_figures, angle)
-        } else {
-            FiguresJson::from_standard(&evaluation.standard_figures)
-        };
         EvaluationJson {
             format: metadata.source_format.map(|f| f.name()),
             axis: measurement
@@ -825,8 +999,7 @@ impl EvaluationJson {
             } else {
                 metadata.length_unit.as_str()
             },
-            targets_mm,
-            targets_deg,
+            targets: TargetsJson::of(measurement),
             runs: RunCountsJson {
                 up: evaluation.runs_up,
                 down: evaluation.runs_down,
@@ -837,9 +1010,7 @@ impl EvaluationJson {
             definitions_reconstructed: evaluation.standard.reconstructed,
             figures_iso230_2_um: (!rotary && !iso_keys(&evaluation.standard_figures))
                 .then(|| FiguresJson::from_figures(&evaluation.figures)),
-            figures_um,
-            figures_arcsec,
-            figures_urad,
+            figures: FiguresByUnit::of(&evaluation.standard_figures, kind, angle),
             deviation,
             per_target,
             outliers: evaluation
