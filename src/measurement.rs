@@ -998,5 +998,33 @@ mod tests {
                 .to_string()
                 .contains("targets differ")
         );
+        assert_eq!(
+            forward.merge(&other).unwrap_err().to_string(),
+            "cannot join the files: targets differ (2 targets 0.0…5.0 mm against 2 targets 0.0…6.0 mm): \
+             target 2 is at 5.0 mm in the first and 6.0 mm in the second"
+        );
+    }
+
+    #[test]
+    fn a_rotary_axis_positions_are_degrees() {
+        let up = |targets: Vec<f64>| {
+            measurement(
+                targets,
+                vec![run(Direction::Up, 1, &[Some(0.0), Some(0.001)])],
+            )
+            .unwrap()
+            .with_kind(AxisKind::Rotary)
+        };
+        let (quarter, half) = (up(vec![0.0, 90.0]), up(vec![0.0, 180.0]));
+        assert_eq!(
+            quarter.positions().collect::<Vec<_>>(),
+            [ByKind::Rotary(Deg(0.0)), ByKind::Rotary(Deg(90.0))]
+        );
+        assert_eq!(AxisKind::Linear.position(90.0), ByKind::Linear(Mm(90.0)));
+        assert_eq!(
+            quarter.merge(&half).unwrap_err().to_string(),
+            "cannot join the files: targets differ (2 targets 0.0…90.0° against 2 targets 0.0…180.0°): \
+             target 2 is at 90.0° in the first and 180.0° in the second"
+        );
     }
 }

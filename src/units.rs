@@ -30,6 +30,22 @@ macro_rules! quantity {
 
 quantity!(
     /// A length in millimetres: a linear axis' position or deviation.
+    ///
+    /// ```
+    /// use axcomp::units::{Deg, Mm, Um, Arcsec};
+    /// assert_eq!(Mm(0.0025).to_um(), Um(2.5));
+    /// assert_eq!(Deg(0.5).to_arcsec(), Arcsec(1800.0));
+    /// ```
+    /// A degree is not a millimetre: neither given where one is expected
+    /// ```compile_fail
+    /// use axcomp::units::{Deg, Mm};
+    /// let travel: Mm = Deg(90.0);
+    /// ```
+    /// nor converted as one:
+    /// ```compile_fail
+    /// use axcomp::units::{Deg, Um};
+    /// let offset: Um = Deg(0.001).to_um();
+    /// ```
     Mm
 );
 quantity!(
@@ -450,6 +466,17 @@ mod tests {
             );
         }
         assert_eq!(arcsec_text(arcsec_to_deg(1.3)), "1.3");
+    }
+
+    #[test]
+    fn quantities_convert_by_hand() {
+        // 0.0025 mm = 2.5 µm; 0.5° = 1800″; 1° = π/180 rad = 17 453.292 519 943 3 µrad.
+        assert_eq!(Mm(0.0025).to_um(), Um(2.5));
+        assert_eq!(Deg(0.5).to_arcsec(), Arcsec(1800.0));
+        assert!((Deg(1.0).to_urad().0 - 17_453.292_519_943_3).abs() < 1e-9);
+        // Written to JSON as the bare number.
+        assert_eq!(serde_json::to_string(&Deg(90.0)).unwrap(), "90.0");
+        assert_eq!(serde_json::to_string(&Some(Um(2.5))).unwrap(), "2.5");
     }
 
     #[test]

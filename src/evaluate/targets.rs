@@ -202,3 +202,41 @@ pub(super) fn per_target_stats<T>(
     }
     per_target
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_are_typed_by_the_axis_kind() {
+        let up = DirectionStats::of(&[0.001, 0.003]);
+        let stats = TargetStats {
+            target_mm: 90.0,
+            up,
+            down: DirectionStats::default(),
+            mean_mm: None,
+            reversal_mm: None,
+            repeatability_up_mm: Some(0.004),
+            repeatability_down_mm: None,
+            repeatability_mm: None,
+        };
+        let ByKind::Rotary(rotary) = stats.typed(AxisKind::Rotary) else {
+            panic!("a rotary axis' statistics are in degrees")
+        };
+        // x̄↑ = 0.002°; 0.002° = 7.2″.
+        assert_eq!(
+            (rotary.target, rotary.mean_up),
+            (Deg(90.0), Some(Deg(0.002)))
+        );
+        let shown = rotary.map_deviations(Deg::to_arcsec);
+        assert_eq!(shown.mean_up, Some(crate::units::Arcsec(7.2)));
+        assert_eq!((shown.n_up, shown.n_down, shown.mean_down), (2, 0, None));
+        let ByKind::Linear(linear) = stats.typed(AxisKind::Linear) else {
+            panic!("a linear axis' statistics are in mm")
+        };
+        assert_eq!(
+            linear.map_deviations(Mm::to_um).repeatability_up,
+            Some(crate::units::Um(4.0))
+        );
+    }
+}

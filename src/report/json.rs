@@ -580,6 +580,35 @@ per_target_json!(
 /// Statistics at one target in the units of its axis and of `--angle-unit`;
 /// each form's keys name its units (`target_mm`, `mean_up_um`;
 /// `target_deg`, `mean_up_arcsec` or `mean_up_urad`).
+///
+/// A rotary target becomes the rotary wire form:
+/// ```
+/// use axcomp::evaluate::TargetIn;
+/// use axcomp::report::json::ArcsecTargetJson;
+/// use axcomp::units::Deg;
+/// fn wire(t: TargetIn<Deg>) -> ArcsecTargetJson {
+///     t.map_deviations(Deg::to_arcsec).into()
+/// }
+/// ```
+/// and cannot become the linear one (`target_mm`, `mean_up_um`), neither
+/// with its deviations in ″
+/// ```compile_fail
+/// use axcomp::evaluate::TargetIn;
+/// use axcomp::report::json::LinearTargetJson;
+/// use axcomp::units::Deg;
+/// fn wire(t: TargetIn<Deg>) -> LinearTargetJson {
+///     t.map_deviations(Deg::to_arcsec).into()
+/// }
+/// ```
+/// nor with its degrees taken for millimetres:
+/// ```compile_fail
+/// use axcomp::evaluate::TargetIn;
+/// use axcomp::report::json::LinearTargetJson;
+/// use axcomp::units::{Deg, Mm};
+/// fn wire(t: TargetIn<Deg>) -> LinearTargetJson {
+///     t.map_deviations(Mm::to_um).into()
+/// }
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum PerTargetJson {
@@ -1040,5 +1069,165 @@ impl EvaluationJson {
             test_setup: TestSetupJson::from_setup(&metadata.setup),
             notes: source_notes(metadata.source_format),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evaluate::DirectionStats;
+    use crate::measurement::Direction;
+
+    /// A target with x̄↑ = 0.001 and x̄↓ = −0.001 in the axis' unit (two
+    /// readings each way, s = 0.0005), computed by hand below.
+    fn target(at: f64) -> TargetStats {
+        let up = DirectionStats::of(&[0.0005, 0.0015]);
+        let down = DirectionStats::of(&[-0.0005, -0.0015]);
+        TargetStats {
+            target_mm: at,
+            up,
+            down,
+            mean_mm: Some(0.0),
+            reversal_mm: Some(0.002),
+            repeatability_up_mm: up.s_mm.map(|s| 4.0 * s),
+            repeatability_down_mm: down.s_mm.map(|s| 4.0 * s),
+            repeatability_mm: Some(0.004),
+        }
+    }
+
+    /// The keys of a flat JSON object, in the order written.
+    fn keys(text: &str) -> Vec<&str> {
+        text.trim_matches(|c| c == '{' || c == '}')
+            .split(',')
+            .map(|entry| entry.split(':').next().unwrap().trim_matches('"'))
+            .collect()
+    }
+
+    #[test]
+    fn a_linear_target_is_in_mm_and_um() {
+        let json = PerTargetJson::from_stats(&target(100.0));
+        let text = serde_json::to_string(&json).unwrap();
+        assert!(text.starts_with(r#"{"target_mm":100.0,"n_up":2,"n_down":2,"mean_up_um":1.0,"#));
+        assert_eq!(
+            keys(&text),
+            [
+                "target_mm",
+                "n_up",
+                "n_down",
+                "mean_up_um",
+                "mean_down_um",
+                "mean_um",
+                "s_up_um",
+                "s_down_um",
+                "B_um",
+                "R_up_um",
+                "R_down_um",
+                "R_um"
+            ]
+        );
+        // B = 0.002 mm = 2 µm, R = 0.004 mm = 4 µm.
+        assert!(
+            text.contains(r#""B_um":2.0,"#) && text.ends_with(r#""R_um":4.0}"#),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_rotary_target_is_in_degrees_and_arcsec_or_urad() {
+        // 0.001° = 3.6″ = 17.453 292 5 µrad; B = 0.002° = 7.2″.
+        let arcsec =
+            PerTargetJson::from_stats_of(&target(90.0), AxisKind::Rotary, AngleUnit::Arcsec);
+        let text = serde_json::to_string(&arcsec).unwrap();
+        assert!(
+            text.starts_with(r#"{"target_deg":90.0,"n_up":2,"n_down":2,"mean_up_arcsec":3.6,"#),
+            "{text}"
+        );
+        assert!(text.contains(r#""B_arcsec":7.2,"#), "{text}");
+        assert_eq!(
+            keys(&text),
+            [
+                "target_deg",
+                "n_up",
+                "n_down",
+                "mean_up_arcsec",
+                "mean_down_arcsec",
+                "mean_arcsec",
+                "s_up_arcsec",
+                "s_down_arcsec",
+                "B_arcsec",
+                "R_up_arcsec",
+                "R_down_arcsec",
+                "R_arcsec"
+            ]
+        );
+        assert_eq!(arcsec.target(), 90.0);
+        assert_eq!(arcsec.cells()[0], ("mean_up_arcsec", Some(3.6)));
+        let urad = PerTargetJson::from_stats_of(&target(90.0), AxisKind::Rotary, AngleUnit::Urad);
+        let (key, value) = urad.cells()[0];
+        assert_eq!(key, "mean_up_urad");
+        assert!((value.unwrap() - 17.453_292_519_943_3).abs() < 1e-9);
+    }
+
+    #[test]
+    fn outliers_carry_the_unit_in_their_keys() {
+        let outlier = SuspectedOutlier {
+            direction: Direction::Down,
+            run: 1,
+            score: 6.5,
+            worst_target_mm: 90.0,
+            offset_mm: 0.01,
+        };
+        // 0.01° = 36″; 0.01 mm = 10 µm.
+        let rotary = OutlierJson::from_outlier(&outlier, AxisKind::Rotary, AngleUnit::Arcsec);
+        assert_eq!(
+            serde_json::to_string(&rotary).unwrap(),
+            r#"{"run":1,"direction":"down","score":6.5,"worst_target_deg":90.0,"offset_arcsec":36.0}"#
+        );
+        let linear = OutlierJson::from_outlier(&outlier, AxisKind::Linear, AngleUnit::Arcsec);
+        assert_eq!(
+            serde_json::to_string(&linear).unwrap(),
+            r#"{"run":1,"direction":"down","score":6.5,"worst_target_mm":90.0,"offset_um":10.0}"#
+        );
+        assert_eq!(linear.shown().offset, 10.0);
+    }
+
+    #[test]
+    fn the_travel_and_the_figures_carry_their_unit_in_their_key() {
+        let length = |kind: AxisKind| {
+            let c = TestConformance {
+                kind,
+                length_mm: 360.0,
+                targets: 25,
+                runs_up: 5,
+                runs_down: 5,
+                checks: Vec::new(),
+            };
+            let json = serde_json::to_value(ConformanceJson::from_conformance(&c)).unwrap();
+            (
+                json.get("length_mm").cloned(),
+                json.get("length_deg").cloned(),
+            )
+        };
+        assert_eq!(length(AxisKind::Linear), (Some(360.0.into()), None));
+        assert_eq!(length(AxisKind::Rotary), (None, Some(360.0.into())));
+        let figures = [StandardFigure {
+            key: "E",
+            value_mm: Some(0.002),
+        }];
+        // 0.002 mm = 2 µm; 0.002° = 7.2″.
+        let key = |kind, angle| {
+            serde_json::to_value(FiguresByUnit::of(&figures, kind, angle))
+                .unwrap()
+                .to_string()
+        };
+        assert_eq!(
+            key(AxisKind::Linear, AngleUnit::Urad),
+            r#"{"figures_um":{"E":2.0}}"#
+        );
+        assert_eq!(
+            key(AxisKind::Rotary, AngleUnit::Arcsec),
+            r#"{"figures_arcsec":{"E":7.2}}"#
+        );
+        assert!(key(AxisKind::Rotary, AngleUnit::Urad).starts_with(r#"{"figures_urad":{"E":34.9"#));
     }
 }

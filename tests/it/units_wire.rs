@@ -91,3 +91,91 @@ fn linear_outliers_keep_their_keys() {
     assert_evaluate_golden("linear-ecmc-outlier-run.json", &["--json", file]);
     assert_evaluate_golden("linear-ecmc-outlier-run.txt", &[file]);
 }
+
+/// `convert` to a file in a temporary folder with `args`, its output (the
+/// folder written as `OUT`) compared with `golden/units/<name>`.
+fn assert_convert_golden(name: &str, args: &[&str]) {
+    let directory = tempfile::tempdir().unwrap();
+    let out = directory.path().join("out.tab");
+    let out = out.to_str().unwrap();
+    let run = axcomp(["convert", "--force", "-o", out].iter().chain(args));
+    assert_eq!(run.code, 0, "{name}: {}", run.stderr);
+    let folder = directory.path().to_str().unwrap();
+    assert_golden(
+        &run.stdout.replace(folder, "OUT"),
+        &test_data(&format!("golden/units/{name}")),
+    );
+}
+
+/// `convert --json` of a rotary axis: `positions_deg`, `start_deg`,
+/// `step_deg`, `reference_deg`, `values_arcsec`, `suggested_backlash_arcsec`.
+#[test]
+fn rotary_convert_json_keeps_its_keys() {
+    let file = "fixtures/rotary/c.csv";
+    assert_convert_golden(
+        "convert-rotary-tnc640.json",
+        &["--json", "--controller", "tnc640", file],
+    );
+    assert_convert_golden(
+        "convert-rotary-tnc640.txt",
+        &["--controller", "tnc640", file],
+    );
+    let bidirectional = ["--controller", "linuxcnc", "--mode", "bidirectional", file];
+    assert_convert_golden(
+        "convert-rotary-bidirectional-linuxcnc.json",
+        &[&["--json"][..], &bidirectional].concat(),
+    );
+    assert_convert_golden("convert-rotary-bidirectional-linuxcnc.txt", &bidirectional);
+    assert_convert_golden(
+        "convert-rotary-inch-machine.json",
+        &[
+            "--json",
+            "--controller",
+            "linuxcnc",
+            "--machine",
+            "fixtures/machines/gantry-inch.toml",
+            file,
+        ],
+    );
+}
+
+/// `convert --json` of a linear axis: `positions_mm`, …, `values_um`.
+#[test]
+fn linear_convert_json_keeps_its_keys() {
+    let file = "fixtures/sample-x.rtl";
+    assert_convert_golden(
+        "convert-linear-tnc640.json",
+        &["--json", "--controller", "tnc640", file],
+    );
+    assert_convert_golden(
+        "convert-linear-tnc640.txt",
+        &["--controller", "tnc640", file],
+    );
+    assert_convert_golden(
+        "convert-linear-bidirectional-sinumerik840d.json",
+        &[
+            "--json",
+            "--controller",
+            "sinumerik840d",
+            "--mode",
+            "bidirectional",
+            "--step",
+            "50",
+            file,
+        ],
+    );
+    let inch = [
+        "--controller",
+        "linuxcnc",
+        "--machine",
+        "fixtures/machines/gantry-inch.toml",
+        "--axis",
+        "X",
+        file,
+    ];
+    assert_convert_golden(
+        "convert-linear-inch-machine.json",
+        &[&["--json"][..], &inch].concat(),
+    );
+    assert_convert_golden("convert-linear-inch-machine.txt", &inch);
+}
