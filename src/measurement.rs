@@ -138,6 +138,14 @@ pub enum ByKind<L, R> {
 }
 
 impl<L, R> ByKind<L, R> {
+    /// The axis' kind.
+    pub fn kind(&self) -> AxisKind {
+        match self {
+            ByKind::Linear(_) => AxisKind::Linear,
+            ByKind::Rotary(_) => AxisKind::Rotary,
+        }
+    }
+
     /// The linear axis' value; `None` on a rotary axis.
     pub fn linear(self) -> Option<L> {
         match self {

@@ -147,7 +147,7 @@ pub struct Evaluation {
 impl Evaluation {
     /// Linear or rotary: the unit of every value here (mm, or °).
     pub fn kind(&self) -> AxisKind {
-        self.conformance.kind
+        self.conformance.kind()
     }
 
     /// The variance of one reading about its target's mean, pooled over
@@ -183,8 +183,7 @@ impl Evaluation {
             standard: StandardUsed::of(&ISO_230_2),
             standard_figures: ISO_230_2.figures(&per_target, &figures),
             conformance: TestConformance {
-                kind: Default::default(),
-                length_mm,
+                length: crate::measurement::ByKind::Linear(crate::units::Mm(length_mm)),
                 targets: per_target.len(),
                 runs_up: runs,
                 runs_down: runs,

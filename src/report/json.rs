@@ -302,9 +302,9 @@ impl ConformanceJson {
         ConformanceJson {
             title: c.title(),
             meets_iso230_2: c.meets_iso230_2(),
-            length: match c.kind.position(c.length_mm) {
+            length: match c.length {
                 ByKind::Linear(length_mm) => LengthJson::Mm(length_mm),
-                ByKind::Rotary(length_deg) => LengthJson::Deg(length_deg),
+                ByKind::Rotary(range_deg) => LengthJson::Deg(range_deg),
             },
             checks: c
                 .checks
@@ -1195,8 +1195,7 @@ mod tests {
     fn the_travel_and_the_figures_carry_their_unit_in_their_key() {
         let length = |kind: AxisKind| {
             let c = TestConformance {
-                kind,
-                length_mm: 360.0,
+                length: kind.position(360.0),
                 targets: 25,
                 runs_up: 5,
                 runs_down: 5,
