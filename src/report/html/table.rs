@@ -1,0 +1,72 @@
+//! `table.html`: the compensation table, its plot and the predicted re-test.
+
+use super::{Plot, signed};
+use crate::compensate::TableMode;
+use crate::report::acceptance::{ReportInput, TableRecord, prediction};
+use crate::report::format::{SourcedUm, um};
+use crate::report::json::iso_keys;
+use crate::units::mm_to_um;
+
+/// `table.html`.
+pub(super) struct TableView {
+    pub(super) file: String,
+    pub(super) controller: &'static str,
+    pub(super) points: usize,
+    pub(super) first_mm: f64,
+    pub(super) last_mm: f64,
+    pub(super) step_mm: Option<f64>,
+    pub(super) mode: TableMode,
+    pub(super) reference_mm: f64,
+    pub(super) max_abs_um: String,
+    pub(super) suggested_backlash_um: Option<String>,
+    pub(super) plot: Option<Plot>,
+    pub(super) prediction: Option<PredictionView>,
+}
+
+pub(super) struct PredictionView {
+    pub(super) range_um: String,
+    pub(super) uncompensated_range_um: String,
+    /// (key, cell) of the figures the paragraph names: A, E, B, or every
+    /// figure of another standard.
+    pub(super) figures: Vec<(&'static str, SourcedUm)>,
+    pub(super) plot: Option<Plot>,
+}
+
+pub(super) fn table_view(
+    input: &ReportInput<'_>,
+    record: &TableRecord<'_>,
+    plot: &dyn Fn(&str) -> Option<Plot>,
+) -> TableView {
+    let table = record.table;
+    let prediction = prediction(&input.before, table, input.standard).map(|predicted| {
+        let iso_family = iso_keys(&predicted.figures);
+        PredictionView {
+            range_um: um(Some(predicted.range_um())),
+            uncompensated_range_um: um(Some(predicted.uncompensated_range_um())),
+            figures: predicted
+                .figures
+                .iter()
+                .filter(|f| !iso_family || ["A", "E", "B"].contains(&f.key))
+                .map(|f| {
+                    let key = format!("prediction.figures_um.{}", f.key);
+                    (f.key, SourcedUm::new(key, f.value_mm.map(mm_to_um)))
+                })
+                .collect(),
+            plot: plot("predicted"),
+        }
+    });
+    TableView {
+        file: record.file.to_string(),
+        controller: record.controller.name(),
+        points: table.positions_mm.len(),
+        first_mm: table.positions_mm.first().copied().unwrap_or_default(),
+        last_mm: table.positions_mm.last().copied().unwrap_or_default(),
+        step_mm: table.regular_step_mm(),
+        mode: table.values.mode(),
+        reference_mm: table.reference_mm,
+        max_abs_um: signed(mm_to_um(table.max_abs_mm()), 2),
+        suggested_backlash_um: table.suggested_backlash_mm.map(|b| signed(mm_to_um(b), 2)),
+        plot: plot("table"),
+        prediction,
+    }
+}
