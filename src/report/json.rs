@@ -71,20 +71,32 @@
 //! `axis_source` says where `axis` came from: `{"kind": "file", "field": …}`
 //! (the field of the file that states it), `{"kind": "given"}` (`--axis`) or
 //! `{"kind": "not_recorded"}`, when `axis` is `null`.
+//!
+//! Each key's unit is the type of the value under it: a linear and a rotary
+//! axis' per-target rows and outliers are different structs
+//! ([`LinearTargetJson`] with `target_mm: Mm` and `mean_up_um: Option<Um>`,
+//! [`ArcsecTargetJson`], [`UradTargetJson`]), and the keys that differ in the
+//! top-level object are serde-flattened enums ([`TargetsJson`],
+//! [`FiguresByUnit`], [`LengthJson`]); no key is renamed at run time.
 
 use serde::Serialize;
 
+mod outlier;
+mod per_target;
+
+pub use outlier::{
+    ArcsecOutlierJson, LinearOutlierJson, OutlierJson, OutlierShown, UradOutlierJson,
+};
+pub use per_target::{ArcsecTargetJson, LinearTargetJson, PerTargetJson, UradTargetJson};
+
 use crate::error::Warning;
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
-use crate::evaluate::{
-    AxisFigures, Evaluation, OutlierIn, StandardFigure, SuspectedOutlier, TargetIn, TargetStats,
-    TestConformance,
-};
+use crate::evaluate::{AxisFigures, Evaluation, StandardFigure, TestConformance};
 use crate::measurement::{
     AxisKind, AxisSource, ByKind, Environment, Measurement, RunSelector, SourceFormat, StartEnd,
     TestSetup,
 };
-use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, opt_mm_to_um};
+use crate::units::{AngleUnit, Deg, DeviationUnit, Mm, opt_mm_to_um};
 
 /// The whole `evaluate --json` object.
 #[derive(Clone, Debug, Serialize)]
@@ -475,316 +487,6 @@ impl Serialize for FiguresJson {
     }
 }
 
-/// Declares the wire form of one target's statistics in one pair of units:
-/// each field's name is its JSON key, its type the unit the key names.
-macro_rules! per_target_json {
-    (
-        $(#[$doc:meta])*
-        $name:ident<$position:ty, $deviation:ty> {
-            $target:ident, $mean_up:ident, $mean_down:ident, $mean:ident, $s_up:ident,
-            $s_down:ident, $b:ident, $r_up:ident, $r_down:ident, $r:ident $(,)?
-        }
-    ) => {
-        $(#[$doc])*
-        #[allow(non_snake_case)]
-        #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-        pub struct $name {
-            /// Target P_i.
-            pub $target: $position,
-            /// Readings ↑.
-            pub n_up: usize,
-            /// Readings ↓.
-            pub n_down: usize,
-            /// x̄_i↑.
-            pub $mean_up: Option<$deviation>,
-            /// x̄_i↓.
-            pub $mean_down: Option<$deviation>,
-            /// x̄_i.
-            pub $mean: Option<$deviation>,
-            /// s_i↑.
-            pub $s_up: Option<$deviation>,
-            /// s_i↓.
-            pub $s_down: Option<$deviation>,
-            /// B_i (signed).
-            pub $b: Option<$deviation>,
-            /// R_i↑.
-            pub $r_up: Option<$deviation>,
-            /// R_i↓.
-            pub $r_down: Option<$deviation>,
-            /// R_i.
-            pub $r: Option<$deviation>,
-        }
-
-        impl From<TargetIn<$position, $deviation>> for $name {
-            fn from(t: TargetIn<$position, $deviation>) -> $name {
-                $name {
-                    $target: t.target,
-                    n_up: t.n_up,
-                    n_down: t.n_down,
-                    $mean_up: t.mean_up,
-                    $mean_down: t.mean_down,
-                    $mean: t.mean,
-                    $s_up: t.s_up,
-                    $s_down: t.s_down,
-                    $b: t.reversal,
-                    $r_up: t.repeatability_up,
-                    $r_down: t.repeatability_down,
-                    $r: t.repeatability,
-                }
-            }
-        }
-
-        impl $name {
-            /// The deviations with their JSON keys, in the order written.
-            fn cells(&self) -> [(&'static str, Option<f64>); 9] {
-                [
-                    (stringify!($mean_up), self.$mean_up.map(|v| v.0)),
-                    (stringify!($mean_down), self.$mean_down.map(|v| v.0)),
-                    (stringify!($mean), self.$mean.map(|v| v.0)),
-                    (stringify!($s_up), self.$s_up.map(|v| v.0)),
-                    (stringify!($s_down), self.$s_down.map(|v| v.0)),
-                    (stringify!($b), self.$b.map(|v| v.0)),
-                    (stringify!($r_up), self.$r_up.map(|v| v.0)),
-                    (stringify!($r_down), self.$r_down.map(|v| v.0)),
-                    (stringify!($r), self.$r.map(|v| v.0)),
-                ]
-            }
-        }
-    };
-}
-
-per_target_json!(
-    /// One target of a linear axis: the target in mm, deviations in µm.
-    LinearTargetJson<Mm, Um> {
-        target_mm, mean_up_um, mean_down_um, mean_um, s_up_um, s_down_um, B_um, R_up_um,
-        R_down_um, R_um,
-    }
-);
-
-per_target_json!(
-    /// One target of a rotary axis: the target in °, deviations in ″.
-    ArcsecTargetJson<Deg, Arcsec> {
-        target_deg, mean_up_arcsec, mean_down_arcsec, mean_arcsec, s_up_arcsec,
-        s_down_arcsec, B_arcsec, R_up_arcsec, R_down_arcsec, R_arcsec,
-    }
-);
-
-per_target_json!(
-    /// One target of a rotary axis: the target in °, deviations in µrad.
-    UradTargetJson<Deg, Urad> {
-        target_deg, mean_up_urad, mean_down_urad, mean_urad, s_up_urad, s_down_urad,
-        B_urad, R_up_urad, R_down_urad, R_urad,
-    }
-);
-
-/// Statistics at one target in the units of its axis and of `--angle-unit`;
-/// each form's keys name its units (`target_mm`, `mean_up_um`;
-/// `target_deg`, `mean_up_arcsec` or `mean_up_urad`).
-///
-/// A rotary target becomes the rotary wire form:
-/// ```
-/// use axcomp::evaluate::TargetIn;
-/// use axcomp::report::json::ArcsecTargetJson;
-/// use axcomp::units::Deg;
-/// fn wire(t: TargetIn<Deg>) -> ArcsecTargetJson {
-///     t.map_deviations(Deg::to_arcsec).into()
-/// }
-/// ```
-/// and cannot become the linear one (`target_mm`, `mean_up_um`), neither
-/// with its deviations in ″
-/// ```compile_fail
-/// use axcomp::evaluate::TargetIn;
-/// use axcomp::report::json::LinearTargetJson;
-/// use axcomp::units::Deg;
-/// fn wire(t: TargetIn<Deg>) -> LinearTargetJson {
-///     t.map_deviations(Deg::to_arcsec).into()
-/// }
-/// ```
-/// nor with its degrees taken for millimetres:
-/// ```compile_fail
-/// use axcomp::evaluate::TargetIn;
-/// use axcomp::report::json::LinearTargetJson;
-/// use axcomp::units::{Deg, Mm};
-/// fn wire(t: TargetIn<Deg>) -> LinearTargetJson {
-///     t.map_deviations(Mm::to_um).into()
-/// }
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum PerTargetJson {
-    /// A linear axis: mm and µm.
-    Linear(LinearTargetJson),
-    /// A rotary axis: ° and ″.
-    Arcsec(ArcsecTargetJson),
-    /// A rotary axis: ° and µrad.
-    Urad(UradTargetJson),
-}
-
-impl PerTargetJson {
-    /// Converts one target's statistics of a linear axis to µm.
-    pub fn from_stats(t: &TargetStats) -> PerTargetJson {
-        PerTargetJson::from_stats_of(t, AxisKind::Linear, AngleUnit::default())
-    }
-
-    /// Converts one target's statistics to µm, or `angle` (″, µrad) on a rotary axis.
-    pub fn from_stats_of(t: &TargetStats, kind: AxisKind, angle: AngleUnit) -> PerTargetJson {
-        match (t.typed(kind), angle) {
-            (ByKind::Linear(t), _) => PerTargetJson::Linear(t.map_deviations(Mm::to_um).into()),
-            (ByKind::Rotary(t), AngleUnit::Arcsec) => {
-                PerTargetJson::Arcsec(t.map_deviations(Deg::to_arcsec).into())
-            }
-            (ByKind::Rotary(t), AngleUnit::Urad) => {
-                PerTargetJson::Urad(t.map_deviations(Deg::to_urad).into())
-            }
-        }
-    }
-
-    /// The target, in its unit (mm, or ° on a rotary axis).
-    pub fn target(&self) -> f64 {
-        match self {
-            PerTargetJson::Linear(t) => t.target_mm.0,
-            PerTargetJson::Arcsec(t) => t.target_deg.0,
-            PerTargetJson::Urad(t) => t.target_deg.0,
-        }
-    }
-
-    /// Readings ↑ and ↓.
-    pub fn readings(&self) -> (usize, usize) {
-        match self {
-            PerTargetJson::Linear(t) => (t.n_up, t.n_down),
-            PerTargetJson::Arcsec(t) => (t.n_up, t.n_down),
-            PerTargetJson::Urad(t) => (t.n_up, t.n_down),
-        }
-    }
-
-    /// The nine deviations with their JSON keys, in the order written:
-    /// x̄↑, x̄↓, x̄, s↑, s↓, B, R↑, R↓, R, in µm (″, µrad).
-    pub fn cells(&self) -> [(&'static str, Option<f64>); 9] {
-        match self {
-            PerTargetJson::Linear(t) => t.cells(),
-            PerTargetJson::Arcsec(t) => t.cells(),
-            PerTargetJson::Urad(t) => t.cells(),
-        }
-    }
-}
-
-/// Declares the wire form of a suspected outlier run in one pair of units:
-/// each field's name is its JSON key, its type the unit the key names.
-macro_rules! outlier_json {
-    (
-        $(#[$doc:meta])*
-        $name:ident<$position:ty, $deviation:ty> { $worst_target:ident, $offset:ident $(,)? }
-    ) => {
-        $(#[$doc])*
-        #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-        pub struct $name {
-            /// Run number within its direction.
-            pub run: u32,
-            /// `up` or `down`.
-            pub direction: &'static str,
-            /// Largest standardised difference from the other runs.
-            pub score: f64,
-            /// Where it differs most.
-            pub $worst_target: $position,
-            /// How much it differs there from the mean of the other runs.
-            pub $offset: $deviation,
-        }
-
-        impl From<OutlierIn<$position, $deviation>> for $name {
-            fn from(o: OutlierIn<$position, $deviation>) -> $name {
-                $name {
-                    run: o.run,
-                    direction: o.direction.as_str(),
-                    score: o.score,
-                    $worst_target: o.worst_target,
-                    $offset: o.offset,
-                }
-            }
-        }
-
-        impl $name {
-            fn shown(&self) -> OutlierShown {
-                OutlierShown {
-                    run: self.run,
-                    direction: self.direction,
-                    score: self.score,
-                    worst_target: self.$worst_target.0,
-                    offset: self.$offset.0,
-                }
-            }
-        }
-    };
-}
-
-outlier_json!(
-    /// A suspected outlier run of a linear axis: mm and µm.
-    LinearOutlierJson<Mm, Um> { worst_target_mm, offset_um }
-);
-
-outlier_json!(
-    /// A suspected outlier run of a rotary axis: ° and ″.
-    ArcsecOutlierJson<Deg, Arcsec> { worst_target_deg, offset_arcsec }
-);
-
-outlier_json!(
-    /// A suspected outlier run of a rotary axis: ° and µrad.
-    UradOutlierJson<Deg, Urad> { worst_target_deg, offset_urad }
-);
-
-/// A suspected outlier run in the units of its axis and of `--angle-unit`,
-/// the keys naming them (`worst_target_mm`, `offset_um`; `worst_target_deg`,
-/// `offset_arcsec` or `offset_urad`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum OutlierJson {
-    /// A linear axis: mm and µm.
-    Linear(LinearOutlierJson),
-    /// A rotary axis: ° and ″.
-    Arcsec(ArcsecOutlierJson),
-    /// A rotary axis: ° and µrad.
-    Urad(UradOutlierJson),
-}
-
-/// A suspected outlier run as a report prints it: the position in its unit
-/// (mm or °), the offset in the deviations' (µm, ″ or µrad).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OutlierShown {
-    /// Run number within its direction.
-    pub run: u32,
-    /// `up` or `down`.
-    pub direction: &'static str,
-    /// Largest standardised difference from the other runs.
-    pub score: f64,
-    /// Where it differs most.
-    pub worst_target: f64,
-    /// How much it differs there from the mean of the other runs.
-    pub offset: f64,
-}
-
-impl OutlierJson {
-    /// Converts a flagged run of an axis of `kind`, an angle's offset to `angle`.
-    pub fn from_outlier(o: &SuspectedOutlier, kind: AxisKind, angle: AngleUnit) -> OutlierJson {
-        match (o.typed(kind), angle) {
-            (ByKind::Linear(o), _) => OutlierJson::Linear(o.map_offset(Mm::to_um).into()),
-            (ByKind::Rotary(o), AngleUnit::Arcsec) => {
-                OutlierJson::Arcsec(o.map_offset(Deg::to_arcsec).into())
-            }
-            (ByKind::Rotary(o), AngleUnit::Urad) => {
-                OutlierJson::Urad(o.map_offset(Deg::to_urad).into())
-            }
-        }
-    }
-
-    /// The run as a report prints it, in its units.
-    pub fn shown(&self) -> OutlierShown {
-        match self {
-            OutlierJson::Linear(o) => o.shown(),
-            OutlierJson::Arcsec(o) => o.shown(),
-            OutlierJson::Urad(o) => o.shown(),
-        }
-    }
-}
-
 /// A start/end pair.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct StartEndJson {
@@ -1075,7 +777,7 @@ impl EvaluationJson {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evaluate::DirectionStats;
+    use crate::evaluate::{DirectionStats, SuspectedOutlier, TargetStats};
     use crate::measurement::Direction;
 
     /// A target with x̄↑ = 0.001 and x̄↓ = −0.001 in the axis' unit (two
