@@ -179,3 +179,33 @@ fn linear_convert_json_keeps_its_keys() {
     );
     assert_convert_golden("convert-linear-inch-machine.txt", &inch);
 }
+
+/// k_c is a stiffness (N/µm): servo-sim's terminal names it so, as its JSON
+/// key `stiffness_n_per_um` does.
+#[test]
+fn servo_sim_names_the_stiffness_a_stiffness() {
+    let run = axcomp([
+        "servo-sim",
+        "--axis",
+        "mcfv5050-x",
+        "--friction",
+        "classic",
+        "--test",
+        "iso230-2",
+        "--targets",
+        "3",
+        "--last-mm",
+        "20",
+        "--runs",
+        "2",
+        "--dwell-s",
+        "0.3",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stdout.contains("\nStiffness    100 N/µm\n"),
+        "{}",
+        run.stdout
+    );
+    assert!(!run.stdout.contains("Compliance"), "{}", run.stdout);
+}
