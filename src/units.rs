@@ -15,15 +15,12 @@
 //!
 //! This module does not format numbers for people; `report` does.
 
-use serde::Serialize;
-
-/// Declares a quantity: an `f64` in one unit, written to JSON as the bare
-/// number (the key names the unit).
+/// Declares a quantity: an `f64` in one unit (`report` writes it to JSON
+/// as the bare number, under a key that names the unit).
 macro_rules! quantity {
     ($(#[$doc:meta])* $name:ident) => {
         $(#[$doc])*
-        #[derive(Clone, Copy, Debug, Default, PartialEq, PartialOrd, Serialize)]
-        #[serde(transparent)]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, PartialOrd)]
         pub struct $name(pub f64);
     };
 }
@@ -474,9 +471,6 @@ mod tests {
         assert_eq!(Mm(0.0025).to_um(), Um(2.5));
         assert_eq!(Deg(0.5).to_arcsec(), Arcsec(1800.0));
         assert!((Deg(1.0).to_urad().0 - 17_453.292_519_943_3).abs() < 1e-9);
-        // Written to JSON as the bare number.
-        assert_eq!(serde_json::to_string(&Deg(90.0)).unwrap(), "90.0");
-        assert_eq!(serde_json::to_string(&Some(Um(2.5))).unwrap(), "2.5");
     }
 
     #[test]
