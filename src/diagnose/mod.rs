@@ -44,6 +44,7 @@ mod periodogram;
 mod problem;
 mod selection;
 mod stats;
+pub mod thermal;
 mod unexplained;
 
 pub use angular_profile::AngularProfile;

@@ -312,9 +312,10 @@ impl ConvertJson {
     /// Sets what the controller does with the suggested backlash
     /// ([`crate::emit::Controller::backlash_parameter`]). A rotary axis'
     /// parameters take degrees, which the advice (in lengths) does not say:
-    /// it gets a note with the value in ° instead.
+    /// it gets a note with the value in ° instead (Fanuc's advice counts
+    /// detection units of the axis, ° on a rotary one: kept).
     pub fn set_backlash(&mut self, advice: BacklashAdvice) {
-        if let TableJson::Rotary(table) = &self.table {
+        if let (TableJson::Rotary(table), false) = (&self.table, self.controller == "fanuc") {
             let backlash_arcsec = table.suggested_backlash_arcsec.unwrap_or_default().0;
             self.backlash_parameter = None;
             self.backlash_note = Some(format!(
