@@ -25,7 +25,7 @@
 //! `deg`, `positions_deg`, `start_deg`, `step_deg`, `reference_deg`,
 //! `values_arcsec`, `suggested_backlash_arcsec`; its backlash is a
 //! `backlash_note` (the parameters' rotary inputs are degrees). The two
-//! forms are two wire structs ([`LinearTableJson`], [`RotaryTableJson`]),
+//! forms are two wire structs (`LinearTableJson`, `RotaryTableJson`),
 //! whose fields are typed in the unit their key names.
 
 use std::fmt::Write;

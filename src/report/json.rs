@@ -74,10 +74,10 @@
 //!
 //! Each key's unit is the type of the value under it: a linear and a rotary
 //! axis' per-target rows and outliers are different structs
-//! ([`LinearTargetJson`] with `target_mm: Mm` and `mean_up_um: Option<Um>`,
-//! [`ArcsecTargetJson`], [`UradTargetJson`]), and the keys that differ in the
-//! top-level object are serde-flattened enums ([`TargetsJson`],
-//! [`FiguresByUnit`], [`LengthJson`]); no key is renamed at run time.
+//! (`LinearTargetJson` with `target_mm: Mm` and `mean_up_um: Option<Um>`,
+//! `ArcsecTargetJson`, `UradTargetJson`), and the keys that differ in the
+//! top-level object are serde-flattened enums (`TargetsJson`,
+//! `FiguresByUnit`, `LengthJson`); no key is renamed at run time.
 
 use serde::Serialize;
 
