@@ -1,10 +1,15 @@
 //! The measurement of one axis: the plain, validated data every stage meets on.
 //!
-//! An axis is linear or rotary ([`AxisKind`]). A rotary axis keeps its
-//! targets and deviations in degrees in the same fields a linear one keeps
-//! mm in (`targets_mm`, `deviations_mm`): the kind says the unit, and every
-//! stage that prints or serialises a value asks it (`../shared/spec/
-//! standards.md` §6: targets in degrees, deviations reported in ″).
+//! An axis is linear or rotary ([`AxisKind`]). Its targets and deviations
+//! are bare `f64`s in the axis' unit: mm on a linear axis, degrees on a
+//! rotary one (`../shared/spec/standards.md` §6: targets in degrees,
+//! deviations reported in ″), as the statistics are the same arithmetic in
+//! either. A value leaves them typed: [`Measurement::positions`] and
+//! [`AxisKind::position`] give a [`Position`] (`Mm` or `Deg`,
+//! `crate::units`), so a stage that prints or serialises a value cannot take
+//! a degree for a millimetre. (`Run::deviations_mm` and
+//! [`Measurement::targets_mm`] keep their names from before rotary axes;
+//! they hold degrees on a rotary axis.)
 //!
 //! A [`Measurement`] holds the targets (mm, strictly increasing), the runs
 //! (each with its direction and one deviation per target, `None` where a
@@ -15,14 +20,14 @@
 //! this check is the last guard, not the user's error message.
 //!
 //! Deviations are positional deviations x_ij = P_ij − P_i (actual minus
-//! target, `../shared/spec/iso230-2.md` "Data"), stored in mm.
+//! target, `../shared/spec/iso230-2.md` "Data"), stored in the axis' unit (mm, or ° on a rotary axis).
 
 use std::fmt;
 use std::path::PathBuf;
 
 use chrono::NaiveDateTime;
 
-use crate::units::{AngleUnit, DeviationUnit, LengthUnit, Mm};
+use crate::units::{AngleUnit, Deg, DeviationUnit, LengthUnit, Mm};
 
 /// Approach direction of a run: ↑ moves in the positive direction, ↓ in the negative.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -108,7 +113,59 @@ impl AxisKind {
             AxisKind::Rotary => "°",
         }
     }
+
+    /// A bare number in this axis' unit (a target, a deviation, a figure),
+    /// typed: [`Mm`] on a linear axis, [`Deg`] on a rotary one. With
+    /// [`crate::evaluate::TargetStats::typed`], the one place where such a
+    /// number gets its unit.
+    pub fn position(self, value: f64) -> Position {
+        match self {
+            AxisKind::Linear => ByKind::Linear(Mm(value)),
+            AxisKind::Rotary => ByKind::Rotary(Deg(value)),
+        }
+    }
 }
+
+/// Something of a linear axis (`L`, in mm) or of a rotary one (`R`, in
+/// degrees): what a bare number in an axis' unit becomes once the axis'
+/// kind is asked ([`AxisKind::position`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ByKind<L, R> {
+    /// Of a linear axis.
+    Linear(L),
+    /// Of a rotary axis.
+    Rotary(R),
+}
+
+impl<L, R> ByKind<L, R> {
+    /// The axis' kind.
+    pub fn kind(&self) -> AxisKind {
+        match self {
+            ByKind::Linear(_) => AxisKind::Linear,
+            ByKind::Rotary(_) => AxisKind::Rotary,
+        }
+    }
+
+    /// The linear axis' value; `None` on a rotary axis.
+    pub fn linear(self) -> Option<L> {
+        match self {
+            ByKind::Linear(value) => Some(value),
+            ByKind::Rotary(_) => None,
+        }
+    }
+
+    /// The rotary axis' value; `None` on a linear axis.
+    pub fn rotary(self) -> Option<R> {
+        match self {
+            ByKind::Linear(_) => None,
+            ByKind::Rotary(value) => Some(value),
+        }
+    }
+}
+
+/// A position, or a length along the axis (a range, a deviation), in its
+/// axis' unit: mm on a linear axis, ° on a rotary one.
+pub type Position = ByKind<Mm, Deg>;
 
 /// One pass over the targets in one direction.
 #[derive(Clone, Debug, PartialEq)]
@@ -121,9 +178,10 @@ pub struct Run {
     pub number: u32,
     /// When the run started, in seconds after the test started, if known.
     pub start_time_s: Option<f64>,
-    /// One deviation per target (same order as the targets), mm (° on a
-    /// rotary axis); `None` is a missing reading.
-    pub deviations_mm: Vec<Option<Mm>>,
+    /// One deviation per target (same order as the targets), in the axis'
+    /// unit: mm, or ° on a rotary axis (the name is older than rotary axes);
+    /// `None` is a missing reading.
+    pub deviations_mm: Vec<Option<f64>>,
 }
 
 impl Run {
@@ -373,12 +431,21 @@ impl Metadata {
 
 /// What differs where two files have as many targets and the same ends:
 /// the first target that is elsewhere.
-fn differing_target_text(difference: Option<(usize, f64, f64)>) -> String {
-    difference.map_or_else(String::new, |(number, first_mm, other_mm)| {
+fn differing_target_text(difference: Option<(usize, f64, f64)>, kind: AxisKind) -> String {
+    let unit = unit_after_number(kind);
+    difference.map_or_else(String::new, |(number, first, other)| {
         format!(
-            ": target {number} is at {first_mm:?} mm in the first and {other_mm:?} mm in the second"
+            ": target {number} is at {first:?}{unit} in the first and {other:?}{unit} in the second"
         )
     })
+}
+
+/// What follows a position in a sentence: ` mm`, or `°` set close.
+fn unit_after_number(kind: AxisKind) -> &'static str {
+    match kind {
+        AxisKind::Linear => " mm",
+        AxisKind::Rotary => "°",
+    }
 }
 
 /// Why a set of targets and runs is not a valid measurement.
@@ -386,25 +453,28 @@ fn differing_target_text(difference: Option<(usize, f64, f64)>) -> String {
 pub enum MeasurementError {
     /// Two files to join have other targets.
     #[error(
-        "cannot join the files: targets differ ({count} targets {first_mm:?}…{last_mm:?} mm against {other_count} targets {other_first_mm:?}…{other_last_mm:?} mm){}",
-        differing_target_text(*first_difference)
+        "cannot join the files: targets differ ({count} targets {first:?}…{last:?}{unit} against {other_count} targets {other_first:?}…{other_last:?}{unit}){}",
+        differing_target_text(*first_difference, *kind),
+        unit = unit_after_number(*kind)
     )]
     TargetsDiffer {
+        /// Linear or rotary (both files): the unit of the positions.
+        kind: AxisKind,
         /// The first target that differs, when both have as many: its
-        /// number (from 1) and its position in each, mm.
+        /// number (from 1) and its position in each, in the axis' unit.
         first_difference: Option<(usize, f64, f64)>,
         /// Targets of the first.
         count: usize,
-        /// Its first target, mm.
-        first_mm: f64,
-        /// Its last target, mm.
-        last_mm: f64,
+        /// Its first target, in the axis' unit (mm or °).
+        first: f64,
+        /// Its last target.
+        last: f64,
         /// Targets of the second.
         other_count: usize,
-        /// Its first target, mm.
-        other_first_mm: f64,
-        /// Its last target, mm.
-        other_last_mm: f64,
+        /// Its first target.
+        other_first: f64,
+        /// Its last target.
+        other_last: f64,
     },
     /// A linear and a rotary measurement cannot be joined.
     #[error("cannot join the files: one is a {} axis, the other {}", first.as_str(), second.as_str())]
@@ -510,7 +580,8 @@ impl fmt::Display for RunSelector {
 pub struct Measurement {
     axis: String,
     kind: AxisKind,
-    targets_mm: Vec<Mm>,
+    /// In the axis' unit: mm, or ° on a rotary axis.
+    targets: Vec<f64>,
     runs: Vec<Run>,
     /// The test conditions.
     pub environment: Environment,
@@ -538,17 +609,17 @@ impl Measurement {
     /// ```
     pub fn new(
         axis: impl Into<String>,
-        targets_mm: Vec<Mm>,
+        targets: Vec<f64>,
         runs: Vec<Run>,
         environment: Environment,
         metadata: Metadata,
     ) -> Result<Measurement, MeasurementError> {
-        check_targets(&targets_mm)?;
-        check_runs(&runs, targets_mm.len())?;
+        check_targets(&targets)?;
+        check_runs(&runs, targets.len())?;
         Ok(Measurement {
             axis: axis.into(),
             kind: AxisKind::Linear,
-            targets_mm,
+            targets,
             runs,
             environment,
             metadata,
@@ -595,9 +666,24 @@ impl Measurement {
         self
     }
 
-    /// The targets P_i, mm (° on a rotary axis), strictly increasing.
-    pub fn targets_mm(&self) -> &[Mm] {
-        &self.targets_mm
+    /// The targets P_i in the axis' unit (mm, or ° on a rotary axis),
+    /// strictly increasing: for arithmetic that is the same in either unit.
+    pub fn targets(&self) -> &[f64] {
+        &self.targets
+    }
+
+    /// The targets P_i in the axis' unit: [`Measurement::targets`] under
+    /// its name from before rotary axes (degrees on a rotary axis; the stages
+    /// that call it handle linear axes, or both alike).
+    pub fn targets_mm(&self) -> &[f64] {
+        &self.targets
+    }
+
+    /// The targets P_i, typed by the axis' kind ([`Position`]: `Mm` or `Deg`).
+    pub fn positions(&self) -> impl Iterator<Item = Position> + '_ {
+        self.targets
+            .iter()
+            .map(|&target| self.kind.position(target))
     }
 
     /// The runs, in the order measured.
@@ -647,12 +733,12 @@ impl Measurement {
     }
 
     /// The same measurement with every reading replaced by
-    /// `reading(run, target index, value mm)`; missing readings stay missing,
+    /// `reading(run, target index, value in the axis' unit)`; missing readings stay missing,
     /// targets, runs and conditions are kept. (A table taken off, an effect
     /// taken out, a predicted change put in.)
     pub fn map_readings(
         &self,
-        reading: impl Fn(&Run, usize, Mm) -> Mm,
+        reading: impl Fn(&Run, usize, f64) -> f64,
     ) -> Result<Measurement, MeasurementError> {
         let runs: Vec<Run> = self
             .runs
@@ -667,12 +753,12 @@ impl Measurement {
                 ..run.clone()
             })
             .collect();
-        check_runs(&runs, self.targets_mm.len())?;
+        check_runs(&runs, self.targets.len())?;
         // Field by field: `..self.clone()` would copy every run once more.
         Ok(Measurement {
             axis: self.axis.clone(),
             kind: self.kind,
-            targets_mm: self.targets_mm.clone(),
+            targets: self.targets.clone(),
             runs,
             environment: self.environment.clone(),
             metadata: self.metadata.clone(),
@@ -690,30 +776,31 @@ impl Measurement {
                 second: other.kind,
             });
         }
-        if self.targets_mm.len() != other.targets_mm.len()
+        if self.targets.len() != other.targets.len()
             || self
-                .targets_mm
+                .targets
                 .iter()
-                .zip(&other.targets_mm)
+                .zip(&other.targets)
                 .any(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
         {
-            let first_difference = (self.targets_mm.len() == other.targets_mm.len())
+            let first_difference = (self.targets.len() == other.targets.len())
                 .then(|| {
-                    self.targets_mm
+                    self.targets
                         .iter()
-                        .zip(&other.targets_mm)
+                        .zip(&other.targets)
                         .position(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
-                        .map(|i| (i + 1, self.targets_mm[i], other.targets_mm[i]))
+                        .map(|i| (i + 1, self.targets[i], other.targets[i]))
                 })
                 .flatten();
             return Err(MeasurementError::TargetsDiffer {
+                kind: self.kind,
                 first_difference,
-                count: self.targets_mm.len(),
-                first_mm: self.targets_mm.first().copied().unwrap_or_default(),
-                last_mm: self.targets_mm.last().copied().unwrap_or_default(),
-                other_count: other.targets_mm.len(),
-                other_first_mm: other.targets_mm.first().copied().unwrap_or_default(),
-                other_last_mm: other.targets_mm.last().copied().unwrap_or_default(),
+                count: self.targets.len(),
+                first: self.targets.first().copied().unwrap_or_default(),
+                last: self.targets.last().copied().unwrap_or_default(),
+                other_count: other.targets.len(),
+                other_first: other.targets.first().copied().unwrap_or_default(),
+                other_last: other.targets.last().copied().unwrap_or_default(),
             });
         }
         let mut runs = self.runs.clone();
@@ -726,7 +813,7 @@ impl Measurement {
         }
         Ok(Measurement::new(
             self.axis.clone(),
-            self.targets_mm.clone(),
+            self.targets.clone(),
             runs,
             self.environment.clone(),
             self.metadata.clone(),
@@ -735,7 +822,7 @@ impl Measurement {
     }
 }
 
-fn check_targets(targets_mm: &[Mm]) -> Result<(), MeasurementError> {
+fn check_targets(targets_mm: &[f64]) -> Result<(), MeasurementError> {
     if targets_mm.is_empty() {
         return Err(MeasurementError::NoTargets);
     }
@@ -918,6 +1005,34 @@ mod tests {
                 .unwrap_err()
                 .to_string()
                 .contains("targets differ")
+        );
+        assert_eq!(
+            forward.merge(&other).unwrap_err().to_string(),
+            "cannot join the files: targets differ (2 targets 0.0…5.0 mm against 2 targets 0.0…6.0 mm): \
+             target 2 is at 5.0 mm in the first and 6.0 mm in the second"
+        );
+    }
+
+    #[test]
+    fn a_rotary_axis_positions_are_degrees() {
+        let up = |targets: Vec<f64>| {
+            measurement(
+                targets,
+                vec![run(Direction::Up, 1, &[Some(0.0), Some(0.001)])],
+            )
+            .unwrap()
+            .with_kind(AxisKind::Rotary)
+        };
+        let (quarter, half) = (up(vec![0.0, 90.0]), up(vec![0.0, 180.0]));
+        assert_eq!(
+            quarter.positions().collect::<Vec<_>>(),
+            [ByKind::Rotary(Deg(0.0)), ByKind::Rotary(Deg(90.0))]
+        );
+        assert_eq!(AxisKind::Linear.position(90.0), ByKind::Linear(Mm(90.0)));
+        assert_eq!(
+            quarter.merge(&half).unwrap_err().to_string(),
+            "cannot join the files: targets differ (2 targets 0.0…90.0° against 2 targets 0.0…180.0°): \
+             target 2 is at 90.0° in the first and 180.0° in the second"
         );
     }
 }

@@ -1,23 +1,86 @@
 //! Units: every conversion factor axcomp uses, in one tested place.
 //!
-//! Inside axcomp every length is a millimetre `f64` (`target_mm`,
-//! `deviation_mm`) and every rotary axis' angle a degree `f64` (a rotary
-//! `Measurement` keeps degrees in the same fields: its `AxisKind` says the
-//! unit); file units are converted in `read` and display units in `report`
-//! (µm, arc-seconds ″, µrad), and both go through the functions here. The aliases below
-//! document a unit; they do not check it, which is why each name also carries
-//! the unit (see `../shared/spec/style.md` §5).
+//! Inside axcomp every length is a millimetre `f64` and every rotary axis'
+//! angle a degree `f64`. The numerical core (ISO 230-2's statistics, which
+//! are the same arithmetic in mm and in degrees) works on bare numbers in
+//! the axis' unit; a value that leaves it for a report gets its unit as a
+//! type here: [`Mm`], [`Deg`] for positions and deviations in the axis' unit,
+//! [`Um`], [`Arcsec`], [`Urad`] for deviations as reported. A field named
+//! `…_mm` of one of these types cannot be given a degree: `Mm` and `Deg`
+//! are different types, and the only conversions between units are the
+//! methods and functions here. `measurement::AxisKind` gives a bare number
+//! its type ([`crate::measurement::Position`], [`crate::measurement::Deviation`]).
+//! File units are converted in `read` and display units in `report`, both
+//! through the functions here (`../shared/spec/style.md` §5).
 //!
 //! This module does not format numbers for people; `report` does.
 
-/// A length in millimetres.
-pub type Mm = f64;
-/// A length in micrometres.
-pub type Um = f64;
-/// An angle in degrees (a rotary axis' targets and, inside, its deviations).
-pub type Deg = f64;
-/// An angle in arc-seconds (″, how rotary deviations are reported).
-pub type Arcsec = f64;
+/// Declares a quantity: an `f64` in one unit (`report` writes it to JSON
+/// as the bare number, under a key that names the unit).
+macro_rules! quantity {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, PartialOrd)]
+        pub struct $name(pub f64);
+    };
+}
+
+quantity!(
+    /// A length in millimetres: a linear axis' position or deviation.
+    ///
+    /// ```
+    /// use axcomp::units::{Deg, Mm, Um, Arcsec};
+    /// assert_eq!(Mm(0.0025).to_um(), Um(2.5));
+    /// assert_eq!(Deg(0.5).to_arcsec(), Arcsec(1800.0));
+    /// ```
+    /// A degree is not a millimetre: neither given where one is expected
+    /// ```compile_fail
+    /// use axcomp::units::{Deg, Mm};
+    /// let travel: Mm = Deg(90.0);
+    /// ```
+    /// nor converted as one:
+    /// ```compile_fail
+    /// use axcomp::units::{Deg, Um};
+    /// let offset: Um = Deg(0.001).to_um();
+    /// ```
+    Mm
+);
+quantity!(
+    /// A length in micrometres: a linear axis' deviation as reported.
+    Um
+);
+quantity!(
+    /// An angle in degrees: a rotary axis' position or deviation.
+    Deg
+);
+quantity!(
+    /// An angle in arc-seconds (″): a rotary axis' deviation as reported.
+    Arcsec
+);
+quantity!(
+    /// An angle in microradians (µrad): a rotary axis' deviation as reported
+    /// with `--angle-unit urad`.
+    Urad
+);
+
+impl Mm {
+    /// In micrometres.
+    pub fn to_um(self) -> Um {
+        Um(mm_to_um(self.0))
+    }
+}
+
+impl Deg {
+    /// In arc-seconds.
+    pub fn to_arcsec(self) -> Arcsec {
+        Arcsec(deg_to_arcsec(self.0))
+    }
+
+    /// In microradians.
+    pub fn to_urad(self) -> Urad {
+        Urad(deg_to_urad(self.0))
+    }
+}
 
 /// Micrometres in one millimetre.
 pub const UM_PER_MM: f64 = 1000.0;
@@ -61,7 +124,7 @@ impl LengthUnit {
     }
 
     /// Converts a length in this unit to millimetres.
-    pub fn to_mm(self, value: f64) -> Mm {
+    pub fn to_mm(self, value: f64) -> f64 {
         match self {
             LengthUnit::Millimetre => value,
             LengthUnit::Inch => inch_to_mm(value),
@@ -69,7 +132,7 @@ impl LengthUnit {
     }
 
     /// Converts a length in millimetres to this unit.
-    pub fn from_mm(self, value_mm: Mm) -> f64 {
+    pub fn from_mm(self, value_mm: f64) -> f64 {
         match self {
             LengthUnit::Millimetre => value_mm,
             LengthUnit::Inch => value_mm / MM_PER_INCH,
@@ -117,7 +180,7 @@ impl AngleUnit {
     }
 
     /// An angle in degrees in this unit.
-    pub fn from_deg(self, value_deg: Deg) -> f64 {
+    pub fn from_deg(self, value_deg: f64) -> f64 {
         match self {
             AngleUnit::Arcsec => deg_to_arcsec(value_deg),
             AngleUnit::Urad => deg_to_urad(value_deg),
@@ -174,12 +237,12 @@ impl DeviationUnit {
 }
 
 /// Millimetres to micrometres.
-pub fn mm_to_um(value_mm: Mm) -> Um {
+pub fn mm_to_um(value_mm: f64) -> f64 {
     value_mm * UM_PER_MM
 }
 
 /// Micrometres to millimetres.
-pub fn um_to_mm(value_um: Um) -> Mm {
+pub fn um_to_mm(value_um: f64) -> f64 {
     value_um / UM_PER_MM
 }
 
@@ -193,13 +256,13 @@ pub fn mm2_to_um2(value_mm2: f64) -> f64 {
 /// exact inverses in binary floating point, so the nearest neighbours of
 /// `value_mm · 1000` are tried too; writers use this so that a file reads back
 /// to the very measurement that was written.
-pub fn um_text(value_mm: Mm) -> String {
+pub fn um_text(value_mm: f64) -> String {
     shortest_text(value_mm, mm_to_um, um_to_mm)
 }
 
 /// The shortest decimal text, in arc-seconds, that reads back (″ → ° with
 /// [`arcsec_to_deg`]) to exactly `value_deg`: [`um_text`] for angles.
-pub fn arcsec_text(value_deg: Deg) -> String {
+pub fn arcsec_text(value_deg: f64) -> String {
     shortest_text(value_deg, deg_to_arcsec, arcsec_to_deg)
 }
 
@@ -237,58 +300,58 @@ fn shortest_text(value: f64, to: fn(f64) -> f64, back: fn(f64) -> f64) -> String
 }
 
 /// Degrees to arc-seconds.
-pub fn deg_to_arcsec(value_deg: Deg) -> Arcsec {
+pub fn deg_to_arcsec(value_deg: f64) -> f64 {
     value_deg * ARCSEC_PER_DEG
 }
 
 /// Arc-seconds to degrees.
-pub fn arcsec_to_deg(value_arcsec: Arcsec) -> Deg {
+pub fn arcsec_to_deg(value_arcsec: f64) -> f64 {
     value_arcsec / ARCSEC_PER_DEG
 }
 
 /// An optional angle in degrees to arc-seconds; `None` stays `None`.
-pub fn opt_deg_to_arcsec(value_deg: Option<Deg>) -> Option<Arcsec> {
+pub fn opt_deg_to_arcsec(value_deg: Option<f64>) -> Option<f64> {
     value_deg.map(deg_to_arcsec)
 }
 
 /// Degrees to microradians.
-pub fn deg_to_urad(value_deg: Deg) -> f64 {
+pub fn deg_to_urad(value_deg: f64) -> f64 {
     value_deg * URAD_PER_DEG
 }
 
 /// Arc-seconds to microradians (1″ ≈ 4.848 µrad).
-pub fn arcsec_to_urad(value_arcsec: Arcsec) -> f64 {
+pub fn arcsec_to_urad(value_arcsec: f64) -> f64 {
     deg_to_urad(arcsec_to_deg(value_arcsec))
 }
 
 /// Metres to millimetres.
-pub fn m_to_mm(value_m: f64) -> Mm {
+pub fn m_to_mm(value_m: f64) -> f64 {
     value_m * MM_PER_M
 }
 
 /// Metres to micrometres.
-pub fn m_to_um(value_m: f64) -> Um {
+pub fn m_to_um(value_m: f64) -> f64 {
     mm_to_um(m_to_mm(value_m))
 }
 
 /// Millimetres to metres.
-pub fn mm_to_m(value_mm: Mm) -> f64 {
+pub fn mm_to_m(value_mm: f64) -> f64 {
     value_mm / MM_PER_M
 }
 
 /// What a rate per metre (µm/m, ppm) gives over `length_mm`, in the rate's
 /// unit (µm/m over 250 mm: µm).
-pub fn per_m_over_mm(rate_per_m: f64, length_mm: Mm) -> f64 {
+pub fn per_m_over_mm(rate_per_m: f64, length_mm: f64) -> f64 {
     rate_per_m * length_mm / MM_PER_M
 }
 
 /// An angle in µrad times a lever in mm, in µm (µrad · mm = nm).
-pub fn urad_times_mm_to_um(value_urad_mm: f64) -> Um {
+pub fn urad_times_mm_to_um(value_urad_mm: f64) -> f64 {
     value_urad_mm / UM_PER_MM
 }
 
 /// An optional length in millimetres to micrometres; `None` stays `None`.
-pub fn opt_mm_to_um(value_mm: Option<Mm>) -> Option<Um> {
+pub fn opt_mm_to_um(value_mm: Option<f64>) -> Option<f64> {
     value_mm.map(mm_to_um)
 }
 
@@ -305,7 +368,7 @@ pub fn rad_to_um_per_m(value_rad: f64) -> f64 {
 }
 
 /// Inches to millimetres.
-pub fn inch_to_mm(value_inch: f64) -> Mm {
+pub fn inch_to_mm(value_inch: f64) -> f64 {
     value_inch * MM_PER_INCH
 }
 
@@ -400,6 +463,14 @@ mod tests {
             );
         }
         assert_eq!(arcsec_text(arcsec_to_deg(1.3)), "1.3");
+    }
+
+    #[test]
+    fn quantities_convert_by_hand() {
+        // 0.0025 mm = 2.5 µm; 0.5° = 1800″; 1° = π/180 rad = 17 453.292 519 943 3 µrad.
+        assert_eq!(Mm(0.0025).to_um(), Um(2.5));
+        assert_eq!(Deg(0.5).to_arcsec(), Arcsec(1800.0));
+        assert!((Deg(1.0).to_urad().0 - 17_453.292_519_943_3).abs() < 1e-9);
     }
 
     #[test]

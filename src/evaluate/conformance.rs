@@ -31,8 +31,8 @@
 //! do) and the report's title.
 
 use crate::error::{Warning, mm_text};
-use crate::measurement::{AxisKind, Direction, Measurement};
-use crate::units::MM_PER_M;
+use crate::measurement::{AxisKind, ByKind, Direction, Measurement, Position};
+use crate::units::{Deg, MM_PER_M, Mm};
 
 /// The fewest targets ISO 230-2 accepts (spec "Test cycle").
 pub const MIN_TARGETS: usize = 5;
@@ -114,10 +114,9 @@ pub struct Check {
 /// The test against ISO 230-2's conditions.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TestConformance {
-    /// Linear or rotary: the unit of `length_mm`.
-    pub kind: AxisKind,
-    /// Travel: last target minus first, mm (° on a rotary axis).
-    pub length_mm: f64,
+    /// Travel: last target minus first, mm on a linear axis, ° on a rotary
+    /// one (the type says which, and so the axis' kind).
+    pub length: Position,
     /// Number of targets.
     pub targets: usize,
     /// Runs ↑.
@@ -146,13 +145,15 @@ pub struct TestConformance {
 ///     does not meet ISO 230-2's 5 runs, 5 targets and 5 targets per metre");
 /// ```
 pub fn check_test(measurement: &Measurement) -> TestConformance {
-    let targets_mm = measurement.targets_mm();
+    let targets_mm = measurement.targets();
     let runs_up = measurement.run_count(Direction::Up);
     let runs_down = measurement.run_count(Direction::Down);
-    let length_mm = match (targets_mm.first(), targets_mm.last()) {
-        (Some(first), Some(last)) => last - first,
-        _ => 0.0,
-    };
+    let length = measurement
+        .kind()
+        .position(match (targets_mm.first(), targets_mm.last()) {
+            (Some(first), Some(last)) => last - first,
+            _ => 0.0,
+        });
     let targets = targets_mm.len();
     let fewest_runs = [runs_up, runs_down]
         .into_iter()
@@ -160,17 +161,18 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
         .min()
         .unwrap_or(0);
     let directions = [runs_up, runs_down].iter().filter(|n| **n > 0).count();
-    let kind = measurement.kind();
-    let one_run_length = match kind {
-        AxisKind::Linear => LONG_AXIS_MM,
-        AxisKind::Rotary => FULL_TURN_DEG,
+    let one_run_is_enough = match length {
+        ByKind::Linear(Mm(length_mm)) => length_mm > LONG_AXIS_MM,
+        ByKind::Rotary(Deg(range_deg)) => range_deg > FULL_TURN_DEG,
     };
-    let runs_required = if length_mm > one_run_length {
-        1
-    } else {
-        STANDARD_RUNS
+    let runs_required = if one_run_is_enough { 1 } else { STANDARD_RUNS };
+    // Targets per metre and even spacing are asked of a linear axis only.
+    let per_metre = match length {
+        ByKind::Linear(Mm(length_mm)) if length_mm > 0.0 => {
+            Some(targets as f64 / (length_mm / MM_PER_M))
+        }
+        _ => None,
     };
-    let per_metre = (length_mm > 0.0).then(|| targets as f64 / (length_mm / MM_PER_M));
     let step = constant_step_mm(targets_mm);
     let mut checks = vec![
         Check {
@@ -205,7 +207,7 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
             required: None,
         },
     ];
-    if kind == AxisKind::Rotary {
+    if length.kind() == AxisKind::Rotary {
         checks.retain(|check| {
             !matches!(
                 check.requirement,
@@ -214,8 +216,7 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
         });
     }
     TestConformance {
-        kind,
-        length_mm,
+        length,
         targets,
         runs_up,
         runs_down,
@@ -237,6 +238,20 @@ fn constant_step_mm(targets_mm: &[f64]) -> Option<f64> {
 }
 
 impl TestConformance {
+    /// Linear or rotary.
+    pub fn kind(&self) -> AxisKind {
+        self.length.kind()
+    }
+
+    /// The travel as a bare number in the axis' unit (mm or °), for the
+    /// sentences that name the unit by [`TestConformance::kind`].
+    fn length_in_axis_unit(&self) -> f64 {
+        match self.length {
+            ByKind::Linear(Mm(length_mm)) => length_mm,
+            ByKind::Rotary(Deg(range_deg)) => range_deg,
+        }
+    }
+
     /// Whether every requirement (not the recommendations) is met.
     pub fn meets_iso230_2(&self) -> bool {
         self.checks
@@ -251,7 +266,7 @@ impl TestConformance {
 
     /// Whether the travel is over [`LONG_AXIS_MM`].
     pub fn is_long_axis(&self) -> bool {
-        self.kind == AxisKind::Linear && self.length_mm > LONG_AXIS_MM
+        matches!(self.length, ByKind::Linear(Mm(length_mm)) if length_mm > LONG_AXIS_MM)
     }
 
     /// What the test is, for the report's title: `bidirectional test, 5 runs,
@@ -269,7 +284,7 @@ impl TestConformance {
             (up, down) if up == down => format!("{up} runs"),
             (up, down) => format!("{up}↑ {down}↓ runs"),
         };
-        let (space, unit) = match self.kind {
+        let (space, unit) = match self.kind() {
             AxisKind::Linear => (" ", "mm"),
             AxisKind::Rotary => ("", "°"),
         };
@@ -277,9 +292,9 @@ impl TestConformance {
             "{kind}, {runs}, {} target{} over {}{space}{unit}",
             self.targets,
             if self.targets == 1 { "" } else { "s" },
-            mm_text(self.length_mm)
+            mm_text(self.length_in_axis_unit())
         );
-        if self.kind == AxisKind::Rotary {
+        if self.kind() == AxisKind::Rotary {
             title.insert_str(0, "rotary axis, ");
         }
         let missed: Vec<&str> = self
@@ -295,7 +310,8 @@ impl TestConformance {
                 if self.is_long_axis() && self.runs_up.max(self.runs_down) == 1 {
                     title.push_str(" (one run: axis over 2000 mm)");
                 }
-                if self.kind == AxisKind::Rotary && self.length_mm > FULL_TURN_DEG {
+                if matches!(self.length, ByKind::Rotary(Deg(range_deg)) if range_deg > FULL_TURN_DEG)
+                {
                     title.push_str(" (one run: rotary axis over 360°)");
                 }
             }
@@ -323,28 +339,29 @@ impl TestConformance {
         }
         if missed(Requirement::Runs) {
             warnings.push(Warning::TooFewRuns {
-                kind: self.kind,
+                kind: self.kind(),
                 runs_up: self.runs_up,
                 runs_down: self.runs_down,
                 required: STANDARD_RUNS,
             });
         }
         if missed(Requirement::Targets) || missed(Requirement::TargetsPerMetre) {
-            let for_length = (MIN_TARGETS_PER_M * self.length_mm / MM_PER_M - 1e-9).ceil();
-            let for_length = match self.kind {
-                AxisKind::Linear => for_length,
-                AxisKind::Rotary => 0.0,
+            let for_length = match self.length {
+                ByKind::Linear(Mm(length_mm)) => {
+                    (MIN_TARGETS_PER_M * length_mm / MM_PER_M - 1e-9).ceil()
+                }
+                ByKind::Rotary(_) => 0.0,
             };
             warnings.push(Warning::TooFewTargets {
-                kind: self.kind,
+                kind: self.kind(),
                 targets: self.targets,
-                length_mm: self.length_mm,
+                length_mm: self.length_in_axis_unit(),
                 required: MIN_TARGETS.max(for_length as usize),
             });
         }
         if self.is_long_axis() && self.runs_up.max(self.runs_down) > 1 {
             warnings.push(Warning::LongAxis {
-                length_mm: self.length_mm,
+                length_mm: self.length_in_axis_unit(),
                 runs: self.runs_up.max(self.runs_down),
             });
         }

@@ -18,7 +18,11 @@
 //! way in degrees; [`rotary`] adds what ISO 230-2 asks of one (the n = 1
 //! rule over 360°, the principal angles, the two ends of a full turn).
 //!
-//! Pure: no I/O, no printing. All lengths in mm, angles in degrees.
+//! Pure: no I/O, no printing. All lengths in mm, angles in degrees: the
+//! statistics are bare numbers in the axis' unit (fields named `…_mm` hold
+//! degrees on a rotary axis; the names are older than rotary axes), and
+//! leave typed by the axis' kind ([`TargetStats::typed`],
+//! [`SuspectedOutlier::typed`], [`crate::measurement::AxisKind::position`]).
 
 pub mod conformance;
 pub mod environment;
@@ -34,10 +38,10 @@ use crate::error::Warning;
 use crate::measurement::{AxisKind, Direction, Measurement};
 pub use conformance::TestConformance;
 use environment::{RefractiveIndexCheck, check_refractive_index};
-pub use outliers::SuspectedOutlier;
+pub use outliers::{OutlierIn, SuspectedOutlier};
 pub use standard::{ISO_230_2, SUPPORTED, Standard, StandardFigure, UnknownStandard, by_name};
 use targets::per_target_stats;
-pub use targets::{DirectionStats, TargetStats};
+pub use targets::{DirectionStats, TargetIn, TargetStats};
 
 /// The axis figures of ISO 230-2, mm; `None` where not evaluated.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -141,6 +145,11 @@ pub struct Evaluation {
 }
 
 impl Evaluation {
+    /// Linear or rotary: the unit of every value here (mm, or °).
+    pub fn kind(&self) -> AxisKind {
+        self.conformance.kind()
+    }
+
     /// The variance of one reading about its target's mean, pooled over
     /// every target and direction, s² = Σ (n − 1)·s_i² / Σ (n − 1), mm²;
     /// `None` without repeated runs. (Each target's own s rests on a handful
@@ -174,8 +183,7 @@ impl Evaluation {
             standard: StandardUsed::of(&ISO_230_2),
             standard_figures: ISO_230_2.figures(&per_target, &figures),
             conformance: TestConformance {
-                kind: Default::default(),
-                length_mm,
+                length: crate::measurement::ByKind::Linear(crate::units::Mm(length_mm)),
                 targets: per_target.len(),
                 runs_up: runs,
                 runs_down: runs,
@@ -229,7 +237,7 @@ pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Eval
     let mut standard_figures = standard.figures(&per_target, &figures);
     if kind == AxisKind::Rotary {
         warnings.extend(rotary::warnings(&per_target));
-        if rotary::over_full_turn(measurement.targets_mm()) {
+        if rotary::over_full_turn(measurement.targets()) {
             // ISO 230-2's n = 1 rule: the scatter figures are not evaluated.
             for figure in [
                 &mut figures.a_mm,

@@ -18,7 +18,8 @@
 //! When the other runs agree exactly (quantised data, pooled s = 0) there is no
 //! scatter to compare with and the run gets no score.
 
-use crate::measurement::{Direction, Measurement};
+use crate::measurement::{AxisKind, ByKind, Direction, Measurement};
+use crate::units::{Deg, Mm};
 
 /// Score above which a run is flagged.
 pub const OUTLIER_SCORE: f64 = 5.0;
@@ -32,10 +33,60 @@ pub struct SuspectedOutlier {
     pub run: u32,
     /// Largest standardised difference from the other runs.
     pub score: f64,
-    /// The target where it differs most, mm.
+    /// The target where it differs most, in the axis' unit (mm, or ° on a
+    /// rotary axis: [`SuspectedOutlier::typed`]).
     pub worst_target_mm: f64,
-    /// Its deviation there minus the mean of the other runs, mm.
+    /// Its deviation there minus the mean of the other runs, in the axis' unit.
     pub offset_mm: f64,
+}
+
+impl SuspectedOutlier {
+    /// The flagged run with its position and offset typed by the axis' kind.
+    pub fn typed(&self, kind: AxisKind) -> ByKind<OutlierIn<Mm>, OutlierIn<Deg>> {
+        match kind {
+            AxisKind::Linear => ByKind::Linear(self.in_unit(Mm)),
+            AxisKind::Rotary => ByKind::Rotary(self.in_unit(Deg)),
+        }
+    }
+
+    fn in_unit<U>(&self, unit: fn(f64) -> U) -> OutlierIn<U> {
+        OutlierIn {
+            direction: self.direction,
+            run: self.run,
+            score: self.score,
+            worst_target: unit(self.worst_target_mm),
+            offset: unit(self.offset_mm),
+        }
+    }
+}
+
+/// A flagged run with its unit as a type: the position in `P` (`Mm` or
+/// `Deg`), the offset in `D` (the axis' unit or the reported one).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutlierIn<P, D = P> {
+    /// ↑ or ↓.
+    pub direction: Direction,
+    /// Run number within its direction.
+    pub run: u32,
+    /// Largest standardised difference from the other runs.
+    pub score: f64,
+    /// The target where it differs most.
+    pub worst_target: P,
+    /// Its deviation there minus the mean of the other runs.
+    pub offset: D,
+}
+
+impl<P, D> OutlierIn<P, D> {
+    /// The same with the offset converted by `convert` (`Mm::to_um`, …).
+    pub fn map_offset<E>(self, convert: fn(D) -> E) -> OutlierIn<P, E> {
+        OutlierIn {
+            direction: self.direction,
+            run: self.run,
+            score: self.score,
+            worst_target: self.worst_target,
+            offset: convert(self.offset),
+        }
+    }
 }
 
 /// Scores every run of every direction with at least 3 runs; returns the flagged ones.
@@ -60,7 +111,7 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
     if runs.len() < 3 {
         return Vec::new();
     }
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let totals = TargetTotals::of(&runs, targets.len());
     let pooled = pooled_squares(&runs, &totals);
     let mut scores = Vec::with_capacity(runs.len());

@@ -4,8 +4,13 @@
 //! denominator, inside the square root: seed 001 eq. (8)/(9) has a typo
 //! there). What a standard derives from them (reversal, repeatability, the
 //! axis figures) is the [`Standard`](super::standard::Standard)'s.
+//!
+//! The statistics are bare numbers in the axis' unit (mm, or ° on a rotary
+//! axis: the arithmetic is the same); [`TargetStats::typed`] gives them their
+//! unit as a type ([`TargetIn`]) for whatever reports them.
 
-use crate::measurement::{Direction, Measurement};
+use crate::measurement::{AxisKind, ByKind, Direction, Measurement};
+use crate::units::{Deg, Mm};
 
 /// Statistics of one target in one direction.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -50,7 +55,9 @@ impl DirectionStats {
     }
 }
 
-/// Everything ISO 230-2 defines at one target (with the standard's k).
+/// Everything ISO 230-2 defines at one target (with the standard's k), in
+/// the axis' unit: every `…_mm` here is ° on a rotary axis (the names are
+/// older than rotary axes); [`TargetStats::typed`] says which.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TargetStats {
     /// Target P_i, mm.
@@ -79,6 +86,88 @@ impl TargetStats {
             Direction::Down => &self.down,
         }
     }
+
+    /// The statistics typed by the axis' kind: in [`Mm`] on a linear axis,
+    /// in [`Deg`] on a rotary one.
+    pub fn typed(&self, kind: AxisKind) -> ByKind<TargetIn<Mm>, TargetIn<Deg>> {
+        match kind {
+            AxisKind::Linear => ByKind::Linear(self.in_unit(Mm)),
+            AxisKind::Rotary => ByKind::Rotary(self.in_unit(Deg)),
+        }
+    }
+
+    fn in_unit<U>(&self, unit: fn(f64) -> U) -> TargetIn<U> {
+        let typed = |value: Option<f64>| value.map(unit);
+        TargetIn {
+            target: unit(self.target_mm),
+            n_up: self.up.n,
+            n_down: self.down.n,
+            mean_up: typed(self.up.mean_mm),
+            mean_down: typed(self.down.mean_mm),
+            mean: typed(self.mean_mm),
+            s_up: typed(self.up.s_mm),
+            s_down: typed(self.down.s_mm),
+            reversal: typed(self.reversal_mm),
+            repeatability_up: typed(self.repeatability_up_mm),
+            repeatability_down: typed(self.repeatability_down_mm),
+            repeatability: typed(self.repeatability_mm),
+        }
+    }
+}
+
+/// One target's statistics with their unit as a type: the target in `P`
+/// (`Mm` or `Deg`), the deviations and the quantities made of them in `D`
+/// (the axis' unit, or the one they are reported in, see
+/// [`TargetIn::map_deviations`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TargetIn<P, D = P> {
+    /// Target P_i.
+    pub target: P,
+    /// Readings ↑.
+    pub n_up: usize,
+    /// Readings ↓.
+    pub n_down: usize,
+    /// x̄_i↑.
+    pub mean_up: Option<D>,
+    /// x̄_i↓.
+    pub mean_down: Option<D>,
+    /// x̄_i.
+    pub mean: Option<D>,
+    /// s_i↑.
+    pub s_up: Option<D>,
+    /// s_i↓.
+    pub s_down: Option<D>,
+    /// B_i (signed).
+    pub reversal: Option<D>,
+    /// R_i↑.
+    pub repeatability_up: Option<D>,
+    /// R_i↓.
+    pub repeatability_down: Option<D>,
+    /// R_i.
+    pub repeatability: Option<D>,
+}
+
+impl<P, D> TargetIn<P, D> {
+    /// The same with every deviation converted by `convert` (`Mm::to_um`,
+    /// `Deg::to_arcsec`, `Deg::to_urad`): the function's type decides which
+    /// unit it accepts.
+    pub fn map_deviations<E>(self, convert: fn(D) -> E) -> TargetIn<P, E> {
+        let shown = |value: Option<D>| value.map(convert);
+        TargetIn {
+            target: self.target,
+            n_up: self.n_up,
+            n_down: self.n_down,
+            mean_up: shown(self.mean_up),
+            mean_down: shown(self.mean_down),
+            mean: shown(self.mean),
+            s_up: shown(self.s_up),
+            s_down: shown(self.s_down),
+            reversal: shown(self.reversal),
+            repeatability_up: shown(self.repeatability_up),
+            repeatability_down: shown(self.repeatability_down),
+            repeatability: shown(self.repeatability),
+        }
+    }
 }
 
 /// The statistics of every target, in target order, handed to `at_target`
@@ -105,11 +194,49 @@ pub(super) fn per_target_stats<T>(
         );
         DirectionStats::of(&readings)
     };
-    let mut per_target = Vec::with_capacity(measurement.targets_mm().len());
-    for (index, &target_mm) in measurement.targets_mm().iter().enumerate() {
+    let mut per_target = Vec::with_capacity(measurement.targets().len());
+    for (index, &target_mm) in measurement.targets().iter().enumerate() {
         let up = stats_of(index, Direction::Up);
         let down = stats_of(index, Direction::Down);
         per_target.push(at_target(target_mm, up, down));
     }
     per_target
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_are_typed_by_the_axis_kind() {
+        let up = DirectionStats::of(&[0.001, 0.003]);
+        let stats = TargetStats {
+            target_mm: 90.0,
+            up,
+            down: DirectionStats::default(),
+            mean_mm: None,
+            reversal_mm: None,
+            repeatability_up_mm: Some(0.004),
+            repeatability_down_mm: None,
+            repeatability_mm: None,
+        };
+        let ByKind::Rotary(rotary) = stats.typed(AxisKind::Rotary) else {
+            panic!("a rotary axis' statistics are in degrees")
+        };
+        // x̄↑ = 0.002°; 0.002° = 7.2″.
+        assert_eq!(
+            (rotary.target, rotary.mean_up),
+            (Deg(90.0), Some(Deg(0.002)))
+        );
+        let shown = rotary.map_deviations(Deg::to_arcsec);
+        assert_eq!(shown.mean_up, Some(crate::units::Arcsec(7.2)));
+        assert_eq!((shown.n_up, shown.n_down, shown.mean_down), (2, 0, None));
+        let ByKind::Linear(linear) = stats.typed(AxisKind::Linear) else {
+            panic!("a linear axis' statistics are in mm")
+        };
+        assert_eq!(
+            linear.map_deviations(Mm::to_um).repeatability_up,
+            Some(crate::units::Um(4.0))
+        );
+    }
 }

@@ -216,7 +216,7 @@ fn a_target_read_once_leaves_a_and_r_unevaluated_and_says_where() {
         .collect();
     m = Measurement::new(
         "X",
-        m.targets_mm().to_vec(),
+        m.targets().to_vec(),
         runs,
         Environment::default(),
         Metadata::default(),
@@ -277,7 +277,7 @@ fn shifted(m: &Measurement, offset_mm: f64) -> Measurement {
         .collect();
     Measurement::new(
         "X",
-        m.targets_mm().to_vec(),
+        m.targets().to_vec(),
         runs,
         Environment::default(),
         Metadata::default(),
@@ -296,7 +296,7 @@ fn swapped(m: &Measurement) -> Measurement {
         .collect();
     Measurement::new(
         "X",
-        m.targets_mm().to_vec(),
+        m.targets().to_vec(),
         runs,
         Environment::default(),
         Metadata::default(),

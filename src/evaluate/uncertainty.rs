@@ -267,7 +267,7 @@ pub fn budget(
     measurement: &Measurement,
     equipment: &Equipment,
 ) -> Result<Budget, UncertaintyError> {
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let length_mm = match (targets.first(), targets.last()) {
         (Some(first), Some(last)) => last - first,
         _ => 0.0,

@@ -21,10 +21,12 @@
 //! (`value` in `unit`), and is null where the controller has no parameter
 //! that works next to the table (LinuxCNC), when `backlash_note` says why.
 //!
-//! A rotary axis' object carries its units in the same keys: `file_unit`
+//! A rotary axis' object carries its units in its keys: `file_unit`
 //! `deg`, `positions_deg`, `start_deg`, `step_deg`, `reference_deg`,
 //! `values_arcsec`, `suggested_backlash_arcsec`; its backlash is a
-//! `backlash_note` (the parameters' rotary inputs are degrees).
+//! `backlash_note` (the parameters' rotary inputs are degrees). The two
+//! forms are two wire structs (`LinearTableJson`, `RotaryTableJson`),
+//! whose fields are typed in the unit their key names.
 
 use std::fmt::Write;
 
@@ -34,24 +36,179 @@ use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::BacklashAdvice;
 use crate::measurement::AxisKind;
 use crate::report::format::{inch_text_places, um};
-use crate::units::{LengthUnit, deg_to_arcsec, mm_to_um, um_to_mm};
+use crate::units::{Arcsec, Deg, LengthUnit, Mm, Um, um_to_mm};
 
-/// The table's values, µm.
-#[derive(Clone, Debug, Serialize)]
+/// The table's values, in `V` (µm, or ″ on a rotary axis).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
-pub enum ValuesJson {
+pub enum ValuesJson<V = f64> {
     /// One column.
     Mean {
         /// Per point.
-        mean: Vec<f64>,
+        mean: Vec<V>,
     },
     /// One column per direction.
     Bidirectional {
         /// Moving +.
-        up: Vec<f64>,
+        up: Vec<V>,
         /// Moving −.
-        down: Vec<f64>,
+        down: Vec<V>,
     },
+}
+
+impl<V: Copy> ValuesJson<V> {
+    /// The values of `table` (mm, or ° on a rotary axis), typed by `unit` and
+    /// converted by `shown`.
+    fn of<P>(table: &TableValues, unit: fn(f64) -> P, shown: fn(P) -> V) -> ValuesJson<V> {
+        let column = |values: &[f64]| values.iter().map(|&v| shown(unit(v))).collect();
+        match table {
+            TableValues::Mean(values) => ValuesJson::Mean {
+                mean: column(values),
+            },
+            TableValues::Bidirectional { up, down } => ValuesJson::Bidirectional {
+                up: column(up),
+                down: column(down),
+            },
+        }
+    }
+
+    /// The same as bare numbers, for the terminal.
+    fn numbers(&self, number: fn(V) -> f64) -> ValuesJson<f64> {
+        let column = |values: &[V]| values.iter().map(|&v| number(v)).collect();
+        match self {
+            ValuesJson::Mean { mean } => ValuesJson::Mean { mean: column(mean) },
+            ValuesJson::Bidirectional { up, down } => ValuesJson::Bidirectional {
+                up: column(up),
+                down: column(down),
+            },
+        }
+    }
+}
+
+/// Declares the wire form of a table's points and values in one pair of
+/// units: each field's name is its JSON key, its type the unit the key names.
+macro_rules! table_json {
+    (
+        $(#[$doc:meta])*
+        $name:ident<$position:ty, $value:ty> {
+            $positions:ident, $start:ident, $step:ident, $reference:ident, $values:ident,
+            $backlash:ident $(,)?
+        }
+    ) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, PartialEq, Serialize)]
+        pub struct $name {
+            /// Compensation points.
+            pub $positions: Vec<$position>,
+            /// Number of points.
+            pub count: usize,
+            /// First point.
+            pub $start: $position,
+            /// Spacing, or `null` when uneven.
+            pub $step: Option<$position>,
+            /// Where the table is zero.
+            pub $reference: $position,
+            /// The values.
+            pub $values: ValuesJson<$value>,
+            /// Suggested backlash parameter (mean mode): −B̄.
+            pub $backlash: Option<$value>,
+        }
+
+        impl $name {
+            /// The points and values of `table` (mm, or ° on a rotary axis),
+            /// typed by `unit`, the values converted by `shown`.
+            fn of(
+                table: &CompensationTable,
+                unit: fn(f64) -> $position,
+                shown: fn($position) -> $value,
+            ) -> $name {
+                $name {
+                    $positions: table.positions_mm.iter().map(|&p| unit(p)).collect(),
+                    count: table.positions_mm.len(),
+                    $start: unit(table.positions_mm[0]),
+                    $step: table.regular_step_mm().map(unit),
+                    $reference: unit(table.reference_mm),
+                    $values: ValuesJson::of(&table.values, unit, shown),
+                    $backlash: table.suggested_backlash_mm.map(|b| shown(unit(b))),
+                }
+            }
+
+            fn numbers(&self) -> TableNumbers {
+                TableNumbers {
+                    positions: self.$positions.iter().map(|p| p.0).collect(),
+                    count: self.count,
+                    start: self.$start.0,
+                    step: self.$step.map(|s| s.0),
+                    reference: self.$reference.0,
+                    values: self.$values.numbers(|v| v.0),
+                    suggested_backlash: self.$backlash.map(|b| b.0),
+                }
+            }
+        }
+    };
+}
+
+table_json!(
+    /// A linear axis' table: points in mm, values in µm.
+    LinearTableJson<Mm, Um> {
+        positions_mm, start_mm, step_mm, reference_mm, values_um, suggested_backlash_um,
+    }
+);
+
+table_json!(
+    /// A rotary axis' table: points in °, values in ″.
+    RotaryTableJson<Deg, Arcsec> {
+        positions_deg, start_deg, step_deg, reference_deg, values_arcsec,
+        suggested_backlash_arcsec,
+    }
+);
+
+/// A table's points and values in the units of its axis, the keys naming them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum TableJson {
+    /// mm and µm.
+    Linear(LinearTableJson),
+    /// ° and ″.
+    Rotary(RotaryTableJson),
+}
+
+impl TableJson {
+    /// The points and values of `table`, of an axis of `kind`.
+    pub fn of(table: &CompensationTable, kind: AxisKind) -> TableJson {
+        match kind {
+            AxisKind::Linear => TableJson::Linear(LinearTableJson::of(table, Mm, Mm::to_um)),
+            AxisKind::Rotary => TableJson::Rotary(RotaryTableJson::of(table, Deg, Deg::to_arcsec)),
+        }
+    }
+
+    /// The points and values as the terminal prints them (mm or °, µm or ″).
+    pub fn numbers(&self) -> TableNumbers {
+        match self {
+            TableJson::Linear(table) => table.numbers(),
+            TableJson::Rotary(table) => table.numbers(),
+        }
+    }
+}
+
+/// A table's points and values as bare numbers in their units (mm or °,
+/// µm or ″), for the terminal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableNumbers {
+    /// Compensation points.
+    pub positions: Vec<f64>,
+    /// Number of points.
+    pub count: usize,
+    /// First point.
+    pub start: f64,
+    /// Spacing, or `None` when uneven.
+    pub step: Option<f64>,
+    /// Where the table is zero.
+    pub reference: f64,
+    /// The values.
+    pub values: ValuesJson<f64>,
+    /// −B̄ (mean mode).
+    pub suggested_backlash: Option<f64>,
 }
 
 /// A controller's backlash parameter and the value to type into it.
@@ -72,12 +229,12 @@ pub struct BacklashParameterJson {
     pub value_text: String,
 }
 
-/// The whole `convert --json` object. On a rotary axis (`kind`) the `_mm`
-/// fields hold ° and the `_um` fields ″, serialised under `_deg` and
-/// `_arcsec` keys (module doc).
-#[derive(Clone, Debug)]
+/// The whole `convert --json` object; a rotary axis' ([`TableJson`]) in °
+/// and ″ under `_deg` and `_arcsec` keys (module doc).
+#[derive(Clone, Debug, Serialize)]
 pub struct ConvertJson {
     /// Linear or rotary: the unit of the values and of the keys.
+    #[serde(skip)]
     pub kind: AxisKind,
     /// The unit of the positions and values in the file written: `mm` or
     /// `inch` (the controller's, from the machine profile; for a Fagor 8055
@@ -93,20 +250,11 @@ pub struct ConvertJson {
     pub also: Vec<String>,
     /// `mean` or `bidirectional`.
     pub mode: &'static str,
-    /// Compensation points, mm.
-    pub positions_mm: Vec<f64>,
-    /// Number of points.
-    pub count: usize,
-    /// First point, mm.
-    pub start_mm: f64,
-    /// Spacing, mm, or `null` when uneven.
-    pub step_mm: Option<f64>,
-    /// Where the table is zero, mm.
-    pub reference_mm: f64,
-    /// The values, µm.
-    pub values_um: ValuesJson,
-    /// Suggested backlash parameter, µm (mean mode): −B̄.
-    pub suggested_backlash_um: Option<f64>,
+    /// The points and values, in the axis' units (`positions_mm`, …,
+    /// `values_um`, `suggested_backlash_um`, or their `_deg` and `_arcsec`
+    /// forms).
+    #[serde(flatten)]
+    pub table: TableJson,
     /// The same as the controller's parameter, in its unit; null without a
     /// suggestion or where the controller has none (then `backlash_note`).
     pub backlash_parameter: Option<BacklashParameterJson>,
@@ -123,6 +271,7 @@ pub struct ConvertJson {
     /// Warnings from reading and evaluating.
     pub warnings: Vec<String>,
     /// The decimals of the file's lengths (an inch table is shown with them).
+    #[serde(skip)]
     pub file_decimals: usize,
 }
 
@@ -137,11 +286,6 @@ impl ConvertJson {
         activation: String,
         warnings: Vec<String>,
     ) -> ConvertJson {
-        let shown = match kind {
-            AxisKind::Linear => mm_to_um,
-            AxisKind::Rotary => deg_to_arcsec,
-        };
-        let to_um = |values: &[f64]| values.iter().copied().map(shown).collect();
         ConvertJson {
             kind,
             file_unit: match kind {
@@ -153,21 +297,7 @@ impl ConvertJson {
             axis: table.axis.clone(),
             also,
             mode: table.values.mode().as_str(),
-            positions_mm: table.positions_mm.clone(),
-            count: table.positions_mm.len(),
-            start_mm: table.positions_mm[0],
-            step_mm: table.regular_step_mm(),
-            reference_mm: table.reference_mm,
-            values_um: match &table.values {
-                TableValues::Mean(values) => ValuesJson::Mean {
-                    mean: to_um(values),
-                },
-                TableValues::Bidirectional { up, down } => ValuesJson::Bidirectional {
-                    up: to_um(up),
-                    down: to_um(down),
-                },
-            },
-            suggested_backlash_um: table.suggested_backlash_mm.map(shown),
+            table: TableJson::of(table, kind),
             backlash_parameter: None,
             backlash_note: None,
             activation,
@@ -185,8 +315,8 @@ impl ConvertJson {
     /// it gets a note with the value in ° instead (Fanuc's advice counts
     /// detection units of the axis, ° on a rotary one: kept).
     pub fn set_backlash(&mut self, advice: BacklashAdvice) {
-        if self.kind == AxisKind::Rotary && self.controller != "fanuc" {
-            let backlash_arcsec = self.suggested_backlash_um.unwrap_or_default();
+        if let (TableJson::Rotary(table), false) = (&self.table, self.controller == "fanuc") {
+            let backlash_arcsec = table.suggested_backlash_arcsec.unwrap_or_default().0;
             self.backlash_parameter = None;
             self.backlash_note = Some(format!(
                 "a rotary axis: enter −B̄ = {backlash_arcsec:.2}″ = {:.4}° in the controller's backlash parameter for the axis, whose rotary input is degrees, or write the table with --mode bidirectional",
@@ -216,11 +346,12 @@ impl ConvertJson {
     /// The terminal summary: what was written, the table, how to activate it.
     pub fn summary(&self) -> String {
         let mut out = String::new();
+        let table = self.table.numbers();
         let (position_unit, value_unit) = match self.kind {
             AxisKind::Linear => (" mm", "µm"),
             AxisKind::Rotary => ("°", "″"),
         };
-        let step = self.step_mm.map_or("uneven spacing".to_string(), |s| {
+        let step = table.step.map_or("uneven spacing".to_string(), |s| {
             format!("step {s}{position_unit}")
         });
         let also = if self.also.is_empty() {
@@ -240,10 +371,10 @@ impl ConvertJson {
             self.controller,
             self.mode,
             self.axis,
-            self.count,
-            self.start_mm,
-            self.positions_mm[self.count - 1],
-            self.reference_mm
+            table.count,
+            table.start,
+            table.positions[table.count - 1],
+            table.reference
         );
         for effect in &self.effects {
             let _ = writeln!(out, "Effect: {effect}");
@@ -254,7 +385,7 @@ impl ConvertJson {
         for note in &self.notes {
             let _ = writeln!(out, "Note: {note}");
         }
-        if let Some(backlash_um) = self.suggested_backlash_um {
+        if let Some(backlash_um) = table.suggested_backlash {
             match (&self.backlash_parameter, &self.backlash_note) {
                 (Some(parameter), _) => {
                     let _ = writeln!(
@@ -295,19 +426,19 @@ impl ConvertJson {
         );
         let position_header = format!("position {}", position_unit.trim_start());
         if self.file_unit == LengthUnit::Inch.as_str() {
-            return self.inch_table(out);
+            return self.inch_table(out, &table);
         }
-        match &self.values_um {
+        match &table.values {
             ValuesJson::Mean { mean } => {
                 let _ = writeln!(out, "{position_header:>12}  {:>9}", "value");
-                for (p, v) in self.positions_mm.iter().zip(mean) {
+                for (p, v) in table.positions.iter().zip(mean) {
                     let mark = self.row_mark(*p);
                     let _ = writeln!(out, "{p:>12}  {:>9}{mark}", um(Some(*v)));
                 }
             }
             ValuesJson::Bidirectional { up, down } => {
                 let _ = writeln!(out, "{position_header:>12}  {:>9}  {:>9}", "↑", "↓");
-                for ((p, u), d) in self.positions_mm.iter().zip(up).zip(down) {
+                for ((p, u), d) in table.positions.iter().zip(up).zip(down) {
                     let mark = self.row_mark(*p);
                     let _ = writeln!(
                         out,
@@ -329,13 +460,13 @@ impl ConvertJson {
 
     /// The table of an inch file: positions and values in inches, as the
     /// file holds them and the controller shows them, beside the µm.
-    fn inch_table(&self, mut out: String) -> String {
+    fn inch_table(&self, mut out: String, table: &TableNumbers) -> String {
         let inch = |mm: f64| inch_text_places(LengthUnit::Inch.from_mm(mm), self.file_decimals);
         let _ = writeln!(
             out,
             "The file is in inches (the controller's unit); µm beside them."
         );
-        let columns: Vec<(&str, &Vec<f64>)> = match &self.values_um {
+        let columns: Vec<(&str, &Vec<f64>)> = match &table.values {
             ValuesJson::Mean { mean } => vec![("value", mean)],
             ValuesJson::Bidirectional { up, down } => vec![("↑", up), ("↓", down)],
         };
@@ -349,7 +480,7 @@ impl ConvertJson {
             );
         }
         out.push('\n');
-        for (index, p) in self.positions_mm.iter().enumerate() {
+        for (index, p) in table.positions.iter().enumerate() {
             let _ = write!(out, "{:>12}  {p:>12}", inch(*p));
             for (_, values) in &columns {
                 let value_um = values[index];
@@ -365,40 +496,5 @@ impl ConvertJson {
         }
         let _ = writeln!(out, "\nActivation:\n{}", self.activation);
         out
-    }
-}
-
-impl Serialize for ConvertJson {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let (position, value) = match self.kind {
-            AxisKind::Linear => ("mm", "um"),
-            AxisKind::Rotary => ("deg", "arcsec"),
-        };
-        let mut map = serializer.serialize_map(Some(20))?;
-        map.serialize_entry("file_unit", self.file_unit)?;
-        map.serialize_entry("controller", self.controller)?;
-        map.serialize_entry("file", &self.file)?;
-        map.serialize_entry("axis", &self.axis)?;
-        map.serialize_entry("also", &self.also)?;
-        map.serialize_entry("mode", self.mode)?;
-        map.serialize_entry(&format!("positions_{position}"), &self.positions_mm)?;
-        map.serialize_entry("count", &self.count)?;
-        map.serialize_entry(&format!("start_{position}"), &self.start_mm)?;
-        map.serialize_entry(&format!("step_{position}"), &self.step_mm)?;
-        map.serialize_entry(&format!("reference_{position}"), &self.reference_mm)?;
-        map.serialize_entry(&format!("values_{value}"), &self.values_um)?;
-        map.serialize_entry(
-            &format!("suggested_backlash_{value}"),
-            &self.suggested_backlash_um,
-        )?;
-        map.serialize_entry("backlash_parameter", &self.backlash_parameter)?;
-        map.serialize_entry("backlash_note", &self.backlash_note)?;
-        map.serialize_entry("activation", &self.activation)?;
-        map.serialize_entry("effects", &self.effects)?;
-        map.serialize_entry("notes", &self.notes)?;
-        map.serialize_entry("update", &self.update)?;
-        map.serialize_entry("warnings", &self.warnings)?;
-        map.end()
     }
 }

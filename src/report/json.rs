@@ -71,18 +71,32 @@
 //! `axis_source` says where `axis` came from: `{"kind": "file", "field": …}`
 //! (the field of the file that states it), `{"kind": "given"}` (`--axis`) or
 //! `{"kind": "not_recorded"}`, when `axis` is `null`.
+//!
+//! Each key's unit is the type of the value under it: a linear and a rotary
+//! axis' per-target rows and outliers are different structs
+//! (`LinearTargetJson` with `target_mm: Mm` and `mean_up_um: Option<Um>`,
+//! `ArcsecTargetJson`, `UradTargetJson`), and the keys that differ in the
+//! top-level object are serde-flattened enums (`TargetsJson`,
+//! `FiguresByUnit`, `LengthJson`); no key is renamed at run time.
 
 use serde::Serialize;
 
+mod outlier;
+mod per_target;
+
+pub use outlier::{
+    ArcsecOutlierJson, LinearOutlierJson, OutlierJson, OutlierShown, UradOutlierJson,
+};
+pub use per_target::{ArcsecTargetJson, LinearTargetJson, PerTargetJson, UradTargetJson};
+
 use crate::error::Warning;
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
-use crate::evaluate::{
-    AxisFigures, Evaluation, StandardFigure, SuspectedOutlier, TargetStats, TestConformance,
-};
+use crate::evaluate::{AxisFigures, Evaluation, StandardFigure, TestConformance};
 use crate::measurement::{
-    AxisKind, AxisSource, Environment, Measurement, RunSelector, SourceFormat, StartEnd, TestSetup,
+    AxisKind, AxisSource, ByKind, Environment, Measurement, RunSelector, SourceFormat, StartEnd,
+    TestSetup,
 };
-use crate::units::{AngleUnit, DeviationUnit, opt_mm_to_um};
+use crate::units::{AngleUnit, Deg, DeviationUnit, Mm, opt_mm_to_um};
 
 /// The whole `evaluate --json` object.
 #[derive(Clone, Debug, Serialize)]
@@ -101,12 +115,9 @@ pub struct EvaluationJson {
     /// Length unit of the source file (`mm` or `inch`; `deg` on a rotary
     /// axis); all values here are mm or µm (° or ″).
     pub length_unit: &'static str,
-    /// Targets, mm (empty, and absent, on a rotary axis).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub targets_mm: Vec<f64>,
-    /// Targets, ° (empty, and absent, on a linear axis).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub targets_deg: Vec<f64>,
+    /// Targets: `targets_mm`, or `targets_deg` on a rotary axis.
+    #[serde(flatten)]
+    pub targets: TargetsJson,
     /// Runs per direction, after exclusions.
     pub runs: RunCountsJson,
     /// Runs left out by `--exclude-run`, as `3`, `3:up` or `3:down`.
@@ -118,21 +129,15 @@ pub struct EvaluationJson {
     /// Whether its definitions are reconstructed from public sources
     /// (`../shared/spec/standards.md`), not read in the standard.
     pub definitions_reconstructed: bool,
-    /// That standard's axis figures, µm, under its keys (empty, and absent,
-    /// on a rotary axis).
-    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
-    pub figures_um: FiguresJson,
+    /// That standard's axis figures under its keys: `figures_um`, or
+    /// `figures_arcsec` (`figures_urad`) on a rotary axis.
+    #[serde(flatten)]
+    pub figures: FiguresByUnit,
     /// The ISO 230-2:2014 figures too, µm, when the standard's keys are
-    /// others (VDI 3441): the report shows both; absent otherwise.
+    /// others (VDI 3441) on a linear axis: the report shows both; absent
+    /// otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub figures_iso230_2_um: Option<FiguresJson>,
-    /// The same in ″ on a rotary axis (empty, and absent, on a linear one).
-    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
-    pub figures_arcsec: FiguresJson,
-    /// The same in µrad on a rotary axis with `--angle-unit urad` (empty,
-    /// and absent, otherwise).
-    #[serde(skip_serializing_if = "FiguresJson::is_empty")]
-    pub figures_urad: FiguresJson,
     /// The unit of every deviation here (µm, ″ or µrad); the keys say it.
     #[serde(skip)]
     pub deviation: DeviationUnit,
@@ -208,14 +213,84 @@ pub struct ConformanceJson {
     pub title: String,
     /// Whether every requirement (not the recommendations) is met.
     pub meets_iso230_2: bool,
-    /// Travel, mm (absent on a rotary axis).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub length_mm: Option<f64>,
-    /// Range, ° (a rotary axis only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub length_deg: Option<f64>,
+    /// Travel: `length_mm`, or the range `length_deg` on a rotary axis.
+    #[serde(flatten)]
+    pub length: LengthJson,
     /// Every check.
     pub checks: Vec<CheckJson>,
+}
+
+/// A travel in its unit, the key saying which.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum LengthJson {
+    /// A linear axis' travel, mm.
+    #[serde(rename = "length_mm")]
+    Mm(Mm),
+    /// A rotary axis' range, °.
+    #[serde(rename = "length_deg")]
+    Deg(Deg),
+}
+
+/// The targets in their unit, the key saying which.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum TargetsJson {
+    /// A linear axis' targets, mm.
+    #[serde(rename = "targets_mm")]
+    Mm(Vec<Mm>),
+    /// A rotary axis' targets, °.
+    #[serde(rename = "targets_deg")]
+    Deg(Vec<Deg>),
+}
+
+impl TargetsJson {
+    /// The targets of `measurement`, typed by its axis' kind.
+    pub fn of(measurement: &Measurement) -> TargetsJson {
+        let positions = measurement.positions();
+        match measurement.kind() {
+            AxisKind::Linear => TargetsJson::Mm(positions.filter_map(ByKind::linear).collect()),
+            AxisKind::Rotary => TargetsJson::Deg(positions.filter_map(ByKind::rotary).collect()),
+        }
+    }
+}
+
+/// A standard's figures in the unit they are reported in, the key saying
+/// which: `figures_um` on a linear axis, `figures_arcsec` or `figures_urad`
+/// on a rotary one.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum FiguresByUnit {
+    /// µm.
+    #[serde(rename = "figures_um")]
+    Um(FiguresJson),
+    /// ″.
+    #[serde(rename = "figures_arcsec")]
+    Arcsec(FiguresJson),
+    /// µrad.
+    #[serde(rename = "figures_urad")]
+    Urad(FiguresJson),
+}
+
+impl FiguresByUnit {
+    /// A standard's figures of an axis of `kind`, an angle's in `angle`.
+    pub fn of(figures: &[StandardFigure], kind: AxisKind, angle: AngleUnit) -> FiguresByUnit {
+        match (kind, angle) {
+            (AxisKind::Linear, _) => FiguresByUnit::Um(FiguresJson::from_standard(figures)),
+            (AxisKind::Rotary, AngleUnit::Arcsec) => {
+                FiguresByUnit::Arcsec(FiguresJson::from_standard_deg(figures, angle))
+            }
+            (AxisKind::Rotary, AngleUnit::Urad) => {
+                FiguresByUnit::Urad(FiguresJson::from_standard_deg(figures, angle))
+            }
+        }
+    }
+
+    /// The figures, in their unit.
+    pub fn values(&self) -> &FiguresJson {
+        match self {
+            FiguresByUnit::Um(figures)
+            | FiguresByUnit::Arcsec(figures)
+            | FiguresByUnit::Urad(figures) => figures,
+        }
+    }
 }
 
 /// One check of the test.
@@ -239,8 +314,10 @@ impl ConformanceJson {
         ConformanceJson {
             title: c.title(),
             meets_iso230_2: c.meets_iso230_2(),
-            length_mm: (c.kind == AxisKind::Linear).then_some(c.length_mm),
-            length_deg: (c.kind == AxisKind::Rotary).then_some(c.length_mm),
+            length: match c.length {
+                ByKind::Linear(length_mm) => LengthJson::Mm(length_mm),
+                ByKind::Rotary(range_deg) => LengthJson::Deg(range_deg),
+            },
             checks: c
                 .checks
                 .iter()
@@ -410,156 +487,6 @@ impl Serialize for FiguresJson {
     }
 }
 
-/// Statistics at one target, µm; on a rotary axis (`kind`) the same fields
-/// hold ° and ″ (or µrad, `deviation`) and serialise as `target_deg`,
-/// `mean_up_arcsec` (`mean_up_urad`), …
-#[allow(non_snake_case)]
-#[derive(Clone, Copy, Debug)]
-pub struct PerTargetJson {
-    /// Linear or rotary: the unit of the target and its JSON key.
-    pub kind: AxisKind,
-    /// The unit of every deviation and of its JSON keys.
-    pub deviation: DeviationUnit,
-    /// Target, mm.
-    pub target_mm: f64,
-    /// Readings ↑.
-    pub n_up: usize,
-    /// Readings ↓.
-    pub n_down: usize,
-    /// x̄_i↑.
-    pub mean_up_um: Option<f64>,
-    /// x̄_i↓.
-    pub mean_down_um: Option<f64>,
-    /// x̄_i.
-    pub mean_um: Option<f64>,
-    /// s_i↑.
-    pub s_up_um: Option<f64>,
-    /// s_i↓.
-    pub s_down_um: Option<f64>,
-    /// B_i (signed).
-    pub B_um: Option<f64>,
-    /// R_i↑.
-    pub R_up_um: Option<f64>,
-    /// R_i↓.
-    pub R_down_um: Option<f64>,
-    /// R_i.
-    pub R_um: Option<f64>,
-}
-
-impl PerTargetJson {
-    /// Converts one target's statistics of a linear axis to µm.
-    pub fn from_stats(t: &TargetStats) -> PerTargetJson {
-        PerTargetJson::from_stats_of(t, AxisKind::Linear, AngleUnit::default())
-    }
-
-    /// Converts one target's statistics to µm, or `angle` (″, µrad) on a rotary axis.
-    pub fn from_stats_of(t: &TargetStats, kind: AxisKind, angle: AngleUnit) -> PerTargetJson {
-        let deviation = kind.deviation_unit(angle);
-        let shown = |value: f64| deviation.from_internal(value);
-        PerTargetJson {
-            kind,
-            deviation,
-            target_mm: t.target_mm,
-            n_up: t.up.n,
-            n_down: t.down.n,
-            mean_up_um: t.up.mean_mm.map(shown),
-            mean_down_um: t.down.mean_mm.map(shown),
-            mean_um: t.mean_mm.map(shown),
-            s_up_um: t.up.s_mm.map(shown),
-            s_down_um: t.down.s_mm.map(shown),
-            B_um: t.reversal_mm.map(shown),
-            R_up_um: t.repeatability_up_mm.map(shown),
-            R_down_um: t.repeatability_down_mm.map(shown),
-            R_um: t.repeatability_mm.map(shown),
-        }
-    }
-}
-
-/// The key suffix of a position: `mm`, or `deg` on a rotary axis.
-fn position_key(kind: AxisKind) -> &'static str {
-    match kind {
-        AxisKind::Linear => "mm",
-        AxisKind::Rotary => "deg",
-    }
-}
-
-impl Serialize for PerTargetJson {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let (position, deviation) = (position_key(self.kind), self.deviation.key());
-        let mut map = serializer.serialize_map(Some(13))?;
-        map.serialize_entry(&format!("target_{position}"), &self.target_mm)?;
-        map.serialize_entry("n_up", &self.n_up)?;
-        map.serialize_entry("n_down", &self.n_down)?;
-        let values = [
-            ("mean_up", self.mean_up_um),
-            ("mean_down", self.mean_down_um),
-            ("mean", self.mean_um),
-            ("s_up", self.s_up_um),
-            ("s_down", self.s_down_um),
-            ("B", self.B_um),
-            ("R_up", self.R_up_um),
-            ("R_down", self.R_down_um),
-            ("R", self.R_um),
-        ];
-        for (stem, value) in values {
-            map.serialize_entry(&format!("{stem}_{deviation}"), &value)?;
-        }
-        map.end()
-    }
-}
-
-/// A suspected outlier run; on a rotary axis (`kind`) the position is ° and
-/// the offset ″ (or µrad), serialised as `worst_target_deg` and
-/// `offset_arcsec` (`offset_urad`).
-#[derive(Clone, Copy, Debug)]
-pub struct OutlierJson {
-    /// Linear or rotary.
-    pub kind: AxisKind,
-    /// The unit of the offset.
-    pub deviation: DeviationUnit,
-    /// Run number within its direction.
-    pub run: u32,
-    /// `up` or `down`.
-    pub direction: &'static str,
-    /// Largest standardised difference from the other runs.
-    pub score: f64,
-    /// Where it differs most, mm.
-    pub worst_target_mm: f64,
-    /// How much it differs there from the mean of the other runs, µm.
-    pub offset_um: f64,
-}
-
-impl OutlierJson {
-    /// Converts a flagged run of an axis of `kind`, an angle's offset to `angle`.
-    pub fn from_outlier(o: &SuspectedOutlier, kind: AxisKind, angle: AngleUnit) -> OutlierJson {
-        let deviation = kind.deviation_unit(angle);
-        OutlierJson {
-            kind,
-            deviation,
-            run: o.run,
-            direction: o.direction.as_str(),
-            score: o.score,
-            worst_target_mm: o.worst_target_mm,
-            offset_um: deviation.from_internal(o.offset_mm),
-        }
-    }
-}
-
-impl Serialize for OutlierJson {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let (position, deviation) = (position_key(self.kind), self.deviation.key());
-        let mut map = serializer.serialize_map(Some(5))?;
-        map.serialize_entry("run", &self.run)?;
-        map.serialize_entry("direction", self.direction)?;
-        map.serialize_entry("score", &self.score)?;
-        map.serialize_entry(&format!("worst_target_{position}"), &self.worst_target_mm)?;
-        map.serialize_entry(&format!("offset_{deviation}"), &self.offset_um)?;
-        map.end()
-    }
-}
-
 /// A start/end pair.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct StartEndJson {
@@ -704,21 +631,16 @@ pub struct MetadataJson {
 
 impl EvaluationJson {
     /// The targets, in their unit (mm, or ° on a rotary axis).
-    pub fn targets(&self) -> &[f64] {
-        if self.targets_deg.is_empty() {
-            &self.targets_mm
-        } else {
-            &self.targets_deg
+    pub fn targets(&self) -> Vec<f64> {
+        match &self.targets {
+            TargetsJson::Mm(targets) => targets.iter().map(|target| target.0).collect(),
+            TargetsJson::Deg(targets) => targets.iter().map(|target| target.0).collect(),
         }
     }
 
     /// The figures, in their unit (µm, or ″ or µrad on a rotary axis).
     pub fn figures(&self) -> &FiguresJson {
-        match self.deviation {
-            DeviationUnit::Micrometre => &self.figures_um,
-            DeviationUnit::Angle(AngleUnit::Arcsec) => &self.figures_arcsec,
-            DeviationUnit::Angle(AngleUnit::Urad) => &self.figures_urad,
-        }
+        self.figures.values()
     }
 
     /// How a deviation's unit is printed: `µm`, or `″` or `µrad` on a rotary axis.
@@ -792,23 +714,6 @@ impl EvaluationJson {
         let kind = measurement.kind();
         let deviation = kind.deviation_unit(angle);
         let rotary = kind == AxisKind::Rotary;
-        let targets = measurement.targets_mm().to_vec();
-        let (targets_mm, targets_deg) = if rotary {
-            (Vec::new(), targets)
-        } else {
-            (targets, Vec::new())
-        };
-        // One of the three is filled, in the unit of `deviation`.
-        let (mut figures_um, mut figures_arcsec, mut figures_urad) = Default::default();
-        *match deviation {
-            DeviationUnit::Micrometre => &mut figures_um,
-            DeviationUnit::Angle(AngleUnit::Arcsec) => &mut figures_arcsec,
-            DeviationUnit::Angle(AngleUnit::Urad) => &mut figures_urad,
-        } = if rotary {
-            FiguresJson::from_standard_deg(&evaluation.standard_figures, angle)
-        } else {
-            FiguresJson::from_standard(&evaluation.standard_figures)
-        };
         EvaluationJson {
             format: metadata.source_format.map(|f| f.name()),
             axis: measurement
@@ -825,8 +730,7 @@ impl EvaluationJson {
             } else {
                 metadata.length_unit.as_str()
             },
-            targets_mm,
-            targets_deg,
+            targets: TargetsJson::of(measurement),
             runs: RunCountsJson {
                 up: evaluation.runs_up,
                 down: evaluation.runs_down,
@@ -837,9 +741,7 @@ impl EvaluationJson {
             definitions_reconstructed: evaluation.standard.reconstructed,
             figures_iso230_2_um: (!rotary && !iso_keys(&evaluation.standard_figures))
                 .then(|| FiguresJson::from_figures(&evaluation.figures)),
-            figures_um,
-            figures_arcsec,
-            figures_urad,
+            figures: FiguresByUnit::of(&evaluation.standard_figures, kind, angle),
             deviation,
             per_target,
             outliers: evaluation
@@ -869,5 +771,164 @@ impl EvaluationJson {
             test_setup: TestSetupJson::from_setup(&metadata.setup),
             notes: source_notes(metadata.source_format),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evaluate::{DirectionStats, SuspectedOutlier, TargetStats};
+    use crate::measurement::Direction;
+
+    /// A target with x̄↑ = 0.001 and x̄↓ = −0.001 in the axis' unit (two
+    /// readings each way, s = 0.0005), computed by hand below.
+    fn target(at: f64) -> TargetStats {
+        let up = DirectionStats::of(&[0.0005, 0.0015]);
+        let down = DirectionStats::of(&[-0.0005, -0.0015]);
+        TargetStats {
+            target_mm: at,
+            up,
+            down,
+            mean_mm: Some(0.0),
+            reversal_mm: Some(0.002),
+            repeatability_up_mm: up.s_mm.map(|s| 4.0 * s),
+            repeatability_down_mm: down.s_mm.map(|s| 4.0 * s),
+            repeatability_mm: Some(0.004),
+        }
+    }
+
+    /// The keys of a flat JSON object, in the order written.
+    fn keys(text: &str) -> Vec<&str> {
+        text.trim_matches(|c| c == '{' || c == '}')
+            .split(',')
+            .map(|entry| entry.split(':').next().unwrap().trim_matches('"'))
+            .collect()
+    }
+
+    #[test]
+    fn a_linear_target_is_in_mm_and_um() {
+        let json = PerTargetJson::from_stats(&target(100.0));
+        let text = serde_json::to_string(&json).unwrap();
+        assert!(text.starts_with(r#"{"target_mm":100.0,"n_up":2,"n_down":2,"mean_up_um":1.0,"#));
+        assert_eq!(
+            keys(&text),
+            [
+                "target_mm",
+                "n_up",
+                "n_down",
+                "mean_up_um",
+                "mean_down_um",
+                "mean_um",
+                "s_up_um",
+                "s_down_um",
+                "B_um",
+                "R_up_um",
+                "R_down_um",
+                "R_um"
+            ]
+        );
+        // B = 0.002 mm = 2 µm, R = 0.004 mm = 4 µm.
+        assert!(
+            text.contains(r#""B_um":2.0,"#) && text.ends_with(r#""R_um":4.0}"#),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_rotary_target_is_in_degrees_and_arcsec_or_urad() {
+        // 0.001° = 3.6″ = 17.453 292 5 µrad; B = 0.002° = 7.2″.
+        let arcsec =
+            PerTargetJson::from_stats_of(&target(90.0), AxisKind::Rotary, AngleUnit::Arcsec);
+        let text = serde_json::to_string(&arcsec).unwrap();
+        assert!(
+            text.starts_with(r#"{"target_deg":90.0,"n_up":2,"n_down":2,"mean_up_arcsec":3.6,"#),
+            "{text}"
+        );
+        assert!(text.contains(r#""B_arcsec":7.2,"#), "{text}");
+        assert_eq!(
+            keys(&text),
+            [
+                "target_deg",
+                "n_up",
+                "n_down",
+                "mean_up_arcsec",
+                "mean_down_arcsec",
+                "mean_arcsec",
+                "s_up_arcsec",
+                "s_down_arcsec",
+                "B_arcsec",
+                "R_up_arcsec",
+                "R_down_arcsec",
+                "R_arcsec"
+            ]
+        );
+        assert_eq!(arcsec.target(), 90.0);
+        assert_eq!(arcsec.cells()[0], ("mean_up_arcsec", Some(3.6)));
+        let urad = PerTargetJson::from_stats_of(&target(90.0), AxisKind::Rotary, AngleUnit::Urad);
+        let (key, value) = urad.cells()[0];
+        assert_eq!(key, "mean_up_urad");
+        assert!((value.unwrap() - 17.453_292_519_943_3).abs() < 1e-9);
+    }
+
+    #[test]
+    fn outliers_carry_the_unit_in_their_keys() {
+        let outlier = SuspectedOutlier {
+            direction: Direction::Down,
+            run: 1,
+            score: 6.5,
+            worst_target_mm: 90.0,
+            offset_mm: 0.01,
+        };
+        // 0.01° = 36″; 0.01 mm = 10 µm.
+        let rotary = OutlierJson::from_outlier(&outlier, AxisKind::Rotary, AngleUnit::Arcsec);
+        assert_eq!(
+            serde_json::to_string(&rotary).unwrap(),
+            r#"{"run":1,"direction":"down","score":6.5,"worst_target_deg":90.0,"offset_arcsec":36.0}"#
+        );
+        let linear = OutlierJson::from_outlier(&outlier, AxisKind::Linear, AngleUnit::Arcsec);
+        assert_eq!(
+            serde_json::to_string(&linear).unwrap(),
+            r#"{"run":1,"direction":"down","score":6.5,"worst_target_mm":90.0,"offset_um":10.0}"#
+        );
+        assert_eq!(linear.shown().offset, 10.0);
+    }
+
+    #[test]
+    fn the_travel_and_the_figures_carry_their_unit_in_their_key() {
+        let length = |kind: AxisKind| {
+            let c = TestConformance {
+                length: kind.position(360.0),
+                targets: 25,
+                runs_up: 5,
+                runs_down: 5,
+                checks: Vec::new(),
+            };
+            let json = serde_json::to_value(ConformanceJson::from_conformance(&c)).unwrap();
+            (
+                json.get("length_mm").cloned(),
+                json.get("length_deg").cloned(),
+            )
+        };
+        assert_eq!(length(AxisKind::Linear), (Some(360.0.into()), None));
+        assert_eq!(length(AxisKind::Rotary), (None, Some(360.0.into())));
+        let figures = [StandardFigure {
+            key: "E",
+            value_mm: Some(0.002),
+        }];
+        // 0.002 mm = 2 µm; 0.002° = 7.2″.
+        let key = |kind, angle| {
+            serde_json::to_value(FiguresByUnit::of(&figures, kind, angle))
+                .unwrap()
+                .to_string()
+        };
+        assert_eq!(
+            key(AxisKind::Linear, AngleUnit::Urad),
+            r#"{"figures_um":{"E":2.0}}"#
+        );
+        assert_eq!(
+            key(AxisKind::Rotary, AngleUnit::Arcsec),
+            r#"{"figures_arcsec":{"E":7.2}}"#
+        );
+        assert!(key(AxisKind::Rotary, AngleUnit::Urad).starts_with(r#"{"figures_urad":{"E":34.9"#));
     }
 }

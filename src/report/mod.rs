@@ -26,6 +26,7 @@ pub mod html;
 pub mod json;
 pub mod plot;
 pub mod predict;
+mod quantity;
 pub mod servo;
 pub mod terminal;
 pub mod thermal;

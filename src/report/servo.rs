@@ -383,14 +383,14 @@ pub fn text(report: &ServoSimJson) -> String {
 }
 
 fn iso_text(out: &mut String, iso: &IsoJson) {
-    let compliance = iso
+    let stiffness = iso
         .stiffness_n_per_um
         .map_or("rigid (laser reads the scale)".to_string(), |k| {
             format!("{k} N/µm")
         });
     let _ = writeln!(
         out,
-        "Cycle        {} targets {}–{} mm, {} runs, dwell {} s, overrun {} mm, {} m/min\nCompliance   {compliance}\n",
+        "Cycle        {} targets {}–{} mm, {} runs, dwell {} s, overrun {} mm, {} m/min\nStiffness    {stiffness}\n",
         iso.targets_mm.len(),
         iso.targets_mm.first().copied().unwrap_or(0.0),
         iso.targets_mm.last().copied().unwrap_or(0.0),

@@ -16,7 +16,7 @@ use crate::report::format::{
     NOT_EVALUATED, SHORT_TEXT, inch_beside, push_integer, push_short, push_shortest, push_um,
     text_of, um,
 };
-use crate::report::json::{EvaluationJson, PerTargetJson, StartEndJson};
+use crate::report::json::{EvaluationJson, OutlierJson, PerTargetJson, StartEndJson};
 
 /// Renders the whole evaluation report.
 pub fn evaluation_report(report: &EvaluationJson) -> String {
@@ -61,15 +61,15 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     }
     if !report.outliers.is_empty() {
         out.push_str("\nSuspected outlier runs (included; exclude with --exclude-run RUN:DIRECTION only if you know why)\n");
-        for o in &report.outliers {
+        for o in report.outliers.iter().map(OutlierJson::shown) {
             let _ = writeln!(
                 out,
                 "  run {}:{}  score {:.1}  largest offset {:+.2} {unit} at {}{}",
                 o.run,
                 o.direction,
                 o.score,
-                o.offset_um,
-                o.worst_target_mm,
+                o.offset,
+                o.worst_target,
                 report.position_unit()
             );
         }
@@ -248,23 +248,14 @@ impl TableCells {
             column = (column + 1) % PER_TARGET_COLUMNS;
         };
         for t in rows {
-            push_shortest(&mut text, t.target_mm);
+            push_shortest(&mut text, t.target());
             end_cell(&text);
-            push_integer(&mut text, t.n_up as u64);
+            let (n_up, n_down) = t.readings();
+            push_integer(&mut text, n_up as u64);
             end_cell(&text);
-            push_integer(&mut text, t.n_down as u64);
+            push_integer(&mut text, n_down as u64);
             end_cell(&text);
-            for value in [
-                t.mean_up_um,
-                t.mean_down_um,
-                t.mean_um,
-                t.s_up_um,
-                t.s_down_um,
-                t.B_um,
-                t.R_up_um,
-                t.R_down_um,
-                t.R_um,
-            ] {
+            for (_, value) in t.cells() {
                 push_um(&mut text, value);
                 end_cell(&text);
             }

@@ -53,5 +53,6 @@ mod survey;
 mod survey_optics;
 mod thermal;
 mod together;
+mod units_wire;
 mod util;
 mod verdict;

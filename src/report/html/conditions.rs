@@ -246,7 +246,7 @@ pub(super) fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
                 finding: format!(
                     "{} per direction, {directions} (5 each way, 1 over {})",
                     runs.and_then(|r| r.found).unwrap_or_default(),
-                    if c.kind == AxisKind::Rotary {
+                    if c.kind() == AxisKind::Rotary {
                         "360°"
                     } else {
                         "2000 mm"
@@ -262,7 +262,7 @@ pub(super) fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
                 .and_then(|d| d.found)
                 .map_or_else(String::new, |d| format!(", {d:.1} per metre"));
             // A rotary axis has no per-metre rule (evaluate::conformance).
-            if c.kind == AxisKind::Rotary {
+            if c.kind() == AxisKind::Rotary {
                 return Cell::Conformance {
                     finding: format!("{} (at least 5)", c.targets),
                     met: met(&[count]),
@@ -279,7 +279,7 @@ pub(super) fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
                 finding: spacing.and_then(|s| s.found).map_or_else(
                     || "irregular".to_string(),
                     |step| {
-                        let unit = if c.kind == AxisKind::Rotary {
+                        let unit = if c.kind() == AxisKind::Rotary {
                             "°"
                         } else {
                             " mm"
@@ -294,7 +294,7 @@ pub(super) fn conformance_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
     // Nor a spacing rule: a rotary test's even steps are its principal angles.
     let rotary = tests
         .iter()
-        .any(|(_, t)| t.evaluation.conformance.kind == AxisKind::Rotary);
+        .any(|(_, t)| t.evaluation.conformance.kind() == AxisKind::Rotary);
     rows.into_iter()
         .filter(|(label, _)| !(rotary && label.starts_with("Spacing")))
         .map(|(label, judge)| wide_row(tests, label, "", &|t| judge(&t.evaluation.conformance)))

@@ -43,36 +43,18 @@ pub(super) fn per_target_rows(
     for (index, stats) in test.evaluation.per_target.iter().enumerate() {
         let t = PerTargetJson::from_stats_of(stats, kind, angle);
         // The JSON key: `mean_up_um`, or `mean_up_arcsec` (`_urad`) on a rotary axis.
-        let key = |name: &str| match (rotary, name.strip_suffix("_um")) {
-            (true, Some(stem)) => {
-                format!("{prefix}.per_target.{index}.{stem}_{}", t.deviation.key())
-            }
-            _ => format!("{prefix}.per_target.{index}.{name}"),
-        };
-        let cells = [
-            ("mean_up_um", t.mean_up_um),
-            ("mean_down_um", t.mean_down_um),
-            ("mean_um", t.mean_um),
-            ("s_up_um", t.s_up_um),
-            ("s_down_um", t.s_down_um),
-            ("B_um", t.B_um),
-            ("R_up_um", t.R_up_um),
-            ("R_down_um", t.R_down_um),
-            ("R_um", t.R_um),
-        ]
-        .map(|(name, value)| SourcedUm::new(key(name), value));
+        let cells = t.cells().map(|(key, value)| {
+            SourcedUm::new(format!("{prefix}.per_target.{index}.{key}"), value)
+        });
+        let (n_up, n_down) = t.readings();
         rows.push(PerTargetRow {
             target: if rotary {
-                format!("{}°", t.target_mm)
+                format!("{}°", t.target())
             } else {
-                format!(
-                    "{}{}",
-                    t.target_mm,
-                    inch_beside(length_unit, &[t.target_mm])
-                )
+                format!("{}{}", t.target(), inch_beside(length_unit, &[t.target()]))
             },
-            n_up: t.n_up,
-            n_down: t.n_down,
+            n_up,
+            n_down,
             cells: cells.to_vec(),
         });
     }
