@@ -3,7 +3,11 @@
 
 use proptest::prelude::*;
 
+use super::rows::{PlainRow, SimpleRow};
 use super::*;
+use crate::measurement::{Direction, Environment, Metadata, Run, SourceFormat, StartEnd};
+use crate::read::text::{self, Line};
+use crate::units::um_to_mm;
 
 /// The composite example of `../shared/notes/rtl-and-com-search.md` A.6
 /// (assembled from five readers and writers; the ENVIRONMENT lines are from a
