@@ -1,7 +1,7 @@
 //! One linear axis on two rails and four carriages: from the straightness of
 //! the rail mounting surfaces to the error motions of the saddle.
 //!
-//! Seed 000 §3.1–3.2 (`../shared/notes/seed000-volumetric-model.md` §3): a
+//! Valášek (2021) §3.1–3.2 (`../shared/notes/seed000-volumetric-model.md` §3): a
 //! rigid saddle rests on four carriages, linear springs of stiffness k_i
 //! (N/mm) in the direction normal to the rail mounting face ("vertical", z)
 //! and across it ("horizontal", y). The rails copy their mounting surfaces,
@@ -24,19 +24,19 @@
 //!   prints Δ_y4 where eq. 28 (and sense) has Δ_y3. Outputs y5 = mean y_i
 //!   (37), yaw = (y1 − y2)/b (38).
 //!
-//! The loads act at the saddle centre: F_zz downwards (the thesis's sign,
+//! The loads act at the saddle centre: F_zz downwards (Valášek's sign,
 //! −F_zz in eq. 9) and F_zy sideways (+F_zy in eq. 29). Both problems are
 //! linear, so [`Guideway::linear_map`] solves them once for unit inputs and
 //! the Monte Carlo study applies the resulting weights to every sample. With
 //! equal stiffness and no load, z5 and y5 are the means of the four rail
 //! deviations (the notes' closed forms, §3.5), which the tests check.
 //!
-//! Tilting stiffness of the carriages is neglected, as in the thesis.
+//! Tilting stiffness of the carriages is neglected, as in Valášek (2021).
 //!
 //! # The carriage side: the saddle's mounting faces
 //!
-//! Seed 000's assignment asks for errors "on the rail side and on the
-//! carriage side"; the thesis models only the rails (notes §3.6). Seed 002
+//! Valášek's (2021) assignment asks for errors "on the rail side and on the
+//! carriage side"; Valášek (2021) models only the rails (notes §3.6). The carriage-side thesis (references.md)
 //! (the paper of the same work, §4) names the carriage-side input, "the
 //! prescribed parallelism tolerance of the faces for the carriages on the
 //! saddle", and draws it in Obr. 8, which the text lacks. [`SaddleFaces`]
@@ -66,7 +66,7 @@
 //!   roll and pitch, which [`GuidewayMap`] computes.
 //!
 //! A lateral counterpart (the carriages' locating edges on the saddle) would
-//! enter the lateral system the same way; seed 002 names only the mounting
+//! enter the lateral system the same way; the carriage-side thesis (references.md) names only the mounting
 //! faces, and it is not modelled.
 
 use nalgebra::{Matrix4, Vector4};
@@ -74,7 +74,7 @@ use nalgebra::{Matrix4, Vector4};
 use super::components::ErrorFunction;
 use super::{ModelError, check_positive};
 
-/// The geometry, stiffness and load of one axis's guideway (seed 000 Tab. 3.1, 3.4).
+/// The geometry, stiffness and load of one axis's guideway (Valášek (2021) Tab. 3.1, 3.4).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Guideway {
     /// a: distance between the two rails, mm.
@@ -92,11 +92,11 @@ pub struct Guideway {
     pub load_lateral_n: f64,
 }
 
-/// The stiffness of every carriage in seed 000 (Tab. 3.3, 3.4), N/mm.
+/// The stiffness of every carriage in Valášek (2021) (Tab. 3.3, 3.4), N/mm.
 pub const THESIS_STIFFNESS_N_PER_MM: f64 = 100_000.0;
 
 impl Guideway {
-    /// Four equal carriages of the thesis's stiffness, no load.
+    /// Four equal carriages of Valášek's stiffness, no load.
     pub fn unloaded(rail_spacing_mm: f64, carriage_pitch_mm: f64) -> Guideway {
         Guideway {
             rail_spacing_mm,
@@ -112,7 +112,7 @@ impl Guideway {
     ///
     /// # Example
     ///
-    /// The thesis's Obr. 3.8 example; the check values are the notes' §3.3:
+    /// Valášek's Obr. 3.8 example; the check values are the notes' §3.3:
     ///
     /// ```
     /// use axcomp::model::{CarriageDeviations, Guideway};
@@ -264,7 +264,7 @@ impl CarriageDeviations {
 }
 
 /// The errors of the saddle's four carriage mounting faces (pads), normal to
-/// them, relative to the saddle's datum face, mm (the carriage side; seed 002
+/// them, relative to the saddle's datum face, mm (the carriage side; the carriage-side thesis (references.md)
 /// Obr. 8). Constant along the stroke: the pads travel with the saddle.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SaddleFaces {
@@ -769,7 +769,7 @@ mod tests {
     }
 
     proptest! {
-        // The solution satisfies the thesis's own equations, whatever the
+        // The solution satisfies Valášek's own equations, whatever the
         // stiffnesses and loads: force and moment balance (9)–(11), (29), (30),
         // the plane condition (5), equal lateral displacement (22), (23) and
         // Hooke's law (7), (26).

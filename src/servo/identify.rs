@@ -1,14 +1,14 @@
-//! The identification arithmetic of seed 004 ch. 5 and the derived
+//! The identification arithmetic of Mendřický (2006) ch. 5 and the derived
 //! parameters of ch. 3–4, as small functions (SI units throughout).
 //!
-//! These are the closed forms the thesis uses to get friction, mass and
+//! These are the closed forms Mendřický (2006) uses to get friction, mass and
 //! stiffness from currents, dial-gauge readings and catalogue data; the unit
-//! tests check each against the thesis's own numbers (notes §9). Callers:
+//! tests check each against Mendřický's own numbers (notes §9). Callers:
 //! `axis` (the LuGre damping of eq. 4.15 for every axis file) and
 //! `friction_fit` (`servo-sim --identify`: the linear fit of the
 //! constant-velocity currents, [`coulomb_viscous_fit`], the feed conversion
 //! and the damping again); the other closed forms (guide estimate, current
-//! jump, circle mass, slider, motor and loop constants) are the thesis's
+//! jump, circle mass, slider, motor and loop constants) are Mendřický's
 //! arithmetic, checked here and not called elsewhere.
 
 /// Guide friction estimate (eq. 5.1, 5.2): equivalent load per carriage
@@ -40,7 +40,7 @@ pub fn viscous_from_current_n_s_per_m(
     (current_a * force_constant_n_per_a - coulomb_n) / velocity_m_per_s
 }
 
-/// F_C and μ_v from the friction force at constant speeds, the thesis's
+/// F_C and μ_v from the friction force at constant speeds, Mendřický's
 /// linear fit of Fig. 5.1 (§5.2): least squares of F = F_C + μ_v·|v| over
 /// the rows, with F the force against the motion (sgn v · K_F3 · I, so runs
 /// in both directions count alike). `None` with fewer than two distinct
@@ -113,7 +113,7 @@ pub fn m_per_min_to_m_per_s(feed_m_per_min: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    //! Every expected number is the thesis's, as listed in notes §9 (row numbers in comments).
+    //! Every expected number is Mendřický's, as listed in notes §9 (row numbers in comments).
 
     use super::*;
     use crate::servo::friction::{Power, Ramp};
@@ -173,7 +173,7 @@ mod tests {
     fn linear_fit_of_tab_5_1() {
         // Tab. 5.1 (notes §4.2) from 1 m/min up, F = 94·I as tabulated: the
         // least-squares line computed by hand (Python, two-pass means) is
-        // F_C = 125.03 N, μ_v = 313.03 N·s/m (the thesis's B1 fit reads
+        // F_C = 125.03 N, μ_v = 313.03 N·s/m (Mendřický's B1 fit reads
         // 110 N and 430 N·s/m off the same curve with its corner v0).
         let feeds = [1.0, 3.2, 5.0, 8.0, 10.0, 16.0, 24.0];
         let forces = [117.5, 141.9, 159.8, 166.4, 188.0, 205.9, 246.3];
@@ -231,7 +231,7 @@ mod tests {
         };
         close(b2.force_n(2e-5) - b2.force_n(1e-5), 3.19, 0.005);
         close(b2.force_n(1e-5) - b2.force_n(0.0), 16.87, 0.005);
-        // The thesis's B1 figure of 0.07 N does not follow from μ0 = 12 000:
+        // Mendřický's B1 figure of 0.07 N does not follow from μ0 = 12 000:
         // the same 1e-5 m/s step gives 0.12 N (notes §5.2, an inconsistency in the text).
         let b1 = Ramp {
             coulomb_n: 115.0,

@@ -1,4 +1,4 @@
-//! The Monte Carlo tolerance study (seed 000 §3.4–3.5, §4): random machines
+//! The Monte Carlo tolerance study (Valášek (2021) §3.4–3.5, §4): random machines
 //! built from straightness tolerances, and the distribution of their maximum
 //! volumetric error; the sensitivity sweep over the six straightness
 //! tolerances; and the single-axis study of the guideway model.
@@ -16,7 +16,7 @@
 //! machine's measure is the largest ‖E‖ over the grid (eq. 71), with E from
 //! the first-order chain and zeroed at the reference position.
 //!
-//! The carriage side (seed 002 Obr. 8; [`super::guideway::SaddleFaces`]):
+//! The carriage side (the carriage-side thesis (references.md) Obr. 8; [`super::guideway::SaddleFaces`]):
 //! each saddle's four pads get a tilt across and along the rails, Δ_a and
 //! Δ_b each uniform in ±half the axis's parallelism tolerance t (so the
 //! pads' plane stays in a zone of width t: |Δ_a| + |Δ_b| ≤ t), and a twist c
@@ -28,14 +28,14 @@
 //! Every number is drawn even when its tolerance is zero, and profiles are
 //! drawn in units of their tolerance, so studies that differ only in
 //! tolerances see the same random shapes (common random numbers): the
-//! sensitivity curves are smooth and the thesis's Tab. 4.12 linearity
+//! sensitivity curves are smooth and Valášek's Tab. 4.12 linearity
 //! (all tolerances scaled together) holds exactly.
 //!
 //! # Speed and determinism
 //!
 //! What does not change between samples is computed once (the plan): the
 //! spline basis rows at the carriage positions of every grid coordinate (as
-//! the NumPy peer does), the guideway weights, and the lever arms of the
+//! the NumPy reference `mc_peer.py` does), the guideway weights, and the lever arms of the
 //! linearised chain. A sample then costs a few small matrix-vector products
 //! and one pass over the grid, which uses that the first-order error is a
 //! sum of functions of one coordinate and products of one coordinate's
@@ -77,15 +77,15 @@ pub const BATCH_SIZE: usize = 256;
 /// `CARRIAGE_STREAM + i`); far above any batch number of the rail streams.
 const CARRIAGE_STREAM: u64 = 1 << 62;
 
-/// The tolerance values of seed 000's sensitivity study (Tab. 4.4), mm.
+/// The tolerance values of Valášek's (2021) sensitivity study (Tab. 4.4), mm.
 pub const THESIS_SWEEP_MM: [f64; 5] = [0.005, 0.015, 0.03, 0.045, 0.06];
 
 /// Which straightness of a guideway.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum RailDirection {
-    /// Normal to the mounting face (the thesis's "vertical").
+    /// Normal to the mounting face (Valášek's "vertical").
     Normal,
-    /// Across the rail (the thesis's "horizontal").
+    /// Across the rail (Valášek's "horizontal").
     Lateral,
 }
 
@@ -110,7 +110,7 @@ impl RailDirection {
 }
 
 /// A tolerance of the saddle's carriage mounting faces (the carriage side,
-/// seed 002 Obr. 8; see [`super::guideway::SaddleFaces`]).
+/// the carriage-side thesis (references.md) Obr. 8; see [`super::guideway::SaddleFaces`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CarriageFace {
     /// The pads' plane against the saddle's datum face: constant roll and pitch.
@@ -155,7 +155,7 @@ pub struct Tolerances {
 
 impl Tolerances {
     /// One straightness tolerance for all six surfaces, one positioning
-    /// tolerance and one squareness for all axes (seed 000 Tab. 3.3 is
+    /// tolerance and one squareness for all axes (Valášek (2021) Tab. 3.3 is
     /// `uniform(0.03, 0.01, 30e-6)`; its sensitivity baseline `uniform(0.03, 0.0, 0.0)`).
     pub fn uniform(straightness_mm: f64, positioning_mm: f64, squareness_rad: f64) -> Tolerances {
         Tolerances {
@@ -216,7 +216,7 @@ pub struct StudyOptions {
     pub tolerances: Tolerances,
     /// The profile generator's shape.
     pub shape: ProfileShape,
-    /// Grid step over the work volume, mm (the thesis's measured data used 50).
+    /// Grid step over the work volume, mm (Valášek's measured data used 50).
     pub grid_step_mm: f64,
 }
 

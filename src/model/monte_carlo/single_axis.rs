@@ -13,7 +13,7 @@ use crate::model::stats::Summary;
 use crate::model::{ModelError, check_positive};
 use crate::spline::basis_matrix;
 
-/// The single-axis study (seed 000 §3.5.1, §4.1, Tab. 3.4).
+/// The single-axis study (Valášek (2021) §3.5.1, §4.1, Tab. 3.4).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AxisStudyOptions {
     /// Number of random axes (at least 1).
@@ -56,7 +56,7 @@ pub struct AxisStudyResult {
     pub improvement_normal: Vec<f64>,
     /// Lateral ("horizontal") direction, per sample.
     pub improvement_lateral: Vec<f64>,
-    /// Summary of the normal improvement; its `p10` is the thesis's "P90"
+    /// Summary of the normal improvement; its `p10` is Valášek's "P90"
     /// (9 of 10 axes improve at least this much).
     pub summary_normal: Summary,
     /// Summary of the lateral improvement.

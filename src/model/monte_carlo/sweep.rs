@@ -21,7 +21,7 @@ pub enum SweptTolerance {
 /// Which side of a guideway a swept tolerance is on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Side {
-    /// The rail mounting surfaces (the thesis's six).
+    /// The rail mounting surfaces (Valášek's six).
     Rail,
     /// The saddle's carriage mounting faces.
     Carriage,
@@ -41,7 +41,7 @@ impl Side {
 }
 
 impl SweptTolerance {
-    /// The six rail tolerances in the thesis's order (X↑, X→, Y↑, Y→, Z↑, Z→),
+    /// The six rail tolerances in Valášek's order (X↑, X→, Y↑, Y→, Z↑, Z→),
     /// all six together, then the six carriage-side tolerances (X
     /// parallelism, X flatness, Y …, Z …).
     pub fn all() -> Vec<SweptTolerance> {
@@ -101,7 +101,7 @@ pub struct Sensitivity {
     /// P90 of the maximum volumetric error at each value, mm.
     pub p90_mm: Vec<f64>,
     /// Least-squares slope of P90 over the tolerance (mm per mm; the
-    /// thesis's "linear trend slope" in µm/mm is 1000 times this).
+    /// Valášek's "linear trend slope" in µm/mm is 1000 times this).
     pub slope: Option<f64>,
 }
 

@@ -63,7 +63,7 @@ fn one_machine_matches_the_numpy_peer() {
 fn fast_path_equals_the_general_model_on_the_same_errors() {
     // The grid pass of `Workspace::max_norm` against `Machine::error_map`
     // with the sample's errors as linear tables over the grid coordinates,
-    // for the thesis's chain and three others. Between them their lever
+    // for Valášek's chain and three others. Between them their lever
     // arms fill every cross table m_kj: ZFYX has XY, XZ, YZ; YFXZ XY, ZX,
     // ZY; XFYZ (X moving on the tool side) YX, ZX; FXYZ ZY.
     use crate::model::tests::{fxyz_machine, yfxz_machine};
@@ -159,7 +159,7 @@ fn a_tilted_saddle_alone_gives_the_hand_computed_error() {
     // The X saddle's pads tilted by Δ_a = 0.02 mm across its rails and
     // Δ_b = 0.01 mm along them (a = 350, b = 640 mm): roll EAX = α =
     // 0.02/350, pitch EBX = β = 0.01/640 at every X. By the peer's §2.5
-    // formulas (mc_peer.py, the thesis's eqs 63–68 for ZFYX with z4 = 80,
+    // formulas (mc_peer.py, Valášek's eqs 63–68 for ZFYX with z4 = 80,
     // zeroed at the origin): Ex = β·Z, Ey = −α·Z, Ez = −α·Y, whatever X.
     // The largest norm is at Y = 500, Z = −550.
     let expected = x_roll_and_pitch_error(0.02 / 350.0, 0.01 / 640.0);

@@ -11,7 +11,7 @@ use crate::units::um_to_mm;
 
 /// The composite example of `../shared/notes/rtl-and-com-search.md` A.6
 /// (assembled from five readers and writers; the ENVIRONMENT lines are from a
-/// real file of seed 001).
+/// real file of Kadlečík (2019)).
 pub(crate) const COMPOSITE: &str = "HEADER::\r\n\
 File type  : rtl\r\n\
 Owner      : Linear\r\n\
