@@ -455,14 +455,8 @@ impl GuidewayMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use approx::assert_abs_diff_eq;
     use proptest::prelude::*;
-
-    fn close(actual: f64, expected: f64, tolerance: f64) {
-        assert!(
-            (actual - expected).abs() <= tolerance,
-            "{actual} differs from {expected} by more than {tolerance}"
-        );
-    }
 
     #[test]
     fn thesis_example_obr_3_8() {
@@ -476,22 +470,22 @@ mod tests {
             .unwrap();
         let expected_z = [0.00375, 0.00325, -0.00225, -0.00175];
         for (actual, expected) in response.corner_normal_mm.iter().zip(expected_z) {
-            close(*actual, expected, 1e-15);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-15);
         }
-        close(response.normal_mm, 0.00075, 1e-15);
-        close(response.roll_rad, -0.0055 / 150.0, 1e-17);
-        close(response.pitch_rad, -2.5e-6, 1e-17);
+        assert_abs_diff_eq!(response.normal_mm, 0.00075, epsilon = 1e-15);
+        assert_abs_diff_eq!(response.roll_rad, -0.0055 / 150.0, epsilon = 1e-17);
+        assert_abs_diff_eq!(response.pitch_rad, -2.5e-6, epsilon = 1e-17);
         for (actual, expected) in response
             .force_normal_n
             .iter()
             .zip([-225.0, 225.0, -225.0, 225.0])
         {
-            close(*actual, expected, 1e-9);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-9);
         }
         // The plane condition (5): z1 − z2 = z4 − z3 = 0.0005.
         let z = response.corner_normal_mm;
-        close(z[0] - z[1], 0.0005, 1e-15);
-        close(z[3] - z[2], 0.0005, 1e-15);
+        assert_abs_diff_eq!(z[0] - z[1], 0.0005, epsilon = 1e-15);
+        assert_abs_diff_eq!(z[3] - z[2], 0.0005, epsilon = 1e-15);
     }
 
     #[test]
@@ -523,48 +517,48 @@ mod tests {
             d_z[3] + twist / 4.0 - sink,
         ];
         for (actual, expected) in response.corner_normal_mm.iter().zip(expected_z) {
-            close(*actual, expected, 1e-15);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-15);
         }
-        close(
+        assert_abs_diff_eq!(
             response.normal_mm,
             d_z.iter().sum::<f64>() / 4.0 - sink,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.roll_rad,
             ((d_z[2] + d_z[3]) - (d_z[0] + d_z[1])) / (2.0 * 400.0),
-            1e-17,
+            epsilon = 1e-17
         );
-        close(
+        assert_abs_diff_eq!(
             response.pitch_rad,
             ((d_z[1] + d_z[2]) - (d_z[0] + d_z[3])) / (2.0 * 500.0),
-            1e-17,
+            epsilon = 1e-17
         );
         let shift = -800.0 / (4.0 * k);
-        close(
+        assert_abs_diff_eq!(
             response.corner_lateral_mm[0],
             (d_y[0] + d_y[3]) / 2.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.corner_lateral_mm[3],
             (d_y[0] + d_y[3]) / 2.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.corner_lateral_mm[1],
             (d_y[1] + d_y[2]) / 2.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.lateral_mm,
             d_y.iter().sum::<f64>() / 4.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.yaw_rad,
             ((d_y[0] + d_y[3]) - (d_y[1] + d_y[2])) / (2.0 * 500.0),
-            1e-17,
+            epsilon = 1e-17
         );
     }
 
@@ -588,23 +582,31 @@ mod tests {
         };
         let [z5, roll, pitch] = map.normal_outputs();
         let [y5, yaw] = map.lateral_outputs();
-        close(apply(&z5, &deviations.normal_mm), response.normal_mm, 1e-15);
-        close(
+        assert_abs_diff_eq!(
+            apply(&z5, &deviations.normal_mm),
+            response.normal_mm,
+            epsilon = 1e-15
+        );
+        assert_abs_diff_eq!(
             apply(&roll, &deviations.normal_mm),
             response.roll_rad,
-            1e-17,
+            epsilon = 1e-17
         );
-        close(
+        assert_abs_diff_eq!(
             apply(&pitch, &deviations.normal_mm),
             response.pitch_rad,
-            1e-17,
+            epsilon = 1e-17
         );
-        close(
+        assert_abs_diff_eq!(
             apply(&y5, &deviations.lateral_mm),
             response.lateral_mm,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(apply(&yaw, &deviations.lateral_mm), response.yaw_rad, 1e-17);
+        assert_abs_diff_eq!(
+            apply(&yaw, &deviations.lateral_mm),
+            response.yaw_rad,
+            epsilon = 1e-17
+        );
     }
 
     #[test]
@@ -630,7 +632,7 @@ mod tests {
         // x − b/2 = 0, x + b/2 = 200.
         let expected = [0.0, 0.2, 0.4, 0.0];
         for (actual, expected) in deviations.normal_mm.iter().zip(expected) {
-            close(*actual, expected, 1e-15);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-15);
         }
     }
 
@@ -658,11 +660,11 @@ mod tests {
         let map = Guideway::unloaded(a, 400.0).linear_map().unwrap();
         let positions = [0.0, 250.0, 700.0];
         for (x, response) in positions.iter().zip(map.along_stroke(&rails, &positions)) {
-            close(response.normal_mm, k * x + c / 2.0, 1e-15);
-            close(response.pitch_rad, k, 1e-15);
-            close(response.roll_rad, c / a, 1e-15);
-            close(response.lateral_mm, -k * x, 1e-15);
-            close(response.yaw_rad, k, 1e-15);
+            assert_abs_diff_eq!(response.normal_mm, k * x + c / 2.0, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.pitch_rad, k, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.roll_rad, c / a, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.lateral_mm, -k * x, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.yaw_rad, k, epsilon = 1e-15);
         }
     }
 
@@ -690,11 +692,11 @@ mod tests {
                 lateral_mm: [0.0; 4],
             };
             let response = map.response(&on_rails.with_saddle_faces(&faces));
-            close(response.roll_rad, 0.02 / 350.0, 1e-18);
-            close(response.pitch_rad, 0.01 / 640.0, 1e-18);
-            close(response.normal_mm, rail, 1e-17);
+            assert_abs_diff_eq!(response.roll_rad, 0.02 / 350.0, epsilon = 1e-18);
+            assert_abs_diff_eq!(response.pitch_rad, 0.01 / 640.0, epsilon = 1e-18);
+            assert_abs_diff_eq!(response.normal_mm, rail, epsilon = 1e-17);
             for force in response.force_normal_n {
-                close(force, 0.0, 1e-9);
+                assert_abs_diff_eq!(force, 0.0, epsilon = 1e-9);
             }
         }
     }
@@ -717,11 +719,11 @@ mod tests {
             .iter()
             .zip(response.force_normal_n)
         {
-            close(*corner, 0.0, 1e-17);
-            close(force.abs(), 1000.0, 1e-9);
+            assert_abs_diff_eq!(*corner, 0.0, epsilon = 1e-17);
+            assert_abs_diff_eq!(force.abs(), 1000.0, epsilon = 1e-9);
         }
-        close(response.force_normal_n[0], -1000.0, 1e-9);
-        close(response.force_normal_n[1], 1000.0, 1e-9);
+        assert_abs_diff_eq!(response.force_normal_n[0], -1000.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(response.force_normal_n[1], 1000.0, epsilon = 1e-9);
         // Unequal carriages turn part of the twist into motion. Carriage 1 at
         // k/2, the others k: eq. 12 with Δ_i = F_i/k_i and the balances
         // (9)–(11) give F = (f, −f, f, −f) with f(2 + 1 + 1 + 1)/k = −4c, so
@@ -732,9 +734,21 @@ mod tests {
             .solve(&CarriageDeviations::default().with_saddle_faces(&faces))
             .unwrap();
         let c = 0.01;
-        close(response.force_normal_n[0], -4.0 * 1e5 * c / 5.0, 1e-9);
-        close(response.corner_normal_mm[0], -3.0 * c / 5.0, 1e-15);
-        close(response.corner_normal_mm[1], -c + 4.0 * c / 5.0, 1e-15);
+        assert_abs_diff_eq!(
+            response.force_normal_n[0],
+            -4.0 * 1e5 * c / 5.0,
+            epsilon = 1e-9
+        );
+        assert_abs_diff_eq!(
+            response.corner_normal_mm[0],
+            -3.0 * c / 5.0,
+            epsilon = 1e-15
+        );
+        assert_abs_diff_eq!(
+            response.corner_normal_mm[1],
+            -c + 4.0 * c / 5.0,
+            epsilon = 1e-15
+        );
         assert!(response.pitch_rad.abs() > 1e-7);
     }
 
