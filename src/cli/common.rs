@@ -8,18 +8,18 @@ use serde::Serialize;
 
 use axcomp::compensate::CompensationTable;
 use axcomp::effects::{Effect, read_effects};
-use axcomp::emit::{Controller, EmitError, EmitOptions, MachineProfile};
+use axcomp::emit::{Controller, EmitError, MachineProfile};
 use axcomp::error::{ParseError, Warning};
 use axcomp::evaluate::Standard;
-use axcomp::evaluate::uncertainty::{Budget, Equipment, budget};
+use axcomp::evaluate::uncertainty::Equipment;
 use axcomp::evaluate::verdict::{AcceptanceProfile, Decision};
 use axcomp::measurement::{AxisKind, Direction, Measurement, RunSelector, SourceFormat};
 use axcomp::model::{Machine, ModelError};
 use axcomp::servo::ServoError;
 use axcomp::synth::SynthError;
-use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::{AngleUnit, LengthUnit};
 use axcomp::workflow;
+use axcomp::workflow::table::{ActiveTable, ActiveTableFile, active_table, read_options};
 
 /// `--format NAME`: one of the input formats.
 pub fn parse_format(name: &str) -> Result<SourceFormat, String> {
@@ -224,9 +224,7 @@ pub fn read_table_of(
     test_unit: LengthUnit,
     kind: AxisKind,
 ) -> Result<(Controller, CompensationTable)> {
-    let mut options = EmitOptions::for_axis(profile, axis, "")?;
-    options.linuxcnc_type = linuxcnc_type.unwrap_or(0);
-    options.kind = kind;
+    let options = read_options(profile, axis, kind, linuxcnc_type)?;
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
     workflow::read_table(&bytes, options, profile, test_unit, linuxcnc_type)
         .map_err(|error| in_file(path, error))
@@ -235,24 +233,26 @@ pub fn read_table_of(
 /// The table that was active during `test` (named `test_label` in messages),
 /// read for the test's axis, and the doubts about the two together: refused
 /// when the test records no axis, or when the table cannot belong to it
-/// (`together`).
+/// (`workflow::table::active_table`).
 pub fn read_active_table(
     path: &Path,
     test: &Measurement,
-    test_label: String,
+    test_label: &str,
     profile: &MachineProfile,
     linuxcnc_type: Option<u8>,
-) -> Result<(Controller, CompensationTable, Vec<Warning>)> {
-    let axis = recorded_axis(test, "to say which axis the table is for")?;
-    let test_unit = test.metadata.length_unit;
-    let (controller, table) =
-        read_table_of(path, axis, profile, linuxcnc_type, test_unit, test.kind())?;
-    let doubts = check_together(
-        Pairing::TableOnTest,
-        &Input::measurement(test, test_label),
-        &Input::table(&table.axis, &table.positions_mm, path.display().to_string()),
-    )?;
-    Ok((controller, table, doubts))
+) -> Result<ActiveTable> {
+    let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
+    Ok(active_table(
+        ActiveTableFile {
+            bytes: &bytes,
+            file: &path.display().to_string(),
+            test_label,
+            how_to_name_the_axis: "give --axis NAME (e.g. --axis X)",
+            linuxcnc_type,
+        },
+        test,
+        profile,
+    )?)
 }
 
 /// Names the measured axis with `--axis`, when given (its source is then "given").
@@ -485,25 +485,6 @@ pub fn load_equipment(args: &UncertaintyArgs) -> Result<Option<Equipment>> {
         &read.measurement,
         &drift_path.display().to_string(),
     )))
-}
-
-/// Refuses a rotary axis where a command handles linear axes only
-/// (prediction is µm and mm throughout, on the volumetric model, which has
-/// no rotary axes yet).
-pub fn linear_only(measurement: &Measurement, command: &str) -> Result<()> {
-    if measurement.kind() == AxisKind::Rotary {
-        anyhow::bail!(
-            "axis {} is a rotary axis: {command} handles linear axes only so far; \
-             `axcomp evaluate`, `convert`, `report` and `diagnose` take rotary axes",
-            measurement.axis()
-        );
-    }
-    Ok(())
-}
-
-/// The uncertainty budget of `measurement` with `equipment`.
-pub fn uncertainty_budget(measurement: &Measurement, equipment: &Equipment) -> Result<Budget> {
-    Ok(budget(measurement, equipment)?)
 }
 
 /// `--linuxcnc-type` for reading a LinuxCNC table (`convert` has its own: the

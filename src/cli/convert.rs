@@ -6,11 +6,12 @@ use anyhow::{Context, Result, bail};
 
 use axcomp::compensate::plan::Request;
 use axcomp::compensate::{self, Extrapolate, TableMode};
-use axcomp::emit::{Controller, EmitOptions};
+use axcomp::emit::Controller;
 use axcomp::evaluate::straightness::ReferenceLine;
 use axcomp::measurement::RunSelector;
 use axcomp::output::write_new;
 use axcomp::read;
+use axcomp::workflow::table::{WriteAs, write_options};
 use axcomp::workflow::{self, Converted, TableRequest};
 
 use super::common::{
@@ -240,14 +241,19 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     .to_string();
     check_selectors(&measurement, &args.exclude_runs)?;
     let mut measurement = measurement.without_runs(&args.exclude_runs)?;
-    let mut options = EmitOptions::for_axis(&profile, &axis, &table_name(&args.output))?;
-    for also in &args.also {
-        options.axes.push(profile.axis(also)?);
-    }
-    options.linuxcnc_type = args.linuxcnc_type;
-    options.max_points = args.max_points.or(options.max_points);
-    options.machine_unit = profile.table_unit(args.controller, measurement.metadata.length_unit);
-    options.kind = measurement.kind();
+    let options = write_options(
+        &profile,
+        &axis,
+        &table_name(&args.output),
+        &WriteAs {
+            controller: args.controller,
+            test_unit: measurement.metadata.length_unit,
+            kind: measurement.kind(),
+            linuxcnc_type: args.linuxcnc_type,
+            max_points: args.max_points,
+            also: &args.also,
+        },
+    )?;
     let mut active = None;
     if let Some(existing) = &args.existing {
         // The table was active during the test: its axis, over the test's range.
@@ -257,16 +263,16 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
             .join(" + ");
-        let (_, table, doubts) = read_active_table(
+        let table = read_active_table(
             existing,
             &measurement,
-            test_name,
+            &test_name,
             &profile,
             Some(args.linuxcnc_type),
         )?;
-        warnings.extend(doubts);
-        measurement = compensate::add_existing_table(&measurement, &table)?;
-        active = Some(table);
+        warnings.extend(table.doubts);
+        measurement = compensate::add_existing_table(&measurement, &table.table)?;
+        active = Some(table.table);
     }
     let effects = match &args.effects {
         Some(path) => load_effects(path)?,

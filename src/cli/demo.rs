@@ -14,21 +14,18 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use axcomp::compensate::effects::build_table_with_effects;
-use axcomp::compensate::plan::{PlanContext, Request, plan};
+use axcomp::compensate::plan::Request;
 use axcomp::compensate::{self, CompensationTable, Extrapolate, GridSpec, TableMode, TableOptions};
-use axcomp::cycle::CycleTiming;
-use axcomp::diagnose::{DiagnoseInput, Diagnosis, diagnose};
+use axcomp::diagnose::Diagnosis;
 use axcomp::effects::{Effect, Parameter, ParameterValue};
 use axcomp::emit::{self, Controller, EmitOptions, MachineProfile};
-use axcomp::evaluate::uncertainty::Equipment;
-use axcomp::evaluate::{Evaluation, ISO_230_2, evaluate};
+use axcomp::evaluate::{Evaluation, ISO_230_2};
 use axcomp::measurement::{Measurement, SourceFormat};
 use axcomp::model::{GeometricErrors, Machine, Optics};
 use axcomp::output::{create_folder, write_all_new};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
 use axcomp::read;
-use axcomp::report::acceptance::{ReportInput, TableRecord, TestRecord, charts};
+use axcomp::report::acceptance::{TableRecord, charts};
 use axcomp::report::chart::chart;
 use axcomp::report::diagnose::DiagnoseJson;
 use axcomp::report::html;
@@ -36,9 +33,13 @@ use axcomp::report::json::EvaluationJson;
 use axcomp::report::plot::PlotFormat;
 use axcomp::report::predict::PredictJson;
 use axcomp::synth::{EffectSpec, Truth};
-use axcomp::units::{LengthUnit, mm_to_um};
+use axcomp::units::mm_to_um;
+use axcomp::workflow::report::{Report, ReportParts};
+use axcomp::workflow::retest::{DiagnoseSettings, diagnosis, effects_file};
+use axcomp::workflow::table::{WriteAs, write_options};
+use axcomp::workflow::{self, Converted, TableRequest, Test};
 
-use super::common::{Verbosity, print_text, uncertainty_budget};
+use super::common::{Verbosity, print_text};
 use super::progress;
 
 const TRUTH: &str = include_str!("../../fixtures/demo/truth.toml");
@@ -76,11 +77,13 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         ("after.rtl".into(), AFTER.into()),
     ];
 
-    // 1. The first test per ISO 230-2.
-    let evaluation = evaluate(&before);
+    // 1. The first test per ISO 230-2, with the measurement uncertainty of
+    // the bundled equipment, as `axcomp report` computes it without --equipment.
+    let before_test = Test::new(before, Vec::new(), &ISO_230_2, None)?;
+    let (before, evaluation) = (&before_test.measurement, &before_test.evaluation);
     let json = EvaluationJson::new(
-        &before,
-        &evaluation,
+        before,
+        evaluation,
         &[],
         &evaluation.warnings,
         Default::default(),
@@ -95,8 +98,9 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         reference_mm: None,
         extrapolate: Extrapolate::Refuse,
     };
-    let table = compensate::build_table(&before, &evaluation, &options)?;
+    let table = compensate::build_table(before, evaluation, &options)?;
     let mut active = None;
+    let mut active_bytes = Vec::new();
     for controller in Controller::ALL
         .into_iter()
         .filter(|c| !c.needs_the_controls_file())
@@ -109,6 +113,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("{}: {e}", controller.name()))?;
         if controller == Controller::Tnc640 {
             active = Some(read_back);
+            active_bytes = bytes.clone();
         }
         files.push((table_path(controller, &table.axis), bytes));
     }
@@ -118,7 +123,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     // 3. The prediction of the re-test with the TNC 640 table (the one the bundled re-test ran with).
     let machine = Machine::bundled();
     let measured = [MeasuredAxis {
-        measurement: &before,
+        measurement: before,
         line_mm: machine.reference_mm(),
         optics: Optics::AT_TOOL_TIP,
     }];
@@ -150,17 +155,14 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     steps.inc(1);
 
     // 4. The re-test, diagnosed against the prediction.
-    let diagnosis = diagnose(&DiagnoseInput {
-        angle: Default::default(),
-        after: &after,
-        before: Some(&before),
-        table: Some(&active),
-        backlash_set: false,
-        angular: None,
-        known_periods: &[],
-        timing: CycleTiming::ASSUMED,
-        standard: &ISO_230_2,
-    })?;
+    let profile = MachineProfile::default();
+    let diagnosis = diagnosis(
+        &after,
+        Some(before),
+        Some(&active),
+        &profile,
+        DiagnoseSettings::plain(&ISO_230_2),
+    )?;
     let diagnose_json = DiagnoseJson::new(
         &diagnosis,
         "after.rtl".into(),
@@ -172,60 +174,35 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         "diagnose.json".into(),
         serde_json::to_vec_pretty(&diagnose_json)?,
     ));
-    files.push((
-        "effects.toml".into(),
-        diagnosis.effects_file("after.rtl").into_bytes(),
-    ));
+    let (effects_text, effects) = effects_file(&diagnosis, "after.rtl")
+        .map_err(|e| anyhow::anyhow!("the effects file:{e}"))?;
+    files.push(("effects.toml".into(), effects_text.into_bytes()));
     steps.inc(1);
 
-    // 5. The next table: the re-test's residual on top of the active table, with the effects.
-    let effects: Vec<Effect> = diagnosis
-        .accepted
-        .iter()
-        .map(|a| a.effect.clone())
-        .collect();
-    let next = next_table(&after, &active, &effects)?;
-    let next_text = emit::write(Controller::Tnc640, &next, &emit_options(&next.axis)?)?;
-    files.push((
-        format!("tables/next/{}.COM", next.axis),
-        next_text.into_bytes(),
-    ));
+    // 5. The next table, as `convert after.rtl --existing X.COM --effects
+    // effects.toml --controller tnc640 -o tables/next/X.COM` writes it.
+    let next = next_table(&after, &active, &active_bytes, &effects, &profile)?;
+    files.push((format!("tables/next/{}.COM", next.table.axis), next.bytes));
+    let next = next.table;
     steps.inc(1);
 
-    // 6. The acceptance report with its plots, and the measurement
-    // uncertainty of each test with the bundled equipment, as `axcomp report`
-    // computes it without --equipment.
-    let after_evaluation = evaluate(&after);
-    let equipment = Equipment::bundled();
-    let before_budget = uncertainty_budget(&before, &equipment)?;
-    let after_budget = uncertainty_budget(&after, &equipment)?;
+    // 6. The acceptance report with its plots.
+    let after = Test::new(after, Vec::new(), &ISO_230_2, None)?;
+    let after_evaluation = &after.evaluation;
     let tnc640_file = table_path(Controller::Tnc640, &table.axis);
     let generator = format!("axcomp {} demo", env!("CARGO_PKG_VERSION"));
-    let input = ReportInput {
-        before: TestRecord {
-            measurement: &before,
-            evaluation: &evaluation,
-            warnings: &evaluation.warnings,
-            budget: Some(&before_budget),
-        },
-        after: Some(TestRecord {
-            measurement: &after,
-            evaluation: &after_evaluation,
-            warnings: &after_evaluation.warnings,
-            budget: Some(&after_budget),
-        }),
+    let report = Report::new(ReportParts {
+        after: Some(&after),
         table: Some(TableRecord {
             table: &active,
             file: &tnc640_file,
             controller: Controller::Tnc640,
         }),
         diagnosis: Some(&diagnosis),
-        limits: &[],
-        decision: Default::default(),
-        standard: &ISO_230_2,
-        angle: Default::default(),
         generator: &generator,
-    };
+        ..ReportParts::of(&before_test, &ISO_230_2)
+    });
+    let input = report.input();
     files.push(("report.html".into(), html::render(&input)?.into_bytes()));
     for named in charts(&input) {
         files.push((
@@ -239,8 +216,8 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     print_text(&summary(&Summary {
         out: &args.out,
         truth: &truth,
-        evaluation: &evaluation,
-        after: &after_evaluation,
+        evaluation,
+        after: after_evaluation,
         prediction: &prediction,
         diagnosis: &diagnosis,
         table: &table,
@@ -274,33 +251,45 @@ fn table_path(controller: Controller, axis: &str) -> String {
     )
 }
 
-/// The table after the re-test: the active table plus the residual the re-test
-/// shows, with the diagnosis's effects (as `convert --existing --effects`);
-/// bidirectional (the TNC 640 takes one) when the re-test measured a reversal
-/// beyond its noise or the diagnosis found one that changed.
+/// The table after the re-test: the active table plus the residual the
+/// re-test shows, with the diagnosis's effects, for the TNC 640: what
+/// `convert --existing --effects` writes.
 fn next_table(
     after: &Measurement,
     active: &CompensationTable,
+    active_bytes: &[u8],
     effects: &[Effect],
-) -> Result<CompensationTable> {
+    profile: &MachineProfile,
+) -> Result<Converted> {
     let without = compensate::add_existing_table(after, active)?;
-    let evaluation = evaluate(&without);
-    let measured = compensate::measured_reversal_mm(&evaluation).is_some();
-    let plan = plan(
-        without.targets_mm(),
-        effects,
-        &Controller::Tnc640.capabilities(LengthUnit::Millimetre),
-        &Request {
-            mode: measured.then_some(TableMode::Bidirectional),
-            ..Request::default()
+    let file_name = Controller::Tnc640.file_name(&active.axis);
+    let options = write_options(
+        profile,
+        &active.axis,
+        &file_name.to_uppercase(),
+        &WriteAs {
+            controller: Controller::Tnc640,
+            test_unit: after.metadata.length_unit,
+            kind: after.kind(),
+            linuxcnc_type: 0,
+            max_points: None,
+            also: &[],
         },
-        &PlanContext::default(),
     )?;
-    Ok(build_table_with_effects(
+    Ok(workflow::convert(
         &without,
-        &evaluation,
-        &plan.options,
-        effects,
+        &mut Vec::new(),
+        &TableRequest {
+            controller: Controller::Tnc640,
+            options: &options,
+            request: &Request::default(),
+            effects,
+            existing: Some(active_bytes),
+            active: Some(active),
+            output: format!("tables/next/{file_name}"),
+            file_name,
+            also: Vec::new(),
+        },
     )?)
 }
 

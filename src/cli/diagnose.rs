@@ -5,15 +5,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use axcomp::cycle::CycleTiming;
+use axcomp::diagnose::AngularProfile;
 use axcomp::diagnose::friction::friction_behind_reversal;
-use axcomp::diagnose::{AngularProfile, DiagnoseInput, diagnose};
-use axcomp::measurement::AxisKind;
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::report::diagnose::{DiagnoseJson, FrictionJson, render};
 use axcomp::together::{Input, Pairing, check_together};
-use axcomp::workflow;
+use axcomp::workflow::retest::{DiagnoseSettings, diagnosis};
+use axcomp::workflow::rotary::{self, Use};
 
 use super::common::{
     AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load,
@@ -116,23 +115,16 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     name_axis(&mut after.measurement, args.axis.as_ref());
     let angle = args.angle_unit.for_axis(&after.measurement)?;
     print_test_warnings(&args.after, &after.measurement, args.verbosity.quiet, angle);
-    if after.measurement.kind() == AxisKind::Rotary {
-        // A rotary re-test is diagnosed in ″ (per-revolution
-        // harmonics, reversal, outlier runs); its effects file and an Abbe
-        // profile are lengths, for linear axes only so far.
-        for (given, flag) in [
-            (args.write_effects.is_some(), "--write-effects"),
-            (args.angular.is_some(), "--angular"),
-            (args.servo_axis.is_some(), "--servo-axis"),
-        ] {
-            if given {
-                anyhow::bail!(
-                    "axis {} is a rotary axis: {flag} is for linear axes only so far (an effects file, an angular profile and a servo description are in mm, µm and N)",
-                    after.measurement.axis()
-                );
-            }
-        }
-    }
+    // A rotary re-test is diagnosed in ″ (per-revolution harmonics,
+    // reversal, outlier runs); what is lengths is refused (`rotary`).
+    rotary::check(
+        &after.measurement,
+        &[
+            (Use::EffectsFile, args.write_effects.is_some()),
+            (Use::AngularProfile, args.angular.is_some()),
+            (Use::ServoAxis, args.servo_axis.is_some()),
+        ],
+    )?;
     let before = match &args.before {
         Some(path) => {
             let mut result = read::read_path(path, None)?;
@@ -150,35 +142,34 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         None => None,
     };
     let profile = args.machine_file.profile()?;
-    let known_periods = workflow::known_periods(&profile, &after.measurement);
     let table = match &args.table {
         Some(path) => {
             // The table was active during the re-test.
-            let (_, table, doubts) = read_active_table(
+            let active = read_active_table(
                 path,
                 &after.measurement,
-                args.after.display().to_string(),
+                &args.after.display().to_string(),
                 &profile,
                 args.table_type.linuxcnc_type,
             )?;
-            print_warnings(&doubts, args.verbosity.quiet);
-            Some(table)
+            print_warnings(&active.doubts, args.verbosity.quiet);
+            Some(active.table)
         }
         None => None,
     };
     let angular = args.angular.as_deref().map(load_angular).transpose()?;
-    let input = DiagnoseInput {
-        angle,
-        after: &after.measurement,
-        before: before.as_ref(),
-        table: table.as_ref(),
-        backlash_set: args.backlash_set,
-        angular: angular.as_ref(),
-        known_periods: &known_periods,
-        timing: CycleTiming::ASSUMED,
-        standard: args.standard.standard,
-    };
-    let diagnosis = diagnose(&input)?;
+    let diagnosis = diagnosis(
+        &after.measurement,
+        before.as_ref(),
+        table.as_ref(),
+        &profile,
+        DiagnoseSettings {
+            angle,
+            backlash_set: args.backlash_set,
+            angular: angular.as_ref(),
+            standard: args.standard.standard,
+        },
+    )?;
     let name = |p: &Path| p.display().to_string();
     if let Some(path) = &args.write_effects {
         let text = diagnosis.effects_file(&name(&args.after));

@@ -18,6 +18,7 @@ use axcomp::read;
 use axcomp::report::predict::{PredictJson, SurveyJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::{LengthUnit, mm_to_um};
+use axcomp::workflow::rotary;
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, StandardArg, Verbosity, load, load_effects,
@@ -161,7 +162,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         let mut result = read::read_path(&path, None)?;
         print_warnings(&result.warnings, args.verbosity.quiet);
         name_axis(&mut result.measurement, axis.as_ref());
-        super::common::linear_only(&result.measurement, "predict")?;
+        rotary::check(&result.measurement, &[(rotary::Use::Predict, true)])?;
         if !result.measurement.axis_recorded() {
             bail!(
                 "{}: the file does not record which axis was measured; name it as --measured X={spec}",
@@ -314,7 +315,7 @@ fn load_survey(
             if let Some(axis) = test.axis {
                 name_axis(&mut result.measurement, Some(&axis.letter().to_string()));
             }
-            super::common::linear_only(&result.measurement, "predict")?;
+            rotary::check(&result.measurement, &[(rotary::Use::Predict, true)])?;
             files.push(SurveyFile::Positioning(Box::new(result.measurement)));
         }
     }

@@ -5,20 +5,21 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use axcomp::cycle::CycleTiming;
-use axcomp::diagnose::{DiagnoseInput, diagnose};
 use axcomp::evaluate::Standard;
 use axcomp::evaluate::uncertainty::Equipment;
 use axcomp::evaluate::verdict::Decision;
-use axcomp::measurement::{AxisKind, Measurement, SourceFormat};
+use axcomp::measurement::SourceFormat;
 use axcomp::output::{create_folder, write_all_new};
 use axcomp::read;
-use axcomp::report::acceptance::{ReportInput, TableRecord, charts};
+use axcomp::report::acceptance::{TableRecord, charts};
 use axcomp::report::chart::chart;
 use axcomp::report::html;
 use axcomp::report::plot::PlotFormat;
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::workflow::Test;
+use axcomp::workflow::report::{Report, ReportParts, generator};
+use axcomp::workflow::retest::{DiagnoseSettings, diagnosis};
+use axcomp::workflow::rotary::{self, ReportAsks};
 
 use super::acceptance::{LimitArgs, load_limits};
 use super::common::{
@@ -135,38 +136,6 @@ fn read_test(
     Ok(Test::new(measurement, warnings, standard, equipment)?)
 }
 
-/// What `report` does not do for a rotary axis yet, refused with the reason
-/// (the rest of the report is in ° and ″).
-fn refuse_for_rotary(args: &ReportArgs, measurement: &Measurement) -> Result<()> {
-    let refused = [
-        (
-            !args.acceptance.limits.is_empty(),
-            "acceptance limits (--limit) are µm, for linear axes only so far",
-        ),
-        (
-            args.uncertainty.equipment.is_some()
-                || args.uncertainty.decision != Decision::default(),
-            "the measurement uncertainty (--equipment, --decision) is the laser's budget, for lengths only so far",
-        ),
-        (
-            args.table.is_some(),
-            "the predicted re-test of a table (--table) is for linear axes only so far",
-        ),
-        (
-            args.diagnose,
-            "the diagnosis (--diagnose) is for linear axes only so far",
-        ),
-        (
-            args.standard.standard.key() != axcomp::evaluate::ISO_230_2.key(),
-            "a rotary axis is reported to ISO 230-2 only so far (--standard)",
-        ),
-    ];
-    if let Some((_, why)) = refused.iter().find(|(applies, _)| *applies) {
-        anyhow::bail!("axis {} is a rotary axis: {why}", measurement.axis());
-    }
-    Ok(())
-}
-
 /// Runs `axcomp report`.
 pub fn run(args: &ReportArgs) -> Result<()> {
     let standard = args.standard.standard;
@@ -179,21 +148,25 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         equipment.as_ref(),
     )?;
     let angle = args.angle_unit.for_axis(&before.measurement)?;
-    if before.measurement.kind() == AxisKind::Rotary {
-        refuse_for_rotary(args, &before.measurement)?;
-    }
+    let asks = |limits: bool| ReportAsks {
+        limits,
+        uncertainty: args.uncertainty.equipment.is_some()
+            || args.uncertainty.decision != Decision::default(),
+        table: args.table.is_some(),
+        diagnose: args.diagnose,
+        standard,
+    };
+    rotary::check_report(
+        &before.measurement,
+        asks(!args.acceptance.limits.is_empty()),
+    )?;
     let limits = load_limits(
         args.machine_file.machine.as_deref(),
         before.measurement.axis(),
         &before.evaluation,
         &args.acceptance,
     )?;
-    if before.measurement.kind() == AxisKind::Rotary && !limits.is_empty() {
-        anyhow::bail!(
-            "axis {} is a rotary axis: acceptance limits (a profile's [acceptance]) are µm, for linear axes only so far",
-            before.measurement.axis()
-        );
-    }
+    rotary::check_report(&before.measurement, asks(!limits.is_empty()))?;
     let mut after = match &args.after {
         Some(path) => Some(read_test(
             path,
@@ -213,58 +186,53 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         )?;
         after.warnings.extend(doubts);
     }
+    let profile = args.machine_file.profile()?;
     let table = match &args.table {
         Some(path) => {
-            let profile = args.machine_file.profile()?;
-            let (controller, table, doubts) = read_active_table(
+            let active = read_active_table(
                 path,
                 &before.measurement,
-                args.file.display().to_string(),
+                &args.file.display().to_string(),
                 &profile,
                 args.table_type.linuxcnc_type,
             )?;
-            before.warnings.extend(doubts);
-            Some((path.display().to_string(), controller, table))
+            before.warnings.extend(active.doubts.iter().cloned());
+            Some((path.display().to_string(), active))
         }
         None => None,
     };
     let diagnosis = match (&after, args.diagnose) {
-        (Some(after), true) => {
-            let input = DiagnoseInput {
-                angle,
-                after: &after.measurement,
-                before: Some(&before.measurement),
-                table: table.as_ref().map(|(_, _, t)| t),
-                backlash_set: false,
-                angular: None,
-                known_periods: &[],
-                timing: CycleTiming::ASSUMED,
-                standard,
-            };
-            Some(diagnose(&input).context("cannot diagnose the re-test")?)
-        }
+        (Some(after), true) => Some(
+            diagnosis(
+                &after.measurement,
+                Some(&before.measurement),
+                table.as_ref().map(|(_, active)| &active.table),
+                &profile,
+                DiagnoseSettings {
+                    angle,
+                    ..DiagnoseSettings::plain(standard)
+                },
+            )
+            .context("cannot diagnose the re-test")?,
+        ),
         _ => None,
     };
-    let generator = format!(
-        "axcomp {} on {}",
-        env!("CARGO_PKG_VERSION"),
-        chrono::Local::now().format("%Y-%m-%d %H:%M")
-    );
-    let input = ReportInput {
-        before: before.record(),
-        after: after.as_ref().map(Test::record),
-        table: table.as_ref().map(|(file, controller, table)| TableRecord {
-            table,
+    let generator = generator(chrono::Local::now());
+    let report = Report::new(ReportParts {
+        after: after.as_ref(),
+        table: table.as_ref().map(|(file, active)| TableRecord {
+            table: &active.table,
             file,
-            controller: *controller,
+            controller: active.controller,
         }),
         diagnosis: diagnosis.as_ref(),
         limits: &limits,
         decision: args.uncertainty.decision,
-        standard,
         angle,
         generator: &generator,
-    };
+        ..ReportParts::of(&before, standard)
+    });
+    let input = report.input();
     // Render everything before writing anything: a failure leaves no half report.
     let mut files: Vec<(PathBuf, Vec<u8>)> =
         vec![(args.output.clone(), html::render(&input)?.into_bytes())];

@@ -129,6 +129,17 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     Ok(out)
 }
 
+/// What a CEC table's values are, for a reader of the file: the correction
+/// (−error) under the reconstructed convention, else the error (the sign of
+/// `crate::emit::cross_axis_file_sign`).
+pub fn value_name(options: &EmitOptions) -> &'static str {
+    if options.cec_values_are_corrections {
+        "correction (−error)"
+    } else {
+        "error"
+    }
+}
+
 /// Writes a cross-axis table as one CEC table, number `t` (the profile's
 /// [`MachineProfile::cec_table`](crate::emit::MachineProfile::cec_table) of
 /// the pair): `$AN_CEC_INPUT_AXIS` the table axis (`input_axis`, its

@@ -4,19 +4,17 @@
 //!
 //! Every number comes from the values the other commands print: the
 //! `Evaluation` of each test (as `evaluate`), the table as read back from its
-//! file (as `convert --existing` reads it), the prediction of
-//! `compensate::retest` and the `Diagnosis` (as `diagnose`). Deviations are
+//! file (as `convert --existing` reads it), the workflow's prediction of
+//! the re-test with it (`compensate::retest`) and the `Diagnosis` (as `diagnose`). Deviations are
 //! drawn in µm through `crate::units`.
 
 use crate::compensate::CompensationTable;
-use crate::compensate::retest::{Applied, KnownError, predicted_deviation_mm, with_scatter};
+use crate::compensate::retest::KnownError;
 use crate::diagnose::{Diagnosis, ReadingResidual};
 use crate::effects::{Effect, Line};
 use crate::emit::Controller;
 use crate::error::Warning;
-use crate::evaluate::{
-    DirectionStats, Evaluation, Standard, StandardFigure, TargetStats, evaluate_with,
-};
+use crate::evaluate::{DirectionStats, Evaluation, Standard, StandardFigure, TargetStats};
 use crate::measurement::AxisKind;
 use crate::measurement::{Direction, Measurement};
 use crate::report::chart::{Chart, Mark, Polar, Rgb, Series};
@@ -55,6 +53,9 @@ pub struct ReportInput<'a> {
     pub after: Option<TestRecord<'a>>,
     /// The table, for its plot and the predicted re-test.
     pub table: Option<TableRecord<'a>>,
+    /// The predicted re-test of the first test with the table (the
+    /// workflow's, `workflow::report`); drawn and tabled with the table.
+    pub prediction: Option<&'a Prediction>,
     /// The diagnosis of the re-test (`before` = the first test, `after` = the re-test).
     pub diagnosis: Option<&'a Diagnosis>,
     /// The acceptance limits for the verdict box (`report::verdict`);
@@ -114,55 +115,6 @@ impl Prediction {
         let low = values.iter().fold(f64::INFINITY, |m, v| m.min(*v));
         high - low
     }
-}
-
-/// Points at which the prediction is sampled: fine enough that linear
-/// interpolation between table points shows as it is.
-const PREDICTION_SAMPLES: usize = 600;
-
-/// The predicted re-test of the first test with the table applied
-/// (`compensate::retest`, with the reversal the first test measured), over
-/// the measured span, its figures per `standard`; `None` if the first test
-/// has no mean deviation anywhere.
-pub fn prediction(
-    before: &TestRecord<'_>,
-    table: &CompensationTable,
-    standard: &dyn Standard,
-) -> Option<Prediction> {
-    let known = KnownError::from_evaluation(before.evaluation)?;
-    let targets_mm = before.measurement.targets_mm();
-    let retest = with_scatter(before.measurement, before.evaluation, |i, direction| {
-        predicted_deviation_mm(&known, Applied::table(table), targets_mm[i], direction)
-    })
-    .ok()?;
-    let first = *known.positions_mm().first()?;
-    let last = *known.positions_mm().last()?;
-    let positions_mm: Vec<f64> = (0..PREDICTION_SAMPLES)
-        .map(|k| first + (last - first) * k as f64 / (PREDICTION_SAMPLES - 1) as f64)
-        .collect();
-    let predict = |direction| {
-        positions_mm
-            .iter()
-            .map(|&x| {
-                mm_to_um(predicted_deviation_mm(
-                    &known,
-                    Applied::table(table),
-                    x,
-                    direction,
-                ))
-            })
-            .collect()
-    };
-    Some(Prediction {
-        up_um: predict(Direction::Up),
-        down_um: predict(Direction::Down),
-        uncompensated_um: positions_mm
-            .iter()
-            .map(|&x| mm_to_um(known.mean_at(x)))
-            .collect(),
-        positions_mm,
-        figures: evaluate_with(&retest, standard).standard_figures,
-    })
 }
 
 /// Colours: ↑ blue, ↓ orange (distinguishable in greyscale print by the
@@ -261,10 +213,10 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
             name: "table",
             chart: table_chart(table.table, input.before.evaluation),
         });
-        if let Some(prediction) = prediction(&input.before, table.table, input.standard) {
+        if let Some(prediction) = input.prediction {
             charts.push(NamedChart {
                 name: "predicted",
-                chart: prediction_chart(&prediction, input.after.map(|a| a.evaluation)),
+                chart: prediction_chart(prediction, input.after.map(|a| a.evaluation)),
             });
         }
     }

@@ -3,7 +3,8 @@
 //! [`json`] holds the `--json` wire formats: dedicated serde structs whose
 //! keys carry units (`A_um`, `target_mm`); internal types are never
 //! serialised directly. [`terminal`] renders the same data as a readable
-//! terminal report. [`convert`] is the summary of `axcomp convert`,
+//! terminal report. [`convert`] is the summary of `axcomp convert` ([`cross_axis`]
+//! for a cross-axis table),
 //! [`predict`] and [`diagnose`] the wire formats and reports of `axcomp
 //! predict` and `axcomp diagnose`;
 //! [`tolerance`] the wire format and terminal report of `axcomp tolerance`,
@@ -18,6 +19,7 @@
 pub mod acceptance;
 pub mod chart;
 pub mod convert;
+pub mod cross_axis;
 pub mod diagnose;
 pub mod format;
 pub mod html;
@@ -31,3 +33,4 @@ pub mod tolerance;
 pub mod uncertainty;
 pub mod update;
 pub mod verdict;
+pub mod web;

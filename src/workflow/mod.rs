@@ -1,11 +1,22 @@
-//! One command's work on inputs already in memory: `evaluate`, `convert`
-//! and the acceptance report's tests. The CLI (`src/cli/`) and the local web
-//! app (`serve`) both call these, so the page shows the very JSON that
-//! `--json` prints and downloads the very bytes `convert` writes.
+//! One command's work on inputs already in memory, every step of it:
+//! `evaluate`, `convert` (and the next table), the table that was active
+//! ([`table`]), the diagnosis of a re-test with the profile's known periods
+//! ([`retest`]), the acceptance report with its predicted re-test
+//! ([`report`]), the cross-axis table of a straightness test
+//! ([`cross_axis`]), and what a rotary axis supports ([`rotary`]). The CLI
+//! (`src/cli/`), the local web app (`serve`) and the demo all call these, so
+//! the page shows the very JSON that `--json` prints and downloads the very
+//! bytes `convert` writes.
 //!
 //! Reading files, the flags and printing stay with the caller; what is here
 //! takes a measurement that is read and named (and runs left out) and the
 //! settings already parsed.
+
+pub mod cross_axis;
+pub mod report;
+pub mod retest;
+pub mod rotary;
+pub mod table;
 
 use crate::compensate::effects::build_table_with_effects;
 use crate::compensate::plan::{PlanContext, Request, plan};
@@ -33,14 +44,36 @@ use crate::units::{AngleUnit, LengthUnit};
 /// as that error does.
 #[derive(Debug, thiserror::Error)]
 pub enum WorkflowError {
-    /// Acceptance limits on a rotary axis (they are µm).
+    /// What a rotary axis does not support ([`rotary::ROTARY`]).
+    #[error(transparent)]
+    Rotary(#[from] rotary::RotaryRefusal),
+    /// A table for a test that does not record its axis.
     #[error(
-        "axis {axis} is a rotary axis: acceptance limits (--limit, a profile's [acceptance]) are µm, for linear axes only so far"
+        "{file}: the file does not record which axis was measured; {how} to say which axis the table is for"
     )]
-    RotaryLimits {
-        /// The axis.
-        axis: String,
+    AxisNotRecorded {
+        /// The test's file.
+        file: String,
+        /// How the front end names the axis.
+        how: String,
     },
+    /// A table file that does not read.
+    #[error("{file}:{error}")]
+    TableFile {
+        /// The table's file.
+        file: String,
+        /// Where and why.
+        error: ParseError,
+    },
+    /// A cross-axis table's model.
+    #[error(transparent)]
+    Predict(#[from] crate::predict::PredictError),
+    /// Input refused, with what was expected (the message names the file).
+    #[error("{0}")]
+    Refused(String),
+    /// Inputs that do not belong together.
+    #[error(transparent)]
+    NotTogether(#[from] crate::together::NotTogether),
     /// The uncertainty budget.
     #[error(transparent)]
     Uncertainty(#[from] UncertaintyError),
@@ -88,19 +121,14 @@ pub fn evaluation_report(
     warnings.extend(evaluation.warnings.iter().cloned());
     // The budget is the laser's, for lengths, and limits are µm: a rotary
     // axis has neither yet.
-    let budget = match measurement.kind() {
-        AxisKind::Rotary if !limits.is_empty() => {
-            return Err(WorkflowError::RotaryLimits {
-                axis: measurement.axis().to_string(),
-            });
-        }
-        AxisKind::Rotary => None,
-        AxisKind::Linear => budget_of(measurement, equipment, warnings)?,
+    rotary::check(measurement, &[(rotary::Use::Limits, !limits.is_empty())])?;
+    let budget = match rotary::allows(measurement, rotary::Use::Uncertainty) {
+        true => budget_of(measurement, equipment, warnings)?,
+        false => None,
     };
-    let verdict = match measurement.kind() {
-        AxisKind::Rotary => None,
-        AxisKind::Linear => verdict::judge(&evaluation, limits, decision, budget.as_ref()),
-    };
+    let verdict = rotary::allows(measurement, rotary::Use::Limits)
+        .then(|| verdict::judge(&evaluation, limits, decision, budget.as_ref()))
+        .flatten();
     let mut report =
         EvaluationJson::from_evaluation(measurement, evaluation, exclude_runs, warnings, angle);
     report.uncertainty_um = budget.as_ref().map(UncertaintyJson::from_budget);
@@ -310,9 +338,9 @@ impl Test {
     ) -> Result<Test, WorkflowError> {
         let evaluation = evaluate_with(&measurement, standard);
         warnings.extend(evaluation.warnings.iter().cloned());
-        let budget = match measurement.kind() {
-            AxisKind::Linear => budget_of(&measurement, equipment, &mut warnings)?,
-            AxisKind::Rotary => None,
+        let budget = match rotary::allows(&measurement, rotary::Use::Uncertainty) {
+            true => budget_of(&measurement, equipment, &mut warnings)?,
+            false => None,
         };
         Ok(Test {
             measurement,

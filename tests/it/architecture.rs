@@ -390,6 +390,118 @@ fn an_upward_import_added_to_the_real_tree_is_caught() {
     assert_eq!(added, [&expected]);
 }
 
+/// The inputs of a step that only `src/workflow/` puts together, so that the
+/// CLI, the web app and the demo cannot each assemble a step their own way.
+const WORKFLOW_ONLY: [&str; 2] = ["DiagnoseInput", "ReportInput"];
+
+/// Where a file outside `src/workflow/` builds one of [`WORKFLOW_ONLY`] as a
+/// struct literal (`DiagnoseInput {`), test code and comments aside.
+fn assembled_outside_the_workflow(files: &[(PathBuf, String)]) -> Vec<String> {
+    let mut found = Vec::new();
+    for (path, text) in files {
+        if path.starts_with("workflow") {
+            continue;
+        }
+        let code = code_of(text);
+        for name in WORKFLOW_ONLY {
+            let literal = format!("{name} {{");
+            if code.contains(&literal) {
+                found.push(format!(
+                    "src/{}: builds a {name}; only src/workflow/ does (ARCHITECTURE.md, front ends thin over workflow)",
+                    path.display()
+                ));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn only_the_workflow_assembles_a_diagnosis_or_a_report() {
+    let found = assembled_outside_the_workflow(&source_tree());
+    assert!(found.is_empty(), "\n{}", found.join("\n"));
+}
+
+#[test]
+fn a_report_assembled_in_the_web_app_is_caught() {
+    let files = tree(&[
+        (
+            "serve/steps.rs",
+            "fn f() { let input = ReportInput {\n before, after: None };\n}\n// ReportInput { in a comment }",
+        ),
+        (
+            "workflow/report.rs",
+            "fn input() { ReportInput { before } }",
+        ),
+        ("report/acceptance.rs", "pub struct ReportInput<'a> {\n}"),
+        (
+            "cli/diagnose.rs",
+            "#[cfg(test)]\nmod tests {\n fn t() { let _ = DiagnoseInput { after }; }\n}",
+        ),
+    ]);
+    assert_eq!(
+        assembled_outside_the_workflow(&files),
+        [
+            "src/serve/steps.rs: builds a ReportInput; only src/workflow/ does (ARCHITECTURE.md, front ends thin over workflow)"
+        ]
+    );
+}
+
+/// Where a file outside `src/report/` derives `Serialize`: the wire
+/// structs (whose keys are a promise to scripts) live in `report`
+/// (ARCHITECTURE.md, "Serialisation"). Reading a file (`Deserialize`) is
+/// anyone's.
+fn wire_structs_outside_report(files: &[(PathBuf, String)]) -> Vec<String> {
+    let mut found = Vec::new();
+    for (path, text) in files {
+        if path.starts_with("report") {
+            continue;
+        }
+        let derives_serialize = code_of(text).lines().any(|line| {
+            line.trim_start()
+                .strip_prefix("#[derive(")
+                .is_some_and(|list| {
+                    list.trim_end_matches(")]")
+                        .split(',')
+                        .any(|name| matches!(name.trim(), "Serialize" | "serde::Serialize"))
+                })
+        });
+        if derives_serialize {
+            found.push(format!(
+                "src/{}: derives Serialize; wire structs live in src/report/",
+                path.display()
+            ));
+        }
+    }
+    found
+}
+
+#[test]
+fn only_report_derives_serialize() {
+    let found = wire_structs_outside_report(&source_tree());
+    assert!(found.is_empty(), "\n{}", found.join("\n"));
+}
+
+#[test]
+fn a_wire_struct_outside_report_is_caught() {
+    let files = tree(&[
+        (
+            "serve/mod.rs",
+            "#[derive(Debug, Serialize)]\nstruct Answer {}",
+        ),
+        ("emit/profile.rs", "#[derive(Deserialize)]\nstruct File {}"),
+        (
+            "report/web.rs",
+            "#[derive(Serialize)]\npub struct Answer {}",
+        ),
+        ("cli/mod.rs", "// #[derive(Serialize)]\nfn f() {}"),
+    ]);
+    assert_eq!(
+        wire_structs_outside_report(&files),
+        ["src/serve/mod.rs: derives Serialize; wire structs live in src/report/"]
+    );
+}
+
 fn layers() -> BTreeMap<String, usize> {
     layers_from(
         "<!-- layers -->\n- 0: `units`\n- 1: `compensate`, `model`: peers\n- 2: `diagnose`\n<!-- /layers -->",

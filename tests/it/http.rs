@@ -1,12 +1,12 @@
-//! A plain HTTP/1.1 client over `TcpStream`, for the two servers the tests
-//! talk to on loopback: `axcomp serve` (its API, with headers a browser
-//! would not let a page set) and chromedriver (WebDriver is JSON over HTTP,
-//! `browser::WebDriver`).
+//! A plain HTTP/1.1 client over `TcpStream`, for what the tests reach over
+//! a socket: chromedriver (WebDriver is JSON over HTTP, `browser::WebDriver`,
+//! the `system` target) and the one test of `axcomp serve` started as a
+//! process; the web app's API is tested in process (`server::App`). And the
+//! `multipart/form-data` body a browser's `FormData` sends.
 //!
-//! Why not a crate: the tests need a handful of requests to 127.0.0.1 with
-//! `Connection: close`, and a WebDriver crate (fantoccini, thirtyfour) or an
-//! HTTP client (reqwest) brings an async client stack with TLS into the test
-//! build for that; this is one file the tests can read.
+//! Why not a crate: a WebDriver crate (fantoccini, thirtyfour) or an HTTP
+//! client (reqwest) brings an async client stack with TLS into the test
+//! build for a handful of requests to 127.0.0.1 with `Connection: close`.
 
 use std::io::{Read, Write};
 use std::net::TcpStream;

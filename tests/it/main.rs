@@ -34,6 +34,7 @@ mod model;
 mod numbers;
 mod outputs;
 mod page;
+mod parity;
 mod pixels;
 mod predict;
 mod read_api_pos;

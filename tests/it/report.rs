@@ -223,13 +223,16 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
     let text = std::fs::read_to_string(&case.table).unwrap();
     let (controller, table) = emit::read_any(&text, &table_options(), None).unwrap();
     let diagnosis = case.diagnosis();
+    let before_record = TestRecord {
+        measurement: &before,
+        evaluation: &evaluation_before,
+        warnings: &[],
+        budget: None,
+    };
+    // The predicted re-test the workflow gives the report.
+    let prediction = axcomp::workflow::report::predicted_retest(&before_record, &table, &ISO_230_2);
     let input = ReportInput {
-        before: TestRecord {
-            measurement: &before,
-            evaluation: &evaluation_before,
-            warnings: &[],
-            budget: None,
-        },
+        before: before_record,
         after: Some(TestRecord {
             measurement: &after,
             evaluation: &evaluation_after,
@@ -241,6 +244,7 @@ fn every_character_the_plots_draw_is_in_the_embedded_font() {
             file: "X.COM",
             controller,
         }),
+        prediction: prediction.as_ref(),
         diagnosis: Some(&diagnosis),
         limits: &[],
         decision: Default::default(),

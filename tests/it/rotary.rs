@@ -632,7 +632,7 @@ fn rotary_truth(harmonics: &[(u32, f64, f64)]) -> axcomp::synth::RotaryTruth {
 /// LinuxCNC table from it written by `convert`, and the re-test with that
 /// table of a truth with one more harmonic (`extra`: order, ″, phase), as
 /// files in `directory`; returns (before, table, after).
-fn rotary_retest_files(
+pub(crate) fn rotary_retest_files(
     directory: &Path,
     extra: (u32, f64, f64),
     seed: u64,

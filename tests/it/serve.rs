@@ -4,18 +4,33 @@
 //! CLI's `file:line:col` message). The page in a real headless browser is
 //! the `system` target's (tests/system/web_page.rs).
 //!
-//! Every test starts its own server on a free port (`--port 0`), so they run
-//! in parallel.
+//! Every test calls the app in process (`server::App`, tower's `oneshot` on
+//! the router), so they run in parallel; one starts `axcomp serve` itself
+//! and talks to it over its socket.
 
 use std::process::Command;
 
 use crate::http::{Form, Response, request};
-use crate::server::{Server, cli_in, read, sample};
+use crate::server::{App, Server, cli_in, read, sample};
 use crate::util::{root, without_time};
+
+/// `axcomp serve --port 0` binds a free port, says where, and answers there
+/// over a real socket: the page, and the API with the port in `Host`.
+#[test]
+fn the_server_starts_and_answers_on_its_port() {
+    let server = Server::start();
+    assert_eq!(server.url(), format!("http://{}/", server.host));
+    let page = request(&server.host, "GET", "/", &[], Vec::new());
+    assert_eq!(page.status, 200);
+    assert!(page.text().contains("<script src=\"/app.js\""));
+    let options = request(&server.host, "GET", "/api/options", &[], Vec::new());
+    assert_eq!(options.status, 200, "{}", options.text());
+    assert!(options.json()["controllers"].to_string().contains("tnc640"));
+}
 
 #[test]
 fn evaluate_answers_with_the_json_evaluate_prints() {
-    let server = Server::start();
+    let server = App::new();
     let answer = server.post(
         "/api/evaluate",
         Form::new().file("file", "sample-x.rtl", &read(&sample())),
@@ -49,7 +64,7 @@ fn evaluate_answers_with_the_json_evaluate_prints() {
 /// under the controller's usual name, for every controller.
 #[test]
 fn the_table_download_is_what_convert_writes() {
-    let server = Server::start();
+    let server = App::new();
     let work = tempfile::tempdir().unwrap();
     let expected_names = [
         ("itnc530", "X.COM"),
@@ -114,7 +129,7 @@ fn the_table_download_is_what_convert_writes() {
 
 #[test]
 fn the_preview_is_the_json_convert_prints_and_the_file_text() {
-    let server = Server::start();
+    let server = App::new();
     let answer = server.post(
         "/api/convert",
         Form::new()
@@ -153,7 +168,7 @@ fn the_preview_is_the_json_convert_prints_and_the_file_text() {
 /// `convert AFTER --existing TABLE --effects E.toml`, byte for byte.
 #[test]
 fn the_retest_answers_as_diagnose_and_convert_do() {
-    let server = Server::start();
+    let server = App::new();
     let demo = root().join("fixtures/demo");
     let form = || {
         Form::new()
@@ -218,7 +233,7 @@ fn the_retest_answers_as_diagnose_and_convert_do() {
 
 #[test]
 fn the_report_download_is_the_acceptance_report() {
-    let server = Server::start();
+    let server = App::new();
     let answer = server.post(
         "/api/report",
         Form::new().file("file", "sample-x.rtl", &read(&sample())),
@@ -251,7 +266,7 @@ fn the_report_download_is_the_acceptance_report() {
 
 #[test]
 fn bad_input_is_a_400_with_the_clis_position() {
-    let server = Server::start();
+    let server = App::new();
     let bad = root().join("tests/data/bad/junk-in-text.rtl");
     let answer = server.post(
         "/api/evaluate",
@@ -307,7 +322,7 @@ fn bad_input_is_a_400_with_the_clis_position() {
 
 #[test]
 fn other_origins_and_host_names_are_refused() {
-    let server = Server::start();
+    let server = App::new();
     let form = || Form::new().file("file", "sample-x.rtl", &read(&sample()));
     let own = server.url().trim_end_matches('/').to_string();
     assert_eq!(
@@ -324,16 +339,10 @@ fn other_origins_and_host_names_are_refused() {
     let rebound = format!("attacker.example:{port}");
     let answer = server.post("/api/evaluate", form(), &[("Host", &rebound)]);
     assert_eq!(answer.status, 403);
-    let page = request(&server.host, "GET", "/", &[("Host", &rebound)], Vec::new());
+    let page = server.get("/", &[("Host", &rebound)]);
     assert_eq!(page.status, 403);
     let localhost = format!("localhost:{port}");
-    let page = request(
-        &server.host,
-        "GET",
-        "/",
-        &[("Host", &localhost)],
-        Vec::new(),
-    );
+    let page = server.get("/", &[("Host", &localhost)]);
     assert_eq!(page.status, 200);
     assert!(page.text().contains("<script src=\"/app.js\""));
 }
@@ -342,7 +351,7 @@ fn other_origins_and_host_names_are_refused() {
 /// goes on answering.
 #[test]
 fn uploads_over_the_limit_are_refused() {
-    let server = Server::start();
+    let server = App::new();
     let big = vec![b'0'; 50 * 1024 * 1024 + 1];
     let answer = server.post(
         "/api/evaluate",
@@ -361,9 +370,9 @@ fn uploads_over_the_limit_are_refused() {
 /// Everything the page needs comes from the app itself: no CDN, no other host.
 #[test]
 fn the_page_loads_nothing_from_elsewhere() {
-    let server = Server::start();
+    let server = App::new();
     for path in ["/", "/app.js", "/app.css"] {
-        let answer = request(&server.host, "GET", path, &[], Vec::new());
+        let answer = server.get(path, &[]);
         assert_eq!(answer.status, 200, "{path}");
         let text = answer.text();
         for outside in ["https://", "http://", "//cdn", "@import"] {
@@ -380,7 +389,7 @@ const PROFILE: &str = "[controller]\nunits = \"mm\"\n\n[controller.axes.X]\nscre
 /// the verdict is `evaluate --json --machine P --limit …`'s, key for key.
 #[test]
 fn the_verdict_is_what_evaluate_prints_with_the_same_limits() {
-    let server = Server::start();
+    let server = App::new();
     let work = tempfile::tempdir().unwrap();
     std::fs::copy(sample(), work.path().join("sample-x.rtl")).unwrap();
     std::fs::write(work.path().join("p.toml"), PROFILE).unwrap();
@@ -459,7 +468,7 @@ fn the_verdict_is_what_evaluate_prints_with_the_same_limits() {
 /// byte `convert --machine P.toml`'s.
 #[test]
 fn the_table_with_a_profile_is_what_convert_writes_with_it() {
-    let server = Server::start();
+    let server = App::new();
     let work = tempfile::tempdir().unwrap();
     let profile = root().join("fixtures/machines/gantry-inch.toml");
     for (controller, name) in [
@@ -528,7 +537,7 @@ fn the_table_with_a_profile_is_what_convert_writes_with_it() {
 /// says it; the Edlén check is in the evaluation, as `evaluate --json` has it.
 #[test]
 fn a_bad_profile_is_refused_with_its_position() {
-    let server = Server::start();
+    let server = App::new();
     let bad = "[controller]\nunits = \"mm\"\nfrobnicate = 3\n";
     let work = tempfile::tempdir().unwrap();
     std::fs::write(work.path().join("bad.toml"), bad).unwrap();
@@ -584,55 +593,28 @@ fn a_bad_profile_is_refused_with_its_position() {
 /// 15 mm lead error (seed 3 of `diagnose_periodic`).
 #[test]
 fn the_retest_with_a_profile_is_what_diagnose_prints_with_it() {
-    let server = Server::start();
+    let server = App::new();
     let work = tempfile::tempdir().unwrap();
-    let case = crate::diagnose_periodic::case(15.0, 3, true);
-    let truth = work.path().join("truth.toml");
-    std::fs::write(&truth, &case.truth).unwrap();
-    crate::util::synth_loop_files(work.path(), &truth, Some("3"));
-    let profile = root().join("fixtures/machines/vc1810.toml");
-    std::fs::copy(&profile, work.path().join("vc1810.toml")).unwrap();
-    let file = |name: &str| read(&work.path().join(name));
+    crate::parity::screw_lead_retest(work.path());
     let answer = server.post(
         "/api/retest",
-        Form::new()
-            .file("file", "before.rtl", &file("before.rtl"))
-            .file("after", "after.rtl", &file("after.rtl"))
-            .file("table", "X.COM", &file("X.COM"))
-            .file("machine", "vc1810.toml", &read(&profile)),
+        crate::parity::form_of(
+            work.path(),
+            &[
+                ("file", "before.rtl"),
+                ("after", "after.rtl"),
+                ("table", "X.COM"),
+                ("machine", "vc1810.toml"),
+            ],
+        ),
         &[],
     );
     assert_eq!(answer.status, 200, "{}", answer.text());
-    let cli: serde_json::Value = serde_json::from_slice(&cli_in(
-        work.path(),
-        &[
-            "diagnose",
-            "--after",
-            "after.rtl",
-            "--before",
-            "before.rtl",
-            "--table",
-            "X.COM",
-            "--machine",
-            "vc1810.toml",
-            "--json",
-        ],
-    ))
-    .unwrap();
+    // The CLI's diagnosis finds the lead error at exactly 15 mm and says
+    // it is the profile's lead (`parity::diagnose_with_the_lead`).
+    let cli = crate::parity::diagnose_with_the_lead(work.path());
     let diagnosis = &answer.json()["diagnosis"];
     assert_eq!(*diagnosis, cli);
-    let periodic = diagnosis["effects"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["kind"] == "periodic")
-        .unwrap_or_else(|| panic!("{diagnosis:#}"));
-    assert_eq!(periodic["params"]["period_mm"], 15.0);
-    assert!(
-        periodic["warnings"]
-            .to_string()
-            .contains("the screw lead the machine profile gives (15 mm)")
-    );
 }
 
 /// The page's re-test refuses what `diagnose` refuses (a re-test of another
@@ -640,7 +622,7 @@ fn the_retest_with_a_profile_is_what_diagnose_prints_with_it() {
 /// the two tests: the doubts of the pair and each test's own, naming its file.
 #[test]
 fn the_retest_refuses_and_warns_as_diagnose_does() {
-    let server = Server::start();
+    let server = App::new();
     let demo = root().join("fixtures/demo");
     let muts = crate::util::shared_data("ecmc/ecmc_target_muts_logger");
     let b02 = read(&muts.join("b02__x__target_x.md_ISO230.dat"));

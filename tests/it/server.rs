@@ -1,12 +1,92 @@
-//! A running `axcomp serve` for the tests of the web app, and the CLI run
-//! beside it. Shared by both test targets.
+//! The web app for its tests: in process ([`App`], the axum router called
+//! through tower's `oneshot`, no socket), or a running `axcomp serve`
+//! ([`Server`], for the browser and the test of the server start itself);
+//! and the CLI run beside it. Shared by both test targets.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-use crate::http::{Form, Response, request};
+use tower::ServiceExt;
+
+use crate::http::{Form, Response};
 use crate::util::root;
+
+/// The app in process, as `axcomp serve` answers on 127.0.0.1:8230: each
+/// request goes through the whole router (the origin guard, the upload
+/// limit, the handlers) by `oneshot`, on a runtime of its own.
+pub struct App {
+    router: axum::Router,
+    runtime: tokio::runtime::Runtime,
+    /// `127.0.0.1:PORT`, the name requests use unless they set `Host`.
+    pub host: String,
+}
+
+impl App {
+    pub fn new() -> App {
+        let addr: std::net::SocketAddr = "127.0.0.1:8230".parse().unwrap();
+        App {
+            router: axcomp::serve::app(addr),
+            runtime: tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+                .unwrap(),
+            host: addr.to_string(),
+        }
+    }
+
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.host)
+    }
+
+    /// A POST of `form` to `path` with extra `headers`.
+    pub fn post(&self, path: &str, form: Form, headers: &[(&str, &str)]) -> Response {
+        let (content_type, body) = form.finish();
+        let mut all = vec![("Content-Type", content_type.as_str())];
+        all.extend_from_slice(headers);
+        self.request("POST", path, &all, body)
+    }
+
+    /// A GET of `path` with `headers`.
+    pub fn get(&self, path: &str, headers: &[(&str, &str)]) -> Response {
+        self.request("GET", path, headers, Vec::new())
+    }
+
+    fn request(
+        &self,
+        method: &str,
+        path: &str,
+        headers: &[(&str, &str)],
+        body: Vec<u8>,
+    ) -> Response {
+        let mut request = axum::http::Request::builder().method(method).uri(path);
+        if !headers.iter().any(|(n, _)| n.eq_ignore_ascii_case("host")) {
+            request = request.header("Host", &self.host);
+        }
+        for (name, value) in headers {
+            request = request.header(*name, *value);
+        }
+        let request = request.body(axum::body::Body::from(body)).unwrap();
+        self.runtime.block_on(async {
+            let response = self.router.clone().oneshot(request).await.unwrap();
+            let status = response.status().as_u16();
+            let headers = response
+                .headers()
+                .iter()
+                .map(|(n, v)| (n.as_str().to_string(), v.to_str().unwrap_or("").to_string()))
+                .collect();
+            let body = axum::body::to_bytes(response.into_body(), usize::MAX)
+                .await
+                .unwrap()
+                .to_vec();
+            Response {
+                status,
+                headers,
+                body,
+            }
+        })
+    }
+}
 
 /// A running `axcomp serve --port 0 --no-open`, stopped when dropped.
 pub struct Server {
@@ -40,14 +120,6 @@ impl Server {
 
     pub fn url(&self) -> String {
         format!("http://{}/", self.host)
-    }
-
-    /// A POST of `form` to `path` with extra `headers`.
-    pub fn post(&self, path: &str, form: Form, headers: &[(&str, &str)]) -> Response {
-        let (content_type, body) = form.finish();
-        let mut all = vec![("Content-Type", content_type.as_str())];
-        all.extend_from_slice(headers);
-        request(&self.host, "POST", path, &all, body)
     }
 }
 

@@ -91,7 +91,7 @@ use uncertainty::{UncertaintyView, uncertainty_view};
 /// let (measurement, warnings) = read::parse_str(csv, SourceFormat::Csv).unwrap();
 /// let evaluation = evaluate(&measurement);
 /// let before = TestRecord { measurement: &measurement, evaluation: &evaluation, warnings: &warnings, budget: None };
-/// let input = ReportInput { before, after: None, table: None, diagnosis: None, limits: &[],
+/// let input = ReportInput { before, after: None, table: None, prediction: None, diagnosis: None, limits: &[],
 ///     decision: Default::default(), standard: &ISO_230_2, angle: Default::default(),
 ///     generator: "axcomp" };
 /// let html = axcomp::report::html::render(&input).unwrap();

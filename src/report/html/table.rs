@@ -2,7 +2,7 @@
 
 use super::{Plot, signed};
 use crate::compensate::TableMode;
-use crate::report::acceptance::{ReportInput, TableRecord, prediction};
+use crate::report::acceptance::{ReportInput, TableRecord};
 use crate::report::format::{SourcedUm, um};
 use crate::report::json::iso_keys;
 use crate::units::mm_to_um;
@@ -38,7 +38,7 @@ pub(super) fn table_view(
     plot: &dyn Fn(&str) -> Option<Plot>,
 ) -> TableView {
     let table = record.table;
-    let prediction = prediction(&input.before, table, input.standard).map(|predicted| {
+    let prediction = input.prediction.map(|predicted| {
         let iso_family = iso_keys(&predicted.figures);
         PredictionView {
             range_um: um(Some(predicted.range_um())),
