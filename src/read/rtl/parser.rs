@@ -19,7 +19,6 @@ use crate::read::text::{self, Line, check_target_mm, end_of_file_line, split_key
 use crate::read::{missing_readings_warning, parse_date};
 use crate::units::LengthUnit;
 
-use super::rows::RunRows;
 use super::{NO_SENSOR_C, ROTARY_OWNER};
 
 /// The sections of an `.rtl` file, in the order the spec gives.
@@ -59,6 +58,22 @@ pub(super) fn section_header(input: &str) -> IResult<&str, &str> {
         .map(|(_, name, _)| name)
         .parse(input)
 }
+/// One file run's deviation rows as they are read: its readings, already
+/// in place, and what its direction needs (the module doc), so that no list
+/// of rows is kept (a large file has a hundred thousand).
+#[derive(Debug, Default)]
+pub(super) struct RunRows {
+    /// Deviations in mm, indexed like the sorted targets; `None` until listed.
+    pub(super) deviations_mm: Vec<Option<f64>>,
+    /// Sorted position and target number of the run's last row so far.
+    pub(super) last: Option<(usize, usize)>,
+    /// Whether the run goes towards larger targets, once it has two rows.
+    pub(super) up: Option<bool>,
+    /// The run's first row that turns back (line, column, its target number
+    /// and that of the row before it).
+    pub(super) turns_back: Option<(usize, usize, usize, usize)>,
+}
+
 /// A number with the line and column it came from.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Located<T> {

@@ -6,23 +6,8 @@ use crate::measurement::{Direction, Run};
 use crate::read::text::{self, Line, check_deviation_mm};
 use crate::units::um_to_mm;
 
-use super::parser::{Located, RtlParser, key_value, sorted_targets};
+use super::parser::{Located, RtlParser, RunRows, key_value, sorted_targets};
 
-/// One file run's deviation rows as they are read: its readings, already
-/// in place, and what its direction needs (the module doc), so that no list
-/// of rows is kept (a large file has a hundred thousand).
-#[derive(Debug, Default)]
-pub(super) struct RunRows {
-    /// Deviations in mm, indexed like the sorted targets; `None` until listed.
-    pub(super) deviations_mm: Vec<Option<f64>>,
-    /// Sorted position and target number of the run's last row so far.
-    pub(super) last: Option<(usize, usize)>,
-    /// Whether the run goes towards larger targets, once it has two rows.
-    pub(super) up: Option<bool>,
-    /// The run's first row that turns back (line, column, its target number
-    /// and that of the row before it).
-    pub(super) turns_back: Option<(usize, usize, usize, usize)>,
-}
 impl RtlParser {
     pub(super) fn deviation_line(
         &mut self,
