@@ -128,6 +128,12 @@ pub struct ConvertArgs {
     #[arg(long = "also", value_name = "AXIS", help_heading = "Table")]
     pub also: Vec<String>,
 
+    /// Fanuc: also write the table with a finer magnification (3623) to
+    /// this file: every point of the axis rescaled, with the parameter
+    /// change to make (for a 3623 too coarse for the error).
+    #[arg(long = "fanuc-rescaled", value_name = "OUT", help_heading = "Output")]
+    pub fanuc_rescaled: Option<PathBuf>,
+
     /// `--machine` (one profile; each command reads its part).
     #[command(flatten)]
     pub machine_file: MachineFile,
@@ -295,12 +301,19 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         reference_mm: args.reference,
         extrapolate: args.extrapolate,
     };
+    if args.fanuc_rescaled.is_some() && args.controller != Controller::Fanuc {
+        bail!("--fanuc-rescaled is for --controller fanuc");
+    }
     if args.controller == Controller::Fanuc
         && let Some(parameters) = &options.axes[0].fanuc
     {
         fanuc_grid(&mut request, parameters, measurement.targets_mm())?;
     }
-    let Converted { bytes, report, .. } = workflow::convert(
+    let Converted {
+        bytes,
+        report,
+        table,
+    } = workflow::convert(
         &measurement,
         &mut warnings,
         &TableRequest {
@@ -316,6 +329,23 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         },
     )?;
     write_new(&args.output, &bytes, &args.inputs(), args.overwrite.force)?;
+    if let Some(path) = &args.fanuc_rescaled {
+        let existing = existing_bytes.and_then(|b| axcomp::emit::decode_table(&b).ok());
+        let existing = existing.as_ref().map(|(text, _)| text.as_str());
+        let fine = axcomp::emit::fanuc::rescaled(existing, &table, &options, None)?;
+        write_new(
+            path,
+            fine.text.as_bytes(),
+            &args.inputs(),
+            args.overwrite.force,
+        )?;
+        let line = format!("{}: {}", path.display(), fine.instruction);
+        if args.json_output.json {
+            eprintln!("{line}")
+        } else {
+            println!("{line}")
+        }
+    }
     print_warnings(&warnings, args.verbosity.quiet);
     if args.json_output.json {
         print_json(&report)

@@ -16,7 +16,7 @@ use axcomp::workflow::rotary::{self, Use};
 
 use super::common::{
     AngleUnitArg, JsonOutput, LinuxCncType, MachineFile, Overwrite, StandardArg, Verbosity, load,
-    name_axis, print_json, print_test_warnings, print_text, print_warnings, read_active_table,
+    name_axis, print_test_warnings, print_warnings, read_active_table,
 };
 use super::servo_sim::load_axis;
 
@@ -78,6 +78,10 @@ pub struct DiagnoseArgs {
         requires = "servo_axis"
     )]
     pub stiffness_n_per_um: Option<f64>,
+
+    /// `--thermal`, `--thermal-model`: the temperatures logged during the re-test.
+    #[command(flatten)]
+    pub thermal: super::thermal::ThermalInputArgs,
 
     /// Save the accepted effects (TOML) for predict --effects and convert --effects.
     #[arg(long = "write-effects", value_name = "E.toml")]
@@ -200,11 +204,11 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
                 .map(|f| FrictionJson::new(servo_axis, &f)),
         );
     }
-    if args.json_output.json {
-        print_json(&report)
-    } else {
-        print_text(&render(&report))
-    }
+    let study = args.thermal.study()?;
+    let share = study.as_ref().and_then(|s| {
+        super::thermal::drift_share(&diagnosis, &after.measurement.environment, Some(s))
+    });
+    super::thermal::print_with_share(&report, render, share, args.json_output.json)
 }
 
 fn load_angular(path: &Path) -> Result<AngularProfile> {

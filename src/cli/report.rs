@@ -64,6 +64,10 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub input_format: InputFormat,
 
+    /// `--thermal`, `--thermal-model`: a thermal log's section.
+    #[command(flatten)]
+    pub thermal: super::thermal::ThermalInputArgs,
+
     /// Name of the axis of FILE and FILE2, instead of the one in the files
     /// (needed with --table when FILE does not record its axis).
     #[arg(long, value_name = "NAME", help_heading = "Input")]
@@ -234,8 +238,13 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     });
     let input = report.input();
     // Render everything before writing anything: a failure leaves no half report.
-    let mut files: Vec<(PathBuf, Vec<u8>)> =
-        vec![(args.output.clone(), html::render(&input)?.into_bytes())];
+    let page = super::thermal::with_thermal_section(
+        html::render(&input)?,
+        &args.thermal,
+        diagnosis.as_ref(),
+        after.as_ref().map(|a| &a.measurement.environment),
+    )?;
+    let mut files: Vec<(PathBuf, Vec<u8>)> = vec![(args.output.clone(), page.into_bytes())];
     if let Some(directory) = &args.png {
         for named in charts(&input) {
             let bytes = chart(&named.chart, PlotFormat::Png)?;
@@ -255,7 +264,8 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         args.machine_file.machine.as_deref(),
         args.uncertainty.equipment.as_deref(),
     ];
-    let inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
+    let mut inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
+    inputs.extend(args.thermal.inputs());
     if let Err(error) = write_all_new(&files, &inputs, args.overwrite.force) {
         if let Some(directory) = created {
             let _ = std::fs::remove_dir(directory);

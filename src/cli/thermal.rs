@@ -82,6 +82,7 @@ impl LogArgs {
         let options = LogOptions {
             drift: self.drift.clone(),
             sample_interval_s: self.sample_interval,
+            drift_optional: false,
         };
         load(path, |text| thermal::parse_log(text, &options))
     }
@@ -144,12 +145,18 @@ pub struct FitArgs {
     pub exclude: Vec<String>,
     /// The reference sensor: each term is a sensor's rise over it (the
     /// measuring loop's other end, e.g. the table), so a uniform change of
-    /// the loop's temperature moves nothing.
+    /// the loop's temperature moves nothing. `auto`: each sensor tried as
+    /// the reference (and none), the one that predicts best kept.
     #[arg(long, value_name = "SENSOR")]
     pub reference: Option<String>,
     /// At most this many sensors (the reference aside).
     #[arg(long = "max-sensors", value_name = "N", default_value_t = 4)]
     pub max_sensors: usize,
+    /// How the cross-validation predicts its blocks: blocked (each from all
+    /// the others) or forward (each from the blocks before it only: what
+    /// the model does on the machine, predicting the hours after its fit).
+    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = ["blocked", "forward"])]
+    pub validation: String,
     /// Write the drift, the model and the residual against time (.svg or .png).
     #[arg(long = "plot", value_name = "FILE", help_heading = "Output")]
     pub plot: Option<PathBuf>,
@@ -237,8 +244,12 @@ fn fit(args: &FitArgs) -> Result<()> {
     let mut options = FitOptions::over(rows);
     options.sensors = args.sensors.clone();
     options.exclude = args.exclude.clone();
-    options.reference = args.reference.clone();
+    options.auto_reference = args.reference.as_deref() == Some("auto");
+    options.reference = args.reference.clone().filter(|r| r != "auto");
     options.max_sensors = args.max_sensors;
+    if args.validation == "forward" {
+        options.validation = thermal::Validation::Forward;
+    }
     let model = thermal::fit(&log, &options).map_err(|e| in_file_thermal(&args.log, e))?;
     write_new(
         &args.output,
@@ -260,19 +271,13 @@ fn fit(args: &FitArgs) -> Result<()> {
 
 fn apply(args: &ApplyArgs) -> Result<()> {
     let model = load(&args.model, ThermalModel::from_toml)?;
-    let log_args = LogArgs {
+    // A log without the model's drift column is run for the prediction alone.
+    let options = LogOptions {
         drift: Some(model.fit.drift.clone()),
-        sample_interval: args.sample_interval,
+        sample_interval_s: args.sample_interval,
+        drift_optional: true,
     };
-    let log = match log_args.read(&args.log) {
-        Ok(log) => log,
-        // A log without the drift column is run for the prediction alone.
-        Err(_) => LogArgs {
-            drift: None,
-            sample_interval: args.sample_interval,
-        }
-        .read(&args.log)?,
-    };
+    let log = load(&args.log, |text| thermal::parse_log(text, &options))?;
     let applied = thermal::apply(&model, &log).map_err(|e| in_file_thermal(&args.log, e))?;
     write_plot(
         args.plot.as_deref(),
@@ -297,18 +302,7 @@ fn in_file_thermal(path: &Path, error: thermal::ThermalError) -> anyhow::Error {
 
 /// `FIRST-LAST`, 1-based inclusive data rows, as a 0-based range.
 fn parse_rows(text: &str, rows: usize) -> Result<std::ops::Range<usize>> {
-    let parsed = text.split_once('-').and_then(|(a, b)| {
-        Some((
-            a.trim().parse::<usize>().ok()?,
-            b.trim().parse::<usize>().ok()?,
-        ))
-    });
-    match parsed {
-        Some((first, last)) if first >= 1 && first < last && last <= rows => Ok(first - 1..last),
-        _ => {
-            bail!("--rows {text}: expected FIRST-LAST, 1 ≤ FIRST < LAST ≤ {rows} (the log's rows)")
-        }
-    }
+    thermal::parse_rows(text, rows).map_err(|message| anyhow::anyhow!("--{message}"))
 }
 
 fn write_plot(
@@ -350,4 +344,153 @@ fn hal(args: &HalArgs) -> Result<()> {
         args.overwrite.force,
     )?;
     Ok(())
+}
+
+/// A thermal log given with a test (`report --thermal`, `diagnose --thermal`).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct ThermalInputArgs {
+    /// A thermal log (CSV, as `thermal evaluate` reads it): the report adds
+    /// its ISO 230-3 view, plots and model; diagnose says how much of a
+    /// drift found its temperatures explain (the log's first row at the
+    /// re-test's start).
+    #[arg(long = "thermal", value_name = "LOG.csv", help_heading = "Thermal")]
+    pub log: Option<PathBuf>,
+    /// The thermal model to run over it (from `axcomp thermal fit`); without
+    /// one, the report fits a model on the whole log when its drift column
+    /// is named (--thermal-drift).
+    #[arg(
+        long = "thermal-model",
+        value_name = "MODEL.toml",
+        requires = "log",
+        help_heading = "Thermal"
+    )]
+    pub model: Option<PathBuf>,
+    /// The log's drift column (default: the model's).
+    #[arg(
+        long = "thermal-drift",
+        value_name = "COLUMN",
+        requires = "log",
+        help_heading = "Thermal"
+    )]
+    pub drift: Option<String>,
+    /// Seconds between the log's rows, for a log without a time column.
+    #[arg(
+        long = "thermal-sample-interval",
+        value_name = "S",
+        requires = "log",
+        help_heading = "Thermal"
+    )]
+    pub sample_interval: Option<f64>,
+}
+
+impl ThermalInputArgs {
+    /// The log studied (`None` without --thermal): with the model given,
+    /// or one fitted on every row when the drift column is named.
+    pub fn study(&self) -> Result<Option<thermal::Study>> {
+        let Some(path) = &self.log else {
+            return Ok(None);
+        };
+        let model = self
+            .model
+            .as_deref()
+            .map(|p| load(p, ThermalModel::from_toml))
+            .transpose()?;
+        let request = thermal::StudyRequest {
+            drift: self.drift.clone(),
+            sample_interval_s: self.sample_interval,
+            model,
+            ..Default::default()
+        };
+        let text = load(path, |text| {
+            Ok::<_, axcomp::error::ParseError>(text.to_string())
+        })?;
+        let study = thermal::study_text(&text, request).map_err(|e| in_file_thermal(path, e))?;
+        Ok(Some(study))
+    }
+
+    /// The files read, for `write_new`'s check that no output is an input.
+    pub fn inputs(&self) -> Vec<&Path> {
+        [self.log.as_deref(), self.model.as_deref()]
+            .into_iter()
+            .flatten()
+            .collect()
+    }
+}
+
+/// The share of the found drift the logged temperatures explain, for
+/// `diagnose --thermal` and `report --diagnose --thermal`.
+pub fn drift_share(
+    diagnosis: &axcomp::diagnose::Diagnosis,
+    environment: &axcomp::measurement::Environment,
+    study: Option<&thermal::Study>,
+) -> Option<report::ShareView> {
+    use axcomp::diagnose::thermal::{recorded_changes, thermal_share};
+    let drift = diagnosis.accepted.iter().find_map(|a| match &a.effect {
+        axcomp::effects::Effect::Drift(d) => Some(*d),
+        _ => None,
+    })?;
+    let recorded = recorded_changes(environment);
+    let Some(study) = study else {
+        return Some(report::ShareView::not_computed(
+            "not computed: no thermal log of the re-test (--thermal LOG.csv --thermal-model MODEL.toml)",
+            &recorded,
+        ));
+    };
+    let Some(applied) = &study.applied else {
+        return Some(report::ShareView::not_computed(
+            "not computed: the thermal log has no model (--thermal-model, or --thermal-drift to fit one)",
+            &recorded,
+        ));
+    };
+    let readings: Vec<_> = diagnosis.readings.iter().map(|r| r.reading).collect();
+    Some(
+        match thermal_share(&drift, &readings, &study.log, applied) {
+            Ok(share) => report::ShareView::of(&share),
+            Err(why) => report::ShareView::not_computed(&format!("not computed: {why}"), &recorded),
+        },
+    )
+}
+
+/// Prints a report (`--json` or text) with the thermal share added: as
+/// `"thermal"` in the JSON, as a paragraph after the text.
+pub fn print_with_share<T: serde::Serialize>(
+    report: &T,
+    render: impl Fn(&T) -> String,
+    share: Option<report::ShareView>,
+    json: bool,
+) -> Result<()> {
+    if json {
+        let Some(share) = share else {
+            return print_json(report);
+        };
+        print_json(&report::WithShare {
+            report,
+            thermal: share,
+        })
+    } else {
+        let mut text = render(report);
+        if let Some(share) = share {
+            text.push_str(&format!("\nThermal: {}\n", share.text));
+        }
+        print_text(&text)
+    }
+}
+
+/// The report's `page` with the thermal section when --thermal is given
+/// (and, with a diagnosis, the share of its drift the log explains).
+pub fn with_thermal_section(
+    page: String,
+    args: &ThermalInputArgs,
+    diagnosis: Option<&axcomp::diagnose::Diagnosis>,
+    environment: Option<&axcomp::measurement::Environment>,
+) -> Result<String> {
+    let Some(study) = args.study()? else {
+        return Ok(page);
+    };
+    let share = match (diagnosis, environment) {
+        (Some(d), Some(e)) => drift_share(d, e, Some(&study)),
+        _ => None,
+    };
+    let section = report::section_html(&study, share.as_ref())?;
+    Ok(report::insert_section(&page, &section))
 }

@@ -18,7 +18,9 @@ use super::covariance::Covariance;
 use super::fit::{Design, GlsBase, WeightedFit, fit_gls};
 use super::gates::{period_range, rotary_orders, set_rejection};
 use super::levels::{Fold, Level};
-use super::periodogram::{aliases, frequency_uncertainty, period_sets};
+use super::periodogram::{
+    aliases, diagonal_gls_chi2, frequency_uncertainty, may_be_lowest, period_sets,
+};
 use super::problem::Problem;
 use super::selection::{Chosen, Search, ShapeSet, forward_selection, shapes};
 use super::stats::chi2_p;
@@ -205,11 +207,17 @@ pub(super) fn select_along_axis(
             let Shape::Period(found, tests) = periodic.shape else {
                 unreachable!("a periodic effect's shape is its period")
             };
-            aliases(found, range, search.span_mm(), |p| {
-                search
-                    .fit_extended(&others, &search.columns(Shape::Period(p, tests)))
-                    .chi2
-            })
+            aliases(
+                found,
+                range,
+                search.span_mm(),
+                |p| {
+                    search
+                        .fit_extended(&others, &search.columns(Shape::Period(p, tests)))
+                        .chi2
+                },
+                |periods| search.screen(&others, periods, tests),
+            )
         }
         _ => Vec::new(),
     };
@@ -241,6 +249,19 @@ impl AlongAxis<'_> {
     fn span_mm(&self) -> f64 {
         let targets = &self.problem.targets_mm;
         targets[targets.len() - 1] - targets[0]
+    }
+
+    /// χ² of `model` with a periodic error at each of `periods` (a scan),
+    /// within [`periodogram::SCREEN_MARGIN`](super::periodogram::SCREEN_MARGIN):
+    /// only for a periodic error new in the re-test on independent levels
+    /// (the sums need plain sines and a diagonal covariance).
+    fn screen(&self, model: &Design, periods: &[f64], tests: PeriodicIn) -> Option<Vec<f64>> {
+        if tests != PeriodicIn::ReTest || model.groups.is_some() {
+            return None;
+        }
+        let weights = self.covariance.inverse_diagonal()?;
+        let positions: Vec<f64> = self.levels.iter().map(|l| l.target_mm).collect();
+        diagonal_gls_chi2(&positions, self.values, &weights, &model.columns, periods)
     }
 }
 
@@ -315,6 +336,24 @@ impl Search for AlongAxis<'_> {
             Some(base) => base.fit_with(extra, self.covariance),
             None => self.fit(&model.with(extra)),
         }
+    }
+
+    /// A scan of periods new in the re-test is screened by the periodogram's sums.
+    fn may_be_best(&self, model: &Design, set: &ShapeSet) -> Option<Vec<bool>> {
+        set.refine?;
+        let mut tests = None;
+        let mut periods = Vec::with_capacity(set.shapes.len());
+        for shape in &set.shapes {
+            let Shape::Period(p, t) = *shape else {
+                return None;
+            };
+            if tests.replace(t).is_some_and(|before| before != t) {
+                return None;
+            }
+            periods.push(p);
+        }
+        let screened = self.screen(model, &periods, tests?)?;
+        Some(may_be_lowest(&screened))
     }
 
     fn statistic(fit: &WeightedFit) -> f64 {

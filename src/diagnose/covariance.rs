@@ -138,6 +138,14 @@ impl Covariance {
         Some(x)
     }
 
+    /// The diagonal of C⁻¹ when C is diagonal (rows that share nothing).
+    pub fn inverse_diagonal(&self) -> Option<Vec<f64>> {
+        match &self.factor {
+            Factor::Diagonal(inverse) => Some(inverse.iter().map(|i| i / self.scale).collect()),
+            _ => None,
+        }
+    }
+
     /// Element (a, b) of C.
     pub fn at(&self, a: usize, b: usize) -> f64 {
         let shared: f64 = self.weights[a]

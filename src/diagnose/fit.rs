@@ -85,7 +85,7 @@ pub struct Fit {
 /// Gram matrix G = XᵀX and b = Xᵀy: the singular values of X are √eig(G),
 /// those above `largest · 1e-10 · scale` count (the rank), and (XᵀX)⁺ is
 /// V Λ⁻¹ Vᵀ over them. Returns (β, rank, (XᵀX)⁺).
-fn solve_normal(
+pub(super) fn solve_normal(
     gram: DMatrix<f64>,
     b: &DVector<f64>,
     scale: usize,

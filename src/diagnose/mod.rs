@@ -44,6 +44,8 @@ mod periodogram;
 mod problem;
 mod selection;
 mod stats;
+pub mod thermal;
+mod trig_sums;
 mod unexplained;
 
 pub use angular_profile::AngularProfile;

@@ -65,9 +65,12 @@ pub(super) fn shapes(kind: Kind, runs: &[Run], chosen: &[Chosen]) -> Vec<Shape> 
 
 /// Tries every shape of the set and returns the one with the lowest score
 /// (the first of equal ones); a period of a scan is refined around the best,
-/// within its range. The shapes are scored in parallel (rayon), chosen in order.
+/// within its range. With `may_be_best` (one per shape, from a screen of the
+/// scan) only the shapes it marks are scored: the others cannot be the best.
+/// The shapes are scored in parallel (rayon), chosen in order.
 pub(super) fn best_of<T: Send>(
     set: &ShapeSet,
+    may_be_best: Option<&[bool]>,
     score: impl Fn(Shape) -> (f64, T) + Sync,
 ) -> Option<(Shape, f64, T)> {
     let lowest = |shapes: Vec<Shape>, best: Option<(Shape, f64, T)>| {
@@ -83,7 +86,17 @@ pub(super) fn best_of<T: Send>(
                 }
             })
     };
-    let best = lowest(set.shapes.clone(), None);
+    let tried: Vec<Shape> = match may_be_best {
+        Some(marks) => set
+            .shapes
+            .iter()
+            .zip(marks)
+            .filter(|(_, m)| **m)
+            .map(|(s, _)| *s)
+            .collect(),
+        None => set.shapes.clone(),
+    };
+    let best = lowest(tried, None);
     if let (
         Some((Shape::Period(period, tests), _, _)),
         Some((shortest, longest)),
@@ -132,6 +145,13 @@ pub(super) trait Search: Sync {
         self.fit(&model.with(extra))
     }
 
+    /// For a scan of periods: which of its shapes may give the lowest
+    /// statistic extending `model`, from a cheaper computation of all of
+    /// them at once; `None`: every shape is fitted.
+    fn may_be_best(&self, _model: &Design, _set: &ShapeSet) -> Option<Vec<bool>> {
+        None
+    }
+
     /// What the best shape of a kind minimises (RSS or χ²).
     fn statistic(fit: &Self::Fit) -> f64;
 
@@ -171,7 +191,8 @@ pub(super) fn forward_selection<S: Search>(
                 continue;
             }
             for set in search.shape_sets(kind, &chosen) {
-                let Some((shape, _, trial_fit)) = best_of(&set, |shape| {
+                let screened = search.may_be_best(&model, &set);
+                let Some((shape, _, trial_fit)) = best_of(&set, screened.as_deref(), |shape| {
                     let f = search.fit_extended(&model, &search.columns(shape));
                     (S::statistic(&f), f)
                 }) else {

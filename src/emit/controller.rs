@@ -91,7 +91,9 @@ impl Controller {
         matches!(self, Controller::Fagor8065 | Controller::Fanuc)
     }
 
-    /// Whether the format holds separate ↑ and ↓ values.
+    /// Whether the format holds separate ↑ and ↓ values (a Fanuc control
+    /// does with 3605#0, which only its parameters tell: `--mode
+    /// bidirectional` asks for it).
     pub fn supports_bidirectional(self) -> bool {
         !matches!(self, Controller::Itnc530 | Controller::Fanuc)
     }

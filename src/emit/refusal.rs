@@ -215,7 +215,12 @@ pub fn check_table(
             });
         }
     }
-    if table.values.mode() == TableMode::Bidirectional && !controller.supports_bidirectional() {
+    // A Fanuc control has a table per direction with 3605#0, which the
+    // axis' parameters tell (`fanuc::write` refuses with what to set).
+    if table.values.mode() == TableMode::Bidirectional
+        && !controller.supports_bidirectional()
+        && controller != Controller::Fanuc
+    {
         return Err(EmitError::NoBidirectional { controller: name });
     }
     // TNC 335/407 manuals: "The error curve must always start with correction value = 0 at the datum point."

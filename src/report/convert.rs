@@ -182,9 +182,10 @@ impl ConvertJson {
     /// Sets what the controller does with the suggested backlash
     /// ([`crate::emit::Controller::backlash_parameter`]). A rotary axis'
     /// parameters take degrees, which the advice (in lengths) does not say:
-    /// it gets a note with the value in ° instead.
+    /// it gets a note with the value in ° instead (Fanuc's advice counts
+    /// detection units of the axis, ° on a rotary one: kept).
     pub fn set_backlash(&mut self, advice: BacklashAdvice) {
-        if self.kind == AxisKind::Rotary {
+        if self.kind == AxisKind::Rotary && self.controller != "fanuc" {
             let backlash_arcsec = self.suggested_backlash_um.unwrap_or_default();
             self.backlash_parameter = None;
             self.backlash_note = Some(format!(

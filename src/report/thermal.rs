@@ -1,11 +1,16 @@
 //! The thermal stage's outputs: the model file (TOML), the `--json` of
-//! `thermal evaluate` and `thermal apply`, their terminal reports, and the
-//! plots of drift and temperatures against time.
+//! `thermal evaluate` and `thermal apply`, their terminal reports, the
+//! plots of drift and temperatures against time, the report's thermal
+//! section and the web app's thermal page, and the share of a re-test's
+//! drift the logged temperatures explain.
 
 use serde::Serialize;
 
-use crate::report::chart::{Chart, Mark, Rgb, Series};
-use crate::thermal::{Application, Iso230_3, ThermalLog, ThermalModel};
+use crate::diagnose::thermal::{RecordedChange, ThermalShare};
+use crate::report::chart::{Chart, Mark, Rgb, Series, chart};
+use crate::report::format::esc;
+use crate::report::plot::{PlotError, PlotFormat};
+use crate::thermal::{Application, Iso230_3, Study, ThermalLog, ThermalModel, Validation};
 
 /// The model file: `[fit]` (what it was fitted on) and one `[[term]]` per
 /// lagged sensor; `thermal::ThermalModel::from_toml` reads it back.
@@ -26,6 +31,7 @@ struct FitFile<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     reference: Option<&'a str>,
     blocks: usize,
+    validation: &'static str,
     cv_rms_um: f64,
     fit_rms_um: f64,
 }
@@ -51,6 +57,7 @@ pub fn model_toml(model: &ThermalModel) -> String {
             candidates: &f.candidates,
             reference: f.reference.as_deref(),
             blocks: f.blocks,
+            validation: f.validation.name(),
             cv_rms_um: f.cv_rms_um,
             fit_rms_um: f.fit_rms_um,
         },
@@ -190,11 +197,19 @@ pub fn apply_text(model: &ThermalModel, json: &ApplyJson) -> String {
     text
 }
 
+/// How a summary says the validation: nothing for the blocked k-fold (the default).
+fn validation_words(validation: Validation) -> &'static str {
+    match validation {
+        Validation::Blocked => "",
+        Validation::Forward => " (each block predicted from the blocks before it)",
+    }
+}
+
 /// The fit report for the terminal.
 pub fn fit_text(model: &ThermalModel) -> String {
     let f = &model.fit;
     let mut text = format!(
-        "Thermal model of {:?} from rows {}–{} ({:.0}–{:.0} min), chosen from {} by {}-block time-blocked cross-validation{}\n",
+        "Thermal model of {:?} from rows {}–{} ({:.0}–{:.0} min), chosen from {} by {}-block time-blocked cross-validation{}{}\n",
         f.drift,
         f.first_row,
         f.last_row,
@@ -202,6 +217,7 @@ pub fn fit_text(model: &ThermalModel) -> String {
         f.to_s / 60.0,
         f.candidates.join(", "),
         f.blocks,
+        validation_words(f.validation),
         f.reference
             .as_deref()
             .map(|r| format!(" as rises over {r}"))
@@ -398,4 +414,220 @@ pub fn temperature_chart(log: &ThermalLog) -> Chart {
         y_range: None,
         polar: None,
     }
+}
+
+/// The thermal section of the HTML report (and of the web app's thermal
+/// page): the ISO 230-3 figures, the drift and temperature plots, and with a
+/// model its terms, its fit and the drift before and after it; with a
+/// re-test's drift, the share the temperatures explain.
+pub fn section_html(study: &Study, share: Option<&ShareView>) -> Result<String, PlotError> {
+    let iso = evaluate_json(&study.iso);
+    let mut html = String::from("<section id=\"thermal\">\n<h2>Thermal drift (ISO 230-3)</h2>\n");
+    html.push_str(&format!(
+        "<p>{}; {:.0} min, {} rows.</p>\n",
+        esc(iso.test_type.unwrap_or("test type not stated")),
+        iso.duration_min,
+        iso.rows
+    ));
+    html.push_str("<table class=\"keep\"><tbody>\n");
+    match (iso.max_drift_um, iso.max_drift_at_min, iso.drift_range_um) {
+        (Some(d), Some(at), Some(range)) => html.push_str(&format!(
+            "<tr><th>largest drift from the start</th><td class=\"num\" data-key=\"thermal.max_drift_um\" data-um=\"{d}\">{d:+.2} µm</td><td>at {at:.0} min</td></tr>\n<tr><th>drift range</th><td class=\"num\" data-key=\"thermal.drift_range_um\" data-um=\"{range}\">{range:.2} µm</td><td></td></tr>\n"
+        )),
+        _ => html.push_str("<tr><th>drift</th><td colspan=\"2\">not recorded in the log</td></tr>\n"),
+    }
+    html.push_str("</tbody></table>\n");
+    html.push_str("<table class=\"keep\"><thead><tr><th>sensor</th><th>start [°C]</th><th>end [°C]</th><th>range [K]</th><th>largest rise [K]</th><th>at [min]</th></tr></thead><tbody>\n");
+    for s in &iso.sensors {
+        html.push_str(&format!(
+            "<tr><th>{}</th><td class=\"num\">{:.2}</td><td class=\"num\">{:.2}</td><td class=\"num\">{:.2}</td><td class=\"num\">{:.2}</td><td class=\"num\">{:.0}</td></tr>\n",
+            esc(&s.name),
+            s.start_c,
+            s.end_c,
+            s.range_k,
+            s.max_rise_k,
+            s.max_rise_at_min
+        ));
+    }
+    html.push_str("</tbody></table>\n");
+    html.push_str(&svg_figure(&drift_chart(
+        &study.log,
+        study.applied.as_ref(),
+    ))?);
+    html.push_str(&svg_figure(&temperature_chart(&study.log))?);
+    if let (Some(model), Some(applied)) = (&study.model, &study.applied) {
+        html.push_str(&model_html(model, &apply_json(model, &study.log, applied)));
+    }
+    if let Some(share) = share {
+        html.push_str(&format!(
+            "<h3>The re-test's drift</h3>\n<p>{}</p>\n",
+            esc(&share.text)
+        ));
+    }
+    html.push_str("</section>\n");
+    Ok(html)
+}
+
+fn model_html(model: &ThermalModel, json: &ApplyJson) -> String {
+    let f = &model.fit;
+    let mut html = format!(
+        "<h3>Model of the drift from the temperatures</h3>\n<p>Each term is a sensor through a first-order lag (time constant τ), times a coefficient; chosen from {} by {}-block time-blocked cross-validation{} on rows {}–{} ({:.0}–{:.0} min){}.</p>\n",
+        esc(&f.candidates.join(", ")),
+        f.blocks,
+        validation_words(f.validation),
+        f.first_row,
+        f.last_row,
+        f.from_s / 60.0,
+        f.to_s / 60.0,
+        f.reference
+            .as_deref()
+            .map(|r| format!(", each a rise over {}", esc(r)))
+            .unwrap_or_default()
+    );
+    html.push_str("<table class=\"keep\"><thead><tr><th>sensor</th><th>τ [min]</th><th>coefficient [µm/K]</th><th>from [°C]</th></tr></thead><tbody>\n");
+    for t in &model.terms {
+        html.push_str(&format!(
+            "<tr><th>{}</th><td class=\"num\">{:.0}</td><td class=\"num\">{:+.3}</td><td class=\"num\">{:.2}</td></tr>\n",
+            esc(&t.sensor),
+            t.tau_s / 60.0,
+            t.coefficient_um_per_k,
+            t.reference_c
+        ));
+    }
+    html.push_str("</tbody></table>\n");
+    html.push_str(&format!(
+        "<p>Fit rms <span data-key=\"thermal.fit_rms_um\" data-um=\"{0}\">{0:.2}</span> µm; cross-validated rms <span data-key=\"thermal.cv_rms_um\" data-um=\"{1}\">{1:.2}</span> µm (the prediction's standard uncertainty).</p>\n",
+        f.fit_rms_um, f.cv_rms_um
+    ));
+    let rows = [
+        ("all rows", "all_rows", &json.all_rows),
+        (
+            "rows not fitted on",
+            "outside_fit_rows",
+            &json.outside_fit_rows,
+        ),
+    ];
+    if rows.iter().any(|r| r.2.is_some()) {
+        html.push_str("<table class=\"keep\"><thead><tr><th>drift [µm]</th><th>rows</th><th>rms before</th><th>largest before</th><th>rms after</th><th>largest after</th></tr></thead><tbody>\n");
+        for (label, key, figures) in rows {
+            if let Some(b) = figures {
+                let cell = |name: &str, v: f64| {
+                    format!(
+                        "<td class=\"num\" data-key=\"thermal.{key}.{name}\" data-um=\"{v}\">{v:.2}</td>"
+                    )
+                };
+                html.push_str(&format!(
+                    "<tr><th>{label}</th><td class=\"num\">{}</td>{}{}{}{}</tr>\n",
+                    b.before.rows,
+                    cell("before.rms_um", b.before.rms_um),
+                    cell("before.max_um", b.before.max_um),
+                    cell("after.rms_um", b.after.rms_um),
+                    cell("after.max_um", b.after.max_um)
+                ));
+            }
+        }
+        html.push_str("</tbody></table>\n");
+    }
+    html
+}
+
+fn svg_figure(chart_data: &Chart) -> Result<String, PlotError> {
+    let bytes = chart(chart_data, PlotFormat::Svg)?;
+    let svg = String::from_utf8_lossy(&bytes);
+    let svg = svg.replacen(
+        "<svg ",
+        &format!(
+            "<svg role=\"img\" aria-label=\"{}\" ",
+            esc(&chart_data.title)
+        ),
+        1,
+    );
+    Ok(format!("<figure class=\"plot keep\">{svg}</figure>\n"))
+}
+
+/// `page` (the report's HTML) with `section` before its signatures (or
+/// before `</body>`, or at the end).
+pub fn insert_section(page: &str, section: &str) -> String {
+    let at = page
+        .find("<section id=\"signatures\"")
+        .or_else(|| page.find("</body>"))
+        .unwrap_or(page.len());
+    format!("{}{}{}", &page[..at], section, &page[at..])
+}
+
+/// The share of a re-test's drift that the logged temperatures explain, as
+/// the terminal, the JSON and the report say it.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShareView {
+    /// The found drift, µm/h (absent when not computed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub found_um_per_h: Option<f64>,
+    /// The model's drift over the readings, µm/h.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub explained_um_per_h: Option<f64>,
+    /// explained / found.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub share: Option<f64>,
+    /// One sentence.
+    pub text: String,
+}
+
+/// A command's JSON with the thermal share added: the report's own keys
+/// first, in its order, then `"thermal"`.
+#[derive(Serialize)]
+pub struct WithShare<'a, T> {
+    /// The command's JSON.
+    #[serde(flatten)]
+    pub report: &'a T,
+    /// The share.
+    pub thermal: ShareView,
+}
+
+impl ShareView {
+    /// Of a computed share.
+    pub fn of(share: &ThermalShare) -> ShareView {
+        ShareView {
+            found_um_per_h: Some(share.found_um_per_h),
+            explained_um_per_h: Some(share.explained_um_per_h),
+            share: Some(share.share),
+            text: format!(
+                "The drift found, {:+.2} µm/h over {:.1} h, is {:.0} % explained by the temperatures logged during the re-test: the thermal model predicts {:+.2} µm/h at the readings' times; the rest ({:+.2} µm/h) is not thermal as far as the logged sensors tell.",
+                share.found_um_per_h,
+                share.span_h,
+                100.0 * share.share,
+                share.explained_um_per_h,
+                share.found_um_per_h - share.explained_um_per_h
+            ),
+        }
+    }
+
+    /// Why it was not computed, with what the test file records.
+    pub fn not_computed(why: &str, recorded: &[RecordedChange]) -> ShareView {
+        let mut text = why.to_string();
+        if !recorded.is_empty() {
+            let list: Vec<String> = recorded
+                .iter()
+                .map(|r| format!("{} {:.2} → {:.2} °C", r.name, r.start_c, r.end_c))
+                .collect();
+            text.push_str(&format!(
+                "; the re-test file records start and end temperatures only ({}), which cannot apportion a drift",
+                list.join(", ")
+            ));
+        }
+        ShareView {
+            found_um_per_h: None,
+            explained_um_per_h: None,
+            share: None,
+            text,
+        }
+    }
+}
+
+/// The web app's thermal page: the upload form and, after a request, the
+/// section (or the error).
+pub fn page_html(body: &str, generator: &str) -> String {
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"generator\" content=\"{}\">\n<title>Thermal drift (ISO 230-3)</title>\n<style>body{{font-family:sans-serif;max-width:60rem;margin:1rem auto;padding:0 1rem}}table{{border-collapse:collapse;margin:.5rem 0}}th,td{{border:1px solid #bbb;padding:.2rem .5rem}}td.num{{text-align:right}}figure svg{{max-width:100%;height:auto}}.error{{color:#a00}}label{{display:block;margin:.3rem 0}}</style>\n</head>\n<body>\n<p><a href=\"/\">axcomp</a></p>\n<h1>Thermal drift</h1>\n<form method=\"post\" action=\"/thermal\" enctype=\"multipart/form-data\">\n<label>Thermal log (CSV) <input type=\"file\" name=\"log\" required></label>\n<label>Drift column <input name=\"drift\" placeholder=\"delta L\"></label>\n<label>Seconds between rows (a log without a time column) <input name=\"sample_interval\" inputmode=\"decimal\"></label>\n<label>Model (TOML, from axcomp thermal fit; none: fitted on the log) <input type=\"file\" name=\"model\"></label>\n<label>Fit on rows FIRST-LAST <input name=\"rows\" placeholder=\"1-1500\"></label>\n<label>Sensors to choose from <input name=\"sensors\" placeholder=\"T0,T1,T2\"></label>\n<label>Reference sensor <input name=\"reference\" placeholder=\"T14\"></label>\n<button type=\"submit\">Evaluate and fit</button>\n</form>\n{body}</body>\n</html>\n",
+        esc(generator)
+    )
 }

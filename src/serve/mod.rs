@@ -41,6 +41,7 @@ mod inputs;
 pub mod origin;
 mod present;
 mod steps;
+mod thermal;
 
 use std::net::{SocketAddr, TcpListener};
 use std::sync::Arc;
@@ -102,6 +103,7 @@ pub fn app(addr: SocketAddr) -> Router {
         .route("/api/table", post(steps::api_table))
         .route("/api/retest", post(steps::api_retest))
         .route("/api/report", post(steps::api_report))
+        .route("/thermal", get(thermal::form).post(thermal::submit))
         .layer(DefaultBodyLimit::max(UPLOAD_LIMIT))
         .layer(middleware::from_fn_with_state(allowed, guard))
 }

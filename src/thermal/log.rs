@@ -26,6 +26,10 @@ use super::{Drift, Sensor, ThermalLog};
 pub struct LogOptions {
     /// The drift column's name (without its unit).
     pub drift: Option<String>,
+    /// Read a log without the drift column too (its drift is then `None`):
+    /// a model is run over temperatures alone. Without this, a named drift
+    /// column the log lacks is refused.
+    pub drift_optional: bool,
     /// The time between rows, s, for a log without a time column.
     pub sample_interval_s: Option<f64>,
 }
@@ -259,6 +263,7 @@ fn header_columns(
         });
     }
     if let Some(drift) = &options.drift
+        && !options.drift_optional
         && !columns.iter().any(|c| matches!(c.role, Role::Drift(_)))
     {
         let names: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();

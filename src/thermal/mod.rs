@@ -11,6 +11,9 @@
 //!   time-blocked cross-validation inside the rows it is fitted on
 //!   ([`fit`]), applied from a log's first row ([`apply`]), and the model
 //!   file read back ([`ThermalModel::from_toml`]; `report::thermal` writes it).
+//! - `study.rs` a log studied as a whole ([`study`]): the ISO 230-3 view and
+//!   the model (given or fitted) run over it, for the report, the web app
+//!   and `diagnose`.
 //!
 //! Inside, time is in seconds, temperatures in °C and the drift in µm (the
 //! field's unit for thermal drift; ISO 230-3 reports µm).
@@ -18,10 +21,14 @@
 mod iso;
 mod log;
 mod model;
+mod study;
 
 pub use iso::{Iso230_3, SensorRise, TestType, evaluate};
 pub use log::{LogOptions, parse_log, write_log};
-pub use model::{Application, FitOptions, FitSummary, Term, ThermalModel, apply, fit, tau_grid_s};
+pub use model::{
+    Application, FitOptions, FitSummary, Term, ThermalModel, Validation, apply, fit, tau_grid_s,
+};
+pub use study::{ModelSource, Study, StudyRequest, parse_rows, study, study_text};
 
 use crate::error::ParseError;
 

@@ -60,6 +60,8 @@ pub struct FitSummary {
     pub reference: Option<String>,
     /// The number of contiguous blocks of the cross-validation.
     pub blocks: usize,
+    /// How the blocks were predicted.
+    pub validation: Validation,
     /// The cross-validated rms (each block predicted from the others), µm:
     /// the prediction's standard uncertainty.
     pub cv_rms_um: f64,
@@ -95,6 +97,33 @@ pub struct FitOptions {
     pub max_sensors: usize,
     /// A sensor is added only if it lowers the cross-validated rms by this fraction.
     pub min_gain: f64,
+    /// How the blocks are predicted.
+    pub validation: Validation,
+    /// Without a reference: try each candidate as the reference (and none)
+    /// and keep the choice that predicts best.
+    pub auto_reference: bool,
+}
+
+/// How the cross-validation predicts its blocks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Validation {
+    /// Each block from all the others (k-fold over contiguous blocks).
+    Blocked,
+    /// Each block from the blocks before it only (a rolling forecast
+    /// origin, Bergmeir and Benítez 2012): what a model does on a machine,
+    /// predicting the hours after the ones it was fitted on. The first
+    /// block is never predicted.
+    Forward,
+}
+
+impl Validation {
+    /// The name the model file and `--validation` use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Validation::Blocked => "blocked",
+            Validation::Forward => "forward",
+        }
+    }
 }
 
 impl FitOptions {
@@ -110,6 +139,8 @@ impl FitOptions {
             blocks: 5,
             max_sensors: 4,
             min_gain: 0.05,
+            validation: Validation::Blocked,
+            auto_reference: false,
         }
     }
 }
@@ -132,6 +163,7 @@ struct Problem {
     /// features follow the candidates'.
     taus: usize,
     candidates: usize,
+    validation: Validation,
 }
 
 /// A choice: candidate features and, with a reference, its feature.
@@ -175,6 +207,7 @@ impl Problem {
             blocks,
             taus: taus_s.len(),
             candidates: columns.len() - usize::from(options.reference.is_some()),
+            validation: options.validation,
         }
     }
 
@@ -227,26 +260,34 @@ impl Problem {
         (yy - 2.0 * c.dot(&v) + (a * c).dot(c)).max(0.0)
     }
 
-    fn rows(&self) -> usize {
-        self.blocks.iter().map(|b| b.3).sum()
-    }
-
     /// Each block predicted by the fit on the others: the rms, µm
     /// (infinite when a fit is singular).
     fn cv_rms(&self, choice: &Choice) -> f64 {
         if choice.features.is_empty() {
-            let total: f64 = self.blocks.iter().map(|b| b.2).sum();
-            return (total / self.rows() as f64).sqrt();
+            let first = usize::from(self.validation == Validation::Forward);
+            let scored = &self.blocks[first.min(self.blocks.len())..];
+            let total: f64 = scored.iter().map(|b| b.2).sum();
+            let rows: usize = scored.iter().map(|b| b.3).sum();
+            return (total / rows.max(1) as f64).sqrt();
         }
         let mut total = 0.0;
-        for held in 0..self.blocks.len() {
-            let (a, v) = self.normal(choice, |b| b != held);
+        let mut rows = 0;
+        let first = match self.validation {
+            Validation::Blocked => 0,
+            Validation::Forward => 1,
+        };
+        for held in first..self.blocks.len() {
+            let (a, v) = match self.validation {
+                Validation::Blocked => self.normal(choice, |b| b != held),
+                Validation::Forward => self.normal(choice, |b| b < held),
+            };
             let Some(c) = solve(a, v) else {
                 return f64::INFINITY;
             };
             total += self.sse(choice, &c, held);
+            rows += self.blocks[held].3;
         }
-        (total / self.rows() as f64).sqrt()
+        (total / rows as f64).sqrt()
     }
 
     /// Forward selection for one reference feature (or none).
@@ -289,8 +330,33 @@ fn solve(a: DMatrix<f64>, v: DVector<f64>) -> Option<DVector<f64>> {
     c.iter().all(|x| x.is_finite()).then_some(c)
 }
 
-/// Fits a model of `log`'s drift on `options.rows`.
+/// Fits a model of `log`'s drift on `options.rows`; with
+/// `auto_reference` (and no reference named), the best of every candidate
+/// as the reference and none, by the same cross-validation.
 pub fn fit(log: &ThermalLog, options: &FitOptions) -> Result<ThermalModel, ThermalError> {
+    if !options.auto_reference || options.reference.is_some() {
+        return fit_one(log, options);
+    }
+    let plain = FitOptions {
+        auto_reference: false,
+        ..options.clone()
+    };
+    let mut best = fit_one(log, &plain)?;
+    for name in &best.fit.candidates.clone() {
+        let trial = FitOptions {
+            reference: Some(name.clone()),
+            ..plain.clone()
+        };
+        if let Ok(model) = fit_one(log, &trial)
+            && model.fit.cv_rms_um < best.fit.cv_rms_um
+        {
+            best = model;
+        }
+    }
+    Ok(best)
+}
+
+fn fit_one(log: &ThermalLog, options: &FitOptions) -> Result<ThermalModel, ThermalError> {
     let drift = log.drift.as_ref().ok_or_else(|| {
         ThermalError::Request("the log has no drift column to fit (--drift)".to_string())
     })?;
@@ -403,6 +469,7 @@ pub fn fit(log: &ThermalLog, options: &FitOptions) -> Result<ThermalModel, Therm
             candidates: candidates.iter().map(|s| s.to_string()).collect(),
             reference: reference_sensor.map(|s| s.name.clone()),
             blocks: options.blocks,
+            validation: options.validation,
             cv_rms_um,
             fit_rms_um,
         },
@@ -479,6 +546,8 @@ struct FitFile {
     candidates: Vec<String>,
     reference: Option<String>,
     blocks: usize,
+    #[serde(default)]
+    validation: Option<String>,
     cv_rms_um: f64,
     fit_rms_um: f64,
 }
@@ -521,6 +590,19 @@ impl ThermalModel {
             });
         }
         let f = file.fit;
+        let validation = match f.validation.as_deref() {
+            None | Some("blocked") => Validation::Blocked,
+            Some("forward") => Validation::Forward,
+            Some(other) => {
+                let at = text.find("validation").unwrap_or(0);
+                let line = text[..at].matches('\n').count() + 1;
+                return Err(ParseError::new(
+                    line,
+                    1,
+                    format!("expected validation \"blocked\" or \"forward\", found {other:?}"),
+                ));
+            }
+        };
         Ok(ThermalModel {
             terms,
             fit: FitSummary {
@@ -532,6 +614,7 @@ impl ThermalModel {
                 candidates: f.candidates,
                 reference: f.reference,
                 blocks: f.blocks,
+                validation,
                 cv_rms_um: f.cv_rms_um,
                 fit_rms_um: f.fit_rms_um,
             },

@@ -18,3 +18,52 @@ fn lag_is_the_exact_first_order_step() {
     lag(&values, &times, 0.0, &mut out);
     assert_eq!(out, values);
 }
+
+#[test]
+fn drift_column_optional_reads_a_log_without_it_once() {
+    let text = "time [s],T1\n0,20\n60,20.5\n";
+    let mut options = LogOptions {
+        drift: Some("d".to_string()),
+        sample_interval_s: None,
+        drift_optional: false,
+    };
+    let refused = parse_log(text, &options).unwrap_err();
+    assert_eq!((refused.position.line, refused.position.column), (1, 1));
+    options.drift_optional = true;
+    let log = parse_log(text, &options).unwrap();
+    assert_eq!(log.drift, None);
+    assert_eq!(log.sensors[0].celsius, [20.0, 20.5]);
+    // With the column present, it is the drift.
+    let log = parse_log("time [s],d,T1\n0,0,20\n60,1.5,20.5\n", &options).unwrap();
+    assert_eq!(log.drift.unwrap().um, [0.0, 1.5]);
+}
+
+/// With no sensor chosen the cross-validated rms is the drift's own rms
+/// over the rows predicted: all of them for the blocked validation, all
+/// but the first block for the forward one (it is never predicted).
+#[test]
+fn forward_validation_never_predicts_the_first_block() {
+    let drift: Vec<f64> = vec![0.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 5.0, 6.0];
+    let log = ThermalLog {
+        times_s: (0..10).map(|k| 60.0 * k as f64).collect(),
+        drift: Some(Drift {
+            name: "d".into(),
+            um: drift.clone(),
+        }),
+        sensors: vec![Sensor {
+            name: "T1".into(),
+            celsius: vec![20.0; 10],
+        }],
+        lines: (2..12).collect(),
+    };
+    let mut options = FitOptions::over(0..10);
+    options.max_sensors = 0;
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+    let blocked = fit(&log, &options).unwrap();
+    assert!((blocked.fit.cv_rms_um - rms(&drift)).abs() < 1e-12);
+    options.validation = Validation::Forward;
+    let forward = fit(&log, &options).unwrap();
+    // Five blocks of two rows: rows 3–10 predicted.
+    assert!((forward.fit.cv_rms_um - rms(&drift[2..])).abs() < 1e-12);
+    assert_eq!(forward.fit.validation, Validation::Forward);
+}

@@ -125,8 +125,8 @@ fn run_block(examples: &[Example]) -> Result<usize, String> {
     Ok(examples.len())
 }
 
-/// README.md and every Markdown file under docs/.
-fn documents() -> Vec<PathBuf> {
+/// Every Markdown file under `folder`, at any depth, sorted.
+pub fn markdown_under(folder: &Path) -> Vec<PathBuf> {
     fn walk(folder: &Path, found: &mut Vec<PathBuf>) {
         let Ok(entries) = std::fs::read_dir(folder) else {
             return;
@@ -140,9 +140,16 @@ fn documents() -> Vec<PathBuf> {
             }
         }
     }
-    let mut found = vec![root().join("README.md")];
-    walk(&root().join("docs"), &mut found);
+    let mut found = Vec::new();
+    walk(folder, &mut found);
     found.sort();
+    found
+}
+
+/// README.md and every Markdown file under docs/.
+fn documents() -> Vec<PathBuf> {
+    let mut found = vec![root().join("README.md")];
+    found.extend(markdown_under(&root().join("docs")));
     found
 }
 
@@ -198,4 +205,22 @@ fn the_example_check_can_fail() {
 
     let other = console_blocks("doc.md", "```console\n$ ls\n```\n").unwrap_err();
     assert_eq!(other, "doc.md:2: only `$ axcomp …` is run here: ls");
+}
+
+/// A real example of the README, one figure changed by hand as a careless
+/// edit would, no longer passes.
+#[test]
+fn a_readme_example_changed_by_hand_fails() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let blocks = console_blocks("README.md", &readme).unwrap();
+    let mut block = blocks
+        .into_iter()
+        .find(|block| block.iter().any(|e| e.output.contains("13.19 ± 1.82")))
+        .expect("README shows the sample's A, 13.19 ± 1.82 µm");
+    assert_eq!(run_block(&block), Ok(block.len()));
+    for example in &mut block {
+        example.output = example.output.replace("13.19 ± 1.82", "13.18 ± 1.82");
+    }
+    let failure = run_block(&block).unwrap_err();
+    assert!(failure.contains("the output differs"), "{failure}");
 }

@@ -16,15 +16,20 @@ use axcomp::measurement::Direction;
 use crate::util::{assert_golden, axcomp, root, shared_data};
 
 /// The golden files `golden_files_read_back` writes (`formats/fanuc/golden/`).
-pub const GOLDENS: &[&str] = &["synth-x-HM100TS.TXT", "sample-mean.TXT"];
+pub const GOLDENS: &[&str] = &[
+    "synth-x-HM100TS.TXT",
+    "sample-mean.TXT",
+    "synth-x-bidirectional.TXT",
+    "synth-x-HM100TS-rescaled.TXT",
+];
 
-fn data(name: &str) -> String {
+pub(crate) fn data(name: &str) -> String {
     shared_data(&format!("fanuc/HM100TS__{name}"))
         .display()
         .to_string()
 }
 
-fn truth() -> String {
+pub(crate) fn truth() -> String {
     root()
         .join("tests/data/fanuc/x-truth.toml")
         .display()
@@ -33,12 +38,12 @@ fn truth() -> String {
 
 /// The truth's axis error, µm (tests/data/fanuc/x-truth.toml, by hand):
 /// 12 µm/m × x + 4 µm × sin(2π x / 1500 mm + 0.7).
-fn truth_error_um(x_mm: f64) -> f64 {
+pub(crate) fn truth_error_um(x_mm: f64) -> f64 {
     12.0 * x_mm / 1000.0 + 4.0 * (std::f64::consts::TAU * x_mm / 1500.0 + 0.7).sin()
 }
 
 /// The data lines of a pitch file: value by point (data number − 10000).
-fn increments(text: &str) -> BTreeMap<i64, i64> {
+pub(crate) fn increments(text: &str) -> BTreeMap<i64, i64> {
     text.lines()
         .filter_map(|line| {
             let line = line.trim_end();
@@ -51,7 +56,7 @@ fn increments(text: &str) -> BTreeMap<i64, i64> {
 /// The absolute compensation at point `n` of X, in its units: zero at the
 /// reference point 40, the running sum of the increments (manual: the value
 /// of point n is output between point n − 1 and point n).
-fn absolute(increments: &BTreeMap<i64, i64>, n: i64) -> i64 {
+pub(crate) fn absolute(increments: &BTreeMap<i64, i64>, n: i64) -> i64 {
     if n >= 40 {
         (41..=n).map(|k| increments[&k]).sum()
     } else {
@@ -75,7 +80,7 @@ fn predict_with(table: &str, parameters: Option<&str>) -> crate::util::Run {
     axcomp(args)
 }
 
-fn ok(args: &[&str]) -> crate::util::Run {
+pub(crate) fn ok(args: &[&str]) -> crate::util::Run {
     let run = axcomp(args);
     assert_eq!(run.code, 0, "axcomp {}: {}", args.join(" "), run.stderr);
     run
@@ -159,43 +164,62 @@ fn every_real_file_reads() {
     );
 }
 
-#[test]
-fn x_of_the_real_backup_is_updated_from_a_synthetic_test() {
-    let directory = tempfile::tempdir().unwrap();
-    let path = |name: &str| directory.path().join(name).display().to_string();
-    let (pitch, parameters) = (data("PITCH.TXT"), data("CNC-PARA.TXT"));
-    // The test measured with the machine's table active.
+/// The synthetic test of X (seed `seed`) measured with the real pitch file
+/// active under `parameters`, written to `directory`/after.rtl, and
+/// `convert --existing` of it for X with `flags`: (after.rtl, the run).
+pub(crate) fn update_x(
+    directory: &Path,
+    parameters: &str,
+    seed: &str,
+    flags: &[&str],
+) -> (String, crate::util::Run) {
+    let (pitch, truth) = (data("PITCH.TXT"), truth());
+    let [before, after] =
+        ["before.rtl", "after.rtl"].map(|n| directory.join(n).display().to_string());
     ok(&[
         "synth",
         "--truth",
-        &truth(),
+        &truth,
         "-o",
-        &path("before.rtl"),
+        &before,
         "--table",
         &pitch,
         "--fanuc-parameters",
-        &parameters,
+        parameters,
         "--o2",
-        &path("after.rtl"),
+        &after,
         "--seed",
-        "30",
+        seed,
     ]);
-    let run = ok(&[
+    let mut args = vec![
         "convert",
-        &path("after.rtl"),
+        &after,
         "--controller",
         "fanuc",
         "--existing",
         &pitch,
         "--fanuc-parameters",
-        &parameters,
+        parameters,
         "--axis",
         "X",
-        "-o",
-        &path("NEW.TXT"),
-        "--json",
-        "-q",
-    ]);
+    ];
+    args.extend_from_slice(flags);
+    let run = ok(&args);
+    (after, run)
+}
+
+#[test]
+fn x_of_the_real_backup_is_updated_from_a_synthetic_test() {
+    let directory = tempfile::tempdir().unwrap();
+    let path = |name: &str| directory.path().join(name).display().to_string();
+    let (pitch, parameters) = (data("PITCH.TXT"), data("CNC-PARA.TXT"));
+    let (after, run) = update_x(
+        directory.path(),
+        &parameters,
+        "30",
+        &["-o", &path("NEW.TXT"), "--json", "-q"],
+    );
+    assert_eq!(after, path("after.rtl"));
     let old_bytes = std::fs::read(&pitch).unwrap();
     let new_bytes = std::fs::read(path("NEW.TXT")).unwrap();
     let old_lines: Vec<&[u8]> = old_bytes.split_inclusive(|b| *b == b'\n').collect();

@@ -26,18 +26,22 @@
 
 mod parameters;
 mod pitch;
+mod rescale;
 mod table;
 mod update;
 
 pub use parameters::{AxisParameters, ParameterBackup, looks_like_parameters};
-use pitch::{data_line, increments, parse_pitch};
+use pitch::{absolute_units, data_line, increments, parse_pitch};
 pub use pitch::{looks_like, read};
-use table::{new_increments, wanted};
+pub use rescale::{Rescaled, rescaled};
+use table::{check_turn, new_increments, wanted};
 pub use table::{notes, parameters_for, points_in, write};
+use update::replace_lines;
 pub use update::{check_read_back, update};
 
 use crate::compensate::CompensationTable;
 use crate::emit::{BacklashAdvice, EmitOptions};
+use crate::measurement::AxisKind;
 
 /// \[file\] Data number of compensation point 0 (`N10000` … in the real `PITCH.TXT`).
 pub const DATA_NUMBER_OFFSET: i64 = 10_000;
@@ -66,20 +70,28 @@ const READ_LIMIT: i64 = 99_999_999;
 /// of movement".
 pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAdvice {
     let axis = options.axes.first().map_or("X", |a| a.axis.as_str());
-    let (unit, known) = match options.axes.first().and_then(|a| a.fanuc.as_ref()) {
-        Some(p) => (p.detection_unit, true),
-        None => (0.001, false),
-    };
+    let backup = options.axes.first().and_then(|a| a.fanuc.as_ref());
+    let rotary = options.kind == AxisKind::Rotary || backup.is_some_and(|p| p.rotary);
+    let length = if rotary { "°" } else { " mm" };
+    let unit = backup.map_or(0.001, |p| p.detection_unit);
     let value = (backlash_mm / unit).round() as i64;
     let unit_text = crate::emit::minimal(unit, 7);
-    let assumed = if known {
-        String::new()
-    } else {
-        " (assumed: IS-B with 1820 = 2; give --fanuc-parameters for the machine's)".to_string()
+    let sign = "positive compensates lost motion, negative an axis that overshoots at a reversal (the value is output in the direction of movement after a reversal)";
+    let rapid = "for rapid traverse set 1852 to the reversal measured at rapid traverse and 1800#4 (RBK) = 1";
+    let Some(p) = backup else {
+        return BacklashAdvice::NoParameter(format!(
+            "set 1851 of axis {axis} (backlash, cutting feed) to {value} detection units of {unit_text}{length} (assumed: IS-B with 1820 = 2; give --fanuc-parameters for the machine's), = {}{length}; {sign}; {rapid}",
+            crate::emit::minimal(value as f64 * unit, 7)
+        ));
     };
+    // [reconstructed] The backup's 1851 was active during the test, which
+    // measured the reversal it left: the new value is the old one plus it.
+    let (old, _) = p.backlash;
+    let new = old + value;
     BacklashAdvice::NoParameter(format!(
-        "set 1851 of axis {axis} (backlash, cutting feed) to {value} detection units of {unit_text} mm{assumed}, = {} mm; positive compensates lost motion (the value is output in the direction of movement after a reversal); for rapid traverse set 1852 to the reversal measured at rapid traverse and 1800#4 (RBK) = 1",
-        crate::emit::minimal(value as f64 * unit, 7)
+        "set 1851 of axis {axis} (backlash, cutting feed) to {value} detection units of {unit_text}{length} more than the {old} of the parameter backup, active during the test: 1851 = {new} (= {}{length}); {sign}; {rapid} (the backup has 1852 = {})",
+        crate::emit::minimal(new as f64 * unit, 7),
+        p.backlash.1
     ))
 }
 
@@ -88,12 +100,25 @@ pub fn activation(file_name: &str, table: &CompensationTable, options: &EmitOpti
     let settings = parameters_for(table, options).map_or_else(
         |e| e.to_string(),
         |p| {
-            let what = if p.from_backup {
-                "as in the parameter backup"
-            } else {
-                "axcomp's numbering; detection unit assumed 0.001 mm (0.001° on a rotary axis): check 1013 and 1820"
+            let old_3627 = options
+                .axes
+                .first()
+                .and_then(|a| a.fanuc.as_ref())
+                .map(|old| old.reference_negative);
+            let what = match old_3627 {
+                Some(old) if p.bidirectional && old != p.reference_negative => format!(
+                    "as in the parameter backup, except 3627: set it to {} (the backup has {old})",
+                    p.reference_negative
+                ),
+                Some(_) => "as in the parameter backup".to_string(),
+                None => "axcomp's numbering; detection unit assumed 0.001 mm (0.001° on a rotary axis): check 1013 and 1820".to_string(),
             };
-            format!("{} ({what})", p.settings())
+            let backlash = if p.bidirectional {
+                "; the tables hold the reversal left with the backlash parameters 1851/1852 active: leave them as they were during the test"
+            } else {
+                ""
+            };
+            format!("{} ({what}){backlash}", p.settings())
         },
     );
     format!(
@@ -103,9 +128,10 @@ pub fn activation(file_name: &str, table: &CompensationTable, options: &EmitOpti
 
 #[cfg(test)]
 mod tests {
+    use proptest::prelude::Just;
+
     use super::*;
     use crate::compensate::TableValues;
-    use crate::measurement::AxisKind;
 
     /// The 0i-PB manual's linear example (B-63980EN/01 p.100): points 33 … 49
     /// around reference 40 (at 0 mm), 50 mm apart.
@@ -247,6 +273,136 @@ mod tests {
         assert!(
             notes[0].contains("0.002° between the start and the end"),
             "{notes:?}"
+        );
+    }
+
+    #[test]
+    fn a_bidirectional_table_goes_to_3626_with_3627_at_the_reference() {
+        // Without a backup: points 0 … 2 (3621 = 1, 3622 = 2), 1 µm units,
+        // the ↓ table right after, 3626 = 3. Up is −0.001 mm at the
+        // reference (the table's zero is the mean of both directions there):
+        // by hand, from it, ↑ 0, 2, 3 µm and ↓ 2, 4, 10 µm; the absolute
+        // compensation is their negative: ↑ 0, −2, −3 (increments −2, −1),
+        // ↓ −2, −4, −10 (3627 = −2; increments −2, −6).
+        let t = CompensationTable {
+            axis: "X".into(),
+            positions_mm: vec![0.0, 100.0, 200.0],
+            values: TableValues::Bidirectional {
+                up: vec![-0.001, 0.001, 0.002],
+                down: vec![0.001, 0.003, 0.009],
+            },
+            reference_mm: 0.0,
+            suggested_backlash_mm: None,
+        };
+        let options = EmitOptions::for_axis(&Default::default(), "X", "").unwrap();
+        let text = write(&t, &options).unwrap();
+        assert_eq!(
+            text,
+            "%\nN10000Q0P0\nN10001Q0P-2 \nN10002Q0P-1 \nN10003Q0P-2 \nN10004Q0P-6 \n%"
+        );
+        let p = parameters_for(&t, &options).unwrap();
+        assert!(
+            p.settings().ends_with("3605#0 = 1, 3626 = 3, 3627 = -2"),
+            "{}",
+            p.settings()
+        );
+        check_read_back(&text, &t, &options).unwrap();
+        let back = read(&text, &p).unwrap();
+        let at = |x: f64, d| back.value_at(x, d) * 1000.0;
+        assert!((at(200.0, crate::measurement::Direction::Up) - 3.0).abs() < 1e-9);
+        assert!((at(0.0, crate::measurement::Direction::Down) - 2.0).abs() < 1e-9);
+        assert!((at(200.0, crate::measurement::Direction::Down) - 10.0).abs() < 1e-9);
+        // A backup without 3605#0 refuses it, saying what to set.
+        let mut options = options;
+        options.axes[0].fanuc = Some(AxisParameters::default_for("X", 3, 100.0, 0, 0.0));
+        let error = write(&t, &options).unwrap_err().to_string();
+        assert!(error.contains("set 3605#0 = 1 and 3626"), "{error}");
+    }
+
+    /// What `fuzz/fuzz_targets/read_fanuc.rs` asks of any input, on
+    /// backups and pitch files built from arbitrary numbers (cargo-fuzz
+    /// mutates bytes; this reaches the arithmetic on parsed values): no
+    /// panic; a pitch file that reads takes its own table back with
+    /// `update`, and `rescaled` of it does not panic.
+    fn fuzz_body(backup: &str, pitch: &str) {
+        if let Ok(backup) = ParameterBackup::parse(backup, "fuzz") {
+            for (_, name) in backup.axis_names() {
+                if let Ok(p) = backup.axis(&name) {
+                    round_trip(pitch, &p);
+                }
+            }
+        }
+    }
+
+    fn round_trip(pitch: &str, p: &AxisParameters) {
+        let Ok(table) = read(pitch, p) else { return };
+        let mut options = EmitOptions::for_axis(&Default::default(), "X", "").unwrap();
+        options.axes[0].fanuc = Some(p.clone());
+        if let Ok(updated) = update(pitch, &table, &options) {
+            let back = read(&updated, p).expect("an updated file reads back");
+            assert_eq!(back.positions_mm, table.positions_mm);
+        }
+        let _ = rescaled(Some(pitch), &table, &options, None);
+    }
+
+    fn parameter_line(number: u32, value: &str) -> String {
+        format!("N{number:05}Q1A1P{value}\n")
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+        #[test]
+        fn the_fuzz_body_holds_on_arbitrary_numbers(
+            points in proptest::collection::vec(-3i64..1600, 6),
+            magnification in proptest::prop_oneof![Just(10i64), -2i64..200, proptest::num::i64::ANY],
+            interval in proptest::prop_oneof![Just("40.0".to_string()), "-?[0-9]{1,3}(\\.[0-9]{1,3})?", "[0-9]{20,40}"],
+            cmr in 0i64..130,
+            bits in "[01]{8}",
+            extreme in proptest::prop_oneof![Just(i64::MIN), Just(i64::MAX), -5i64..5],
+            values in proptest::collection::vec(proptest::prop_oneof![-200i64..200, Just(99_999_999i64), Just(i64::MIN)], 0..140),
+        ) {
+            let mut backup = String::from("%\n");
+            backup.push_str(&parameter_line(1020, "88"));
+            backup.push_str(&parameter_line(1820, &cmr.to_string()));
+            backup.push_str(&parameter_line(1013, "00000000"));
+            backup.push_str("N01001Q1L1P00000000\n");
+            backup.push_str(&parameter_line(1006, &bits));
+            backup.push_str(&parameter_line(3605, &bits));
+            for (k, number) in [3620u32, 3621, 3622, 3626, 3627].iter().enumerate() {
+                let value = if k == 4 { extreme } else { points[k] };
+                backup.push_str(&parameter_line(*number, &value.to_string()));
+            }
+            backup.push_str(&parameter_line(3623, &magnification.to_string()));
+            backup.push_str(&parameter_line(3624, &interval));
+            backup.push_str(&parameter_line(3625, &points[5].to_string()));
+            backup.push_str(&parameter_line(1240, "0.0"));
+            backup.push_str(&parameter_line(1851, &extreme.to_string()));
+            backup.push_str(&parameter_line(1852, "0"));
+            backup.push('%');
+            let mut pitch = String::from("%\n");
+            for (n, v) in values.iter().enumerate() {
+                pitch.push_str(&data_line(n as i64, *v));
+                pitch.push('\n');
+            }
+            pitch.push('%');
+            fuzz_body(&backup, &pitch);
+            // And the bounds the reader has for any number in a parameter.
+            let extreme_backup = backup.replace(&parameter_line(3621, &points[1].to_string()), &parameter_line(3621, &extreme.to_string()));
+            fuzz_body(&extreme_backup, &pitch);
+        }
+    }
+
+    #[test]
+    fn the_smallest_integer_is_refused_not_negated() {
+        // Found running the fuzz target's body: |i64::MIN| overflowed.
+        let error = parse_pitch("%\nN10000Q0P-9223372036854775808\n%").unwrap_err();
+        assert_eq!((error.position.line, error.position.column), (2, 10));
+        let backup = "%\nN01020Q1A1P88\nN03621Q1A1P-9223372036854775808\n%";
+        let backup = ParameterBackup::parse(backup, "P").unwrap();
+        let error = backup.integer(3621, Some(('A', 1))).unwrap_err();
+        assert!(
+            error.contains("P:3:12: parameter 3621: expected an integer of at most 8 digits"),
+            "{error}"
         );
     }
 

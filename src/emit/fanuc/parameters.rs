@@ -3,8 +3,9 @@
 
 use std::collections::BTreeMap;
 
-use super::MAX_POINT;
+use super::{MAX_POINT, READ_LIMIT};
 use crate::error::ParseError;
+use crate::measurement::Direction;
 use crate::read::text::{self, Line};
 
 /// The parameter backup of a Fanuc control (`CNC-PARA.TXT`): every
@@ -47,6 +48,12 @@ pub struct AxisParameters {
     pub travel_per_turn: f64,
     /// 3605#0: bidirectional pitch error compensation.
     pub bidirectional: bool,
+    /// 3626: with 3605#0, the most negative point of the table for travel
+    /// in the negative direction (its points 3626 … 3626 + 3622 − 3621).
+    pub negative_first: i64,
+    /// 3627: with 3605#0, the absolute compensation at the reference
+    /// position for travel in the negative direction, in units.
+    pub reference_negative: i64,
     /// 1240: the machine position of the reference position, mm or °.
     pub reference_position: f64,
     /// Least command increment / CMR (1013, 1820), mm or °.
@@ -78,6 +85,8 @@ impl AxisParameters {
             interval: step,
             travel_per_turn: 0.0,
             bidirectional: false,
+            negative_first: 0,
+            reference_negative: 0,
             reference_position: at,
             detection_unit: 0.001,
             rotary: false,
@@ -102,6 +111,34 @@ impl AxisParameters {
         self.most_negative - 1
     }
 
+    /// The directions the axis has a table for: ↑, and ↓ with 3605#0.
+    pub fn directions(&self) -> &'static [Direction] {
+        if self.bidirectional {
+            &Direction::BOTH
+        } else {
+            &[Direction::Up]
+        }
+    }
+
+    /// The data point holding the section that ends at `point` for travel
+    /// in `direction`: \[reconstructed\] the ↓ table (3626 …) in the order
+    /// of the ↑ one (3621 …), point 3626 + k for the section of 3621 + k.
+    pub fn data_point(&self, direction: Direction, point: i64) -> i64 {
+        match direction {
+            Direction::Up => point,
+            Direction::Down => point - self.most_negative + self.negative_first,
+        }
+    }
+
+    /// The absolute compensation at the reference position, in units:
+    /// zero for travel in the positive direction, 3627 in the negative one.
+    pub fn at_reference(&self, direction: Direction) -> i64 {
+        match direction {
+            Direction::Up => 0,
+            Direction::Down => self.reference_negative,
+        }
+    }
+
     /// The point at `position`, when it is one.
     pub(super) fn point_at(&self, position: f64) -> Option<i64> {
         let exact = (position - self.reference_position) / self.interval;
@@ -123,6 +160,12 @@ impl AxisParameters {
             text.push_str(&format!(
                 ", 3625 = {}",
                 crate::emit::minimal(self.travel_per_turn, 4)
+            ));
+        }
+        if self.bidirectional {
+            text.push_str(&format!(
+                ", 3605#0 = 1, 3626 = {}, 3627 = {}",
+                self.negative_first, self.reference_negative
             ));
         }
         text
@@ -171,14 +214,21 @@ impl ParameterBackup {
             })
     }
 
-    fn integer(&self, number: u32, index: Option<(char, usize)>) -> Result<i64, String> {
+    /// An integer parameter: \[reconstructed\] at most 8 digits, as every
+    /// one of the real backup (beyond, the point arithmetic would overflow).
+    pub(super) fn integer(&self, number: u32, index: Option<(char, usize)>) -> Result<i64, String> {
         let entry = self.value(number, index)?;
-        entry.value.parse().map_err(|_| {
-            format!(
-                "{}:{}:{}: parameter {number:04}: expected an integer, found {:?}",
-                self.source, entry.line, entry.column, entry.value
-            )
-        })
+        entry
+            .value
+            .parse()
+            .ok()
+            .filter(|v: &i64| v.unsigned_abs() <= READ_LIMIT as u64)
+            .ok_or_else(|| {
+                format!(
+                    "{}:{}:{}: parameter {number:04}: expected an integer of at most 8 digits, found {:?}",
+                    self.source, entry.line, entry.column, entry.value
+                )
+            })
     }
 
     fn real(&self, number: u32, index: Option<(char, usize)>) -> Result<f64, String> {
@@ -284,6 +334,9 @@ impl ParameterBackup {
             interval: self.real(3624, a)?,
             travel_per_turn: self.real(3625, a).unwrap_or(0.0),
             bidirectional: self.bit(3605, a, 0)?,
+            // [manual] A-77810E table (a); absent on a control without the function.
+            negative_first: self.integer(3626, a).unwrap_or(0),
+            reference_negative: self.integer(3627, a).unwrap_or(0),
             reference_position: self.real(1240, a)?,
             detection_unit: least_command_increment / cmr,
             rotary: self.bit(1006, a, 0)?,
@@ -324,6 +377,20 @@ fn check_parameters(p: &AxisParameters) -> Result<(), String> {
         return Err(format!(
             "3621 … 3622 of axis {axis} are {} … {}: the points are 0 … {MAX_POINT} (data numbers N10000 … N99999)",
             p.most_negative, p.most_positive
+        ));
+    }
+    let last_negative = p.data_point(Direction::Down, p.most_positive);
+    if p.bidirectional
+        && (p.negative_first < 0
+            || last_negative > MAX_POINT
+            || (p.negative_first <= p.most_positive && last_negative >= p.first_point()))
+    {
+        return Err(format!(
+            "3626 of axis {axis} is {}: its table for travel in the negative direction, points {} … {last_negative}, must lie in 0 … {MAX_POINT} apart from the positive one ({} … {})",
+            p.negative_first,
+            p.negative_first,
+            p.first_point(),
+            p.most_positive
         ));
     }
     Ok(())

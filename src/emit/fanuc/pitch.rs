@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use super::{AxisParameters, DATA_NUMBER_OFFSET, READ_LIMIT};
 use crate::compensate::{CompensationTable, TableValues};
 use crate::error::ParseError;
+use crate::measurement::Direction;
 use crate::read::text::{self, Line};
 
 /// Whether the text is a pitch file: a `%` line, then `N1nnnnQ0P…`.
@@ -54,7 +55,7 @@ pub(super) fn parse_pitch(
         let value: i64 = value_text
             .parse()
             .ok()
-            .filter(|v: &i64| v.abs() <= READ_LIMIT)
+            .filter(|v: &i64| v.unsigned_abs() <= READ_LIMIT as u64)
             .ok_or_else(|| line.expected_at(value_text, "an integer value of at most 8 digits"))?;
         if number < DATA_NUMBER_OFFSET {
             return Err(line.error_at(
@@ -77,39 +78,54 @@ pub(super) fn parse_pitch(
     }
 }
 
-/// The increments of points `from ..= to`, or an error at `end` naming the missing one.
+/// The increments of the sections ending at points 3621 … 3622 for travel
+/// in `direction` (keyed by those points; the ↓ ones read at 3626 …), or an
+/// error at `end` naming the missing data number.
 pub(super) fn increments(
     data: &BTreeMap<i64, DataLine<'_>>,
     end: &Line<'_>,
     p: &AxisParameters,
+    direction: Direction,
 ) -> Result<BTreeMap<i64, i64>, ParseError> {
     (p.most_negative..=p.most_positive)
-        .map(|point| match data.get(&point) {
-            Some(d) => Ok((point, d.value)),
-            None => Err(end.error_at(
-                end.text,
-                format!(
-                    "the pitch file has no data number N{} (point {point} of axis {}: {}): the parameter backup does not belong to this pitch file",
-                    point + DATA_NUMBER_OFFSET,
-                    p.axis,
-                    p.source
-                ),
-            )),
+        .map(|point| {
+            let at = p.data_point(direction, point);
+            match data.get(&at) {
+                Some(d) => Ok((point, d.value)),
+                None => Err(end.error_at(
+                    end.text,
+                    format!(
+                        "the pitch file has no data number N{} (point {at} of axis {}{}: {}): the parameter backup does not belong to this pitch file",
+                        at + DATA_NUMBER_OFFSET,
+                        p.axis,
+                        match direction {
+                            Direction::Up => "",
+                            Direction::Down => " for travel in the negative direction, 3626",
+                        },
+                        p.source
+                    ),
+                )),
+            }
         })
         .collect()
 }
 
-/// The absolute compensation, in units, at every point `first ..= last`
-/// from the increments: zero at the reference point.
-fn absolute_units(p: &AxisParameters, increments: &BTreeMap<i64, i64>) -> Vec<(i64, i64)> {
+/// The absolute compensation, in units, at every point 3621 − 1 … 3622
+/// from the increments: `at_reference` at the reference point (0, or 3627
+/// for travel in the negative direction).
+pub(super) fn absolute_units(
+    p: &AxisParameters,
+    increments: &BTreeMap<i64, i64>,
+    at_reference: i64,
+) -> Vec<(i64, i64)> {
     let mut absolute = BTreeMap::new();
-    absolute.insert(p.reference_point, 0i64);
-    let mut sum = 0;
+    absolute.insert(p.reference_point, at_reference);
+    let mut sum = at_reference;
     for point in p.reference_point + 1..=p.most_positive {
         sum += increments[&point];
         absolute.insert(point, sum);
     }
-    let mut sum = 0;
+    let mut sum = at_reference;
     for point in (p.first_point()..p.reference_point).rev() {
         sum -= increments[&(point + 1)];
         absolute.insert(point, sum);
@@ -119,29 +135,31 @@ fn absolute_units(p: &AxisParameters, increments: &BTreeMap<i64, i64>) -> Vec<(i
 
 /// Reads the pitch error compensation of the axis of `p` from a pitch file:
 /// the error it compensates (−absolute compensation) at every point
-/// 3621 − 1 … 3622, zero at the reference point.
+/// 3621 − 1 … 3622, zero at the reference point; with 3605#0 one column
+/// per direction, the ↓ one 3627 from zero there.
 pub fn read(input: &str, p: &AxisParameters) -> Result<CompensationTable, ParseError> {
     let (data, end) = parse_pitch(input)?;
-    if p.bidirectional {
-        return Err(ParseError::new(
-            1,
-            1,
-            format!(
-                "3605#0 of axis {} is 1 (bidirectional pitch error compensation): axcomp reads the one-direction table only",
-                p.axis
-            ),
-        ));
-    }
-    let increments = increments(&data, &end, p)?;
     let unit = p.unit();
-    let (positions_mm, values): (Vec<f64>, Vec<f64>) = absolute_units(p, &increments)
-        .into_iter()
-        .map(|(point, units)| (p.position(point), -(units as f64) * unit + 0.0))
-        .unzip();
+    let mut columns = Vec::with_capacity(2);
+    let mut positions_mm = Vec::new();
+    for direction in p.directions() {
+        let increments = increments(&data, &end, p, *direction)?;
+        let (positions, values): (Vec<f64>, Vec<f64>) =
+            absolute_units(p, &increments, p.at_reference(*direction))
+                .into_iter()
+                .map(|(point, units)| (p.position(point), -(units as f64) * unit + 0.0))
+                .unzip();
+        positions_mm = positions;
+        columns.push(values);
+    }
+    let values = match <[Vec<f64>; 2]>::try_from(columns) {
+        Ok([up, down]) => TableValues::Bidirectional { up, down },
+        Err(mut one) => TableValues::Mean(one.remove(0)),
+    };
     Ok(CompensationTable {
         axis: p.axis.clone(),
         positions_mm,
-        values: TableValues::Mean(values),
+        values,
         reference_mm: p.position(p.reference_point),
         suggested_backlash_mm: None,
     })

@@ -6,7 +6,10 @@ use std::collections::BTreeMap;
 use super::{AxisParameters, POINT_LIMIT, data_line};
 use crate::compensate::{CompensationTable, TableMode};
 use crate::emit::{EmitError, EmitOptions};
-use crate::measurement::AxisKind;
+use crate::measurement::{AxisKind, Direction};
+
+/// The fewest of the control's points a test must cover to make a table.
+const MIN_POINTS: usize = 3;
 
 /// The control's points inside the measured range `first_mm ..= last_mm`:
 /// the first one's position and their count; refused when the reference
@@ -20,6 +23,21 @@ pub fn points_in(p: &AxisParameters, first_mm: f64, last_mm: f64) -> Result<(f64
         })
         .collect();
     let reference = p.position(p.reference_point);
+    let all = p.most_positive - p.first_point() + 1;
+    let (low, high) = (p.position(p.first_point()), p.position(p.most_positive));
+    // A table of one or two points is no compensation (one section, and a
+    // test that far off the axis' points is most likely in other
+    // coordinates than the control's machine coordinates).
+    if inside.len() < MIN_POINTS {
+        return Err(format!(
+            "the measured range {first_mm} … {last_mm} holds {} of the {all} compensation points of axis {} ({low} … {high}, {}): too few for a table; check that the test's positions are the control's machine coordinates (1240 = {} at the reference point 3620 = {}) and measure over the axis' points",
+            inside.len(),
+            p.axis,
+            p.source,
+            p.reference_position,
+            p.reference_point
+        ));
+    }
     match (inside.first(), inside.last()) {
         (Some(a), Some(b)) if (*a..=*b).contains(&p.reference_point) => {
             Ok((p.position(*a), inside.len()))
@@ -37,9 +55,7 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     let Ok(p) = parameters_for(table, options) else {
         return Vec::new();
     };
-    let values = table
-        .values
-        .for_direction(crate::measurement::Direction::Up);
+    let values = table.values.for_direction(Direction::Up);
     let (low, high) = values
         .iter()
         .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
@@ -51,6 +67,16 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     // The finest magnification whose points still hold every section's change.
     let finest = ((largest_step / p.detection_unit / POINT_LIMIT as f64).ceil() as i64).max(1);
     let mut notes = Vec::new();
+    let all = (p.most_positive - p.first_point() + 1) as usize;
+    if p.from_backup && table.positions_mm.len() * 2 < all {
+        notes.push(format!(
+            "Fanuc: the test covers {} of the {all} compensation points of axis {} ({} … {}); the others keep their old values, which this test does not check",
+            table.positions_mm.len(),
+            p.axis,
+            p.position(p.first_point()),
+            p.position(p.most_positive)
+        ));
+    }
     if let Some(k) = closing_point(table, &p) {
         let closure = values[k] - values[0];
         if closure.abs() > p.unit() / 2.0 {
@@ -62,7 +88,7 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     }
     if p.unit() > range / 10.0 && finest < p.magnification {
         notes.push(format!(
-            "Fanuc: 3623 = {} gives steps of {} mm, coarse for an error of {} mm peak to valley; 3623 = {finest} would give {} mm steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data)",
+            "Fanuc: 3623 = {} gives steps of {} mm, coarse for an error of {} mm peak to valley; 3623 = {finest} would give {} mm steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data: convert --fanuc-rescaled FILE writes it)",
             p.magnification,
             crate::emit::minimal(p.unit(), 7),
             crate::emit::minimal(range, 4),
@@ -80,9 +106,30 @@ pub fn parameters_for(
     options: &EmitOptions,
 ) -> Result<AxisParameters, EmitError> {
     let axis = options.axes.first().map_or("X", |a| a.axis.as_str());
-    if let Some(p) = options.axes.first().and_then(|a| a.fanuc.clone()) {
-        return Ok(p);
+    let mut p = match options.axes.first().and_then(|a| a.fanuc.clone()) {
+        Some(p) => p,
+        None => default_parameters(table, options, axis)?,
+    };
+    if p.bidirectional && table.values.mode() == TableMode::Bidirectional {
+        // 3627: the ↓ table's absolute compensation at the reference position.
+        let at = table
+            .positions_mm
+            .iter()
+            .position(|x| (x - p.position(p.reference_point)).abs() < 1e-6);
+        if let Some(k) = at {
+            p.reference_negative = absolute_units_of(table, &p, Direction::Down)[k];
+        }
     }
+    Ok(p)
+}
+
+/// axcomp's numbering for a table without a parameter backup: its own
+/// grid, points 0 … count − 1, with 3605#0 the ↓ table right after.
+fn default_parameters(
+    table: &CompensationTable,
+    options: &EmitOptions,
+    axis: &str,
+) -> Result<AxisParameters, EmitError> {
     let step = table.regular_step_mm().ok_or(EmitError::UnevenSpacing {
         controller: "fanuc",
     })?;
@@ -107,22 +154,22 @@ pub fn parameters_for(
     if p.rotary {
         p.travel_per_turn = 360.0;
     }
+    if table.values.mode() == TableMode::Bidirectional {
+        p.bidirectional = true;
+        p.negative_first = p.most_positive + 1;
+    }
     Ok(p)
 }
 
-/// The new increments of the points the table covers, in units: the
-/// absolute compensation −value rounded at each point (the rounding
-/// carried, never accumulated), differenced. Only points whose section lies
-/// inside the table get one.
+/// The new increments of the points the table covers, in units, by data
+/// point (with 3605#0 the ↓ table's at 3626 …): the absolute compensation
+/// −value rounded at each point (the rounding carried, never accumulated),
+/// differenced. Only points whose section lies inside the table get one.
 pub(super) fn new_increments(
     table: &CompensationTable,
     p: &AxisParameters,
 ) -> Result<BTreeMap<i64, i64>, EmitError> {
-    if table.values.mode() == TableMode::Bidirectional {
-        return Err(EmitError::NoBidirectional {
-            controller: "fanuc",
-        });
-    }
+    check_mode(table, p)?;
     let mut points = Vec::with_capacity(table.positions_mm.len());
     for position in &table.positions_mm {
         let point = p
@@ -149,12 +196,6 @@ pub(super) fn new_increments(
             p.position(p.reference_point)
         )));
     }
-    let unit = p.unit();
-    let absolute: Vec<i64> = wanted(table, p)
-        .iter()
-        .map(|v| (-v / unit).round() as i64)
-        .collect();
-    let mut increments = BTreeMap::new();
     for k in 1..points.len() {
         if points[k] != points[k - 1] + 1 {
             return Err(EmitError::Profile(format!(
@@ -162,25 +203,106 @@ pub(super) fn new_increments(
                 p.axis, p.interval
             )));
         }
-        increments.insert(points[k], absolute[k].saturating_sub(absolute[k - 1]));
+    }
+    let mut increments = BTreeMap::new();
+    for direction in p.directions() {
+        let absolute = absolute_units_of(table, p, *direction);
+        for k in 1..points.len() {
+            increments.insert(
+                p.data_point(*direction, points[k]),
+                absolute[k].saturating_sub(absolute[k - 1]),
+            );
+        }
     }
     check_limits(&increments, p)?;
     Ok(increments)
 }
 
-/// The table's values as the control can hold them: \[manual\] 0i-PB
-/// p.100, on a rotary axis the points of one turn sum to zero, else the
-/// error accumulates turn after turn: the end of a full turn takes the
+/// The absolute compensation the table asks for at its points in
+/// `direction`, in units, rounded at each point.
+fn absolute_units_of(
+    table: &CompensationTable,
+    p: &AxisParameters,
+    direction: Direction,
+) -> Vec<i64> {
+    let unit = p.unit();
+    wanted(table, p, direction)
+        .iter()
+        .map(|v| (-v / unit).round() as i64)
+        .collect()
+}
+
+/// A table the axis' parameters hold: one column without 3605#0, one per
+/// direction with it.
+fn check_mode(table: &CompensationTable, p: &AxisParameters) -> Result<(), EmitError> {
+    match (table.values.mode(), p.bidirectional) {
+        (TableMode::Mean, false) | (TableMode::Bidirectional, true) => Ok(()),
+        (TableMode::Bidirectional, false) => Err(EmitError::Profile(format!(
+            "3605#0 of axis {} is 0 in the parameter backup ({}): the control compensates pitch error the same in both directions; for a table per direction (if the control has bidirectional pitch error compensation) set 3605#0 = 1 and 3626 to the first of {} free points, give the changed backup and convert again; else use --mode mean and set the backlash parameters 1851/1852",
+            p.axis,
+            p.source,
+            p.most_positive - p.most_negative + 1
+        ))),
+        (TableMode::Mean, true) => Err(EmitError::Profile(format!(
+            "3605#0 of axis {} is 1 in the parameter backup: the control holds a table per direction (3621 … 3622 and 3626 = {} …): convert with --mode bidirectional",
+            p.axis, p.negative_first
+        ))),
+    }
+}
+
+/// The table's values in `direction` as the control can hold them: from
+/// the ↑ value at the reference point (the control's zero), and \[manual\]
+/// 0i-PB p.100, on a rotary axis the points of one turn sum to zero, else
+/// the error accumulates turn after turn: the end of a full turn takes the
 /// start's value (`notes` says what is dropped).
-pub(super) fn wanted(table: &CompensationTable, p: &AxisParameters) -> Vec<f64> {
-    let mut values = table
+pub(super) fn wanted(
+    table: &CompensationTable,
+    p: &AxisParameters,
+    direction: Direction,
+) -> Vec<f64> {
+    let zero = table.value_at(p.position(p.reference_point), Direction::Up);
+    let mut values: Vec<f64> = table
         .values
-        .for_direction(crate::measurement::Direction::Up)
-        .to_vec();
+        .for_direction(direction)
+        .iter()
+        .map(|v| v - zero)
+        .collect();
     if let Some(k) = closing_point(table, p) {
         values[k] = values[0];
     }
     values
+}
+
+/// \[manual\] 0i-PB p.100: "If the sum of the compensation value from 61 to
+/// 68 is not zero, the pitch error per rotation accumulates, resulting in a
+/// positional shift": on a rotary axis whose points 3621 … 3622 span one
+/// turn (3625, 0 for 360°), `increments` (theirs, in order) must sum to 0.
+pub(super) fn check_turn(
+    p: &AxisParameters,
+    increments: impl Iterator<Item = i64>,
+) -> Result<(), EmitError> {
+    let turn = if p.travel_per_turn > 0.0 {
+        p.travel_per_turn
+    } else {
+        360.0
+    };
+    let span = (p.most_positive - p.most_negative + 1) as f64 * p.interval;
+    if !p.rotary || (span - turn).abs() > 1e-6 {
+        return Ok(());
+    }
+    let sum: i64 = increments.sum();
+    if sum == 0 {
+        return Ok(());
+    }
+    Err(EmitError::Profile(format!(
+        "the points {} … {} of rotary axis {} span one turn ({}°) and must sum to zero, or the error accumulates turn after turn (0i-PB parameter manual); with the new values they sum to {sum} units ({}°): measure the whole turn (0 … {}°) so that every point is new",
+        p.most_negative,
+        p.most_positive,
+        p.axis,
+        crate::emit::minimal(turn, 4),
+        crate::emit::minimal(sum as f64 * p.unit(), 7),
+        crate::emit::minimal(turn, 4)
+    )))
 }
 
 /// On a rotary axis, the index of the table point one turn after its first
@@ -223,18 +345,29 @@ fn check_limits(increments: &BTreeMap<i64, i64>, p: &AxisParameters) -> Result<(
 
 /// A new pitch file with the points of the table's axis: `%`, the data
 /// lines of points 3621 − 1 … 3622 (the sections outside the table hold
-/// the compensation: 0), `%`, LF, as the real backup.
+/// the compensation: 0), with 3605#0 those of 3626 …, `%`, LF, as the
+/// real backup.
 pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String, EmitError> {
     let p = parameters_for(table, options)?;
     let increments = new_increments(table, &p)?;
     let mut out = String::from("%\n");
-    for point in p.first_point()..=p.most_positive {
-        let value = increments.get(&point).copied().unwrap_or(0);
-        out.push_str(&data_line(
-            point,
-            rotary_reference_value(&p, point, value, &increments),
-        ));
-        out.push('\n');
+    for direction in p.directions() {
+        let first = match direction {
+            Direction::Up => p.first_point(),
+            Direction::Down => p.most_negative,
+        };
+        let mut turn = Vec::new();
+        for point in first..=p.most_positive {
+            let at = p.data_point(*direction, point);
+            let value = increments.get(&at).copied().unwrap_or(0);
+            let value = rotary_reference_value(&p, *direction, point, value, &increments);
+            out.push_str(&data_line(at, value));
+            out.push('\n');
+            if point >= p.most_negative {
+                turn.push(value);
+            }
+        }
+        check_turn(&p, turn.into_iter())?;
     }
     out.push('%');
     Ok(out)
@@ -245,12 +378,14 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
 /// most positive one.
 fn rotary_reference_value(
     p: &AxisParameters,
+    direction: Direction,
     point: i64,
     value: i64,
     increments: &BTreeMap<i64, i64>,
 ) -> i64 {
     if p.rotary && point == p.reference_point && p.most_negative == p.reference_point {
-        return increments.get(&p.most_positive).copied().unwrap_or(value);
+        let last = p.data_point(direction, p.most_positive);
+        return increments.get(&last).copied().unwrap_or(value);
     }
     value
 }
