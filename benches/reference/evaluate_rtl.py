@@ -3,9 +3,9 @@
 (../shared/spec/renishaw-rtl.md: targets in mm, deviations in µm) and prints
 the ISO 230-2 figures (../shared/spec/iso230-2.md), standard library only.
 
-It is the yardstick of issue 12's speed figure (axcomp reads and evaluates a
-10 000-target x 10-run file in at most 1/20 of this script's time, whole
-process) and a second, independent implementation of the figures:
+It is the yardstick of the evaluate speed figure (axcomp reads and evaluates
+a 10 000-target x 10-run file at least 10 times faster than this script,
+whole process) and a second, independent implementation of the figures:
 
     python3 benches/reference/evaluate_rtl.py FILE.rtl
 

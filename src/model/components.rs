@@ -1,7 +1,7 @@
 //! The 21 geometric errors of a three-axis machine (ISO 230-1 names), each as
 //! a function of its own axis.
 //!
-//! Seed 000 §2.1 and §3.3.1 (`../shared/notes/seed000-volumetric-model.md`
+//! Valášek (2021) §2.1 and §3.3.1 (`../shared/notes/seed000-volumetric-model.md`
 //! §1): a linear axis has six error motions, one per rigid-body degree of
 //! freedom, and a three-axis machine adds three squareness errors, 21 in all.
 //! The name `E<direction><axis>` gives the direction of a translation (X, Y, Z)
@@ -9,9 +9,9 @@
 //! EYX is the straightness of X in Y, EBX the rotation of X about Y.
 //! Translations are mm, rotations rad (small, right-handed, as in the error
 //! matrices of eqs 48–50). The 18 motion errors depend only on their own
-//! axis's position (the thesis neglects the influence of the other axes,
+//! axis's position (Valášek (2021) neglects the influence of the other axes,
 //! §2.1.1); the squareness errors EXOY, EXOZ, EYOZ are constants (eqs 51–53:
-//! rotations about Z, Y and X). The thesis spells them with a letter O in the
+//! rotations about Z, Y and X). Valášek (2021) spells them with a letter O in the
 //! glossary and a zero in eqs 63/64; they are the same quantities.
 //!
 //! A position-dependent error is an [`ErrorFunction`]: a constant or an
@@ -106,7 +106,7 @@ impl SquarenessPair {
     }
 }
 
-/// The ISO 230-1 name of one of the 21 errors, as the thesis writes it.
+/// The ISO 230-1 name of one of the 21 errors, as Valášek (2021) writes it.
 #[allow(clippy::upper_case_acronyms)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ErrorName {
@@ -176,7 +176,7 @@ pub enum ErrorComponent {
 }
 
 impl ErrorName {
-    /// All 21, in the order of the thesis's glossary.
+    /// All 21, in the order of Valášek's glossary.
     pub const ALL: [ErrorName; 21] = [
         ErrorName::EXX,
         ErrorName::EYX,

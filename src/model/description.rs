@@ -14,7 +14,7 @@ use super::guideway::Guideway;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum BranchDeviations {
-    /// E = Δtool + Δworkpiece, as the thesis writes eq. 67 ("superposition").
+    /// E = Δtool + Δworkpiece, as Valášek (2021) writes eq. 67 ("superposition").
     Sum,
     /// E = Δtool − Δworkpiece: the tool relative to the workpiece.
     Difference,

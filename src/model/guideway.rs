@@ -1,7 +1,7 @@
 //! One linear axis on two rails and four carriages: from the straightness of
 //! the rail mounting surfaces to the error motions of the saddle.
 //!
-//! Seed 000 §3.1–3.2 (`../shared/notes/seed000-volumetric-model.md` §3): a
+//! Valášek (2021) §3.1–3.2 (`../shared/notes/seed000-volumetric-model.md` §3): a
 //! rigid saddle rests on four carriages, linear springs of stiffness k_i
 //! (N/mm) in the direction normal to the rail mounting face ("vertical", z)
 //! and across it ("horizontal", y). The rails copy their mounting surfaces,
@@ -24,19 +24,19 @@
 //!   prints Δ_y4 where eq. 28 (and sense) has Δ_y3. Outputs y5 = mean y_i
 //!   (37), yaw = (y1 − y2)/b (38).
 //!
-//! The loads act at the saddle centre: F_zz downwards (the thesis's sign,
+//! The loads act at the saddle centre: F_zz downwards (Valášek's sign,
 //! −F_zz in eq. 9) and F_zy sideways (+F_zy in eq. 29). Both problems are
 //! linear, so [`Guideway::linear_map`] solves them once for unit inputs and
 //! the Monte Carlo study applies the resulting weights to every sample. With
 //! equal stiffness and no load, z5 and y5 are the means of the four rail
 //! deviations (the notes' closed forms, §3.5), which the tests check.
 //!
-//! Tilting stiffness of the carriages is neglected, as in the thesis.
+//! Tilting stiffness of the carriages is neglected, as in Valášek (2021).
 //!
 //! # The carriage side: the saddle's mounting faces
 //!
-//! Seed 000's assignment asks for errors "on the rail side and on the
-//! carriage side"; the thesis models only the rails (notes §3.6). Seed 002
+//! Valášek's (2021) assignment asks for errors "on the rail side and on the
+//! carriage side"; Valášek (2021) models only the rails (notes §3.6). The carriage-side thesis (references.md)
 //! (the paper of the same work, §4) names the carriage-side input, "the
 //! prescribed parallelism tolerance of the faces for the carriages on the
 //! saddle", and draws it in Obr. 8, which the text lacks. [`SaddleFaces`]
@@ -66,7 +66,7 @@
 //!   roll and pitch, which [`GuidewayMap`] computes.
 //!
 //! A lateral counterpart (the carriages' locating edges on the saddle) would
-//! enter the lateral system the same way; seed 002 names only the mounting
+//! enter the lateral system the same way; the carriage-side thesis (references.md) names only the mounting
 //! faces, and it is not modelled.
 
 use nalgebra::{Matrix4, Vector4};
@@ -74,7 +74,7 @@ use nalgebra::{Matrix4, Vector4};
 use super::components::ErrorFunction;
 use super::{ModelError, check_positive};
 
-/// The geometry, stiffness and load of one axis's guideway (seed 000 Tab. 3.1, 3.4).
+/// The geometry, stiffness and load of one axis's guideway (Valášek (2021) Tab. 3.1, 3.4).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Guideway {
     /// a: distance between the two rails, mm.
@@ -92,11 +92,11 @@ pub struct Guideway {
     pub load_lateral_n: f64,
 }
 
-/// The stiffness of every carriage in seed 000 (Tab. 3.3, 3.4), N/mm.
+/// The stiffness of every carriage in Valášek (2021) (Tab. 3.3, 3.4), N/mm.
 pub const THESIS_STIFFNESS_N_PER_MM: f64 = 100_000.0;
 
 impl Guideway {
-    /// Four equal carriages of the thesis's stiffness, no load.
+    /// Four equal carriages of Valášek's stiffness, no load.
     pub fn unloaded(rail_spacing_mm: f64, carriage_pitch_mm: f64) -> Guideway {
         Guideway {
             rail_spacing_mm,
@@ -112,7 +112,7 @@ impl Guideway {
     ///
     /// # Example
     ///
-    /// The thesis's Obr. 3.8 example; the check values are the notes' §3.3:
+    /// Valášek's Obr. 3.8 example; the check values are the notes' §3.3:
     ///
     /// ```
     /// use axcomp::model::{CarriageDeviations, Guideway};
@@ -264,7 +264,7 @@ impl CarriageDeviations {
 }
 
 /// The errors of the saddle's four carriage mounting faces (pads), normal to
-/// them, relative to the saddle's datum face, mm (the carriage side; seed 002
+/// them, relative to the saddle's datum face, mm (the carriage side; the carriage-side thesis (references.md)
 /// Obr. 8). Constant along the stroke: the pads travel with the saddle.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SaddleFaces {
@@ -455,14 +455,8 @@ impl GuidewayMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use approx::assert_abs_diff_eq;
     use proptest::prelude::*;
-
-    fn close(actual: f64, expected: f64, tolerance: f64) {
-        assert!(
-            (actual - expected).abs() <= tolerance,
-            "{actual} differs from {expected} by more than {tolerance}"
-        );
-    }
 
     #[test]
     fn thesis_example_obr_3_8() {
@@ -476,22 +470,22 @@ mod tests {
             .unwrap();
         let expected_z = [0.00375, 0.00325, -0.00225, -0.00175];
         for (actual, expected) in response.corner_normal_mm.iter().zip(expected_z) {
-            close(*actual, expected, 1e-15);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-15);
         }
-        close(response.normal_mm, 0.00075, 1e-15);
-        close(response.roll_rad, -0.0055 / 150.0, 1e-17);
-        close(response.pitch_rad, -2.5e-6, 1e-17);
+        assert_abs_diff_eq!(response.normal_mm, 0.00075, epsilon = 1e-15);
+        assert_abs_diff_eq!(response.roll_rad, -0.0055 / 150.0, epsilon = 1e-17);
+        assert_abs_diff_eq!(response.pitch_rad, -2.5e-6, epsilon = 1e-17);
         for (actual, expected) in response
             .force_normal_n
             .iter()
             .zip([-225.0, 225.0, -225.0, 225.0])
         {
-            close(*actual, expected, 1e-9);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-9);
         }
         // The plane condition (5): z1 − z2 = z4 − z3 = 0.0005.
         let z = response.corner_normal_mm;
-        close(z[0] - z[1], 0.0005, 1e-15);
-        close(z[3] - z[2], 0.0005, 1e-15);
+        assert_abs_diff_eq!(z[0] - z[1], 0.0005, epsilon = 1e-15);
+        assert_abs_diff_eq!(z[3] - z[2], 0.0005, epsilon = 1e-15);
     }
 
     #[test]
@@ -523,48 +517,48 @@ mod tests {
             d_z[3] + twist / 4.0 - sink,
         ];
         for (actual, expected) in response.corner_normal_mm.iter().zip(expected_z) {
-            close(*actual, expected, 1e-15);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-15);
         }
-        close(
+        assert_abs_diff_eq!(
             response.normal_mm,
             d_z.iter().sum::<f64>() / 4.0 - sink,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.roll_rad,
             ((d_z[2] + d_z[3]) - (d_z[0] + d_z[1])) / (2.0 * 400.0),
-            1e-17,
+            epsilon = 1e-17
         );
-        close(
+        assert_abs_diff_eq!(
             response.pitch_rad,
             ((d_z[1] + d_z[2]) - (d_z[0] + d_z[3])) / (2.0 * 500.0),
-            1e-17,
+            epsilon = 1e-17
         );
         let shift = -800.0 / (4.0 * k);
-        close(
+        assert_abs_diff_eq!(
             response.corner_lateral_mm[0],
             (d_y[0] + d_y[3]) / 2.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.corner_lateral_mm[3],
             (d_y[0] + d_y[3]) / 2.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.corner_lateral_mm[1],
             (d_y[1] + d_y[2]) / 2.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.lateral_mm,
             d_y.iter().sum::<f64>() / 4.0 + shift,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(
+        assert_abs_diff_eq!(
             response.yaw_rad,
             ((d_y[0] + d_y[3]) - (d_y[1] + d_y[2])) / (2.0 * 500.0),
-            1e-17,
+            epsilon = 1e-17
         );
     }
 
@@ -588,23 +582,31 @@ mod tests {
         };
         let [z5, roll, pitch] = map.normal_outputs();
         let [y5, yaw] = map.lateral_outputs();
-        close(apply(&z5, &deviations.normal_mm), response.normal_mm, 1e-15);
-        close(
+        assert_abs_diff_eq!(
+            apply(&z5, &deviations.normal_mm),
+            response.normal_mm,
+            epsilon = 1e-15
+        );
+        assert_abs_diff_eq!(
             apply(&roll, &deviations.normal_mm),
             response.roll_rad,
-            1e-17,
+            epsilon = 1e-17
         );
-        close(
+        assert_abs_diff_eq!(
             apply(&pitch, &deviations.normal_mm),
             response.pitch_rad,
-            1e-17,
+            epsilon = 1e-17
         );
-        close(
+        assert_abs_diff_eq!(
             apply(&y5, &deviations.lateral_mm),
             response.lateral_mm,
-            1e-15,
+            epsilon = 1e-15
         );
-        close(apply(&yaw, &deviations.lateral_mm), response.yaw_rad, 1e-17);
+        assert_abs_diff_eq!(
+            apply(&yaw, &deviations.lateral_mm),
+            response.yaw_rad,
+            epsilon = 1e-17
+        );
     }
 
     #[test]
@@ -630,7 +632,7 @@ mod tests {
         // x − b/2 = 0, x + b/2 = 200.
         let expected = [0.0, 0.2, 0.4, 0.0];
         for (actual, expected) in deviations.normal_mm.iter().zip(expected) {
-            close(*actual, expected, 1e-15);
+            assert_abs_diff_eq!(*actual, expected, epsilon = 1e-15);
         }
     }
 
@@ -658,11 +660,11 @@ mod tests {
         let map = Guideway::unloaded(a, 400.0).linear_map().unwrap();
         let positions = [0.0, 250.0, 700.0];
         for (x, response) in positions.iter().zip(map.along_stroke(&rails, &positions)) {
-            close(response.normal_mm, k * x + c / 2.0, 1e-15);
-            close(response.pitch_rad, k, 1e-15);
-            close(response.roll_rad, c / a, 1e-15);
-            close(response.lateral_mm, -k * x, 1e-15);
-            close(response.yaw_rad, k, 1e-15);
+            assert_abs_diff_eq!(response.normal_mm, k * x + c / 2.0, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.pitch_rad, k, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.roll_rad, c / a, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.lateral_mm, -k * x, epsilon = 1e-15);
+            assert_abs_diff_eq!(response.yaw_rad, k, epsilon = 1e-15);
         }
     }
 
@@ -690,11 +692,11 @@ mod tests {
                 lateral_mm: [0.0; 4],
             };
             let response = map.response(&on_rails.with_saddle_faces(&faces));
-            close(response.roll_rad, 0.02 / 350.0, 1e-18);
-            close(response.pitch_rad, 0.01 / 640.0, 1e-18);
-            close(response.normal_mm, rail, 1e-17);
+            assert_abs_diff_eq!(response.roll_rad, 0.02 / 350.0, epsilon = 1e-18);
+            assert_abs_diff_eq!(response.pitch_rad, 0.01 / 640.0, epsilon = 1e-18);
+            assert_abs_diff_eq!(response.normal_mm, rail, epsilon = 1e-17);
             for force in response.force_normal_n {
-                close(force, 0.0, 1e-9);
+                assert_abs_diff_eq!(force, 0.0, epsilon = 1e-9);
             }
         }
     }
@@ -717,11 +719,11 @@ mod tests {
             .iter()
             .zip(response.force_normal_n)
         {
-            close(*corner, 0.0, 1e-17);
-            close(force.abs(), 1000.0, 1e-9);
+            assert_abs_diff_eq!(*corner, 0.0, epsilon = 1e-17);
+            assert_abs_diff_eq!(force.abs(), 1000.0, epsilon = 1e-9);
         }
-        close(response.force_normal_n[0], -1000.0, 1e-9);
-        close(response.force_normal_n[1], 1000.0, 1e-9);
+        assert_abs_diff_eq!(response.force_normal_n[0], -1000.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(response.force_normal_n[1], 1000.0, epsilon = 1e-9);
         // Unequal carriages turn part of the twist into motion. Carriage 1 at
         // k/2, the others k: eq. 12 with Δ_i = F_i/k_i and the balances
         // (9)–(11) give F = (f, −f, f, −f) with f(2 + 1 + 1 + 1)/k = −4c, so
@@ -732,9 +734,21 @@ mod tests {
             .solve(&CarriageDeviations::default().with_saddle_faces(&faces))
             .unwrap();
         let c = 0.01;
-        close(response.force_normal_n[0], -4.0 * 1e5 * c / 5.0, 1e-9);
-        close(response.corner_normal_mm[0], -3.0 * c / 5.0, 1e-15);
-        close(response.corner_normal_mm[1], -c + 4.0 * c / 5.0, 1e-15);
+        assert_abs_diff_eq!(
+            response.force_normal_n[0],
+            -4.0 * 1e5 * c / 5.0,
+            epsilon = 1e-9
+        );
+        assert_abs_diff_eq!(
+            response.corner_normal_mm[0],
+            -3.0 * c / 5.0,
+            epsilon = 1e-15
+        );
+        assert_abs_diff_eq!(
+            response.corner_normal_mm[1],
+            -c + 4.0 * c / 5.0,
+            epsilon = 1e-15
+        );
         assert!(response.pitch_rad.abs() > 1e-7);
     }
 
@@ -769,7 +783,7 @@ mod tests {
     }
 
     proptest! {
-        // The solution satisfies the thesis's own equations, whatever the
+        // The solution satisfies Valášek's own equations, whatever the
         // stiffnesses and loads: force and moment balance (9)–(11), (29), (30),
         // the plane condition (5), equal lateral displacement (22), (23) and
         // Hooke's law (7), (26).

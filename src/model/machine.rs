@@ -45,7 +45,7 @@
 //! # mapping_signs = { normal = 1, lateral = 1, roll = 1, pitch = 1, yaw = 1 }
 //! ```
 //!
-//! The chain code is read as seed 000 writes ZFYX for its C-frame mill with
+//! The chain code is read as Valášek (2021) writes ZFYX for its C-frame mill with
 //! a cross table: the letters left of `F` carry the tool, listed from the
 //! tool towards the frame; the letters right of `F` carry the workpiece,
 //! listed from the frame towards the workpiece. So ZFYX is tool ← Z ← frame
@@ -55,12 +55,12 @@
 //! thesis.) How the chain is evaluated is in [`super::volumetric`].
 //!
 //! The guideway of each axis turns four rail profiles into its six errors
-//! (seed 000 Tab. 3.2): the normal straightness feeds the translation along
+//! (Valášek (2021) Tab. 3.2): the normal straightness feeds the translation along
 //! `normal`, the lateral straightness the translation along the remaining
 //! direction, roll the rotation about the axis itself, pitch the rotation
 //! about the lateral direction and yaw the rotation about the normal. The
 //! thesis gives no signs for this mapping; `mapping_signs` defaults to +1
-//! throughout, as the NumPy peer does.
+//! throughout, as the NumPy reference `mc_peer.py` does.
 
 use serde::Deserialize;
 
@@ -75,7 +75,7 @@ use super::guideway::{Guideway, GuidewayMap, THESIS_STIFFNESS_N_PER_MM};
 use super::volumetric::{ErrorMap, Grid, Kinematics, Method, VolumetricError};
 use crate::error::{ParseError, check_machine_profile_keys};
 
-/// The bundled description of seed 000's machine.
+/// The bundled description of Valášek's (2021) machine.
 const BUNDLED_TOML: &str = include_str!("../../fixtures/machines/mcv754-quick.toml");
 
 /// A validated machine description with its compiled chain.
@@ -87,7 +87,7 @@ pub struct Machine {
 }
 
 impl Machine {
-    /// Seed 000's MCV 754 Quick with the documented assumed dimensions
+    /// Valášek's (2021) MCV 754 Quick with the documented assumed dimensions
     /// (`fixtures/machines/mcv754-quick.toml`).
     pub fn bundled() -> Machine {
         // The bundled text is part of the program, not user input, and a test parses it.
@@ -185,7 +185,7 @@ impl Machine {
         self.description.reference_mm
     }
 
-    /// Sum (the thesis) or difference of the branch deviations.
+    /// Sum (Valášek (2021)) or difference of the branch deviations.
     pub fn branch_deviations(&self) -> BranchDeviations {
         self.description.branch_deviations
     }
@@ -264,7 +264,7 @@ impl Machine {
     /// point at the optic, and the other body's angles stay constant along
     /// the test. On the tool's side that point is the tool tip (the tool
     /// offset, eq. 59); on the workpiece's, the workpiece point under it
-    /// (eq. 60): seed 000 §2.5's EBX·(Z + z4 + 550) in E_x becomes
+    /// (eq. 60): Valášek (2021) §2.5's EBX·(Z + z4 + 550) in E_x becomes
     /// EBX·(Z + z4 + 550 + d_z) for an optic d_z from the tool tip on the
     /// table (`../shared/notes/seed000-volumetric-model.md` §2.3–2.5). The
     /// offset is held along the line, as the workpiece point is: the reading
@@ -550,8 +550,8 @@ mod tests {
 
     #[test]
     fn bundled_machine_is_the_thesis_machine() {
-        // Strokes and a/b from seed 000 (notes §2.1, Tab. 3.1); the assumed
-        // dimensions z3 = 200, z4 = 80, y2 = 0, yt = 280, zt = 250 mm from the issue.
+        // Strokes and a/b from Valášek (2021) (notes §2.1, Tab. 3.1); the assumed
+        // dimensions z3 = 200, z4 = 80, y2 = 0, yt = 280, zt = 250 mm as `Machine::bundled` documents them.
         let machine = Machine::bundled();
         assert_eq!(machine.chain().as_str(), "ZFYX");
         let expected = [

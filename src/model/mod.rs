@@ -1,11 +1,11 @@
 //! The geometric model of a three-axis machine: 21 errors → volumetric error
-//! (seed 000), rail mounting surfaces and the saddle's carriage mounting
+//! (Valášek 2021), rail mounting surfaces and the saddle's carriage mounting
 //! faces → axis errors (guideway model), and the Monte Carlo tolerance study
 //! built on both.
 //!
 //! The source is Valášek (2021), extracted with every equation, typo and
 //! check value in `../shared/notes/seed000-volumetric-model.md`; equation
-//! numbers in this module's comments are the thesis's.
+//! numbers in this module's comments are Valášek's.
 //!
 //! - [`components`]: the 21 errors with their ISO 230-1 names
 //!   ([`ErrorName`]), each a function of its own axis ([`ErrorFunction`]:
@@ -18,7 +18,7 @@
 //!   to first order ([`Method`]), at a point or over a [`Grid`].
 //! - [`guideway`]: one axis on two rails and four carriages ([`Guideway`]),
 //!   and the carriage side: the saddle's carriage mounting faces
-//!   ([`SaddleFaces`], seed 002 Obr. 8).
+//!   ([`SaddleFaces`], the carriage-side thesis (references.md) Obr. 8).
 //! - [`profile`]: the random profile generator ([`ProfileShape`]).
 //! - [`monte_carlo`]: the tolerance study (rail and carriage-side
 //!   tolerances), its sensitivity sweep and ranking, and the single-axis
@@ -62,7 +62,7 @@
 //! The volumetric error is zero at the machine's reference position (eq. 68;
 //! the origin unless the description says otherwise); the rotational
 //! components (eq. 69) are not zeroed. Set [`BranchDeviations::Difference`]
-//! for the tool-relative-to-workpiece convention instead of the thesis's sum.
+//! for the tool-relative-to-workpiece convention instead of Valášek's sum.
 
 pub mod components;
 pub mod description;

@@ -1,6 +1,6 @@
-//! Random straightness and positioning profiles (seed 000 §3.2.2, eq. 39).
+//! Random straightness and positioning profiles (Valášek (2021) §3.2.2, eq. 39).
 //!
-//! The thesis observed that measured mounting surfaces are not random point
+//! Valášek (2021) observed that measured mounting surfaces are not random point
 //! clouds but "evolve", and generates them as follows
 //! (`../shared/notes/seed000-volumetric-model.md` §3.7):
 //!
@@ -10,13 +10,13 @@
 //! 3. dy(j+1) = dy(j) + m · U(−tol, tol) (eq. 39), clipped to the band;
 //! 4. a cubic spline through the knots.
 //!
-//! What the text leaves open is settled as the NumPy peer
+//! What the text leaves open is settled as the NumPy reference `mc_peer.py`
 //! (`../shared/tools/mc_peer.py`) settles it: ⌈length / period⌉ + 1 evenly
 //! spaced knots from end to end, a band ±tol/2 centred on zero (its width is
 //! configurable; its position does not matter for peak-to-peak straightness
 //! or for an error map zeroed at a reference point), and the not-a-knot
 //! spline (MATLAB's `spline`). The spline may overshoot the band slightly,
-//! as the thesis notes.
+//! as Valášek (2021) notes.
 //!
 //! Randomness comes from the caller's [`ChaCha8Rng`]; uniform numbers are
 //! built here from the generator's raw 64-bit output (53 random bits), so the
@@ -43,7 +43,7 @@ pub struct ProfileShape {
 }
 
 impl ProfileShape {
-    /// Seed 000's choice for all its studies: period 100 mm, m = 0.5, band ±tol/2.
+    /// Valášek's (2021) choice for all its studies: period 100 mm, m = 0.5, band ±tol/2.
     pub const THESIS: ProfileShape = ProfileShape {
         period_mm: 100.0,
         step_factor: 0.5,

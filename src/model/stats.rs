@@ -3,7 +3,7 @@
 //!
 //! Percentiles interpolate linearly between order statistics (Hyndman and
 //! Fan's type 7, the default of NumPy's `percentile` and of spreadsheets),
-//! so the figures compare one to one with the NumPy peer. Sums run in index
+//! so the figures compare one to one with the NumPy reference `mc_peer.py`. Sums run in index
 //! order, so a result does not depend on how the samples were computed.
 
 /// Mean, median, extremes and the 10th and 90th percentiles of a sample.
@@ -21,7 +21,7 @@ pub struct Summary {
     pub max: f64,
     /// 10th percentile.
     pub p10: f64,
-    /// 90th percentile (the thesis's "P90": 9 of 10 machines are at least this good).
+    /// 90th percentile (Valášek's "P90": 9 of 10 machines are at least this good).
     pub p90: f64,
 }
 

@@ -433,7 +433,7 @@ proptest! {
     }
 }
 
-/// Seed 000's simplified model, eqs 72–79, typed in from the notes (§2.6):
+/// Valášek's (2021) simplified model, eqs 72–79, typed in from the notes (§2.6):
 /// no kinematic dimensions, each axis's error matrix applied at its own
 /// frame's origin (so angles do not enter), squareness matrices in front of
 /// Y (EXOY) and Z (EXOZ, EYOZ). `delta(axis, q)` gives the axis's three
@@ -472,7 +472,7 @@ fn simplified_model(
 
 #[test]
 fn the_simplified_model_agrees_with_the_full_chain_along_lines_through_the_origin() {
-    // Seed 000 §3.3.5 (notes §5): with errors identified from volumetric
+    // Valášek (2021) §3.3.5 (notes §5): with errors identified from volumetric
     // measurements without the machine's dimensions (Trac-cal), the
     // simplified model (eqs 72–79) matched the measured error along lines
     // through the origin [0, 0, 0] and deviated away from it. Here the

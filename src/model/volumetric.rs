@@ -1,15 +1,15 @@
 //! The volumetric error of a three-axis machine from its 21 geometric errors:
 //! the kinematic chain, evaluated with full homogeneous transforms or to first order.
 //!
-//! Seed 000 §2.4 and §3.3 (`../shared/notes/seed000-volumetric-model.md` §2).
+//! Valášek (2021) §2.4 and §3.3 (`../shared/notes/seed000-volumetric-model.md` §2).
 //! Each branch of the machine (frame → tool, frame → workpiece) is a product
 //! of 4 × 4 matrices: fixed offsets between joints (eqs 54–56), the axis
 //! motions, the error matrices T_E of each axis (eqs 48–50, linearised
-//! rotations I + \[ε\]× as in the thesis) and the squareness matrices (eqs
+//! rotations I + \[ε\]× as in Valášek (2021)) and the squareness matrices (eqs
 //! 51–53). The deviation of a branch is where its functional point goes with
 //! the errors minus where it goes without (eqs 61–66); the volumetric error
 //! combines the two branches (eq. 67) and subtracts its value at the
-//! reference position (eq. 68, the machine origin in the thesis); the
+//! reference position (eq. 68, the machine origin in Valášek (2021)); the
 //! rotational error is the sum of the angles (eq. 69), not zeroed.
 //!
 //! # The chain, generalised from eqs 63 and 64
@@ -47,7 +47,7 @@
 //! kept); [`Method::FirstOrder`] sums δ + ε × r over the error frames, where
 //! r is the ideal lever arm from the frame to the functional point (an affine
 //! function of the position, precomputed). For µm-level errors the two agree
-//! to about 1e-9 mm (tested). The first-order form for the thesis's ZFYX
+//! to about 1e-9 mm (tested). The first-order form for Valášek's ZFYX
 //! chain is the notes' §2.5 expansion, which the tests check term by term.
 
 use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
@@ -146,7 +146,7 @@ pub struct ErrorMap {
 }
 
 impl ErrorMap {
-    /// The largest ‖E‖ (eq. 71) and where it occurs: the thesis's measure of a machine.
+    /// The largest ‖E‖ (eq. 71) and where it occurs: Valášek's measure of a machine.
     pub fn max_translation(&self) -> (f64, [f64; 3]) {
         let mut best = (0.0, self.grid.position_mm(0));
         for (index, error) in self.errors.iter().enumerate() {
@@ -326,7 +326,7 @@ pub(crate) struct Kinematics {
     workpiece: Vec<Element>,
     /// The workpiece functional point in the last workpiece frame.
     workpiece_point: Affine,
-    /// +1 (sum, the thesis) or −1 (difference) for the workpiece branch.
+    /// +1 (sum, Valášek (2021)) or −1 (difference) for the workpiece branch.
     workpiece_sign: f64,
     pub reference_mm: [f64; 3],
     pub terms: FirstOrderTerms,

@@ -61,21 +61,28 @@
 //!
 //! Pure: values in, values out.
 
+use crate::compensate::CompensationTable;
 use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::retest::{Applied, BacklashRefusal, KnownError};
-use crate::compensate::{CompensationTable, TableMode};
 use crate::effects::Effect;
-use crate::evaluate::{
-    AxisFigures, Standard, StandardFigure, StandardUsed, evaluate, evaluate_with,
-};
-use crate::measurement::{Direction, Measurement, Run};
+use crate::evaluate::{Standard, StandardUsed, evaluate};
+use crate::measurement::{Direction, Measurement};
 use crate::model::{
     Axis, ErrorComponent, ErrorFunction, ErrorName, ErrorTable, GeometricErrors, Grid,
     Interpolation, Machine, Method, ModelError, Optics,
 };
-use crate::units::um_to_mm;
 
+mod calibrate;
+mod cross_axis;
+mod retest;
 pub mod survey;
+
+use calibrate::calibrated_errors;
+pub use calibrate::{calibrate_positioning, positioning_error, positioning_sign};
+pub(crate) use cross_axis::cross_compensated;
+pub use cross_axis::{cross_axis_table, cross_axis_table_at};
+use retest::{Line, predicted_retest};
+pub use retest::{PredictedRetest, PredictedTarget};
 
 /// A measured file and the line it was measured on.
 #[derive(Clone, Copy, Debug)]
@@ -124,72 +131,6 @@ pub struct PredictInput<'a> {
     /// ([`PredictedRetest::standard_figures`]); the prediction itself does
     /// not depend on it.
     pub standard: &'a dyn Standard,
-}
-
-/// The predicted re-test of one compensated axis.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PredictedRetest {
-    /// The axis.
-    pub axis: Axis,
-    /// The line, mm.
-    pub line_mm: [f64; 3],
-    /// Per target: the deviation without and with the table.
-    pub per_target: Vec<PredictedTarget>,
-    /// The predicted re-test as readings (with the measured scatter when the
-    /// axis was measured).
-    pub retest: Measurement,
-    /// Its ISO 230-2:2014 figures.
-    pub figures: AxisFigures,
-    /// The ISO 230-2:2014 figures of the same line without the table.
-    pub figures_before: AxisFigures,
-    /// Its figures as [`PredictInput::standard`] reports them (its keys):
-    /// `evaluate_with` of [`PredictedRetest::retest`].
-    pub standard_figures: Vec<StandardFigure>,
-    /// The same line without the table, as that standard reports it.
-    pub standard_figures_before: Vec<StandardFigure>,
-    /// Whether the readings carry a measured test's scatter (else one run per
-    /// direction, no repeatability).
-    pub with_measured_scatter: bool,
-    /// The mean reversal B̄ the first test of the axis measured, which the
-    /// prediction carries, mm; `None` without a bidirectional first test.
-    pub measured_mean_reversal_mm: Option<f64>,
-    /// The mean reversal the controller's backlash parameter takes out, mm (0 if not set).
-    pub backlash_reversal_mm: f64,
-    /// Whether the table is mean or bidirectional.
-    pub table_mode: TableMode,
-}
-
-/// One target of a predicted re-test, mm.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PredictedTarget {
-    /// Target, mm.
-    pub target_mm: f64,
-    /// Deviation on the line without the table moving ↑, mm.
-    pub before_up_mm: f64,
-    /// The same moving ↓ (differs from ↑ only by effects), mm.
-    pub before_down_mm: f64,
-    /// Predicted deviation with the table moving ↑, mm.
-    pub up_mm: f64,
-    /// Predicted deviation with the table moving ↓, mm.
-    pub down_mm: f64,
-}
-
-impl PredictedTarget {
-    /// With the table, in a direction, mm.
-    pub fn after(&self, direction: Direction) -> f64 {
-        match direction {
-            Direction::Up => self.up_mm,
-            Direction::Down => self.down_mm,
-        }
-    }
-
-    /// Without the table, in a direction, mm.
-    pub fn before(&self, direction: Direction) -> f64 {
-        match direction {
-            Direction::Up => self.before_up_mm,
-            Direction::Down => self.before_down_mm,
-        }
-    }
 }
 
 /// The largest volumetric error over the grid and where, mm.
@@ -491,272 +432,6 @@ pub fn axis_named(what: &'static str, name: &str) -> Result<Axis, PredictError> 
     })
 }
 
-/// The positioning error of an axis: EXX, EYY or EZZ.
-pub fn positioning_error(axis: Axis) -> ErrorName {
-    match axis {
-        Axis::X => ErrorName::EXX,
-        Axis::Y => ErrorName::EYY,
-        Axis::Z => ErrorName::EZZ,
-    }
-}
-
-/// The sign with which an axis's positioning error enters the volumetric
-/// error along that axis: +1 in every chain the model builds (the error is
-/// defined as actual − nominal along the axis); anything else is a bug.
-pub fn positioning_sign(machine: &Machine, axis: Axis) -> Result<f64, PredictError> {
-    let [low, high] = machine.axis(axis).stroke_mm;
-    let mut errors = GeometricErrors::default();
-    let slope = ErrorTable::new(vec![low, high], vec![0.0, 1e-3], Interpolation::Linear)?;
-    errors.set(positioning_error(axis), ErrorFunction::Table(slope))?;
-    let at = |x: f64| {
-        let mut p = machine.reference_mm();
-        p[axis.index()] = x;
-        machine
-            .volumetric_error(&errors, p, Method::Full)
-            .translation_mm[axis.index()]
-    };
-    let gain = (at(high) - at(low)) / 1e-3;
-    if (gain.abs() - 1.0).abs() > 1e-6 {
-        return Err(PredictError::Internal(format!(
-            "{} enters E_{axis} with a gain of {gain}, not ±1",
-            positioning_error(axis)
-        )));
-    }
-    Ok(gain.signum())
-}
-
-/// D(x): the laser's reading on `line_mm` with `axis` at `x_mm`, mm.
-fn line_deviation(
-    machine: &Machine,
-    errors: &GeometricErrors,
-    axis: Axis,
-    sign: f64,
-    line_mm: [f64; 3],
-    x_mm: f64,
-) -> f64 {
-    let mut p = line_mm;
-    p[axis.index()] = x_mm;
-    let reference = machine.reference_mm()[axis.index()];
-    let own_at_reference = errors
-        .function(positioning_error(axis))
-        .map_or(0.0, |f| f.value_at(reference));
-    sign * machine
-        .volumetric_error(errors, p, Method::Full)
-        .translation_mm[axis.index()]
-        + own_at_reference
-}
-
-/// The errors with each measured axis's positioning error set so that the
-/// model reproduces the measured means on the measured line.
-fn calibrated_errors(input: &PredictInput<'_>) -> Result<GeometricErrors, PredictError> {
-    calibrate_positioning(input.machine, input.errors, input.measured)
-}
-
-/// The 21 errors with each measured axis's positioning error set so that the
-/// model reproduces the measured means on the measured line (module doc):
-/// what `predict` predicts with, and what `predict --survey` assembles.
-pub fn calibrate_positioning(
-    machine: &Machine,
-    errors: &GeometricErrors,
-    measured: &[MeasuredAxis<'_>],
-) -> Result<GeometricErrors, PredictError> {
-    let mut errors = errors.clone();
-    let mut given: Vec<ErrorName> = ErrorName::ALL
-        .into_iter()
-        .filter(|name| {
-            errors
-                .function(*name)
-                .is_some_and(|f| *f != ErrorFunction::Constant(0.0))
-        })
-        .collect();
-    for measured in measured {
-        let axis = axis_named("a measurement", measured.measurement.axis())?;
-        let name = positioning_error(axis);
-        if given.contains(&name) {
-            return Err(PredictError::GivenTwice(name));
-        }
-        given.push(name);
-        let known = KnownError::from_evaluation(&evaluate(measured.measurement))
-            .ok_or(PredictError::NoMeans(axis))?;
-        let machine = machine.with_optics(&measured.optics)?;
-        let sign = positioning_sign(&machine, axis)?;
-        // The others' contribution on the measured line, with EAA still zero.
-        let values: Vec<f64> = known
-            .positions_mm()
-            .iter()
-            .zip(known.mean_values_mm())
-            .map(|(&x, mean)| {
-                mean - line_deviation(&machine, &errors, axis, sign, measured.line_mm, x)
-            })
-            .collect();
-        let table = ErrorTable::new(known.positions_mm().to_vec(), values, Interpolation::Spline)?;
-        errors.set(name, ErrorFunction::Table(table))?;
-    }
-    Ok(errors)
-}
-
-/// An axis and the line its re-test runs on.
-#[derive(Clone, Copy, Debug)]
-struct Line {
-    axis: Axis,
-    line_mm: [f64; 3],
-}
-
-/// The re-test of one compensated axis on the line.
-fn predicted_retest(
-    machine: &Machine,
-    errors: &GeometricErrors,
-    line: Line,
-    table: &CompensationTable,
-    measured: Option<&Measurement>,
-    input: &PredictInput<'_>,
-) -> Result<PredictedRetest, PredictError> {
-    let Line { axis, line_mm } = line;
-    let (effects, backlash_set, standard) = (input.effects, input.backlash_set, input.standard);
-    let sign = positioning_sign(machine, axis)?;
-    let targets: Vec<f64> = match measured {
-        Some(m) => m.targets_mm().to_vec(),
-        None => table.positions_mm.clone(),
-    };
-    // The first test's own error, per direction: the reversal it measured.
-    let known = measured.and_then(|m| KnownError::from_evaluation(&evaluate(m)));
-    let measured_mean_reversal_mm = known
-        .as_ref()
-        .filter(|k| k.is_bidirectional())
-        .map(KnownError::mean_reversal_mm);
-    let applied = Applied::with_backlash(Some(table), known.as_ref(), backlash_set)
-        .map_err(|why| PredictError::Backlash { axis, why })?;
-    let first_target = targets.first().copied().unwrap_or(0.0);
-    // D(x, d): the model's reading, the measured reversal and the effects it lacks, mm.
-    let deviation = |x: f64, direction: Direction| {
-        let effects_um: f64 = effects
-            .iter()
-            .filter_map(|e| e.systematic_um(x, direction, first_target))
-            .sum();
-        let reversal = known
-            .as_ref()
-            .map_or(0.0, |k| k.reversal_share_at(x, direction));
-        line_deviation(machine, errors, axis, sign, line_mm, x) + reversal + um_to_mm(effects_um)
-    };
-    let compensated = |x: f64, direction: Direction| {
-        let v = applied.value_at(x, direction);
-        deviation(x - v, direction) - v
-    };
-    let per_target: Vec<PredictedTarget> = targets
-        .iter()
-        .map(|&x| PredictedTarget {
-            target_mm: x,
-            before_up_mm: deviation(x, Direction::Up),
-            before_down_mm: deviation(x, Direction::Down),
-            up_mm: compensated(x, Direction::Up),
-            down_mm: compensated(x, Direction::Down),
-        })
-        .collect();
-    let (retest, before) = match measured {
-        Some(m) => (
-            with_scatter(m, |i, d| per_target[i].after(d))?,
-            with_scatter(m, |i, d| per_target[i].before(d))?,
-        ),
-        None => (
-            one_run_each_way(axis, &per_target, PredictedTarget::after)?,
-            one_run_each_way(axis, &per_target, PredictedTarget::before)?,
-        ),
-    };
-    Ok(PredictedRetest {
-        axis,
-        line_mm,
-        figures: evaluate(&retest).figures,
-        figures_before: evaluate(&before).figures,
-        standard_figures: evaluate_with(&retest, standard).standard_figures,
-        standard_figures_before: evaluate_with(&before, standard).standard_figures,
-        per_target,
-        retest,
-        with_measured_scatter: measured.is_some(),
-        measured_mean_reversal_mm,
-        backlash_reversal_mm: applied.backlash_reversal_mm,
-        table_mode: table.values.mode(),
-    })
-}
-
-/// The measured readings with their per-target, per-direction mean replaced
-/// by `systematic(target index, direction)`: the scatter is kept.
-fn with_scatter(
-    measured: &Measurement,
-    systematic: impl Fn(usize, Direction) -> f64,
-) -> Result<Measurement, PredictError> {
-    Ok(crate::compensate::retest::with_scatter(
-        measured,
-        &evaluate(measured),
-        systematic,
-    )?)
-}
-
-/// A re-test of one run each way holding the predicted values.
-fn one_run_each_way(
-    axis: Axis,
-    per_target: &[PredictedTarget],
-    value: fn(&PredictedTarget, Direction) -> f64,
-) -> Result<Measurement, PredictError> {
-    let runs = Direction::BOTH
-        .into_iter()
-        .map(|direction| Run {
-            direction,
-            number: 1,
-            start_time_s: None,
-            deviations_mm: per_target
-                .iter()
-                .map(|t| Some(value(t, direction)))
-                .collect(),
-        })
-        .collect();
-    let metadata = crate::measurement::Metadata {
-        axis_source: crate::measurement::AxisSource::Given,
-        ..Default::default()
-    };
-    Measurement::new(
-        axis.letter().to_string(),
-        per_target.iter().map(|t| t.target_mm).collect(),
-        runs,
-        Default::default(),
-        metadata,
-    )
-    .map_err(PredictError::from)
-}
-
-/// The errors with each cross-axis table applied to the straightness it
-/// compensates: E<column><table axis>_c(x) = E(x) − v(x), linear through
-/// the grid's positions and the table's points (the column axis's own
-/// errors move by v, a few µm: below a nanometre, as for positioning).
-pub(crate) fn cross_compensated(
-    errors: &GeometricErrors,
-    tables: &[CrossAxisTable],
-    grid: &Grid,
-) -> Result<GeometricErrors, PredictError> {
-    let mut compensated = errors.clone();
-    for cross in tables {
-        let axis = axis_named("a cross-axis table", &cross.table_axis)?;
-        let direction = axis_named("a cross-axis table's column", &cross.table.axis)?;
-        if axis == direction {
-            return Err(PredictError::Survey {
-                what: format!("the cross-axis table {direction} = F({axis})"),
-                why: "moves its own axis: that is a positioning table (--table)".to_string(),
-            });
-        }
-        let name = ErrorName::of(ErrorComponent::Translation { axis, direction });
-        let own = compensated.function(name).cloned().unwrap_or_default();
-        let positions = merged_positions(grid.axis_mm(axis), &cross.table.positions_mm);
-        let values = positions
-            .iter()
-            .map(|&x| own.value_at(x) - cross.value_at(x))
-            .collect();
-        compensated.set(
-            name,
-            ErrorFunction::Table(ErrorTable::new(positions, values, Interpolation::Linear)?),
-        )?;
-    }
-    Ok(compensated)
-}
-
 /// Each error's share of the volumetric error at `at_mm` (first order, so
 /// the shares add up to 1), largest |share| first.
 fn shares_at(machine: &Machine, errors: &GeometricErrors, at_mm: [f64; 3]) -> Vec<ErrorShare> {
@@ -803,64 +478,6 @@ fn merged_positions(grid_mm: &[f64], table_mm: &[f64]) -> Vec<f64> {
     positions.sort_by(f64::total_cmp);
     positions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
     positions
-}
-
-/// A cross-axis table of the straightness `name` (EYX: X's in Y) as the
-/// errors hold it, at `points` evenly spaced positions over its axis's
-/// stroke, zero at the machine's reference position.
-pub fn cross_axis_table(
-    machine: &Machine,
-    errors: &GeometricErrors,
-    name: ErrorName,
-    points: usize,
-) -> Result<CrossAxisTable, PredictError> {
-    let ErrorComponent::Translation { axis, .. } = name.component() else {
-        return Err(PredictError::Internal(format!("{name} is no straightness")));
-    };
-    if points < 2 {
-        return Err(PredictError::Internal(format!(
-            "{name} with {points} points is no straightness table"
-        )));
-    }
-    let [low, high] = machine.axis(axis).stroke_mm;
-    let positions: Vec<f64> = (0..points)
-        .map(|i| low + (high - low) * i as f64 / (points - 1) as f64)
-        .collect();
-    cross_axis_table_at(
-        errors,
-        name,
-        positions,
-        machine.reference_mm()[axis.index()],
-    )
-}
-
-/// A cross-axis table of the straightness `name` as the errors hold it, at
-/// `positions_mm` of its axis, zero at `reference_mm` (`convert` writes it
-/// on the grid the engineer chose).
-pub fn cross_axis_table_at(
-    errors: &GeometricErrors,
-    name: ErrorName,
-    positions_mm: Vec<f64>,
-    reference_mm: f64,
-) -> Result<CrossAxisTable, PredictError> {
-    let ErrorComponent::Translation { axis, direction } = name.component() else {
-        return Err(PredictError::Internal(format!("{name} is no straightness")));
-    };
-    if axis == direction || positions_mm.len() < 2 {
-        return Err(PredictError::Internal(format!(
-            "{name} with {} points is no straightness table",
-            positions_mm.len()
-        )));
-    }
-    let function = errors.function(name).cloned().unwrap_or_default();
-    let values = positions_mm.iter().map(|&x| function.value_at(x)).collect();
-    Ok(CrossAxisTable::new(
-        &axis.to_string(),
-        &direction.to_string(),
-        positions_mm,
-        values,
-        reference_mm,
-    ))
 }
 
 /// A table and the first test of its axis, as its reversal is known.

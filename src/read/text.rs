@@ -165,8 +165,7 @@ pub fn consumed<'a>(input: &'a str, rest: &str) -> &'a str {
 ///
 /// `what` names the quantity for the message ("target", "deviation").
 pub fn number(line: &Line<'_>, token: &str, what: &str) -> Result<f64, ParseError> {
-    // Only an error needs the text (formatting it for every reading was a
-    // fifth of the time a large file took to read).
+    // Only an error needs the text: it is not formatted for a reading that parses.
     // The common case first: a token of digits, sign, point and exponent
     // letters that the standard parser takes is a decimal of the grammar
     // below (which would parse the same token with the same parser); every

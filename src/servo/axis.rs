@@ -1,4 +1,4 @@
-//! Axis parameters: the feed-drive model of seed 004 ch. 3 as data, read from TOML.
+//! Axis parameters: the feed-drive model of Mendřický (2006) ch. 3 as data, read from TOML.
 //!
 //! An [`Axis`] holds what the simulation needs (notes §3): the moving mass,
 //! the DC-equivalent motor, the PI current loop with the converter's dead
@@ -6,7 +6,7 @@
 //! feedforward weights, and one set of friction parameters from which each
 //! of the four models is built ([`Axis::friction`]).
 //!
-//! The thesis's two axes of the MCFV 5050 LN are bundled
+//! Mendřický's two axes of the MCFV 5050 LN are bundled
 //! (`fixtures/axes/mcfv5050-x.toml`, `mcfv5050-y.toml`, each value commented
 //! with its source) and compiled in, so [`Axis::bundled`] works anywhere.
 //! [`Axis::from_toml_str`] reads the same layout from text; it never sees a
@@ -15,7 +15,7 @@
 //! Deliberately not modelled, and so not in the file: the 2 kHz notch filter
 //! of the velocity loop (its depth ζ_F1 is not given, notes §3.3), the scale
 //! slider (0.5 kg at 2 kHz, far above the loops' bandwidth) and the
-//! three-phase commutation (the thesis itself calls the DC-equivalent motor
+//! three-phase commutation (Mendřický (2006) calls the DC-equivalent motor
 //! adequate, §3.1). The notes' independent re-implementation reproduces
 //! Tab. 6.4 without them (notes §10).
 

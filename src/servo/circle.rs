@@ -1,7 +1,7 @@
 //! The circular test (thesis §6.3, Tab. 6.4): simulate one axis's share of a
 //! circle and read the quadrant error at its reversals.
 //!
-//! The thesis tabulates, per axis and feed, the "quadrant error" of the
+//! Mendřický (2006) tabulates, per axis and feed, the "quadrant error" of the
 //! following error (the spike when the axis reverses, xe and ye) and the
 //! current (Ix, Iy), the mean of the + and − reversal where they differ. Here:
 //! the simulation runs the 0.3 s run-up and two revolutions (notes §10); each

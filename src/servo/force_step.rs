@@ -2,10 +2,10 @@
 //! constant-velocity run (§6.1).
 //!
 //! Force step: the axis stands under closed position control; at `at_s` a
-//! constant external force starts to act on the mass (the thesis imitated it
+//! constant external force starts to act on the mass (Mendřický (2006) imitated it
 //! on the machine by a current step into the current controller; its
 //! simulation put it on the motors: 1500 N, half the continuous force, at
-//! t = 0.01 s). The thesis reports a peak position deviation of ≈ 80 µm and a
+//! t = 0.01 s). Mendřický (2006) reports a peak position deviation of ≈ 80 µm and a
 //! return in ≈ 70 ms, with every friction model alike except B2.
 //!
 //! Constant velocity: one long jerk-limited move at the feed; in the middle of
@@ -30,7 +30,7 @@ pub struct ForceStepResult {
     /// Friction force at the end, N.
     pub final_friction_n: f64,
     /// Largest |friction| change between consecutive macro steps in the last
-    /// half of the run, N (B2's chatter in the thesis; none here).
+    /// half of the run, N (B2's chatter in Mendřický (2006); none here).
     pub final_friction_ripple_n: f64,
     /// Simulated time, s.
     pub simulated_s: f64,

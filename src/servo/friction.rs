@@ -1,4 +1,4 @@
-//! The four friction models of seed 004 (Mendřický 2006, ch. 4;
+//! The four friction models of Mendřický (2006, ch. 4;
 //! `../shared/notes/seed004-friction-model.md` §2.6–2.9), each a small type
 //! with its parameters in SI units, and their implicit update over one step.
 //!
@@ -25,10 +25,10 @@
 //! force). That makes the stiff parts unconditionally stable without a tiny
 //! step: the stick of model A is the set-valued law at v = 0 (the force that
 //! brings the mass to rest, if it is within ±F_Ts), B2's infinite slope does
-//! not chatter (the thesis's ±15 N chatter, §6.2, is an artefact of explicit
+//! not chatter (Mendřický's ±15 N chatter, §6.2, is an artefact of explicit
 //! stepping), and LuGre's bristle state is advanced by the exact solution of
 //! ż = v − |v| z/g with v held (notes §7), which stays bounded (|z| ≤ g,
-//! property 1 of the thesis's ref. 13) at any step. With the thesis's F_Ts = F_C, g is
+//! property 1 of Mendřický's ref. 13) at any step. With Mendřický's F_Ts = F_C, g is
 //! constant and every equation solved here is monotone, so the solution is
 //! unique.
 
@@ -107,7 +107,7 @@ pub enum FrictionKind {
 }
 
 impl FrictionKind {
-    /// All four, in the thesis's order A, B1, B2, C.
+    /// All four, in Mendřický's order A, B1, B2, C.
     pub const ALL: [FrictionKind; 4] = [
         FrictionKind::Classic,
         FrictionKind::Ramp,
@@ -125,7 +125,7 @@ impl FrictionKind {
         }
     }
 
-    /// The thesis's label (A, B1, B2, C).
+    /// Mendřický's label (A, B1, B2, C).
     pub fn thesis_label(self) -> &'static str {
         match self {
             FrictionKind::Classic => "A",
@@ -297,7 +297,7 @@ impl Power {
         v.signum() * self.coefficient_n * root
     }
 
-    /// u^(n−1), without `powf` for the thesis's orders 3 and 4 (it is in the inner loop).
+    /// u^(n−1), without `powf` for Mendřický's orders 3 and 4 (it is in the inner loop).
     fn power_below_order(&self, u: f64) -> f64 {
         if self.order == 3.0 {
             u * u
@@ -347,7 +347,7 @@ impl LuGre {
         self.g_and_slope(v).0
     }
 
-    /// g(v) and dg/dv. With F_Ts = F_C (the thesis's Tab. 6.1 and 6.3) g is
+    /// g(v) and dg/dv. With F_Ts = F_C (Mendřický's Tab. 6.1 and 6.3) g is
     /// constant; far beyond v_s the Stribeck term is below 1e-300 and skipped
     /// (also to keep `exp` off its slow underflow path).
     fn g_and_slope(&self, v: f64) -> (f64, f64) {

@@ -1,16 +1,16 @@
-//! `servo-sim --identify`: the friction parameters of seed 004 ch. 5
+//! `servo-sim --identify`: the friction parameters of Mendřický (2006) ch. 5
 //! (F_C, μ_v and the LuGre stiffness k_s) fitted to two records of an axis.
 //!
-//! 1. **Constant-velocity record** (the thesis's Tab. 5.1, §5.2): the mean
+//! 1. **Constant-velocity record** (Mendřický's Tab. 5.1, §5.2): the mean
 //!    motor current at several constant feeds. At constant speed the loops
 //!    hold the friction force, F = K_F3·I (the PI velocity loop's integrator
 //!    takes it all, so the following error there carries no friction and is
 //!    not used); F_C and μ_v are the least-squares line F = F_C + μ_v·|v|
 //!    ([`identify::coulomb_viscous_fit`], the linear fit of Fig. 5.1).
 //! 2. **A measured reversal** (§6.3, Fig. 6.13): the following error of the
-//!    axis on the thesis's circle, sampled at the position loop, through its
+//!    axis on Mendřický's circle, sampled at the position loop, through its
 //!    quadrant reversals. The spike at each reversal is the pre-sliding of
-//!    the friction contact, set by k_s (the thesis tuned k_s to this very
+//!    the friction contact, set by k_s (Mendřický (2006) tuned k_s to this very
 //!    record, §6.3.4). With F_C and μ_v from step 1, k_s is the value whose
 //!    simulated circle ([`circle::run_circle`], LuGre with the axis's ζ_s
 //!    and b_s by eq. 4.15) matches the record best in least squares: a

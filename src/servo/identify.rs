@@ -1,14 +1,14 @@
-//! The identification arithmetic of seed 004 ch. 5 and the derived
+//! The identification arithmetic of Mendřický (2006) ch. 5 and the derived
 //! parameters of ch. 3–4, as small functions (SI units throughout).
 //!
-//! These are the closed forms the thesis uses to get friction, mass and
+//! These are the closed forms Mendřický (2006) uses to get friction, mass and
 //! stiffness from currents, dial-gauge readings and catalogue data; the unit
-//! tests check each against the thesis's own numbers (notes §9). Callers:
+//! tests check each against Mendřický's own numbers (notes §9). Callers:
 //! `axis` (the LuGre damping of eq. 4.15 for every axis file) and
 //! `friction_fit` (`servo-sim --identify`: the linear fit of the
 //! constant-velocity currents, [`coulomb_viscous_fit`], the feed conversion
 //! and the damping again); the other closed forms (guide estimate, current
-//! jump, circle mass, slider, motor and loop constants) are the thesis's
+//! jump, circle mass, slider, motor and loop constants) are Mendřický's
 //! arithmetic, checked here and not called elsewhere.
 
 /// Guide friction estimate (eq. 5.1, 5.2): equivalent load per carriage
@@ -40,7 +40,7 @@ pub fn viscous_from_current_n_s_per_m(
     (current_a * force_constant_n_per_a - coulomb_n) / velocity_m_per_s
 }
 
-/// F_C and μ_v from the friction force at constant speeds, the thesis's
+/// F_C and μ_v from the friction force at constant speeds, Mendřický's
 /// linear fit of Fig. 5.1 (§5.2): least squares of F = F_C + μ_v·|v| over
 /// the rows, with F the force against the motion (sgn v · K_F3 · I, so runs
 /// in both directions count alike). `None` with fewer than two distinct
@@ -113,25 +113,19 @@ pub fn m_per_min_to_m_per_s(feed_m_per_min: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    //! Every expected number is the thesis's, as listed in notes §9 (row numbers in comments).
+    //! Every expected number is Mendřický's, as listed in notes §9 (row numbers in comments).
 
     use super::*;
     use crate::servo::friction::{Power, Ramp};
-
-    fn close(actual: f64, expected: f64, tolerance: f64) {
-        assert!(
-            (actual - expected).abs() <= tolerance,
-            "{actual} is not {expected} ± {tolerance}"
-        );
-    }
+    use approx::assert_abs_diff_eq;
 
     #[test]
     fn guide_friction_estimate() {
         // §9 row 1: P = 2950 + (15000 + 2000)/6 = 5783 N; F_Tx = 0.003·5783·6 = 104.1 N.
-        close(
+        assert_abs_diff_eq!(
             guide_friction_n(2950.0, 15_000.0, 2000.0, 6.0, 0.003),
             104.1,
-            0.05,
+            epsilon = 0.05
         );
     }
 
@@ -143,10 +137,14 @@ mod tests {
             viscous_n_s_per_m: 430.0,
             slope_n_s_per_m: 12_000.0,
         };
-        close(ramp.corner_velocity_m_per_s() * 60.0, 0.55, 1e-12);
-        close(12_000.0 * m_per_min_to_m_per_s(0.55), 110.0, 1e-9);
+        assert_abs_diff_eq!(ramp.corner_velocity_m_per_s() * 60.0, 0.55, epsilon = 1e-12);
+        assert_abs_diff_eq!(12_000.0 * m_per_min_to_m_per_s(0.55), 110.0, epsilon = 1e-9);
         // §9 row 3: I_C = 2.2 A, K_F3 = 94: F_C = 103.4 N (eq. 5.3).
-        close(coulomb_from_current_jump_n(2.2, 94.0), 103.4, 1e-9);
+        assert_abs_diff_eq!(
+            coulomb_from_current_jump_n(2.2, 94.0),
+            103.4,
+            epsilon = 1e-9
+        );
     }
 
     #[test]
@@ -162,10 +160,10 @@ mod tests {
         ];
         for (feed, current, force, viscous) in rows {
             let v = m_per_min_to_m_per_s(feed);
-            close(current * 94.0, force, 1e-9);
+            assert_abs_diff_eq!(current * 94.0, force, epsilon = 1e-9);
             // The table rounds to 0.1 N·s/m (359.55 → 359.6).
             let identified = viscous_from_current_n_s_per_m(current, 94.0, 103.4, v);
-            close(identified, viscous, 0.0501);
+            assert_abs_diff_eq!(identified, viscous, epsilon = 0.0501);
         }
     }
 
@@ -173,14 +171,14 @@ mod tests {
     fn linear_fit_of_tab_5_1() {
         // Tab. 5.1 (notes §4.2) from 1 m/min up, F = 94·I as tabulated: the
         // least-squares line computed by hand (Python, two-pass means) is
-        // F_C = 125.03 N, μ_v = 313.03 N·s/m (the thesis's B1 fit reads
+        // F_C = 125.03 N, μ_v = 313.03 N·s/m (Mendřický's B1 fit reads
         // 110 N and 430 N·s/m off the same curve with its corner v0).
         let feeds = [1.0, 3.2, 5.0, 8.0, 10.0, 16.0, 24.0];
         let forces = [117.5, 141.9, 159.8, 166.4, 188.0, 205.9, 246.3];
         let speeds: Vec<f64> = feeds.iter().map(|&f| m_per_min_to_m_per_s(f)).collect();
         let (coulomb, viscous) = coulomb_viscous_fit(&speeds, &forces).unwrap();
-        close(coulomb, 125.029, 0.001);
-        close(viscous, 313.035, 0.001);
+        assert_abs_diff_eq!(coulomb, 125.029, epsilon = 0.001);
+        assert_abs_diff_eq!(viscous, 313.035, epsilon = 0.001);
         assert_eq!(coulomb_viscous_fit(&[0.1, 0.1], &[5.0, 6.0]), None);
         assert_eq!(coulomb_viscous_fit(&[0.1], &[5.0]), None);
     }
@@ -188,38 +186,46 @@ mod tests {
     #[test]
     fn mass_and_centripetal_force_from_the_circle() {
         // §9 row 5: I_a = 8.4 A, R = 0.09 m, 24 m/min: m = 222.1 kg (eq. 5.12).
-        close(
+        assert_abs_diff_eq!(
             mass_from_circle_kg(8.4, 94.0, 0.09, m_per_min_to_m_per_s(24.0)),
             222.1,
-            0.05,
+            epsilon = 0.05
         );
         // §9 row 6: a = v²/R = 0.1975 and 1.778 m/s² at 8 and 24 m/min; F_a = 43.5 and 391 N with m = 220 kg.
         for (feed, acceleration, force) in [(8.0, 0.1975, 43.5), (24.0, 1.778, 391.0)] {
             let v = m_per_min_to_m_per_s(feed);
-            close(v * v / 0.09, acceleration, 5e-4);
-            close(220.0 * v * v / 0.09, force, 0.5);
+            assert_abs_diff_eq!(v * v / 0.09, acceleration, epsilon = 5e-4);
+            assert_abs_diff_eq!(220.0 * v * v / 0.09, force, epsilon = 0.5);
         }
     }
 
     #[test]
     fn pre_sliding_stiffness_and_lugre_damping() {
         // §9 row 8 (Tab. 5.3): 120 N / 4.3 µm ≈ 2.8e7 N/m, 100 N / 47 µm ≈ 2.1e6 N/m.
-        close(120.0 / 4.3e-6, 2.8e7, 0.01e7);
-        close(100.0 / 47e-6, 2.1e6, 0.05e6);
+        assert_abs_diff_eq!(120.0 / 4.3e-6, 2.8e7, epsilon = 0.01e7);
+        assert_abs_diff_eq!(100.0 / 47e-6, 2.1e6, epsilon = 0.05e6);
         // §9 row 9: Tab. 4.3, b_s = 0.2·√(4e7·400) = 25 298 N·s/m.
-        close(lugre_damping_n_s_per_m(4e7, 400.0, 0.1), 25_298.2, 0.1);
+        assert_abs_diff_eq!(
+            lugre_damping_n_s_per_m(4e7, 400.0, 0.1),
+            25_298.2,
+            epsilon = 0.1
+        );
     }
 
     #[test]
     fn slider_motor_and_loop_constants() {
         // §9 row 10: m_j = 0.5 kg, 2 kHz, ζ 0.05: k_j = 7.896e7 N/m, b_j = 628.3 N·s/m.
         let (k, b) = spring_damper(0.5, 2000.0, 0.05);
-        close(k, 7.896e7, 0.001e7);
-        close(b, 628.3, 0.05);
+        assert_abs_diff_eq!(k, 7.896e7, epsilon = 0.001e7);
+        assert_abs_diff_eq!(b, 628.3, epsilon = 0.05);
         // §9 rows 11–13: K_F3 = 1.5·62.8 = 94.2 N/A; T_d = 0.125 ms; K_v = 83.3 1/s.
-        close(three_phase_force_constant_n_per_a(62.8), 94.2, 1e-9);
-        close(converter_dead_time_s(4000.0), 0.125e-3, 1e-15);
-        close(position_gain_per_s(5.0), 83.33, 0.005);
+        assert_abs_diff_eq!(
+            three_phase_force_constant_n_per_a(62.8),
+            94.2,
+            epsilon = 1e-9
+        );
+        assert_abs_diff_eq!(converter_dead_time_s(4000.0), 0.125e-3, epsilon = 1e-15);
+        assert_abs_diff_eq!(position_gain_per_s(5.0), 83.33, epsilon = 0.005);
     }
 
     #[test]
@@ -229,15 +235,15 @@ mod tests {
             coefficient_n: 300.0,
             order: 4.0,
         };
-        close(b2.force_n(2e-5) - b2.force_n(1e-5), 3.19, 0.005);
-        close(b2.force_n(1e-5) - b2.force_n(0.0), 16.87, 0.005);
-        // The thesis's B1 figure of 0.07 N does not follow from μ0 = 12 000:
+        assert_abs_diff_eq!(b2.force_n(2e-5) - b2.force_n(1e-5), 3.19, epsilon = 0.005);
+        assert_abs_diff_eq!(b2.force_n(1e-5) - b2.force_n(0.0), 16.87, epsilon = 0.005);
+        // Mendřický's B1 figure of 0.07 N does not follow from μ0 = 12 000:
         // the same 1e-5 m/s step gives 0.12 N (notes §5.2, an inconsistency in the text).
         let b1 = Ramp {
             coulomb_n: 115.0,
             viscous_n_s_per_m: 430.0,
             slope_n_s_per_m: 12_000.0,
         };
-        close(b1.force_n(1e-5) - b1.force_n(0.0), 0.12, 1e-9);
+        assert_abs_diff_eq!(b1.force_n(1e-5) - b1.force_n(0.0), 0.12, epsilon = 1e-9);
     }
 }

@@ -4,7 +4,7 @@
 //! "Test cycle"): start below the first target by the overrun; per run, every
 //! target in the ↑ direction with a dwell at each, past the last target by the
 //! overrun, every target ↓ with a dwell, past the first target by the
-//! overrun; `runs` times. Moves are the thesis's jerk-limited run-up
+//! overrun; `runs` times. Moves are Mendřický's jerk-limited run-up
 //! (`trajectory`).
 //!
 //! The reading at a target is taken at the end of its dwell, as a laser
@@ -22,7 +22,7 @@
 //! massless, and the closed loop as seeing a rigid axis): valid while the
 //! structural mode, √(k_c/m) ≈ 670 rad/s for k_c = 100 N/µm and 225 kg, is
 //! well above the velocity loop's bandwidth (≈ 40 Hz); readings after a
-//! dwell do not depend on it. The thesis gives no such compliance (notes
+//! dwell do not depend on it. Mendřický (2006) gives no such compliance (notes
 //! §6.2): [`DEFAULT_STIFFNESS_N_PER_UM`] is illustrative. With `None` the
 //! laser reads the scale position.
 //!
@@ -41,7 +41,7 @@ use crate::units::m_to_mm;
 
 /// The structural stiffness between the motor's force line and the measured
 /// point used when none is given, N/µm: illustrative (notes §6.2's example),
-/// a plausible order for a machine-tool table; not from the thesis.
+/// a plausible order for a machine-tool table; not from Mendřický (2006).
 pub const DEFAULT_STIFFNESS_N_PER_UM: f64 = 100.0;
 
 /// The test.

@@ -1,4 +1,4 @@
-//! Feed-drive friction and servo model (seed 004: Mendřický 2006), and what
+//! Feed-drive friction and servo model (Mendřický 2006), and what
 //! friction does to an ISO 230-2 positioning test.
 //!
 //! # Brief overview
@@ -7,7 +7,7 @@
 //!   (power law) and C (LuGre), each a small type, with an implicit update
 //!   over a step that stays stable at machine speeds.
 //! - [`axis`]: the axis parameters (mass, motor, cascade gains, sampling,
-//!   quantisation, dead time, friction), read from TOML; the thesis's MCFV
+//!   quantisation, dead time, friction), read from TOML; Mendřický's MCFV
 //!   5050 LN X and Y axes are bundled.
 //! - [`trajectory`]: circle, point-to-point moves with dwells, standstill.
 //! - [`simulate`]: the cascade in time, exact for the linear part, with
@@ -20,7 +20,7 @@
 //!   friction force held through the structure with it).
 //! - [`force_step`]: the force-step (impact compliance) test; and a
 //!   constant-velocity run.
-//! - [`identify`]: the thesis's identification arithmetic (every axis
+//! - [`identify`]: Mendřický's identification arithmetic (every axis
 //!   file uses the LuGre damping; [`friction_fit`] the linear fit of the
 //!   constant-velocity currents).
 //! - [`friction_fit`]: `servo-sim --identify`, F_C and μ_v from a

@@ -5,7 +5,7 @@
 //! of its own: the loop drives the scale reading to the target within one
 //! increment, whichever way the axis came (notes §6.2). What remains after an
 //! approach is the force the drive holds against friction at standstill,
-//! F_res, pointing the way the axis last moved (the thesis measured it just
+//! F_res, pointing the way the axis last moved (Mendřický (2006) measured it just
 //! below the Coulomb force, §6.4; LuGre and the classic model keep it, the
 //! velocity-only models B1 and B2 let it decay to zero). That force passes
 //! through the structure between the motor's force line and the point the

@@ -1,4 +1,4 @@
-//! Time simulation of one feed axis: the cascade of seed 004 ch. 3 with a
+//! Time simulation of one feed axis: the cascade of Mendřický (2006) ch. 3 with a
 //! friction model, following a trajectory.
 //!
 //! # The model (notes §3, §10)
@@ -14,7 +14,7 @@
 //!
 //! The feedforward is continuous (the notes found that holding it with the
 //! 1 ms sample raises every circle spike by 4–5 µm and does not reproduce
-//! Tab. 6.4); the velocity loop uses the true velocity (the thesis does not
+//! Tab. 6.4); the velocity loop uses the true velocity (Mendřický (2006) does not
 //! say which signal it used).
 //!
 //! # The scheme

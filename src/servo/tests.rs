@@ -1,9 +1,9 @@
-//! Reproducing seed 004 and checking the scheme: the thesis's Tab. 6.4, the
+//! Reproducing Mendřický (2006) and checking the scheme: Mendřický's Tab. 6.4, the
 //! notes' independent re-implementation (notes §10), the LuGre demonstrations
 //! (§4.4.3), the force step (§6.2), and the adaptive scheme against the
 //! uniform 1 µs reference on a short ISO 230-2 cycle.
 //!
-//! Expected numbers come from the thesis (Tab. 6.4 as reconstructed in notes
+//! Expected numbers come from Mendřický (2006) (Tab. 6.4 as reconstructed in notes
 //! §5.3.6) or from the notes' [CHK] re-simulation, never from this code.
 
 use crate::measurement::Direction;
@@ -64,7 +64,7 @@ fn circle_table(axis_name: &str, circle_axis: CircleAxis) -> [[(f64, f64); 5]; 4
     table
 }
 
-/// Mean |sim − meas|/meas in %, the thesis's row average (eq. 6.12 with the sign as tabulated).
+/// Mean |sim − meas|/meas in %, Mendřický's row average (eq. 6.12 with the sign as tabulated).
 fn mean_abs_error_pct(simulated: &[f64; 5], measured: &[f64; 5]) -> f64 {
     simulated
         .iter()
@@ -86,14 +86,14 @@ fn check_tab_6_4(axis_name: &str, circle_axis: CircleAxis, expected: &Tab64) {
                 kind.thesis_label(),
                 FEEDS_M_PER_MIN[column]
             );
-            // The tolerance against the thesis's simulated values.
+            // The tolerance against Mendřický's simulated values.
             if (error_um - expected.error_um[model][column]).abs() > 1.0 {
                 failures.push(format!(
                     "{label}: error {error_um:.2} µm vs thesis {}",
                     expected.error_um[model][column]
                 ));
             }
-            // The thesis prints currents to 0.1 A, so its simulated value lies
+            // Mendřický (2006) prints currents to 0.1 A, so its simulated value lies
             // within ±0.05 A of the printed figure; the 0.2 A is
             // measured from that interval. Two Y cells need it: B2 at 24 m/min
             // (13.69 A against a printed 13.9; the notes' independent model
@@ -127,7 +127,7 @@ fn check_tab_6_4(axis_name: &str, circle_axis: CircleAxis, expected: &Tab64) {
         let simulated: [f64; 5] = std::array::from_fn(|column| table[model][column].0);
         error_pct[model] = mean_abs_error_pct(&simulated, &expected.measured_error_um);
         let currents: [f64; 5] = std::array::from_fn(|column| table[model][column].1);
-        // The thesis: "the mean current error is about 10 % for all models".
+        // Mendřický (2006): "the mean current error is about 10 % for all models".
         let current_pct = mean_abs_error_pct(&currents, &expected.measured_current_a);
         if current_pct > 16.0 {
             failures.push(format!(
@@ -137,7 +137,7 @@ fn check_tab_6_4(axis_name: &str, circle_axis: CircleAxis, expected: &Tab64) {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    // What the thesis concludes (§6.3, Tab. 6.4 means: A 123/114 %, B1 26/26 %,
+    // What Mendřický (2006) concludes (§6.3, Tab. 6.4 means: A 123/114 %, B1 26/26 %,
     // B2 6/6 %, C 6/8 %): B2 and LuGre best, B1 in between, classic worst by far.
     let [classic, ramp, power, lugre] = error_pct;
     assert!(
@@ -322,7 +322,7 @@ fn force_step_peak_and_recovery() {
             (0.035..=0.065).contains(&result.recovery_s),
             "{kind:?}: {result:?}"
         );
-        // No chatter: the thesis's B2 showed ±15 N at standstill from explicit stepping.
+        // No chatter: Mendřický's B2 showed ±15 N at standstill from explicit stepping.
         assert!(result.final_friction_ripple_n < 1.0, "{kind:?}: {result:?}");
         // Residual friction after the transient (Fig. 6.5): B1 and B2 cannot
         // hold a force at rest, so theirs goes to zero (A and C keep some).
@@ -397,7 +397,7 @@ fn free_mass(
 fn lugre_stick_slip_has_stick_phases() {
     // Fig. 4.15–4.17: m = 400 kg on a 5000 N/m spring pulled at 0.1 m/s.
     // The notes' RK4 (§2.10): first slip at 1.166 s (spring force ≈ 582 N),
-    // stick again at ≈ 2.56 s, period ≈ 1.89 s (the thesis: stop at ≈ 2.4 s).
+    // stick again at ≈ 2.56 s, period ≈ 1.89 s (Mendřický (2006): stop at ≈ 2.4 s).
     let trace = free_mass(|t, x| 5000.0 * (0.1 * t - x), 5.0, 1e-5);
     let slipping = |v: f64| v > 1e-3;
     let first_slip = trace.iter().find(|s| slipping(s.2)).unwrap();
@@ -428,7 +428,7 @@ fn lugre_stick_slip_has_stick_phases() {
 #[test]
 fn lugre_pre_sliding_leaves_a_residual_displacement() {
     // Fig. 4.9: a force ramped to 540 N (90 % of F_Ts), held, ramped to −540 N.
-    // 1 s ramps and holds (not given in the thesis); the notes get a peak of
+    // 1 s ramps and holds (not given in Mendřický (2006)); the notes get a peak of
     // 39.5 µm and 29.8 µm left when the force is back at 0.
     let force = |t: f64| match t {
         t if t < 1.0 => 540.0 * t,

@@ -6,12 +6,12 @@
 //!
 //! - [`Circle`]: one axis's share of the circular test (thesis eq. 6.1–6.6),
 //!   CCW from a start angle, with the angular speed run up by a cosine ramp.
-//!   The thesis's jerk-limited run-up (Tab. 6.2) is used with parameters the
+//!   Mendřický's jerk-limited run-up (Tab. 6.2) is used with parameters the
 //!   text does not give; the notes' reproduction (§10) used a 0.3 s cosine
 //!   ramp of ω from φ = π/2, which is what [`Circle::thesis`] does.
 //! - [`Profile`]: piecewise constant-jerk motion built from point-to-point
 //!   moves and dwells ([`ProfileBuilder`]). Each move has the shape of the
-//!   thesis's run-up function (Tab. 6.2, eq. 6.7): jerk ±J for t_r = a/J,
+//!   Mendřický's run-up function (Tab. 6.2, eq. 6.7): jerk ±J for t_r = a/J,
 //!   constant acceleration up to t_a = v/a, cruise, and the mirror image.
 //!   The constant-velocity run and the ISO 230-2 cycle are profiles.
 //! - [`Trajectory::Hold`]: standing still (the force-step test).
@@ -139,8 +139,8 @@ impl Trajectory {
 }
 
 impl Circle {
-    /// The thesis's test (§6.3.4): R = 90 mm, CCW, feed in m/min, started at
-    /// φ = π/2 with a 0.3 s cosine run-up (notes §10; the thesis's run-up
+    /// Mendřický's test (§6.3.4): R = 90 mm, CCW, feed in m/min, started at
+    /// φ = π/2 with a 0.3 s cosine run-up (notes §10; Mendřický's run-up
     /// parameters are not in the text).
     pub fn thesis(feed_m_per_min: f64, axis: CircleAxis) -> Circle {
         Circle {

@@ -1,13 +1,18 @@
 //! `.rtl` parser tests: the composite example of the spec, each leniency the
 //! spec allows, each error it asks for, and the write → parse round trip.
 
+use approx::assert_abs_diff_eq;
 use proptest::prelude::*;
 
+use super::rows::{PlainRow, SimpleRow};
 use super::*;
+use crate::measurement::{Direction, Environment, Metadata, Run, SourceFormat, StartEnd};
+use crate::read::text::{self, Line};
+use crate::units::um_to_mm;
 
 /// The composite example of `../shared/notes/rtl-and-com-search.md` A.6
 /// (assembled from five readers and writers; the ENVIRONMENT lines are from a
-/// real file of seed 001).
+/// real file of Kadlečík (2019)).
 pub(crate) const COMPOSITE: &str = "HEADER::\r\n\
 File type  : rtl\r\n\
 Owner      : Linear\r\n\
@@ -59,10 +64,6 @@ fn parse_ok(text: &str) -> (Measurement, Vec<Warning>) {
     parse(text).unwrap_or_else(|error| panic!("{error}"))
 }
 
-fn close(a: Option<f64>, b: f64) -> bool {
-    a.is_some_and(|a| (a - b).abs() < 1e-12)
-}
-
 #[test]
 fn composite_example_reads_with_directions_from_row_order() {
     let (m, warnings) = parse_ok(COMPOSITE);
@@ -73,10 +74,10 @@ fn composite_example_reads_with_directions_from_row_order() {
     assert_eq!((runs[0].direction, runs[0].number), (Direction::Up, 1));
     assert_eq!((runs[1].direction, runs[1].number), (Direction::Down, 1));
     // µm in the file, mm inside: 1.270 µm = 0.00127 mm.
-    assert!(close(runs[0].deviations_mm[1], 0.00127));
+    assert_abs_diff_eq!(runs[0].deviations_mm[1].unwrap(), 0.00127, epsilon = 1e-12);
     // Run 2 lists target 1 last: keyed on the target column, not the row.
-    assert!(close(runs[1].deviations_mm[0], -0.00006));
-    assert!(close(runs[1].deviations_mm[2], 0.00198));
+    assert_abs_diff_eq!(runs[1].deviations_mm[0].unwrap(), -0.00006, epsilon = 1e-12);
+    assert_abs_diff_eq!(runs[1].deviations_mm[2].unwrap(), 0.00198, epsilon = 1e-12);
 }
 
 #[test]
@@ -130,11 +131,15 @@ fn leniencies_of_the_spec() {
     // Run 1 visits −10.5, −5.25, 0, 10 mm: ↑. Run 2 visits 10, −10.5 mm: ↓.
     let up = &m.runs()[0];
     assert_eq!(up.direction, Direction::Up);
-    assert!(close(up.deviations_mm[1], -0.00025));
-    assert!(close(up.deviations_mm[2], 0.0015));
+    assert_abs_diff_eq!(up.deviations_mm[1].unwrap(), -0.00025, epsilon = 1e-12);
+    assert_abs_diff_eq!(up.deviations_mm[2].unwrap(), 0.0015, epsilon = 1e-12);
     assert_eq!(up.deviations_mm[4], None);
     assert_eq!(m.runs()[1].direction, Direction::Down);
-    assert!(close(m.runs()[1].deviations_mm[0], 0.005));
+    assert_abs_diff_eq!(
+        m.runs()[1].deviations_mm[0].unwrap(),
+        0.005,
+        epsilon = 1e-12
+    );
     assert_eq!(
         m.environment.air_temperature_c,
         StartEnd::new(Some(20.0), Some(21.0))
@@ -199,8 +204,12 @@ fn descending_target_list_gives_physical_directions() {
     assert_eq!(m.targets_mm(), &[0.0, 50.0, 100.0]);
     assert_eq!(m.runs()[0].direction, Direction::Down);
     // File run 1, target number 2 (= 50 mm) is 1.270 µm.
-    assert!(close(m.runs()[0].deviations_mm[1], 0.00127));
-    assert!(close(m.runs()[0].deviations_mm[2], 0.0));
+    assert_abs_diff_eq!(
+        m.runs()[0].deviations_mm[1].unwrap(),
+        0.00127,
+        epsilon = 1e-12
+    );
+    assert_abs_diff_eq!(m.runs()[0].deviations_mm[2].unwrap(), 0.0, epsilon = 1e-12);
 }
 
 /// Each bad variant of the composite example, with where and what the error must say.
