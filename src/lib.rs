@@ -15,13 +15,13 @@
 //!   standard leaves a figure undefined, and flags suspected outlier runs.
 //! - [`compensate`] builds the compensation table (actual − target, zero at
 //!   the reference) and [`emit`] writes and reads it for each controller.
-//! - [`model`] is the geometric model of a three-axis machine (seed 000):
+//! - [`model`] is the geometric model of a three-axis machine (Valášek (2021)):
 //!   the 21 errors, the kinematic chain as data, the volumetric error, the
 //!   guideway model and the Monte Carlo tolerance study; [`predict`] applies
 //!   tables to it and predicts the re-test and the residual volumetric error.
 //! - [`diagnose`] traces the residual of a re-test to the effects the model
 //!   lacks (reversal, scale, drift, periodic, outlier run, Abbe).
-//! - [`servo`] simulates a feed axis with friction (seed 004) and gives the
+//! - [`servo`] simulates a feed axis with friction (Mendřický (2006)) and gives the
 //!   reversal B ≈ 2·F_res/k_c that friction leaves through a compliance.
 //! - [`synth`] writes measurements from a known truth, with the ISO 230-2
 //!   cycle's timing from [`cycle`].

@@ -10,7 +10,7 @@ mod cli;
 // for the file, the runs, the statistics and the printed table; mimalloc
 // reuses freed pages and asks for transparent huge pages, and evaluate of
 // that file took a fifth less CPU time on a quiet machine, less when huge
-// pages are scarce (README, Speed). ripgrep likewise replaces the allocator
+// pages are scarce (docs/src/speed.md). ripgrep likewise replaces the allocator
 // where the system's is slow (jemalloc, in its musl builds).
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;

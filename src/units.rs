@@ -440,7 +440,7 @@ mod tests {
 
     #[test]
     fn angle_conversions_by_hand() {
-        // 30 µm/m (seed 000 Tab. 3.3) is 30 µrad.
+        // 30 µm/m (Valášek (2021) Tab. 3.3) is 30 µrad.
         assert_eq!(um_per_m_to_rad(30.0), 30e-6);
         assert_eq!(rad_to_um_per_m(um_per_m_to_rad(30.0)), 30.0);
     }

@@ -391,7 +391,7 @@ pub struct InputFormat {
 pub struct MachineFile {
     /// Machine profile (TOML): [controller] the tables' axis names and units,
     /// [kinematics] the model (default: the bundled MCV 754 Quick),
-    /// [acceptance] the permissible values (README.md).
+    /// [acceptance] the permissible values (docs/src/evaluate.md).
     #[arg(long, value_name = "M.toml", help_heading = "Machine")]
     pub machine: Option<PathBuf>,
 
@@ -443,7 +443,7 @@ pub struct UncertaintyArgs {
     /// the expansion coefficient's ± limit, the misalignment (mrad) and the
     /// environmental variation E_VE (eve_um, or drift_test = "FILE", a
     /// measurement file relative to the profile; E_VE is its range). The
-    /// bundled default is fixtures/equipment/hene-default.toml (README.md).
+    /// bundled default is fixtures/equipment/hene-default.toml (docs/src/evaluate.md).
     #[arg(long, value_name = "E.toml", help_heading = "Uncertainty")]
     pub equipment: Option<PathBuf>,
 

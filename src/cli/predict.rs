@@ -40,7 +40,7 @@ pub struct PredictArgs {
 
     /// A machine's measured state: a TOML listing its measurement files
     /// (geometry and positioning tests, lines, optics offsets, squareness;
-    /// README, Geometry tests), from which the 21 errors are built. Errors it
+    /// docs/src/geometry.md), from which the 21 errors are built. Errors it
     /// does not measure are the survey's `errors` file's, or zero.
     #[arg(long, value_name = "S.toml", help_heading = "Errors")]
     pub survey: Option<PathBuf>,

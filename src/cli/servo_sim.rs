@@ -1,6 +1,6 @@
-//! `axcomp servo-sim`: simulate a feed axis with a friction model (seed 004)
+//! `axcomp servo-sim`: simulate a feed axis with a friction model (Mendřický (2006))
 //! in the circle test, a force step, a constant-velocity run or an ISO 230-2
-//! cycle, and print what the thesis reports (or the ISO figures).
+//! cycle, and print what Mendřický (2006) reports (or the ISO figures).
 
 use std::path::{Path, PathBuf};
 
@@ -85,7 +85,7 @@ pub struct ServoSimArgs {
     /// One row per constant feed (signed: a run in −x has a negative feed
     /// and current), the mean motor current there; F = K_F3·I of the axis
     /// file. With --reversal also k_s. Prints the values and the servo-sim
-    /// flags that start from them. See README "Identifying the friction".
+    /// flags that start from them. See docs/src/servo.md, "Identifying the friction".
     #[arg(long, value_name = "CSV", help_heading = "Identification")]
     pub identify: Option<PathBuf>,
 
@@ -122,7 +122,7 @@ pub struct ServoSimArgs {
     /// Step uniformly at 1 µs (the reference) instead of adaptively.
     ///
     /// About 100–1000 times slower; the adaptive scheme agrees with it
-    /// within 0.05 µm (see README).
+    /// within 0.05 µm (docs/src/servo.md).
     #[arg(long, help_heading = "Numerics")]
     pub reference: bool,
 

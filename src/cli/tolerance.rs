@@ -1,4 +1,4 @@
-//! `axcomp tolerance`: the Monte Carlo tolerance study of seed 000.
+//! `axcomp tolerance`: the Monte Carlo tolerance study of Valášek (2021).
 //!
 //! Random machines from straightness, positioning, squareness and
 //! carriage-side (saddle mounting face) tolerances, the distribution of their

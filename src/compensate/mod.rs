@@ -18,7 +18,7 @@
 //!    measured range is refused unless extrapolation is asked for (hold the
 //!    end value, or write zero);
 //! 3. the table is shifted so its value at the reference point is zero
-//!    (controllers reference there; default the first point, as seed 001's
+//!    (controllers reference there; default the first point, as Kadlečík's (2019)
 //!    tool does);
 //! 4. in `mean` mode the suggested backlash parameter is −B̄ = mean(x̄↓ − x̄↑).
 //!

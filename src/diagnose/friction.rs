@@ -1,5 +1,5 @@
 //! The friction force behind a reversal the diagnosis found, for an axis
-//! with a servo description (seed 004; README "What friction does to an ISO
+//! with a servo description (Mendřický (2006); docs/src/servo.md "What friction does to an ISO
 //! 230-2 positioning test").
 //!
 //! A drive with its scale in the loop holds, after each approach, the force

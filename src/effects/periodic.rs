@@ -100,7 +100,7 @@ impl Model for Periodic {
 
 impl Periodic {
     /// The sentence on a rotary axis: the order per revolution and what
-    /// commonly causes it (seed 001 and `../shared/spec/standards.md` §6:
+    /// commonly causes it (Kadlečík (2019) and `../shared/spec/standards.md` §6:
     /// eccentricity once, encoder mounting twice per revolution).
     fn rotary_explanation(&self, context: &Context) -> String {
         let order = match self.per_revolution() {

@@ -1,6 +1,6 @@
 //! Heidenhain iTNC 530 nonlinear axis error compensation table (`.COM`): writer and reader.
 //!
-//! Spec and sources: `formats/itnc530/README.md`. \[seen\] seed 001 Fig. 28
+//! Spec and sources: `formats/itnc530/README.md`. \[seen\] Kadlečík (2019) Fig. 28
 //! (the control's table editor: `DATUM` = start of the compensated range,
 //! `DISTANCE` = spacing in mm, columns `NR`, an unlabelled position column,
 //! `1=F() 2=F() 3=F()`…, one value per point in the column of the axis

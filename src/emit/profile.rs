@@ -28,7 +28,7 @@
 //!
 //! Axes missing from the profile get defaults from their letter (X, Y, Z, A,
 //! B, C, U, V, W → iTNC columns 1–9, TNC 640 column = the letter, Sinumerik
-//! `X1`…, LinuxCNC joints 0–8), documented in README.md.
+//! `X1`…, LinuxCNC joints 0–8), documented in docs/src/tables.md.
 //!
 //! Sinumerik CEC table numbers are allocated from the profile
 //! ([`MachineProfile::cec_table`]), so the files of one machine never load

@@ -1,6 +1,6 @@
 //! Heidenhain TNC 640 nonlinear axis error compensation table (`.COM`): writer and reader.
 //!
-//! Spec and sources: `formats/tnc640/README.md`. \[seen\] seed 001 Fig. 29 (the
+//! Spec and sources: `formats/tnc640/README.md`. \[seen\] Kadlečík (2019) Fig. 29 (the
 //! table the seed's after-test on a real TNC 640 used), the MANUALplus 620
 //! technical manual p.716/718 (same NC family: AXISPOS with respect to the
 //! machine datum, BACKLASH with the values measured in the negative
@@ -12,7 +12,7 @@
 //!
 //! Numbers carry an explicit sign: AXISPOS with minimal digits (`+100`,
 //! `+12.5`), values with 4 decimals (`-0.0023`), as Fig. 29 shows. The value
-//! is the mean measured deviation (actual − target), not negated; seed 001's
+//! is the mean measured deviation (actual − target), not negated; Kadlečík's (2019)
 //! after-test confirms the sign (A 9.7 µm → 2.3 µm).
 
 use crate::compensate::cross_axis::CrossAxisTable;

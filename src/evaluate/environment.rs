@@ -2,7 +2,7 @@
 //! the one the recorded air conditions give?
 //!
 //! A Renishaw XL-80 with its XC-80 compensator corrects the laser wavelength
-//! for the air with the simplified empirical Edlén equation of seed 001,
+//! for the air with the simplified empirical Edlén equation of Kadlečík (2019),
 //! eq. (36):
 //!
 //! ```text
@@ -17,7 +17,7 @@
 //!
 //! The `.rtl` file records the factor the laser applied ("Env factor", µm).
 //! `../shared/spec/renishaw-rtl.md` reads it as λ_vac / (2·n_air). The only
-//! real file we have (seed 001's X axis, Table 9; its ENVIRONMENT lines are in
+//! real file we have (Kadlečík's (2019) X axis, Table 9; its ENVIRONMENT lines are in
 //! the spec) says it also holds the normal-temperature correction of the
 //! material: between start and end the factor falls by 0.917 ppm, while
 //! eq. (36) changes n_air by only −0.016 ppm and the material sensor rose by
@@ -54,7 +54,7 @@ pub const AGREEMENT_PPM: f64 = 1.0;
 /// The reference temperature of ISO 1 to which lengths are referred, °C.
 pub const REFERENCE_TEMPERATURE_C: f64 = 20.0;
 
-/// The refractive index of air by seed 001 eq. (36): air temperature °C,
+/// The refractive index of air by Kadlečík (2019) eq. (36): air temperature °C,
 /// pressure kPa (as `Environment` keeps it), relative humidity %.
 ///
 /// # Example
@@ -241,7 +241,7 @@ mod tests {
         }
     }
 
-    /// The ENVIRONMENT lines of seed 001's own X-axis file (Table 9), as the
+    /// The ENVIRONMENT lines of Kadlečík's (2019) own X-axis file (Table 9), as the
     /// `.rtl` spec quotes them.
     fn seed001_table9() -> Environment {
         let pair = |start, end| StartEnd::new(Some(start), Some(end));

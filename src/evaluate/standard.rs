@@ -12,7 +12,7 @@
 //! reversal value B_i = x̄_i↑ − x̄_i↓, the repeatabilities R_i↑ = 2k·s_i↑,
 //! R_i↓ = 2k·s_i↓, R_i = max(k·s_i↑ + k·s_i↓ + |B_i|; R_i↑; R_i↓); per axis A,
 //! A↑, A↓ (the span of x̄ ± k·s), E, E↑, E↓, M, R, R↑, R↓, B = max |B_i| and
-//! the signed mean reversal B̄ (seed 001 eq. (22) swaps two signs in A; the
+//! the signed mean reversal B̄ (Kadlečík (2019) eq. (22) swaps two signs in A; the
 //! spec's form is used), with k = 2. An axis figure is evaluated only when
 //! what it needs is defined at every target.
 //!

@@ -1,7 +1,7 @@
 //! The statistics of each target (ISO 230-2 §2, `../shared/spec/iso230-2.md`):
 //! per direction the number of readings n, the mean positional deviation x̄
 //! and the estimator of the standard uncertainty s (n − 1 in the
-//! denominator, inside the square root: seed 001 eq. (8)/(9) has a typo
+//! denominator, inside the square root: Kadlečík (2019) eq. (8)/(9) has a typo
 //! there). What a standard derives from them (reversal, repeatability, the
 //! axis figures) is the [`Standard`](super::standard::Standard)'s.
 //!

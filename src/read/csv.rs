@@ -1,6 +1,6 @@
 //! axcomp's plain CSV measurement layout: parser and writer.
 //!
-//! For data from any other source. The layout (documented in README.md):
+//! For data from any other source. The layout (documented in docs/src/input-formats.md):
 //! ```text
 //! # axis: X
 //! # machine: MCV 754 Quick

@@ -53,7 +53,7 @@ use crate::read::text::{
 use crate::units::LengthUnit;
 
 /// What `evaluate` and the report say beside an ecmc file's figures: the
-/// ecmc script's own `report.md` differs, and why (README "ecmc's own
+/// ecmc script's own `report.md` differs, and why (docs/src/input-formats.md "ecmc's own
 /// reports", pinned by `tests/it/conformance.rs`).
 pub const VENDOR_REPORT_NOTE: &str = "ecmc's own report of this file will differ: \
     it swaps ↑ and ↓ (REF_DATA_FWD is shown as backward, so B̄ changes sign and the ↑/↓ figures trade places), \

@@ -2,7 +2,7 @@
 //! multi-error (6-DOF) measurements of one linear axis, parser and writer.
 //!
 //! The positioning CSV ([`super::csv`]) with one column per measured error
-//! instead of `deviation_um` (documented in README.md, "Geometry tests"):
+//! instead of `deviation_um` (documented in docs/src/input-formats.md, "Geometry tests"):
 //! ```text
 //! # axis: X
 //! target_mm,run,direction,EYX_um,EZX_um,EBX_urad,ECX_arcsec

@@ -125,7 +125,7 @@ fn not_a_positioning_test(text: &str) -> ParseError {
         Some(line) if geometry::is_header(line.text.trim()) => line.error_at(
             line.text.trim(),
             "this is a geometry test (straightness or angular error columns), not a positioning test: \
-             list it in a survey and give predict --survey S.toml (README, Geometry tests)",
+             list it in a survey and give predict --survey S.toml (docs/src/geometry.md)",
         ),
         _ => unknown_format_error(),
     }

@@ -574,7 +574,7 @@ pub fn render(report: &DiagnoseJson) -> String {
         "\n{heading:<width$} |  measured | predicted | predicted with effects   ({}{})",
         report.standard_name,
         if report.definitions_reconstructed {
-            "; definitions reconstructed from public sources (README, Standards)"
+            "; definitions reconstructed from public sources (docs/src/evaluate.md, Standards)"
         } else {
             ""
         }

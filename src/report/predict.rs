@@ -426,7 +426,7 @@ pub fn render(report: &PredictJson) -> String {
     if report.definitions_reconstructed {
         let _ = writeln!(
             out,
-            "             definitions reconstructed from public sources, not read in the standard (README, Standards)"
+            "             definitions reconstructed from public sources, not read in the standard (docs/src/evaluate.md, Standards)"
         );
     }
     for retest in report.retest.iter().chain(&report.also) {

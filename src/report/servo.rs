@@ -27,7 +27,7 @@
 //!                              "deviation_um": …, "scale_deviation_um": …, "friction_n": …}, …]} }
 //! ```
 //!
-//! `reversal_error_um` is the thesis's quadrant error (Tab. 6.4 xe/ye): the
+//! `reversal_error_um` is Mendřický's (2006) quadrant error (Tab. 6.4 xe/ye): the
 //! mean over this axis's reversals of the peak |following error|;
 //! `reversal_current_a` likewise for |current|. In `iso230_2`, `B` is
 //! max |B_i| and `B_mean` the signed mean (↑ minus ↓); `deviation_um` is what
@@ -69,7 +69,7 @@ pub struct ServoSimJson {
     pub axis_source: String,
     /// Friction model: classic, ramp, power, lugre.
     pub friction: &'static str,
-    /// The thesis's label: A, B1, B2, C.
+    /// Mendřický's (2006) label: A, B1, B2, C.
     pub friction_label: &'static str,
     /// Test: circle, step, constant-velocity, iso230-2.
     pub test: &'static str,

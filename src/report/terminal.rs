@@ -38,7 +38,7 @@ pub fn evaluation_report(report: &EvaluationJson) -> String {
     if report.definitions_reconstructed {
         let _ = write!(
             out,
-            "\nDefinitions reconstructed from public sources, not read in the standard (README, Standards)."
+            "\nDefinitions reconstructed from public sources, not read in the standard (docs/src/evaluate.md, Standards)."
         );
     }
     out.push('\n');

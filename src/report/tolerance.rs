@@ -25,12 +25,12 @@
 //! (`model::guideway::SaddleFaces`): `parallelism` of its carriage mounting
 //! faces to its datum face, `flatness` of the four faces.
 //! `sensitivity` is present only with `--sweep`: the six rail tolerances,
-//! `"all"` (all six straightness tolerances scaled together, seed 000 Tab.
+//! `"all"` (all six straightness tolerances scaled together, Valášek (2021) Tab.
 //! 4.12), then the six carriage-side tolerances (`X.carriage_parallelism`,
 //! `X.carriage_flatness`, …). `side` is `rail`, `carriage` or `all`; `rank`
 //! orders the single tolerances of both sides by slope, 1 the largest
 //! (`null` for `all` and for a row without a slope).
-//! `normal` is the thesis's "vertical" straightness (normal to the rail
+//! `normal` is Valášek's (2021) "vertical" straightness (normal to the rail
 //! mounting face), `lateral` its "horizontal". `p90` is the 90th percentile
 //! (linear interpolation, as NumPy's default). `slope_um_per_mm` is the
 //! least-squares slope of `p90_um` over `values_mm` (`null` with fewer than
@@ -46,7 +46,7 @@
 //!                                           "lateral": {…}}} }
 //! ```
 //!
-//! `p10` of the improvement is what the thesis calls its "P90": 9 of 10
+//! `p10` of the improvement is what Valášek (2021) calls its "P90": 9 of 10
 //! axes improve at least this much.
 
 use std::collections::BTreeMap;
@@ -323,7 +323,7 @@ pub struct ImprovementSummaryJson {
     pub min: f64,
     /// Largest.
     pub max: f64,
-    /// 10th percentile (the thesis's "P90").
+    /// 10th percentile (Valášek's (2021) "P90").
     pub p10: f64,
 }
 

@@ -135,7 +135,7 @@ pub fn terminal(uncertainty: &UncertaintyJson, evaluated: &[&str]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "\nMeasurement uncertainty (ISO 230-2:2014 Annex A, ISO/TR 230-9; README, Measurement uncertainty)\n{}\n{table}\n{}.",
+        "\nMeasurement uncertainty (ISO 230-2:2014 Annex A, ISO/TR 230-9; docs/src/evaluate.md, Measurement uncertainty)\n{}\n{table}\n{}.",
         uncertainty.summary(evaluated),
         NOT_EVALUATED_NOTE
     );

@@ -64,7 +64,7 @@ pub enum Stepping {
 
 impl Stepping {
     /// The adaptive scheme with the tolerance the speed and accuracy figures
-    /// are stated for (README): a change of 2 N over 125 µs is a smooth
+    /// are stated for (docs/src/servo.md): a change of 2 N over 125 µs is a smooth
     /// change (acceleration times μ_v) that the implicit step follows to well
     /// under 0.01 µm; a friction jump at a reversal is 100 N or more.
     pub const DEFAULT: Stepping = Stepping::Adaptive {

@@ -1,5 +1,5 @@
 //! The survey against a synthetic machine with a known truth (`synth::geometry`)
-//! and the notes' first-order expansion of the thesis chain (§2.5).
+//! and the notes' first-order expansion of Valášek's (2021) chain (§2.5).
 
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
@@ -92,7 +92,7 @@ fn a_synthetic_machine_is_predicted_off_the_measured_lines() {
 #[test]
 fn squareness_equals_the_truth_in_both_conventions() {
     // To 1 µrad with both sign conventions. Expected
-    // from the notes' §2.5 expansion of the thesis chain (ZFYX), not from
+    // from the notes' §2.5 expansion of Valášek's (2021) chain (ZFYX), not from
     // the model: EXOY adds EXOY·Y to E_x and EXOY·X to E_y, so the angle
     // X–Y is 90° − 2·EXOY; EXOZ adds EXOZ·Z to E_x only: 90° − EXOZ;
     // EYOZ adds −EYOZ·Z to E_y only: 90° + EYOZ.

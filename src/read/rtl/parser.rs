@@ -207,7 +207,7 @@ impl RtlParser {
                         value,
                         format!(
                             "found Owner : {value}, a rotary axis test: the layout of Renishaw's rotary files is not public, \
-                             so it is not read; export the data as CSV with the header target_deg,run,direction,deviation_arcsec (README, CSV)"
+                             so it is not read; export the data as CSV with the header target_deg,run,direction,deviation_arcsec (docs/src/input-formats.md, The CSV layout)"
                         ),
                     ));
                 }
@@ -228,7 +228,7 @@ impl RtlParser {
                         format!(
                             "found Owner : {value}, a straightness or angular test: no sample of Renishaw's layout for it is public, \
                              so it is not read (a wrong guess would put the wrong error in the model); export the readings as CSV \
-                             with error columns (target_mm,run,direction,EYX_um,… or EBX_urad,…; README, Geometry tests)"
+                             with error columns (target_mm,run,direction,EYX_um,… or EBX_urad,…; docs/src/input-formats.md, Geometry tests)"
                         ),
                     ));
                 }
