@@ -268,7 +268,7 @@ fn a_test_that_covers_two_of_the_axis_points_is_refused() {
     assert_eq!(run.code, 2, "{}", run.stdout);
     assert!(
         run.stderr.contains(
-            "the measured range 0 … 750 holds 2 of the 42 compensation points of axis X (-1600 … 40"
+            "the measured range 0 … 750 mm holds 2 of the 42 compensation points of axis X (-1600 … 40 mm"
         ),
         "{}",
         run.stderr

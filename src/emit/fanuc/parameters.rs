@@ -101,6 +101,11 @@ impl AxisParameters {
         self.detection_unit * self.magnification as f64
     }
 
+    /// The unit of the axis' positions: `°` on a rotary axis, else `mm`.
+    pub fn length_unit(&self) -> &'static str {
+        if self.rotary { "°" } else { "mm" }
+    }
+
     /// The machine position of point `point`, mm or °.
     pub fn position(&self, point: i64) -> f64 {
         self.reference_position + (point - self.reference_point) as f64 * self.interval

@@ -25,12 +25,13 @@ pub fn points_in(p: &AxisParameters, first_mm: f64, last_mm: f64) -> Result<(f64
     let reference = p.position(p.reference_point);
     let all = p.most_positive - p.first_point() + 1;
     let (low, high) = (p.position(p.first_point()), p.position(p.most_positive));
+    let unit = p.length_unit();
     // A table of one or two points is no compensation (one section, and a
     // test that far off the axis' points is most likely in other
     // coordinates than the control's machine coordinates).
     if inside.len() < MIN_POINTS {
         return Err(format!(
-            "the measured range {first_mm} … {last_mm} holds {} of the {all} compensation points of axis {} ({low} … {high}, {}): too few for a table; check that the test's positions are the control's machine coordinates (1240 = {} at the reference point 3620 = {}) and measure over the axis' points",
+            "the measured range {first_mm} … {last_mm} {unit} holds {} of the {all} compensation points of axis {} ({low} … {high} {unit}, {}): too few for a table; check that the test's positions are the control's machine coordinates (1240 = {} {unit} at the reference point 3620 = {}) and measure over the axis' points",
             inside.len(),
             p.axis,
             p.source,
@@ -43,7 +44,7 @@ pub fn points_in(p: &AxisParameters, first_mm: f64, last_mm: f64) -> Result<(f64
             Ok((p.position(*a), inside.len()))
         }
         _ => Err(format!(
-            "the reference point 3620 = {} of axis {} is at {reference} ({}), outside the measured range {first_mm} … {last_mm}: the Fanuc compensation is zero there, so the test must reach it",
+            "the reference point 3620 = {} of axis {} is at {reference} {unit} ({}), outside the measured range {first_mm} … {last_mm} {unit}: the Fanuc compensation is zero there, so the test must reach it",
             p.reference_point, p.axis, p.source
         )),
     }
@@ -70,11 +71,12 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     let all = (p.most_positive - p.first_point() + 1) as usize;
     if p.from_backup && table.positions_mm.len() * 2 < all {
         notes.push(format!(
-            "Fanuc: the test covers {} of the {all} compensation points of axis {} ({} … {}); the others keep their old values, which this test does not check",
+            "Fanuc: the test covers {} of the {all} compensation points of axis {} ({} … {} {}); the others keep their old values, which this test does not check",
             table.positions_mm.len(),
             p.axis,
             p.position(p.first_point()),
-            p.position(p.most_positive)
+            p.position(p.most_positive),
+            p.length_unit()
         ));
     }
     if let Some(k) = closing_point(table, &p) {
