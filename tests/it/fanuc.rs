@@ -164,6 +164,13 @@ fn every_real_file_reads() {
     );
 }
 
+/// The synthetic test of X (seed 30) written to `directory`/x.rtl: its path.
+pub(crate) fn synthetic_x(directory: &Path) -> String {
+    let x = directory.join("x.rtl").display().to_string();
+    ok(&["synth", "--truth", &truth(), "-o", &x, "--seed", "30"]);
+    x
+}
+
 /// The synthetic test of X (seed `seed`) measured with the real pitch file
 /// active under `parameters`, written to `directory`/after.rtl, and
 /// `convert --existing` of it for X with `flags`: (after.rtl, the run).
@@ -319,15 +326,7 @@ fn a_backup_whose_points_the_pitch_file_lacks_is_refused_at_its_position() {
 fn golden_files_read_back() {
     let directory = tempfile::tempdir().unwrap();
     let path = |name: &str| directory.path().join(name).display().to_string();
-    ok(&[
-        "synth",
-        "--truth",
-        &truth(),
-        "-o",
-        &path("x.rtl"),
-        "--seed",
-        "30",
-    ]);
+    synthetic_x(directory.path());
     // With the machine's parameters: X's points 0 … 41, the measured ones
     // 15 … 40, the others holding the compensation (0).
     let out = path("PITCH.TXT");

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use axcomp::measurement::{Direction, Measurement};
 
-use crate::fanuc::{absolute, data, increments, ok, truth, update_x};
+use crate::fanuc::{absolute, data, increments, ok, synthetic_x, update_x};
 use crate::util::{axcomp, root};
 
 /// The mean reading of `direction` (all directions: `None`) at target `i`, µm.
@@ -60,15 +60,7 @@ fn bidirectional_compensation_needs_3605_and_goes_to_3626() {
     let path = |name: &str| directory.path().join(name).display().to_string();
     let pitch = data("PITCH.TXT");
     // The real backup has 3605#0 = 0 on X: refused, with what to set.
-    ok(&[
-        "synth",
-        "--truth",
-        &truth(),
-        "-o",
-        &path("x.rtl"),
-        "--seed",
-        "30",
-    ]);
+    synthetic_x(directory.path());
     let run = axcomp([
         "convert",
         &path("x.rtl"),
@@ -368,15 +360,7 @@ fn the_new_golden_files_read_back() {
     use axcomp::emit::{EmitOptions, MachineProfile};
     let directory = tempfile::tempdir().unwrap();
     let path = |name: &str| directory.path().join(name).display().to_string();
-    ok(&[
-        "synth",
-        "--truth",
-        &truth(),
-        "-o",
-        &path("x.rtl"),
-        "--seed",
-        "30",
-    ]);
+    synthetic_x(directory.path());
     // Bidirectional without a backup: X's 26 targets −1000 … 0 mm are
     // points 0 … 25 (3620 = 0 at −1000 mm, 3621 = 1, 3622 = 25), the ↓
     // table right after (3626 = 26 … 50), 1 µm units (0.001 mm, 3623 = 1).
