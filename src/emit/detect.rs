@@ -20,54 +20,43 @@ pub fn read_any(
     let Some(axis) = options.axes.first() else {
         return Err(ParseError::new(1, 1, "no axis given to read the table of"));
     };
-    let first = text
-        .lines()
-        .map(str::trim)
-        .find(|l| !l.is_empty())
-        .unwrap_or("");
-    let (controller, mut table) = if fanuc::looks_like(text) {
-        let Some(parameters) = &axis.fanuc else {
-            return Err(ParseError::new(
-                1,
-                1,
-                "a Fanuc pitch error compensation file counts in units the parameter backup gives (3620–3624, 1820): give it with --fanuc-parameters CNC-PARA.TXT",
-            ));
-        };
-        (Controller::Fanuc, fanuc::read(text, parameters)?)
-    } else if fanuc::looks_like_parameters(text) {
+    if !fanuc::looks_like(text) && fanuc::looks_like_parameters(text) {
         return Err(ParseError::new(
             1,
             1,
             "this is a Fanuc parameter backup (N…Q1 lines), not the pitch error compensation data: give it with --fanuc-parameters and the pitch file (PITCH.TXT, N1…Q0 lines) as the table",
         ));
-    } else if fagor8065::looks_like(text) {
-        (Controller::Fagor8065, fagor8065::read(text, &axis.axis)?)
-    } else if fagor8055::looks_like(text) {
-        let table = fagor8055::read(text, &axis.axis, options.machine_unit)?;
-        (Controller::Fagor8055, table)
-    } else if first.starts_with("BEGIN") && first.contains("DATUM") {
-        (
-            Controller::Itnc530,
-            itnc530::read(text, axis.itnc530_column)?,
-        )
-    } else if first.starts_with("BEGIN") {
-        (Controller::Tnc640, tnc640::read(text, &axis.tnc640_column)?)
-    } else if first.starts_with('%') || text.contains("$AA_ENC_COMP") || text.contains("$AN_CEC") {
-        let table = sinumerik840d::read(
-            text,
-            &axis.sinumerik_axis,
-            options.cec_values_are_corrections,
-        )?;
-        (Controller::Sinumerik840d, table)
-    } else if first.split_whitespace().count() == 3 {
-        let table = linuxcnc::read(text, &axis.axis, linuxcnc_type, options.file_unit())?;
-        (Controller::LinuxCnc, table)
-    } else {
+    }
+    let Some(controller) = detect(text) else {
         return Err(ParseError::new(
             1,
             1,
             "unknown compensation table format: expected a Heidenhain .COM (BEGIN …), a Sinumerik .MPF (%_N_…), a LinuxCNC COMP_FILE (nominal forward reverse), a Fagor 8055 AL<axis> (P0001 X … EX … EX …), a Fagor 8065 .mp (/LSCRWDATA/…) or a Fanuc pitch file (%, N10000Q0P…)",
         ));
+    };
+    let mut table = match controller {
+        Controller::Fanuc => {
+            let Some(parameters) = &axis.fanuc else {
+                return Err(ParseError::new(
+                    1,
+                    1,
+                    "a Fanuc pitch error compensation file counts in units the parameter backup gives (3620–3624, 1820): give it with --fanuc-parameters CNC-PARA.TXT",
+                ));
+            };
+            fanuc::read(text, parameters)?
+        }
+        Controller::Fagor8065 => fagor8065::read(text, &axis.axis)?,
+        Controller::Fagor8055 => fagor8055::read(text, &axis.axis, options.machine_unit)?,
+        Controller::Itnc530 => itnc530::read(text, axis.itnc530_column)?,
+        Controller::Tnc640 => tnc640::read(text, &axis.tnc640_column)?,
+        Controller::Sinumerik840d => sinumerik840d::read(
+            text,
+            &axis.sinumerik_axis,
+            options.cec_values_are_corrections,
+        )?,
+        Controller::LinuxCnc => {
+            linuxcnc::read(text, &axis.axis, linuxcnc_type, options.file_unit())?
+        }
     };
     table.axis = axis.axis.clone();
     Ok((controller, table))
