@@ -18,6 +18,7 @@ mod convert;
 mod cross_axis;
 mod demo;
 mod diagnose;
+mod diagnose_wire;
 mod diagnose_periodic;
 mod doc_examples;
 mod evaluate_ecmc;
