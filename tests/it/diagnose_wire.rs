@@ -120,3 +120,63 @@ fn rotary_reversal_keeps_its_keys() {
     assert_diagnose("rotary-reversal.json", &["--after", file, "--json", "-q"]);
     assert_diagnose("rotary-reversal.txt", &["--after", file, "-q"]);
 }
+
+/// The keys of the objects at `indent` spaces in pretty-printed JSON, in
+/// the order written (serde_json's `Value` keeps them sorted, so they are
+/// read from the text).
+fn keys_at(text: &str, indent: usize) -> Vec<&str> {
+    let prefix = format!("{}\"", " ".repeat(indent));
+    text.lines()
+        .filter_map(|line| line.strip_prefix(prefix.as_str()))
+        .filter_map(|rest| rest.split_once("\":").map(|(key, _)| key))
+        .collect()
+}
+
+/// The text from the first `from` to the next `to` after it.
+fn block<'a>(text: &'a str, from: &str, to: &str) -> &'a str {
+    let start = text.find(from).unwrap();
+    &text[start..start + text[start..].find(to).unwrap()]
+}
+
+/// A rotary axis' `diagnose --json` writes its keys in the order a linear
+/// axis' does, with `axis_kind` after the files (they were sorted by name,
+/// a side effect of renaming them at run time): the same object, the
+/// evidence and the figures in the standard's order (`A`, `A_up`, …).
+#[test]
+fn rotary_keys_are_in_the_linear_order() {
+    let linear =
+        std::fs::read_to_string(test_data("golden/diagnose/linear-periodic.json")).unwrap();
+    for (name, unit) in [
+        ("rotary-retest.json", "arcsec"),
+        ("rotary-retest-urad.json", "urad"),
+    ] {
+        let rotary =
+            std::fs::read_to_string(test_data(&format!("golden/diagnose/{name}"))).unwrap();
+        let in_rotary_units = |keys: Vec<&str>| -> Vec<String> {
+            keys.into_iter()
+                .map(|key| {
+                    key.replace("_um", &format!("_{unit}"))
+                        .replace("_mm", "_deg")
+                })
+                .collect()
+        };
+        let mut expected = in_rotary_units(keys_at(&linear, 2));
+        expected.insert(3, "axis_kind".to_string());
+        assert_eq!(keys_at(&rotary, 2), expected, "{name}");
+        // The effect's keys and its evidence's (the one periodic effect of each).
+        assert_eq!(
+            keys_at(block(&rotary, "\"effects\"", "\"rejected\""), 6),
+            keys_at(block(&linear, "\"effects\"", "\"rejected\""), 6),
+            "{name}"
+        );
+        assert_eq!(
+            keys_at(block(&rotary, "\"evidence\"", "}"), 8),
+            in_rotary_units(keys_at(block(&linear, "\"evidence\"", "}"), 8)),
+            "{name}"
+        );
+        assert!(
+            rotary.contains("\"measured\": {\n      \"A\": "),
+            "{name}: {rotary}"
+        );
+    }
+}
