@@ -217,3 +217,38 @@ fn automatic_reference_is_the_coldest_sensor() {
     assert_eq!(alone.fit.reference, None);
     assert_eq!(alone.terms[0].sensor, "bearing");
 }
+
+/// With `same_sign`, the rises over the reference take the drift's sign:
+/// a drift of 2 µm/K of the bearing's rise over the room minus 3 µm/K of
+/// the chiller's is fitted exactly by free least squares (+2, −3); held to
+/// the drift's sign (it grows), the chiller cannot enter with −3.
+#[test]
+fn same_sign_keeps_every_rise_in_the_drift_direction() {
+    let mut log = three_sensor_log(|b, r| 2.0 * (b - r));
+    let chiller = log.sensors[1].celsius.clone();
+    let room = log.sensors[2].celsius.clone();
+    let drift = &mut log.drift.as_mut().unwrap().um;
+    for k in 0..drift.len() {
+        drift[k] -= 3.0 * ((chiller[k] - room[k]) - (chiller[0] - room[0]));
+    }
+    assert!(drift.iter().sum::<f64>() > 0.0, "the drift grows");
+    let mut options = FitOptions::over(0..90);
+    options.reference = Some("room".into());
+    options.max_sensors = 2;
+    let coefficient = |model: &ThermalModel, name: &str| {
+        model
+            .terms
+            .iter()
+            .find(|t| t.sensor == name)
+            .map(|t| t.coefficient_um_per_k)
+    };
+    let free = fit(&log, &options).unwrap();
+    assert!((coefficient(&free, "bearing").unwrap() - 2.0).abs() < 1e-9);
+    assert!((coefficient(&free, "chiller").unwrap() + 3.0).abs() < 1e-9);
+    options.same_sign = true;
+    let signed = fit(&log, &options).unwrap();
+    assert!(signed.terms.iter().any(|t| t.sensor == "bearing"));
+    for term in signed.terms.iter().filter(|t| t.sensor != "room") {
+        assert!(term.coefficient_um_per_k >= 0.0, "{term:?}");
+    }
+}
