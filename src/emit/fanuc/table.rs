@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use super::{AxisParameters, POINT_LIMIT, data_line};
+use super::{AxisParameters, POINT_RANGE, data_line, magnification_for};
 use crate::compensate::{CompensationTable, TableMode};
 use crate::emit::{EmitError, EmitOptions};
 use crate::measurement::{AxisKind, Direction};
@@ -61,12 +61,8 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
         .iter()
         .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
     let range = high - low;
-    let largest_step = values
-        .windows(2)
-        .map(|w| (w[1] - w[0]).abs())
-        .fold(0.0, f64::max);
     // The finest magnification whose points still hold every section's change.
-    let finest = ((largest_step / p.detection_unit / POINT_LIMIT as f64).ceil() as i64).max(1);
+    let finest = finest_for_sections(&[values], p.detection_unit);
     let mut notes = Vec::new();
     let all = (p.most_positive - p.first_point() + 1) as usize;
     if p.from_backup && table.positions_mm.len() * 2 < all {
@@ -78,6 +74,9 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
             p.position(p.most_positive),
             p.length_unit()
         ));
+    }
+    if let Some(note) = unknown_bits_note(&p) {
+        notes.push(note);
     }
     if let Some(k) = closing_point(table, &p) {
         let closure = values[k] - values[0];
@@ -99,6 +98,29 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
         ));
     }
     notes
+}
+
+/// The bits of 3605 besides #0 the backup sets, said: their meaning on the
+/// control was not found (`formats/fanuc/README.md`), so the user checks
+/// them before loading a table axcomp computed without them.
+fn unknown_bits_note(p: &AxisParameters) -> Option<String> {
+    let bits = p.unknown_3605_bits();
+    if bits.is_empty() {
+        return None;
+    }
+    let list: Vec<String> = bits.iter().map(|b| format!("#{b}")).collect();
+    Some(format!(
+        "Fanuc: 3605 of axis {} is {} in the parameter backup: {} {} set besides #0 (bidirectional pitch error compensation); axcomp does not know what {} changes (no public Fanuc manual page giving it was found) and wrote the data as 3620–3627 alone describe them: check {} in the control's parameter manual before loading the file",
+        p.axis,
+        p.bits_3605,
+        if bits.len() == 1 { "bit" } else { "bits" },
+        list.join(", "),
+        if bits.len() == 1 { "it" } else { "they" },
+        list.iter()
+            .map(|b| format!("3605{b}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
 }
 
 /// The parameters a table is written with: the backup's, or axcomp's
@@ -325,21 +347,34 @@ fn closing_point(table: &CompensationTable, p: &AxisParameters) -> Option<usize>
         .position(|x| (x - first - turn).abs() < 1e-6)
 }
 
-/// Refuses increments beyond a point's limit, naming the magnification that would hold them.
+/// The finest magnification whose points hold every section of `columns`
+/// (errors, mm or °): a section's increment is the change of the
+/// compensation, the negative of the error's, in detection units.
+pub(super) fn finest_for_sections(columns: &[&[f64]], detection_unit: f64) -> i64 {
+    columns
+        .iter()
+        .flat_map(|c| c.windows(2).map(|w| -(w[1] - w[0]) / detection_unit))
+        .map(magnification_for)
+        .fold(1, i64::max)
+}
+
+/// Refuses increments beyond a point's range ([`POINT_RANGE`]), naming the
+/// magnification that would hold them.
 fn check_limits(increments: &BTreeMap<i64, i64>, p: &AxisParameters) -> Result<(), EmitError> {
-    let Some((&point, &value)) = increments.iter().max_by_key(|(_, v)| v.unsigned_abs()) else {
+    let Some((&point, &value)) = increments.iter().find(|(_, v)| !POINT_RANGE.contains(v)) else {
         return Ok(());
     };
-    if value.unsigned_abs() <= POINT_LIMIT as u64 {
-        return Ok(());
-    }
-    let needed =
-        (value.unsigned_abs() as f64 * p.magnification as f64 / POINT_LIMIT as f64).ceil() as i64;
+    let needed = increments
+        .values()
+        .map(|v| magnification_for(*v as f64 * p.magnification as f64))
+        .fold(1, i64::max);
     Err(EmitError::Profile(format!(
-        "point {point} of axis {} needs {value} × {} = {} mm, beyond ±{POINT_LIMIT} units a point holds (3623 = {}): set 3623 = {needed} (every point rescaled; units of {} mm) and convert again",
+        "point {point} of axis {} needs {value} × {} = {} mm, beyond the {} … {} units a point holds (3623 = {}): set 3623 = {needed} (every point rescaled; units of {} mm) and convert again",
         p.axis,
         crate::emit::minimal(p.unit(), 7),
         crate::emit::minimal(value as f64 * p.unit(), 7),
+        POINT_RANGE.start(),
+        POINT_RANGE.end(),
         p.magnification,
         crate::emit::minimal(p.detection_unit * needed as f64, 7)
     )))
