@@ -43,7 +43,7 @@ fn read(path: &str) -> Measurement {
 /// The real backup with X's bidirectional pitch error compensation on
 /// (3605 = 00000011) and its table for travel in the negative direction at
 /// points 50 … 90 (3626 = 50; the real pitch file holds 0 there), 3627 = 0.
-fn bidirectional_backup(directory: &Path) -> String {
+pub(crate) fn bidirectional_backup(directory: &Path) -> String {
     let text = std::fs::read_to_string(data("CNC-PARA.TXT")).unwrap();
     let changed = text
         .replace("N03605Q1A1P00000010A2", "N03605Q1A1P00000011A2")
