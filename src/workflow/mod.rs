@@ -315,7 +315,7 @@ pub fn convert(
     report.notes = plan.table_notes;
     if table.controller == Controller::Fanuc {
         report
-            .effects
+            .notes
             .extend(emit::fanuc::notes(&compensation, options));
     }
     if measurement.kind() == AxisKind::Linear {

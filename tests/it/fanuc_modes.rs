@@ -178,7 +178,7 @@ fn the_rescaled_alternative_keeps_the_compensation_in_a_finer_unit() {
     // sections (at most 5 units × 10 = 50 of 0.1 µm) is 1.
     assert!(
         run.stdout
-            .contains("set 3623 of axis X to 1 (it is 10: units of 0.0001 instead of 0.001 mm)"),
+            .contains("set 3623 of axis X to 1 (it is 10: units of 0.0001 mm instead of 0.001 mm)"),
         "{}",
         run.stdout
     );
@@ -320,6 +320,12 @@ fn a_rotary_axis_turn_sums_to_zero_and_its_backlash_is_in_degrees() {
         "{note}"
     );
     assert!(note.contains("negative an axis that overshoots"), "{note}");
+    // B's unit in degrees: 1820 = 20 (CMR 10), 0.001° / 10 × 3623 = 1.
+    let activation = json["activation"].as_str().unwrap();
+    assert!(
+        activation.contains("in units of 0.0001° (detection unit 0.0001° × 3623 = 1)"),
+        "{activation}"
+    );
     // Half a turn updated into the real file: B's old points 307 … 312 with
     // the new 301 … 306 no longer sum to zero over the turn: refused.
     let half = axcomp::synth::rotary_test(&truth(180.0, 7), 8).unwrap();

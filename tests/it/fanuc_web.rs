@@ -118,6 +118,9 @@ fn the_rescaled_file_on_the_web_is_the_clis() {
         json["text"].as_str().unwrap().as_bytes(),
         read(Path::new(&new))
     );
+    // The page shows `notes` (not `effects`): the unknown bit of 3605 among them.
+    let notes = json["convert"]["notes"].to_string();
+    assert!(notes.contains("3605 of axis X is 00000010"), "{notes}");
     // Without the option the answer has none; for another controller it is
     // refused with the CLI's words.
     let form = update_form(&after, &data("CNC-PARA.TXT"), &[]);

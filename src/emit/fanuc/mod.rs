@@ -130,7 +130,13 @@ pub fn activation(file_name: &str, table: &CompensationTable, options: &EmitOpti
             } else {
                 ""
             };
-            format!("{} ({what}){backlash}", p.settings())
+            format!(
+                "{} ({what}); its values are increments per section in units of {} (detection unit {} × 3623 = {}){backlash}",
+                p.settings(),
+                p.unit_text(p.unit()),
+                p.unit_text(p.detection_unit),
+                p.magnification
+            )
         },
     );
     format!(

@@ -105,6 +105,15 @@ impl AxisParameters {
         self.detection_unit * self.magnification as f64
     }
 
+    /// `value` (mm or °) as the user reads it: `0.001 mm`, `0.0001°`.
+    pub fn unit_text(&self, value: f64) -> String {
+        let number = crate::emit::minimal(value, 7);
+        match self.rotary {
+            true => format!("{number}°"),
+            false => format!("{number} mm"),
+        }
+    }
+
     /// The unit of the axis' positions: `°` on a rotary axis, else `mm`.
     pub fn length_unit(&self) -> &'static str {
         if self.rotary { "°" } else { "mm" }

@@ -75,11 +75,11 @@ pub fn rescaled(
         None => write(table, &fine_options)?,
     };
     let instruction = format!(
-        "set 3623 of axis {} to {m} (it is {}: units of {} instead of {} mm) together with loading this file, in place of the one at 3623 = {}; then turn the power off and on and return the axis to the reference position",
+        "set 3623 of axis {} to {m} (it is {}: units of {} instead of {}) together with loading this file, in place of the one at 3623 = {}; then turn the power off and on and return the axis to the reference position",
         p.axis,
         p.magnification,
-        crate::emit::minimal(fine.unit(), 7),
-        crate::emit::minimal(p.unit(), 7),
+        p.unit_text(fine.unit()),
+        p.unit_text(p.unit()),
         p.magnification
     );
     Ok(Rescaled {

@@ -89,11 +89,11 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     }
     if p.unit() > range / 10.0 && finest < p.magnification {
         notes.push(format!(
-            "Fanuc: 3623 = {} gives steps of {} mm, coarse for an error of {} mm peak to valley; 3623 = {finest} would give {} mm steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data: convert --fanuc-rescaled FILE writes it)",
+            "Fanuc: 3623 = {} gives steps of {}, coarse for an error of {} peak to valley; 3623 = {finest} would give {} steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data: convert --fanuc-rescaled FILE writes it)",
             p.magnification,
-            crate::emit::minimal(p.unit(), 7),
-            crate::emit::minimal(range, 4),
-            crate::emit::minimal(p.detection_unit * finest as f64, 7),
+            p.unit_text(p.unit()),
+            p.unit_text((range * 1e4).round() / 1e4),
+            p.unit_text(p.detection_unit * finest as f64),
             p.magnification
         ));
     }
@@ -369,14 +369,14 @@ fn check_limits(increments: &BTreeMap<i64, i64>, p: &AxisParameters) -> Result<(
         .map(|v| magnification_for(*v as f64 * p.magnification as f64))
         .fold(1, i64::max);
     Err(EmitError::Profile(format!(
-        "point {point} of axis {} needs {value} × {} = {} mm, beyond the {} … {} units a point holds (3623 = {}): set 3623 = {needed} (every point rescaled; units of {} mm) and convert again",
+        "point {point} of axis {} needs {value} × {} = {}, beyond the {} … {} units a point holds (3623 = {}): set 3623 = {needed} (every point rescaled; units of {}) and convert again",
         p.axis,
-        crate::emit::minimal(p.unit(), 7),
-        crate::emit::minimal(value as f64 * p.unit(), 7),
+        p.unit_text(p.unit()),
+        p.unit_text(value as f64 * p.unit()),
         POINT_RANGE.start(),
         POINT_RANGE.end(),
         p.magnification,
-        crate::emit::minimal(p.detection_unit * needed as f64, 7)
+        p.unit_text(p.detection_unit * needed as f64)
     )))
 }
 
