@@ -558,7 +558,8 @@ fn the_unknown_bit_of_3605_is_said() {
     let json = convert_with(&|_| data("CNC-PARA.TXT"));
     let notes = json["notes"].to_string();
     assert!(
-        notes.contains("3605 of axis X is 00000010 in the parameter backup: bit #1 set besides #0")
+        notes.contains("3605 of axis X is 00000010 in the parameter backup (")
+            && notes.contains("HM100TS__CNC-PARA.TXT:1411:12): bit #1 set besides #0")
             && notes.contains("check 3605#1 in the control's parameter manual"),
         "{notes}"
     );

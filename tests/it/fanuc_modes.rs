@@ -75,7 +75,9 @@ fn bidirectional_compensation_needs_3605_and_goes_to_3626() {
     ]);
     assert_eq!(run.code, 2, "{}", run.stdout);
     assert!(
-        run.stderr.contains("3605#0 of axis X is 0")
+        run.stderr
+            .contains("3605#0 of axis X is 0 in the parameter backup (3605 = 00000010 at ")
+            && run.stderr.contains("HM100TS__CNC-PARA.TXT:1411:12)")
             && run.stderr.contains("set 3605#0 = 1 and 3626"),
         "{}",
         run.stderr

@@ -51,6 +51,9 @@ pub struct AxisParameters {
     /// 3605 as the backup has it (8 bits, `#7 … #0`; empty without a
     /// backup): its other bits are not known to axcomp (`notes` says so).
     pub bits_3605: String,
+    /// Where 3605 of the axis stands in the backup (`FILE:LINE:COL`; empty
+    /// without a backup).
+    pub at_3605: String,
     /// 3626: with 3605#0, the most negative point of the table for travel
     /// in the negative direction (its points 3626 … 3626 + 3622 − 3621).
     pub negative_first: i64,
@@ -89,6 +92,7 @@ impl AxisParameters {
             travel_per_turn: 0.0,
             bidirectional: false,
             bits_3605: String::new(),
+            at_3605: String::new(),
             negative_first: 0,
             reference_negative: 0,
             reference_position: at,
@@ -364,6 +368,9 @@ impl ParameterBackup {
             travel_per_turn: self.real(3625, a).unwrap_or(0.0),
             bidirectional: self.bit(3605, a, 0)?,
             bits_3605: self.value(3605, a)?.value.clone(),
+            at_3605: self
+                .value(3605, a)
+                .map(|e| format!("{}:{}:{}", self.source, e.line, e.column))?,
             // [manual] A-77810E table (a); absent on a control without the function.
             negative_first: self.integer(3626, a).unwrap_or(0),
             reference_negative: self.integer(3627, a).unwrap_or(0),

@@ -110,9 +110,10 @@ fn unknown_bits_note(p: &AxisParameters) -> Option<String> {
     }
     let list: Vec<String> = bits.iter().map(|b| format!("#{b}")).collect();
     Some(format!(
-        "Fanuc: 3605 of axis {} is {} in the parameter backup: {} {} set besides #0 (bidirectional pitch error compensation); axcomp does not know what {} changes (no public Fanuc manual page giving it was found) and wrote the data as 3620–3627 alone describe them: check {} in the control's parameter manual before loading the file",
+        "Fanuc: 3605 of axis {} is {} in the parameter backup ({}): {} {} set besides #0 (bidirectional pitch error compensation); axcomp does not know what {} changes (no public Fanuc manual page giving it was found) and wrote the data as 3620–3627 alone describe them: check {} in the control's parameter manual before loading the file",
         p.axis,
         p.bits_3605,
+        p.at_3605,
         if bits.len() == 1 { "bit" } else { "bits" },
         list.join(", "),
         if bits.len() == 1 { "it" } else { "they" },
@@ -262,9 +263,10 @@ fn check_mode(table: &CompensationTable, p: &AxisParameters) -> Result<(), EmitE
     match (table.values.mode(), p.bidirectional) {
         (TableMode::Mean, false) | (TableMode::Bidirectional, true) => Ok(()),
         (TableMode::Bidirectional, false) => Err(EmitError::Profile(format!(
-            "3605#0 of axis {} is 0 in the parameter backup ({}): the control compensates pitch error the same in both directions; for a table per direction (if the control has bidirectional pitch error compensation) set 3605#0 = 1 and 3626 to the first of {} free points, give the changed backup and convert again; else use --mode mean and set the backlash parameters 1851/1852",
+            "3605#0 of axis {} is 0 in the parameter backup (3605 = {} at {}): the control compensates pitch error the same in both directions; for a table per direction (if the control has bidirectional pitch error compensation) set 3605#0 = 1 and 3626 to the first of {} free points, give the changed backup and convert again; else use --mode mean and set the backlash parameters 1851/1852",
             p.axis,
-            p.source,
+            p.bits_3605,
+            p.at_3605,
             p.most_positive - p.most_negative + 1
         ))),
         (TableMode::Mean, true) => Err(EmitError::Profile(format!(
