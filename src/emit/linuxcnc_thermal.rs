@@ -11,8 +11,24 @@
 //! scale(9), sum2(9), conv_float_s32(9); the External Offsets chapter of the
 //! LinuxCNC 2.9 documentation): `lowpass.N.gain` is a parameter and
 //! `lowpass.N.load` a pin that copies `in` to `out`; external offsets need
-//! `[AXIS_L]OFFSET_AV_RATIO` in the INI and `axis.L.eoffset-enable`.
+//! `[AXIS_L]OFFSET_AV_RATIO` in the INI and `axis.L.eoffset-enable`. A
+//! component module is loaded once: beside a configuration that loads the
+//! same components, the file needs `[HAL]TWOPASS`, which combines the
+//! `loadrt` lines of all HAL files when they all use `names=` (LinuxCNC 2.9
+//! `twopass.tcl`; the HAL manual's "Twopass" chapter).
 //! `conv_float_s32` truncates toward zero: the offset is within 1 nm.
+//!
+//! The motion controller takes `eoffset-counts` as increments: each period
+//! it adds the change of the counts since the last period, but only while
+//! the machine is on and every joint homed, and it zeroes the offset when
+//! the machine is switched on (LinuxCNC 2.9 `src/emc/motion/control.c`,
+//! `plan_external_offsets`; motion(9): "the register is reset to zero at
+//! each machine startup"). The model runs from the file's loading, so its
+//! offset is already there at switch-on: fed straight in, it would be lost
+//! and only its later changes applied. The counts therefore pass a gate
+//! (`and2` of `motion.motion-enabled` and `motion.is-all-homed` selecting a
+//! `mux2`) and are 0 until the machine is on and homed: their first change
+//! is then the whole offset, and switching off and on again repeats it.
 
 use crate::thermal::ThermalModel;
 use crate::units::um_to_mm;
@@ -20,12 +36,14 @@ use crate::units::um_to_mm;
 /// The offset's resolution, mm per count (`axis.L.eoffset-scale`).
 pub const EOFFSET_SCALE_MM: f64 = 1e-6;
 
-/// The lowpass gain of a lag `tau_s` updated every `period_s`.
+/// The lowpass gain of a lag `tau_s` updated every `period_s`:
+/// `1 − e^(−T/τ)`, as `−expm1(−T/τ)`, which keeps its digits where T/τ is
+/// tiny (1 ms against hours: `1 − e^(−x)` would lose ten of them).
 pub fn lowpass_gain(tau_s: f64, period_s: f64) -> f64 {
     if tau_s <= 0.0 {
         1.0
     } else {
-        1.0 - (-period_s / tau_s).exp()
+        -(-period_s / tau_s).exp_m1()
     }
 }
 
@@ -46,7 +64,12 @@ pub fn write_hal(model: &ThermalModel, axis: &str, period_s: f64, thread: &str) 
          # Fitted on rows {}-{} of the drift {:?}; prediction uncertainty {:.2} um (1 sigma).\n\
          # Connect each temperature (degC) to its signal, e.g. net thermal-T0 <= <sensor pin>.\n\
          # Hold thermal-load TRUE for the first period: the lags start at the first reading.\n\
-         # Needs [AXIS_{}]OFFSET_AV_RATIO in the INI (external offsets, LinuxCNC 2.8+).\n",
+         # Needs [AXIS_{}]OFFSET_AV_RATIO in the INI (external offsets, LinuxCNC 2.8+).\n\
+         # Links motion.motion-enabled and motion.is-all-homed: where the configuration\n\
+         # has them on signals already, use those signals in the two nets below.\n\
+         # A component is loaded once: where the configuration loads lowpass, scale, sum2,\n\
+         # and2, mux2 or conv_float_s32 too, set [HAL]TWOPASS = on (LinuxCNC then combines\n\
+         # the loadrt lines of all HAL files; they must all use names=, not count=).\n",
         model.fit.first_row,
         model.fit.last_row,
         model.fit.drift,
@@ -72,7 +95,11 @@ pub fn write_hal(model: &ThermalModel, axis: &str, period_s: f64, thread: &str) 
             names("thermal-sum-", n - 1, 1)
         ));
     }
-    hal.push_str("loadrt conv_float_s32 names=thermal-counts\n");
+    hal.push_str(
+        "loadrt and2 names=thermal-ready\n\
+         loadrt mux2 names=thermal-gate\n\
+         loadrt conv_float_s32 names=thermal-counts\n",
+    );
     for k in 0..n {
         hal.push_str(&format!("addf thermal-lag-{k} {thread}\n"));
     }
@@ -83,7 +110,10 @@ pub fn write_hal(model: &ThermalModel, axis: &str, period_s: f64, thread: &str) 
         hal.push_str(&format!("addf thermal-sum-{k} {thread}\n"));
     }
     hal.push_str(&format!(
-        "addf thermal-to-counts {thread}\naddf thermal-counts {thread}\n"
+        "addf thermal-to-counts {thread}\n\
+         addf thermal-ready {thread}\n\
+         addf thermal-gate {thread}\n\
+         addf thermal-counts {thread}\n"
     ));
     for (k, term) in model.terms.iter().enumerate() {
         let c_mm = um_to_mm(term.coefficient_um_per_k);
@@ -117,7 +147,13 @@ pub fn write_hal(model: &ThermalModel, axis: &str, period_s: f64, thread: &str) 
     hal.push_str(&format!(
         "net thermal-offset-mm {total} => thermal-to-counts.in\n\
          setp thermal-to-counts.gain {:e}\n\
-         net thermal-offset-counts-float thermal-to-counts.out => thermal-counts.in\n\
+         net thermal-offset-counts-float thermal-to-counts.out => thermal-gate.in1\n\
+         # The counts stay 0 until the machine is on and homed: LinuxCNC adds only\n\
+         # their changes, from then on, to an offset it zeroes at machine on.\n\
+         net thermal-machine-on motion.motion-enabled => thermal-ready.in0\n\
+         net thermal-homed motion.is-all-homed => thermal-ready.in1\n\
+         net thermal-ready thermal-ready.out => thermal-gate.sel\n\
+         net thermal-offset-counts-gated thermal-gate.out => thermal-counts.in\n\
          setp axis.{axis}.eoffset-scale {:e}\n\
          net thermal-offset-counts thermal-counts.out => axis.{axis}.eoffset-counts\n\
          setp axis.{axis}.eoffset-enable 1\n",
