@@ -8,7 +8,8 @@ use axcomp::output::write_new;
 use axcomp::report::chart::chart;
 use axcomp::report::plot::PlotFormat;
 use axcomp::report::thermal as report;
-use axcomp::thermal::{self, FitOptions, LogOptions, TestType, ThermalLog, ThermalModel};
+use axcomp::thermal::{self, LogOptions, TestType, ThermalLog, ThermalModel};
+use axcomp::workflow::thermal::{self as workflow, FitRequest, StudyRequest};
 
 use super::common::{JsonOutput, Overwrite, Verbosity, in_file, load, print_json, print_text};
 
@@ -98,7 +99,7 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub log_args: LogArgs,
     /// The ISO 230-3 test the log records: etve, spindle or linear-axis.
-    #[arg(long = "test", value_name = "TYPE", value_parser = parse_test)]
+    #[arg(long = "test", value_name = "TYPE", value_parser = workflow::test_type)]
     pub test_type: Option<TestType>,
     /// Write the drift against time (.svg or .png).
     #[arg(long = "drift-plot", value_name = "FILE", help_heading = "Output")]
@@ -155,8 +156,8 @@ pub struct FitArgs {
     /// How the cross-validation predicts its blocks: blocked (each from all
     /// the others) or forward (each from the blocks before it only: what
     /// the model does on the machine, predicting the hours after its fit).
-    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = ["blocked", "forward"])]
-    pub validation: String,
+    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = workflow::validation)]
+    pub validation: thermal::Validation,
     /// Write the drift, the model and the residual against time (.svg or .png).
     #[arg(long = "plot", value_name = "FILE", help_heading = "Output")]
     pub plot: Option<PathBuf>,
@@ -192,11 +193,6 @@ pub struct ApplyArgs {
     /// `-q`.
     #[command(flatten)]
     pub verbosity: Verbosity,
-}
-
-fn parse_test(name: &str) -> Result<TestType, String> {
-    TestType::from_name(name)
-        .ok_or_else(|| format!("expected etve, spindle or linear-axis, found {name:?}"))
 }
 
 /// Runs `axcomp thermal`.
@@ -237,19 +233,18 @@ fn fit(args: &FitArgs) -> Result<()> {
         bail!("thermal fit needs the drift column: --drift COLUMN");
     }
     let log = args.log_args.read(&args.log)?;
-    let rows = match &args.rows {
-        None => 0..log.len(),
-        Some(text) => parse_rows(text, log.len())?,
+    let request = FitRequest {
+        rows: args.rows.clone(),
+        sensors: args.sensors.clone(),
+        exclude: args.exclude.clone(),
+        reference: args.reference.clone(),
+        max_sensors: Some(args.max_sensors),
+        validation: Some(args.validation),
     };
-    let mut options = FitOptions::over(rows);
-    options.sensors = args.sensors.clone();
-    options.exclude = args.exclude.clone();
-    options.auto_reference = args.reference.as_deref() == Some("auto");
-    options.reference = args.reference.clone().filter(|r| r != "auto");
-    options.max_sensors = args.max_sensors;
-    if args.validation == "forward" {
-        options.validation = thermal::Validation::Forward;
-    }
+    let options = request.options(log.len()).map_err(|e| match e {
+        thermal::ThermalError::Request(message) => anyhow::anyhow!("--{message}"),
+        other => in_file_thermal(&args.log, other),
+    })?;
     let model = thermal::fit(&log, &options).map_err(|e| in_file_thermal(&args.log, e))?;
     write_new(
         &args.output,
@@ -298,11 +293,6 @@ fn in_file_thermal(path: &Path, error: thermal::ThermalError) -> anyhow::Error {
         thermal::ThermalError::Parse(parse) => in_file(path, parse),
         other => anyhow::anyhow!("{}: {other}", path.display()),
     }
-}
-
-/// `FIRST-LAST`, 1-based inclusive data rows, as a 0-based range.
-fn parse_rows(text: &str, rows: usize) -> Result<std::ops::Range<usize>> {
-    thermal::parse_rows(text, rows).map_err(|message| anyhow::anyhow!("--{message}"))
 }
 
 fn write_plot(
@@ -381,6 +371,16 @@ pub struct ThermalInputArgs {
         help_heading = "Thermal"
     )]
     pub sample_interval: Option<f64>,
+    /// The ISO 230-3 test the log records, shown in the report: etve,
+    /// spindle or linear-axis (as `thermal evaluate --test`).
+    #[arg(
+        long = "thermal-test",
+        value_name = "TYPE",
+        value_parser = workflow::test_type,
+        requires = "log",
+        help_heading = "Thermal"
+    )]
+    pub test_type: Option<TestType>,
 }
 
 impl ThermalInputArgs {
@@ -395,16 +395,18 @@ impl ThermalInputArgs {
             .as_deref()
             .map(|p| load(p, ThermalModel::from_toml))
             .transpose()?;
-        let request = thermal::StudyRequest {
+        let request = StudyRequest {
             drift: self.drift.clone(),
             sample_interval_s: self.sample_interval,
+            test_type: self.test_type,
             model,
             ..Default::default()
         };
         let text = load(path, |text| {
             Ok::<_, axcomp::error::ParseError>(text.to_string())
         })?;
-        let study = thermal::study_text(&text, request).map_err(|e| in_file_thermal(path, e))?;
+        let study = axcomp::workflow::thermal::study_text(&text, request)
+            .map_err(|e| in_file_thermal(path, e))?;
         Ok(Some(study))
     }
 

@@ -28,7 +28,7 @@ pub use log::{LogOptions, parse_log, write_log};
 pub use model::{
     Application, FitOptions, FitSummary, Term, ThermalModel, Validation, apply, fit, tau_grid_s,
 };
-pub use study::{ModelSource, Study, StudyRequest, parse_rows, study, study_text};
+pub use study::{ModelSource, Study, parse_rows, study};
 
 use crate::error::ParseError;
 

@@ -52,6 +52,7 @@ mod standards;
 mod survey;
 mod survey_optics;
 mod thermal;
+mod thermal_front;
 mod thermal_hal;
 mod together;
 mod units_wire;

@@ -18,9 +18,7 @@
 
 use serde_json::Value;
 
-use crate::util::{axcomp, shared_data, test_data};
-
-const REAL: &str = "thermal/data__thermal expansion error original.csv";
+use crate::util::{THERMAL_LOG as REAL, axcomp, fit_warm_up, shared_data, test_data};
 const ROWS: usize = 90;
 /// `axis.z.eoffset-scale` as the file sets it: mm per count.
 const SCALE_MM: f64 = 1e-6;
@@ -128,24 +126,10 @@ fn linuxcnc_hal_offset_equals_thermal_apply_at_every_step() {
     let path = |name: &str| dir.path().join(name);
     let real = shared_data(REAL);
     // The model of the README: fitted on the warm-up.
-    let fit = axcomp([
-        "thermal",
-        "fit",
-        real.to_str().unwrap(),
-        "--drift",
-        "delta L",
-        "--sample-interval",
-        "60",
-        "--rows",
-        "1-1500",
-        "--sensors",
-        "T0,T1,T2,T3,T4",
-        "--reference",
-        "T14",
-        "-o",
-        path("model.toml").to_str().unwrap(),
-    ]);
-    assert_eq!(fit.code, 0, "{}", fit.stderr);
+    fit_warm_up(
+        &path("model.toml"),
+        &["--sensors", "T0,T1,T2,T3,T4", "--reference", "T14"],
+    );
     let hal = axcomp([
         "thermal",
         "hal",
