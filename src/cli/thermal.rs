@@ -11,7 +11,9 @@ use axcomp::report::thermal as report;
 use axcomp::thermal::{self, LogOptions, TestType, ThermalLog, ThermalModel};
 use axcomp::workflow::thermal::{self as workflow, FitRequest, StudyRequest};
 
-use super::common::{JsonOutput, Overwrite, Verbosity, in_file, load, print_json, print_text};
+use super::common::{
+    JsonOutput, Overwrite, Verbosity, in_file, load, load_profile, print_json, print_text,
+};
 
 /// Flags of `axcomp thermal`.
 #[derive(Debug, clap::Args)]
@@ -59,6 +61,10 @@ pub struct HalArgs {
     /// The HAL file to write.
     #[arg(short = 'o', long = "output", value_name = "FILE.hal")]
     pub output: PathBuf,
+    /// Machine profile (TOML): its [controller] units (mm or inch, the
+    /// machine's [TRAJ]LINEAR_UNITS) is the unit of the offset (default mm).
+    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
+    pub machine: Option<PathBuf>,
     /// `--force`.
     #[command(flatten)]
     pub overwrite: Overwrite,
@@ -325,14 +331,19 @@ fn hal(args: &HalArgs) -> Result<()> {
             args.axis
         );
     }
-    let text =
-        axcomp::emit::linuxcnc_thermal::write_hal(&model, &args.axis, args.period, &args.thread);
-    write_new(
-        &args.output,
-        text.as_bytes(),
-        &[&args.model],
-        args.overwrite.force,
-    )?;
+    let unit = load_profile(args.machine.as_deref())?.machine_unit();
+    let text = axcomp::emit::linuxcnc_thermal::write_hal(
+        &model,
+        &args.axis,
+        unit,
+        args.period,
+        &args.thread,
+    );
+    let inputs: Vec<&Path> = [Some(args.model.as_path()), args.machine.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    write_new(&args.output, text.as_bytes(), &inputs, args.overwrite.force)?;
     Ok(())
 }
 

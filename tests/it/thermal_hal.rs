@@ -94,3 +94,49 @@ fn the_counts_stay_zero_until_the_machine_is_on_and_homed() {
     assert!(at("thermal-to-counts") < at("thermal-gate"));
     assert!(at("thermal-gate") < at("thermal-counts"));
 }
+
+/// On an inch machine (`[controller] units = "inch"`, LinuxCNC's
+/// `[TRAJ]LINEAR_UNITS = inch`) the external offset is in inches: the same
+/// model's gains divided by 25.4, counts of 0.1 µin.
+#[test]
+fn on_an_inch_machine_the_offset_is_in_inches() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("thermal.hal");
+    let run = axcomp([
+        "thermal",
+        "hal",
+        test_data(MODEL).to_str().unwrap(),
+        "--axis",
+        "z",
+        "--machine",
+        root()
+            .join("fixtures/machines/gantry-inch.toml")
+            .to_str()
+            .unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let hal = std::fs::read_to_string(out).unwrap();
+    assert!(hal.contains("offset (inch)"), "{hal}");
+    // 1.5 µm/K = 0.0015 mm/K = 0.0015/25.4 in/K = 5.905 511 811e-5 in/K;
+    // from 25 °C: 1.476 377 952 8e-3 in. −2 µm/K: 7.874 015 748e-5 in/K.
+    let close = |name: &str, expected: f64| {
+        let value = setp(&hal, name);
+        assert!(
+            (value / expected - 1.0).abs() < 1e-12,
+            "{name}: {value:e}, expected {expected:e}"
+        );
+    };
+    close("thermal-term-0.gain", -5.905_511_811_023_622e-5);
+    close("thermal-term-0.offset", 1.476_377_952_755_905_5e-3);
+    close("thermal-term-1.gain", 7.874_015_748_031_496e-5);
+    close("thermal-term-1.offset", -1.574_803_149_606_299_3e-3);
+    // The lag does not depend on the unit.
+    assert_eq!(
+        setp(&hal, "thermal-lag-0.gain"),
+        setp(&hal_for(MODEL, "z"), "thermal-lag-0.gain")
+    );
+    assert_eq!(setp(&hal, "thermal-to-counts.gain"), 1e7);
+    assert_eq!(setp(&hal, "axis.z.eoffset-scale"), 1e-7);
+}

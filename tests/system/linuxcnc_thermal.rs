@@ -231,7 +231,7 @@ fn linuxcnc_hal_offset_equals_thermal_apply_at_every_step() {
         let value = |name: &str| point[name].as_f64().unwrap();
         let expected_mm = -predicted[k] / 1000.0;
         // The model in HAL: halcmd prints floats to 7 significant digits.
-        let offset_mm = value("thermal-offset-mm");
+        let offset_mm = value("thermal-offset");
         assert!(
             (offset_mm - expected_mm).abs() < 1e-8,
             "row {k}: HAL {offset_mm} mm, apply {expected_mm} mm"

@@ -49,7 +49,7 @@ try:
     steps = json.load(open(os.path.join(HERE, "steps.json")))
     axis, joint, signals, rows = steps["axis"], steps["joint"], steps["signals"], steps["rows"]
     machine.ready_in_mdi()
-    names = ["thermal-steps", "thermal-offset-mm", "thermal-offset-counts",
+    names = ["thermal-steps", "thermal-offset", "thermal-offset-counts",
              "axis.%s.eoffset-request" % axis, "axis.%s.eoffset" % axis,
              "axis.%s.pos-cmd" % axis, "joint.%d.pos-cmd" % joint,
              "motion.eoffset-active"]
