@@ -8,6 +8,10 @@ use crate::util::{assert_golden, axcomp, root, test_data};
 
 const MODEL: &str = "thermal/two-terms.toml";
 
+/// The golden files `thermal hal` writes, by controller folder
+/// (`convert::every_golden_file_has_a_case`).
+pub const GOLDENS: [(&str, &str); 1] = [("linuxcnc", "thermal-z.hal")];
+
 fn hal_for(model: &str, axis: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("thermal.hal");
@@ -37,7 +41,11 @@ fn setp(hal: &str, name: &str) -> f64 {
 #[test]
 fn the_hal_file_of_a_two_term_model_is_the_golden_file() {
     let hal = hal_for(MODEL, "z");
-    assert_golden(&hal, &root().join("formats/linuxcnc/golden/thermal-z.hal"));
+    let (controller, name) = GOLDENS[0];
+    assert_golden(
+        &hal,
+        &root().join(format!("formats/{controller}/golden/{name}")),
+    );
 }
 
 #[test]
