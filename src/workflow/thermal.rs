@@ -51,13 +51,16 @@ impl FitRequest {
     }
 }
 
-/// The validation `name` says (`blocked` or `forward`, as the model file,
-/// `--validation` and the web form name them), or what was expected.
+/// The validation `name` says (`blocked`, `forward`, `late`, as the model
+/// file, `--validation` and the web form name them), or what was expected.
 pub fn validation(name: &str) -> Result<Validation, String> {
-    [Validation::Blocked, Validation::Forward]
+    Validation::ALL
         .into_iter()
         .find(|v| v.name() == name)
-        .ok_or_else(|| format!("expected blocked or forward, found {name:?}"))
+        .ok_or_else(|| {
+            let names: Vec<&str> = Validation::ALL.iter().map(|v| v.name()).collect();
+            format!("expected one of {}, found {name:?}", names.join(", "))
+        })
 }
 
 /// The ISO 230-3 test type `name` says (`etve`, `spindle`, `linear-axis`:

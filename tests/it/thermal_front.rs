@@ -116,6 +116,7 @@ fn the_web_form_offers_what_the_cli_takes() {
     assert!(page.contains("<select name=\"test\"><option value=\"\">not stated</option>"));
     assert!(page.contains("<select name=\"validation\"><option value=\"blocked\">"));
     assert!(page.contains("<option value=\"forward\">"));
+    assert!(page.contains("<option value=\"late\">"));
     assert!(page.contains("placeholder=\"T14 or auto\""));
 }
 
@@ -172,7 +173,7 @@ fn the_web_fit_with_auto_reference_and_forward_validation_equals_the_cli_fit() {
         (
             "validation",
             "k-fold",
-            "cross-validation: expected blocked or forward, found &quot;k-fold&quot;",
+            "cross-validation: expected one of blocked, forward, late, found &quot;k-fold&quot;",
         ),
         (
             "test",
