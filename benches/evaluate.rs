@@ -21,7 +21,7 @@
 //! on `/usr/bin/python3 benches/reference/evaluate_rtl.py /tmp/big.rtl`,
 //! several runs each, medians). Time the interpreter itself: a version
 //! manager's `python3` shim adds its own start (0.3 s on one machine) and
-//! flatters the ratio. README, Speed, gives the last figures.
+//! flatters the ratio. docs/src/speed.md gives the last figures.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;

@@ -8,9 +8,12 @@ use axcomp::output::write_new;
 use axcomp::report::chart::chart;
 use axcomp::report::plot::PlotFormat;
 use axcomp::report::thermal as report;
-use axcomp::thermal::{self, FitOptions, LogOptions, TestType, ThermalLog, ThermalModel};
+use axcomp::thermal::{self, LogOptions, TestType, ThermalLog, ThermalModel};
+use axcomp::workflow::thermal::{self as workflow, FitRequest, StudyRequest};
 
-use super::common::{JsonOutput, Overwrite, Verbosity, in_file, load, print_json, print_text};
+use super::common::{
+    JsonOutput, Overwrite, Verbosity, in_file, load, load_profile, print_json, print_text,
+};
 
 /// Flags of `axcomp thermal`.
 #[derive(Debug, clap::Args)]
@@ -58,6 +61,10 @@ pub struct HalArgs {
     /// The HAL file to write.
     #[arg(short = 'o', long = "output", value_name = "FILE.hal")]
     pub output: PathBuf,
+    /// Machine profile (TOML): its [controller] units (mm or inch, the
+    /// machine's [TRAJ]LINEAR_UNITS) is the unit of the offset (default mm).
+    #[arg(long, value_name = "M.toml", help_heading = "Machine")]
+    pub machine: Option<PathBuf>,
     /// `--force`.
     #[command(flatten)]
     pub overwrite: Overwrite,
@@ -98,7 +105,7 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub log_args: LogArgs,
     /// The ISO 230-3 test the log records: etve, spindle or linear-axis.
-    #[arg(long = "test", value_name = "TYPE", value_parser = parse_test)]
+    #[arg(long = "test", value_name = "TYPE", value_parser = workflow::test_type)]
     pub test_type: Option<TestType>,
     /// Write the drift against time (.svg or .png).
     #[arg(long = "drift-plot", value_name = "FILE", help_heading = "Output")]
@@ -158,8 +165,8 @@ pub struct FitArgs {
     /// the model does on the machine, predicting the hours after its fit)
     /// or late (forward over the last third of the rows: the blocks nearest
     /// the steady state).
-    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = ["blocked", "forward", "late"])]
-    pub validation: String,
+    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = workflow::validation)]
+    pub validation: thermal::Validation,
     /// Write the drift, the model and the residual against time (.svg or .png).
     #[arg(long = "plot", value_name = "FILE", help_heading = "Output")]
     pub plot: Option<PathBuf>,
@@ -195,11 +202,6 @@ pub struct ApplyArgs {
     /// `-q`.
     #[command(flatten)]
     pub verbosity: Verbosity,
-}
-
-fn parse_test(name: &str) -> Result<TestType, String> {
-    TestType::from_name(name)
-        .ok_or_else(|| format!("expected etve, spindle or linear-axis, found {name:?}"))
 }
 
 /// Runs `axcomp thermal`.
@@ -240,21 +242,18 @@ fn fit(args: &FitArgs) -> Result<()> {
         bail!("thermal fit needs the drift column: --drift COLUMN");
     }
     let log = args.log_args.read(&args.log)?;
-    let rows = match &args.rows {
-        None => 0..log.len(),
-        Some(text) => parse_rows(text, log.len())?,
+    let request = FitRequest {
+        rows: args.rows.clone(),
+        sensors: args.sensors.clone(),
+        exclude: args.exclude.clone(),
+        reference: args.reference.clone(),
+        max_sensors: Some(args.max_sensors),
+        validation: Some(args.validation),
     };
-    let mut options = FitOptions::over(rows);
-    options.sensors = args.sensors.clone();
-    options.exclude = args.exclude.clone();
-    options.auto_reference = args.reference.as_deref() == Some("auto");
-    options.reference = args.reference.clone().filter(|r| r != "auto");
-    options.max_sensors = args.max_sensors;
-    options.validation = match args.validation.as_str() {
-        "forward" => thermal::Validation::Forward,
-        "late" => thermal::Validation::Late,
-        _ => thermal::Validation::Blocked,
-    };
+    let options = request.options(log.len()).map_err(|e| match e {
+        thermal::ThermalError::Request(message) => anyhow::anyhow!("--{message}"),
+        other => in_file_thermal(&args.log, other),
+    })?;
     let model = thermal::fit(&log, &options).map_err(|e| in_file_thermal(&args.log, e))?;
     write_new(
         &args.output,
@@ -305,11 +304,6 @@ fn in_file_thermal(path: &Path, error: thermal::ThermalError) -> anyhow::Error {
     }
 }
 
-/// `FIRST-LAST`, 1-based inclusive data rows, as a 0-based range.
-fn parse_rows(text: &str, rows: usize) -> Result<std::ops::Range<usize>> {
-    thermal::parse_rows(text, rows).map_err(|message| anyhow::anyhow!("--{message}"))
-}
-
 fn write_plot(
     path: Option<&Path>,
     make: impl FnOnce() -> axcomp::report::chart::Chart,
@@ -340,14 +334,19 @@ fn hal(args: &HalArgs) -> Result<()> {
             args.axis
         );
     }
-    let text =
-        axcomp::emit::linuxcnc_thermal::write_hal(&model, &args.axis, args.period, &args.thread);
-    write_new(
-        &args.output,
-        text.as_bytes(),
-        &[&args.model],
-        args.overwrite.force,
-    )?;
+    let unit = load_profile(args.machine.as_deref())?.machine_unit();
+    let text = axcomp::emit::linuxcnc_thermal::write_hal(
+        &model,
+        &args.axis,
+        unit,
+        args.period,
+        &args.thread,
+    );
+    let inputs: Vec<&Path> = [Some(args.model.as_path()), args.machine.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    write_new(&args.output, text.as_bytes(), &inputs, args.overwrite.force)?;
     Ok(())
 }
 
@@ -386,6 +385,16 @@ pub struct ThermalInputArgs {
         help_heading = "Thermal"
     )]
     pub sample_interval: Option<f64>,
+    /// The ISO 230-3 test the log records, shown in the report: etve,
+    /// spindle or linear-axis (as `thermal evaluate --test`).
+    #[arg(
+        long = "thermal-test",
+        value_name = "TYPE",
+        value_parser = workflow::test_type,
+        requires = "log",
+        help_heading = "Thermal"
+    )]
+    pub test_type: Option<TestType>,
 }
 
 impl ThermalInputArgs {
@@ -400,16 +409,18 @@ impl ThermalInputArgs {
             .as_deref()
             .map(|p| load(p, ThermalModel::from_toml))
             .transpose()?;
-        let request = thermal::StudyRequest {
+        let request = StudyRequest {
             drift: self.drift.clone(),
             sample_interval_s: self.sample_interval,
+            test_type: self.test_type,
             model,
             ..Default::default()
         };
         let text = load(path, |text| {
             Ok::<_, axcomp::error::ParseError>(text.to_string())
         })?;
-        let study = thermal::study_text(&text, request).map_err(|e| in_file_thermal(path, e))?;
+        let study = axcomp::workflow::thermal::study_text(&text, request)
+            .map_err(|e| in_file_thermal(path, e))?;
         Ok(Some(study))
     }
 

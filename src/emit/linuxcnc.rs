@@ -23,8 +23,9 @@ use crate::measurement::Direction;
 use crate::read::text::{self, Line};
 use crate::units::LengthUnit;
 
-/// Decimals written: 1 nm in mm machines, 0.1 µin in inch machines.
-fn decimals(unit: LengthUnit) -> usize {
+/// Decimals written: 1 nm in mm machines, 0.1 µin in inch machines (also
+/// the resolution of the thermal model's external offset, `linuxcnc_thermal`).
+pub(crate) fn decimals(unit: LengthUnit) -> usize {
     match unit {
         LengthUnit::Millimetre => 6,
         LengthUnit::Inch => 7,

@@ -359,12 +359,24 @@ pub fn cross_axis_activation(
     })
 }
 
-/// What a cross-axis file holds, times the table's error: −1 where a
-/// Sinumerik CEC holds corrections, else +1.
-pub fn cross_axis_file_sign(controller: Controller, options: &EmitOptions) -> f64 {
+/// What a cross-axis file's values are, for a reader of the file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CrossAxisValues {
+    /// The value in the file, times the table's error: −1 where a Sinumerik
+    /// CEC holds corrections, else +1.
+    pub sign: f64,
+    /// What the values are called: `error`, or `correction (−error)`.
+    pub name: &'static str,
+}
+
+/// What the cross-axis file [`write_cross_axis`] writes holds.
+pub fn cross_axis_values(controller: Controller, options: &EmitOptions) -> CrossAxisValues {
     match controller {
-        Controller::Sinumerik840d if options.cec_values_are_corrections => -1.0,
-        _ => 1.0,
+        Controller::Sinumerik840d => sinumerik840d::cross_axis_values(options),
+        _ => CrossAxisValues {
+            sign: 1.0,
+            name: "error",
+        },
     }
 }
 

@@ -24,7 +24,8 @@ use std::collections::BTreeMap;
 use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::{CompensationTable, TableValues};
 use crate::emit::{
-    AxisProfile, BacklashAdvice, BacklashParameter, EmitError, EmitOptions, minimal,
+    AxisProfile, BacklashAdvice, BacklashParameter, CrossAxisValues, EmitError, EmitOptions,
+    minimal,
 };
 use crate::error::ParseError;
 use crate::read::text::{self, Line};
@@ -129,14 +130,16 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     Ok(out)
 }
 
-/// What a CEC table's values are, for a reader of the file: the correction
-/// (−error) under the reconstructed convention, else the error (the sign of
-/// `crate::emit::cross_axis_file_sign`).
-pub fn value_name(options: &EmitOptions) -> &'static str {
-    if options.cec_values_are_corrections {
-        "correction (−error)"
-    } else {
-        "error"
+/// What a CEC table's values are: the correction (−error) under the
+/// reconstructed convention, else the error.
+pub fn cross_axis_values(options: &EmitOptions) -> CrossAxisValues {
+    CrossAxisValues {
+        sign: cec_sign(options),
+        name: if options.cec_values_are_corrections {
+            "correction (−error)"
+        } else {
+            "error"
+        },
     }
 }
 
@@ -708,6 +711,30 @@ mod tests {
         );
         let back = read(&text, "X1", true).unwrap();
         assert_eq!((back.positions, back.values), (lec.positions, lec.values));
+    }
+
+    #[test]
+    fn cross_axis_values_say_what_the_cec_holds() {
+        // Corrections: the file holds −error; otherwise the error itself.
+        let corrections = options();
+        let errors = EmitOptions {
+            cec_values_are_corrections: false,
+            ..options()
+        };
+        assert_eq!(
+            cross_axis_values(&corrections),
+            CrossAxisValues {
+                sign: -1.0,
+                name: "correction (−error)"
+            }
+        );
+        assert_eq!(
+            cross_axis_values(&errors),
+            CrossAxisValues {
+                sign: 1.0,
+                name: "error"
+            }
+        );
     }
 
     #[test]

@@ -78,30 +78,15 @@ fn push_two_decimals(out: &mut Vec<u8>, value: f64) {
             }
             let sign = usize::from(hundredths < 0);
             let point = sign + digits as usize;
-            let mut text = [b'-'; SHORT_TEXT];
+            let mut text = [b'-'; 16];
             write_digits(&mut text[sign..point], units);
             text[point] = b'.';
             write_digits(&mut text[point + 1..point + 3], cents);
-            push_short(out, &text, point + 3);
+            out.extend_from_slice(&text[..point + 3]);
             return;
         }
     }
     let _ = write!(out, "{value:.2}");
-}
-
-/// The room of a short text made for [`push_short`]: a cell of the reports
-/// is at most this long in its common forms.
-pub const SHORT_TEXT: usize = 16;
-
-/// Appends the first `length` bytes of `text` (at most [`SHORT_TEXT`]) with
-/// one copy of a known size, then drops the rest: for a few bytes, the
-/// general copy of a length known only at run time cost more than the bytes.
-#[inline]
-pub fn push_short(out: &mut Vec<u8>, text: &[u8; SHORT_TEXT], length: usize) {
-    debug_assert!(length <= SHORT_TEXT);
-    let old = out.len();
-    out.extend_from_slice(text);
-    out.truncate(old + length);
 }
 
 /// Appends `format!("{value}")` to `out` (the shortest text that reads back

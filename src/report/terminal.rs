@@ -13,8 +13,7 @@ use unicode_width::UnicodeWidthStr;
 
 use crate::evaluate::standard::vdi_figure_name;
 use crate::report::format::{
-    NOT_EVALUATED, SHORT_TEXT, inch_beside, push_integer, push_short, push_shortest, push_um,
-    text_of, um,
+    NOT_EVALUATED, inch_beside, push_integer, push_shortest, push_um, text_of, um,
 };
 use crate::report::json::{EvaluationJson, OutlierJson, PerTargetJson, StartEndJson};
 
@@ -174,11 +173,12 @@ fn environment_line(r: &EvaluationJson) -> String {
 const PER_TARGET_COLUMNS: usize = 12;
 
 /// The per-target table as `tabled`'s `Style::psql()` with every column
-/// right-aligned draws it, byte for byte.
+/// right-aligned draws it, byte for byte, each row written straight into
+/// the report.
 ///
 /// Drawn here rather than by `tabled::Table`, which keeps every cell as a
-/// `String` with its own layout state; `tabled::tables::IterTable`, which
-/// streams, has no header rule. The small tables keep `tabled`.
+/// `String` with its own layout state (a large test has 120 000 cells);
+/// the small tables keep `tabled`.
 /// Fast path: with it and the others of the evaluate report, a 10 000-target × 10-run `evaluate` takes 0.014 s cpu whole process, 0.028 s without.
 fn per_target_table(out: &mut String, r: &EvaluationJson) {
     let target_header = format!("target [{}]", r.position_unit().trim_start());
@@ -196,21 +196,21 @@ fn per_target_table(out: &mut String, r: &EvaluationJson) {
         "R_i↓",
         "R_i",
     ];
-    let cells = TableCells::of(&r.per_target);
-    let mut widths = header.map(cell_width);
-    for (width, widest) in widths.iter_mut().zip(cells.widths) {
-        *width = (*width).max(widest);
-    }
+    let widths = column_widths(header.map(cell_width), &r.per_target);
     let line_width: usize = widths.iter().map(|w| w + 3).sum();
     // Written as bytes into the report's own buffer (a byte is pushed
     // without the encoding a `String` push goes through), which is text again after.
     let mut table = std::mem::take(out).into_bytes();
     table.reserve((r.per_target.len() + 2) * (line_width + 8));
-    push_psql_row(
-        &mut table,
-        &widths,
-        header.map(|cell| (cell.as_bytes(), cell.len(), cell_width(cell))),
-    );
+    for (column, cell) in header.iter().enumerate() {
+        push_cell(
+            &mut table,
+            column,
+            widths[column],
+            cell.as_bytes(),
+            cell_width(cell),
+        );
+    }
     table.push(b'\n');
     for (column, width) in widths.iter().enumerate() {
         if column > 0 {
@@ -218,72 +218,97 @@ fn per_target_table(out: &mut String, r: &EvaluationJson) {
         }
         table.extend(std::iter::repeat_n(b'-', width + 2));
     }
-    cells.push_rows(&mut table, &widths);
+    let mut row = Vec::new();
+    for t in &r.per_target {
+        table.push(b'\n');
+        let ends = row_cells(&mut row, t);
+        let mut start = 0;
+        for (column, end) in ends.into_iter().enumerate() {
+            let cell = &row[start..end];
+            push_cell(
+                &mut table,
+                column,
+                widths[column],
+                cell,
+                data_cell_width(cell),
+            );
+            start = end;
+        }
+    }
     *out = text_of(table);
 }
 
-/// The per-target table's rows, formatted: every cell's text in one buffer
-/// and each cell's length (no `String` per cell; a cell is one number's
-/// text, a few hundred bytes at most, so its length fits a `u32`), and the widest cell of each column, found as
-/// the cells are made.
-struct TableCells {
-    text: Vec<u8>,
-    lengths: Vec<u32>,
-    widths: [usize; PER_TARGET_COLUMNS],
+/// The cells of one row, written one after another into `row` (emptied
+/// first), and where each ends.
+fn row_cells(row: &mut Vec<u8>, t: &PerTargetJson) -> [usize; PER_TARGET_COLUMNS] {
+    row.clear();
+    let mut ends = [0; PER_TARGET_COLUMNS];
+    push_shortest(row, t.target());
+    ends[0] = row.len();
+    let (n_up, n_down) = t.readings();
+    push_integer(row, n_up as u64);
+    ends[1] = row.len();
+    push_integer(row, n_down as u64);
+    ends[2] = row.len();
+    for (column, (_, value)) in t.cells().into_iter().enumerate() {
+        push_um(row, value);
+        ends[column + 3] = row.len();
+    }
+    ends
 }
 
-impl TableCells {
-    fn of(rows: &[PerTargetJson]) -> TableCells {
-        let mut text = Vec::with_capacity(rows.len() * 80);
-        let mut lengths: Vec<u32> = Vec::with_capacity(rows.len() * PER_TARGET_COLUMNS);
-        let mut widths = [0; PER_TARGET_COLUMNS];
-        let mut cell_start = 0;
-        let mut column = 0;
-        let mut end_cell = |text: &Vec<u8>| {
-            let cell = &text[cell_start..];
-            widths[column] = widths[column].max(data_cell_width(cell));
-            lengths.push(cell.len() as u32);
-            cell_start = text.len();
-            column = (column + 1) % PER_TARGET_COLUMNS;
-        };
-        for t in rows {
-            push_shortest(&mut text, t.target());
-            end_cell(&text);
-            let (n_up, n_down) = t.readings();
-            push_integer(&mut text, n_up as u64);
-            end_cell(&text);
-            push_integer(&mut text, n_down as u64);
-            end_cell(&text);
-            for (_, value) in t.cells() {
-                push_um(&mut text, value);
-                end_cell(&text);
+/// The columns each column of the table takes: its header's or its widest
+/// cell's. A target's text is made to be measured (the shortest text of a
+/// number is not the longest at the largest number); a count's or a
+/// two-decimal value's text is longest at the column's largest or its
+/// smallest value (and `—`, one column, where a value is missing).
+fn column_widths(
+    header: [usize; PER_TARGET_COLUMNS],
+    rows: &[PerTargetJson],
+) -> [usize; PER_TARGET_COLUMNS] {
+    let mut widths = header;
+    let mut text = Vec::new();
+    let mut widen = |column: usize, text: &mut Vec<u8>| {
+        widths[column] = widths[column].max(data_cell_width(text));
+        text.clear();
+    };
+    let mut most_readings = (0, 0);
+    let mut lowest = [f64::INFINITY; 9];
+    let mut highest = [f64::NEG_INFINITY; 9];
+    let mut missing = [false; 9];
+    for t in rows {
+        push_shortest(&mut text, t.target());
+        widen(0, &mut text);
+        let (n_up, n_down) = t.readings();
+        most_readings = (most_readings.0.max(n_up), most_readings.1.max(n_down));
+        for (column, (_, value)) in t.cells().into_iter().enumerate() {
+            match value {
+                Some(v) => {
+                    lowest[column] = lowest[column].min(v);
+                    highest[column] = highest[column].max(v);
+                }
+                None => missing[column] = true,
             }
         }
-        TableCells {
-            text,
-            lengths,
-            widths,
+    }
+    if !rows.is_empty() {
+        push_integer(&mut text, most_readings.0 as u64);
+        widen(1, &mut text);
+        push_integer(&mut text, most_readings.1 as u64);
+        widen(2, &mut text);
+    }
+    for column in 0..9 {
+        let extremes = [lowest[column], highest[column]];
+        for value in extremes.into_iter().filter(|v| v.is_finite()) {
+            push_um(&mut text, Some(value));
+            widen(column + 3, &mut text);
+        }
+        if missing[column] {
+            push_um(&mut text, None);
+            widen(column + 3, &mut text);
         }
     }
-
-    /// Each row after a line break.
-    fn push_rows(&self, out: &mut Vec<u8>, widths: &[usize; PER_TARGET_COLUMNS]) {
-        let mut offset = 0;
-        let (rows, _) = self.lengths.as_chunks::<PER_TARGET_COLUMNS>();
-        for row_lengths in rows {
-            out.push(b'\n');
-            let row = row_lengths.map(|length| {
-                let length = length as usize;
-                // The cell and what follows it, for one copy of a known size.
-                let end = (offset + SHORT_TEXT).min(self.text.len());
-                let window = &self.text[offset..end.max(offset + length)];
-                let cell = &window[..length];
-                offset += length;
-                (window, length, data_cell_width(cell))
-            });
-            push_psql_row(out, widths, row);
-        }
-    }
+    widths
 }
 
 /// The columns a data cell takes: every one is ASCII (a number) but
@@ -305,27 +330,17 @@ fn cell_width(cell: &str) -> usize {
     }
 }
 
-/// One row as `Style::psql()` draws it, every cell right-aligned in its
-/// column. A cell is given as its text's first `length` bytes of `window`
-/// (which may go on past it, for a copy of a known size) and the columns it
-/// takes.
-fn push_psql_row<const N: usize>(
-    out: &mut Vec<u8>,
-    widths: &[usize; N],
-    row: [(&[u8], usize, usize); N],
-) {
-    for (column, (window, length, cell_width)) in row.into_iter().enumerate() {
-        if column > 0 {
-            out.push(b'|');
-        }
-        out.push(b' ');
-        out.extend(std::iter::repeat_n(b' ', widths[column] - cell_width));
-        match window.first_chunk::<SHORT_TEXT>() {
-            Some(short) if length <= SHORT_TEXT => push_short(out, short, length),
-            _ => out.extend_from_slice(&window[..length]),
-        }
-        out.push(b' ');
+/// One cell as `Style::psql()` draws it, right-aligned in its column of
+/// `width`: the column's separator, a space, the padding, the cell (which
+/// takes `cell_width` columns) and a space.
+fn push_cell(out: &mut Vec<u8>, column: usize, width: usize, cell: &[u8], cell_width: usize) {
+    if column > 0 {
+        out.push(b'|');
     }
+    out.push(b' ');
+    out.extend(std::iter::repeat_n(b' ', width - cell_width));
+    out.extend_from_slice(cell);
+    out.push(b' ');
 }
 
 /// A standard's figures one per row, as its keys name them (VDI 3441).
@@ -398,6 +413,79 @@ fn figures_table(r: &EvaluationJson) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::measurement::{Direction, Environment, Measurement, Metadata, Run};
+    use crate::units::AngleUnit;
+
+    fn run(direction: Direction, number: u32, deviations_mm: [Option<f64>; 3]) -> Run {
+        Run {
+            direction,
+            number,
+            start_time_s: None,
+            deviations_mm: deviations_mm.to_vec(),
+        }
+    }
+
+    /// The table drawn cell by cell is the one `tabled` draws from the
+    /// same cells: widths from the widest cell wherever it is (a negative
+    /// smallest value, a long target, `—`), every column right-aligned.
+    #[test]
+    fn per_target_table_is_tableds_psql_table() {
+        let (up, down) = (Direction::Up, Direction::Down);
+        let runs = vec![
+            run(up, 1, [Some(0.0123), Some(-0.1), None]),
+            run(down, 1, [Some(0.000001), Some(-0.10004), Some(0.2)]),
+            run(up, 2, [Some(0.0124), Some(-0.09), Some(0.21)]),
+            run(down, 2, [Some(-0.000001), Some(-0.1), Some(0.19999)]),
+        ];
+        let measurement = Measurement::new(
+            "X",
+            vec![0.0, 12.5, 1000.125],
+            runs,
+            Environment::default(),
+            Metadata::default(),
+        )
+        .unwrap();
+        let report = EvaluationJson::from_evaluation(
+            &measurement,
+            crate::evaluate::evaluate(&measurement),
+            &[],
+            &[],
+            AngleUnit::default(),
+        );
+        let mut drawn = String::new();
+        per_target_table(&mut drawn, &report);
+
+        let mut builder = Builder::default();
+        builder.push_record([
+            format!("target [{}]", report.position_unit().trim_start()),
+            "n↑".into(),
+            "n↓".into(),
+            "x̄↑".into(),
+            "x̄↓".into(),
+            "x̄".into(),
+            "s↑".into(),
+            "s↓".into(),
+            "B_i".into(),
+            "R_i↑".into(),
+            "R_i↓".into(),
+            "R_i".into(),
+        ]);
+        for t in &report.per_target {
+            let (n_up, n_down) = t.readings();
+            let mut row = vec![t.target().to_string(), n_up.to_string(), n_down.to_string()];
+            row.extend(t.cells().map(|(_, value)| um(value)));
+            builder.push_record(row);
+        }
+        let mut table = builder.build();
+        table
+            .with(Style::psql())
+            .modify(Columns::new(..), Alignment::right());
+        assert_eq!(drawn, table.to_string());
+        // The cases the widths come from are there.
+        for cell in [" 1000.125 ", " -100.02 ", " — ", " 0.00 "] {
+            assert!(drawn.contains(cell), "{cell} in\n{drawn}");
+        }
+    }
 
     #[test]
     fn missing_values_show_a_dash_not_zero() {

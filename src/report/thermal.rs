@@ -10,7 +10,9 @@ use crate::diagnose::thermal::{RecordedChange, ThermalShare};
 use crate::report::chart::{Chart, Mark, Rgb, Series, chart};
 use crate::report::format::esc;
 use crate::report::plot::{PlotError, PlotFormat};
-use crate::thermal::{Application, Iso230_3, Study, ThermalLog, ThermalModel, Validation};
+use crate::thermal::{
+    Application, Iso230_3, Study, TestType, ThermalLog, ThermalModel, Validation,
+};
 
 /// The model file: `[fit]` (what it was fitted on) and one `[[term]]` per
 /// lagged sensor; `thermal::ThermalModel::from_toml` reads it back.
@@ -630,7 +632,41 @@ impl ShareView {
 /// section (or the error).
 pub fn page_html(body: &str, generator: &str) -> String {
     format!(
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"generator\" content=\"{}\">\n<title>Thermal drift (ISO 230-3)</title>\n<style>body{{font-family:sans-serif;max-width:60rem;margin:1rem auto;padding:0 1rem}}table{{border-collapse:collapse;margin:.5rem 0}}th,td{{border:1px solid #bbb;padding:.2rem .5rem}}td.num{{text-align:right}}figure svg{{max-width:100%;height:auto}}.error{{color:#a00}}label{{display:block;margin:.3rem 0}}</style>\n</head>\n<body>\n<p><a href=\"/\">axcomp</a></p>\n<h1>Thermal drift</h1>\n<form method=\"post\" action=\"/thermal\" enctype=\"multipart/form-data\">\n<label>Thermal log (CSV) <input type=\"file\" name=\"log\" required></label>\n<label>Drift column <input name=\"drift\" placeholder=\"delta L\"></label>\n<label>Seconds between rows (a log without a time column) <input name=\"sample_interval\" inputmode=\"decimal\"></label>\n<label>Model (TOML, from axcomp thermal fit; none: fitted on the log) <input type=\"file\" name=\"model\"></label>\n<label>Fit on rows FIRST-LAST <input name=\"rows\" placeholder=\"1-1500\"></label>\n<label>Sensors to choose from <input name=\"sensors\" placeholder=\"T0,T1,T2\"></label>\n<label>Reference sensor <input name=\"reference\" placeholder=\"T14\"></label>\n<button type=\"submit\">Evaluate and fit</button>\n</form>\n{body}</body>\n</html>\n",
-        esc(generator)
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"generator\" content=\"{}\">\n<title>Thermal drift (ISO 230-3)</title>\n<style>body{{font-family:sans-serif;max-width:60rem;margin:1rem auto;padding:0 1rem}}table{{border-collapse:collapse;margin:.5rem 0}}th,td{{border:1px solid #bbb;padding:.2rem .5rem}}td.num{{text-align:right}}figure svg{{max-width:100%;height:auto}}.error{{color:#a00}}label{{display:block;margin:.3rem 0}}</style>\n</head>\n<body>\n<p><a href=\"/\">axcomp</a></p>\n<h1>Thermal drift</h1>\n<form method=\"post\" action=\"/thermal\" enctype=\"multipart/form-data\">\n<label>Thermal log (CSV) <input type=\"file\" name=\"log\" required></label>\n<label>Drift column <input name=\"drift\" placeholder=\"delta L\"></label>\n<label>Seconds between rows (a log without a time column) <input name=\"sample_interval\" inputmode=\"decimal\"></label>\n<label>Model (TOML, from axcomp thermal fit; none: fitted on the log) <input type=\"file\" name=\"model\"></label>\n<label>Fit on rows FIRST-LAST <input name=\"rows\" placeholder=\"1-1500\"></label>\n<label>Sensors to choose from <input name=\"sensors\" placeholder=\"T0,T1,T2\"></label>\n<label>Reference sensor (auto: each sensor tried, and none, the best kept) <input name=\"reference\" placeholder=\"T14 or auto\"></label>\n<label>Cross-validation <select name=\"validation\">{}</select></label>\n<label>ISO 230-3 test <select name=\"test\"><option value=\"\">not stated</option>{}</select></label>\n<button type=\"submit\">Evaluate and fit</button>\n</form>\n{body}</body>\n</html>\n",
+        esc(generator),
+        Validation::ALL
+            .iter()
+            .map(|v| format!(
+                "<option value=\"{}\">{}</option>",
+                v.name(),
+                validation_choice(*v)
+            ))
+            .collect::<String>(),
+        TestType::ALL
+            .iter()
+            .map(|t| format!("<option value=\"{}\">{}</option>", t.name(), t.title()))
+            .collect::<String>(),
+    )
+}
+
+/// How the form offers a validation.
+fn validation_choice(validation: Validation) -> &'static str {
+    match validation {
+        Validation::Blocked => "blocked: each block predicted from all the others",
+        Validation::Forward => {
+            "forward: each block predicted from the blocks before it (Bergmeir and Benítez 2012)"
+        }
+        Validation::Late => {
+            "late: the blocks in the last third of the rows, each predicted from every row before it (Tashman 2000)"
+        }
+    }
+}
+
+/// The model file a fit on the web page made, as `thermal fit` writes it,
+/// to copy or save (`thermal apply`, `thermal hal`, `report --thermal-model`).
+pub fn model_file_html(model: &ThermalModel) -> String {
+    format!(
+        "<details open>\n<summary>Model file (TOML, as <code>axcomp thermal fit</code> writes it)</summary>\n<pre id=\"model-toml\">{}</pre>\n</details>\n",
+        esc(&model_toml(model))
     )
 }

@@ -3,18 +3,23 @@
 //! fit and the plots shown, as `report --thermal` shows them.
 //!
 //! `GET` is the form; `POST` (multipart: `log`, optional `model`, `drift`,
-//! `sample_interval`, `rows`, `sensors`, `reference`) answers the same page
-//! with the thermal section below the form, or a 400 whose message is the
-//! CLI's (`LOG.csv:line:col: …`). Plain HTML, no script: the work is
-//! `thermal::study`, this file only reads the form and answers.
+//! `sample_interval`, `rows`, `sensors`, `reference` (a sensor or `auto`),
+//! `validation` (`blocked` or `forward`), `test` (the ISO 230-3 test type:
+//! `etve`, `spindle`, `linear-axis`), the names `thermal fit` and `report
+//! --thermal-test` take) answers the same page with the thermal section
+//! below the form and, when it fitted one, the model file `thermal fit`
+//! writes; or a 400 whose message is the CLI's (`LOG.csv:line:col: …`).
+//! Plain HTML, no script: the work is `workflow::thermal::study_text`, this
+//! file only reads the form and answers.
 
 use axum::extract::Multipart;
 use axum::http::{StatusCode, header};
 use axum::response::{IntoResponse, Response};
 
 use crate::report::format::esc;
-use crate::report::thermal::{page_html, section_html};
-use crate::thermal::{self, StudyRequest, ThermalModel};
+use crate::report::thermal::{model_file_html, page_html, section_html};
+use crate::thermal::{self, ThermalModel};
+use crate::workflow::thermal::{self as workflow, FitRequest, StudyRequest, study_text};
 
 /// The fields the form sends.
 #[derive(Debug, Default)]
@@ -26,6 +31,8 @@ struct ThermalForm {
     rows: Option<String>,
     sensors: Option<String>,
     reference: Option<String>,
+    validation: Option<String>,
+    test: Option<String>,
 }
 
 fn generator() -> String {
@@ -101,6 +108,8 @@ async fn read_form(mut multipart: Multipart) -> Result<ThermalForm, String> {
             "rows" => &mut form.rows,
             "sensors" => &mut form.sensors,
             "reference" => &mut form.reference,
+            "validation" => &mut form.validation,
+            "test" => &mut form.test,
             other => return Err(format!("unknown form field {other:?}")),
         };
         let value = text();
@@ -141,17 +150,37 @@ fn work(form: &ThermalForm) -> Result<String, String> {
             .filter(|s| !s.is_empty())
             .collect()
     };
+    let validation = form
+        .validation
+        .as_deref()
+        .map(|name| workflow::validation(name).map_err(|e| format!("cross-validation: {e}")))
+        .transpose()?;
+    let test_type = form
+        .test
+        .as_deref()
+        .map(|name| workflow::test_type(name).map_err(|e| format!("ISO 230-3 test: {e}")))
+        .transpose()?;
+    let given = model.is_some();
     let request = StudyRequest {
         drift: form.drift.clone(),
         sample_interval_s,
+        test_type,
         model,
-        rows: form.rows.clone(),
-        sensors: list(&form.sensors),
-        reference: form.reference.clone(),
+        fit: FitRequest {
+            rows: form.rows.clone(),
+            sensors: list(&form.sensors),
+            reference: form.reference.clone(),
+            validation,
+            ..Default::default()
+        },
     };
-    let study = thermal::study_text(utf8(log_name, log_bytes)?, request).map_err(|e| match e {
+    let study = study_text(utf8(log_name, log_bytes)?, request).map_err(|e| match e {
         thermal::ThermalError::Parse(p) => format!("{log_name}:{p}"),
         other => format!("{log_name}: {other}"),
     })?;
-    section_html(&study, None).map_err(|e| e.to_string())
+    let mut html = section_html(&study, None).map_err(|e| e.to_string())?;
+    if let Some(fitted) = study.model.as_ref().filter(|_| !given) {
+        html.push_str(&model_file_html(fitted));
+    }
+    Ok(html)
 }

@@ -21,14 +21,21 @@ pub enum TestType {
 }
 
 impl TestType {
+    /// Every test type, in the order the flags and the web form list them.
+    pub const ALL: [TestType; 3] = [TestType::Etve, TestType::Spindle, TestType::LinearAxis];
+
     /// The flag value: `etve`, `spindle`, `linear-axis`.
-    pub fn from_name(name: &str) -> Option<TestType> {
-        match name {
-            "etve" => Some(TestType::Etve),
-            "spindle" => Some(TestType::Spindle),
-            "linear-axis" => Some(TestType::LinearAxis),
-            _ => None,
+    pub fn name(self) -> &'static str {
+        match self {
+            TestType::Etve => "etve",
+            TestType::Spindle => "spindle",
+            TestType::LinearAxis => "linear-axis",
         }
+    }
+
+    /// The test type a flag value names.
+    pub fn from_name(name: &str) -> Option<TestType> {
+        TestType::ALL.into_iter().find(|t| t.name() == name)
     }
 
     /// How a report names it.

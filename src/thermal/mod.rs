@@ -29,7 +29,7 @@ pub use model::{
     Application, FitOptions, FitSummary, Term, ThermalModel, Validation, apply, coldest, fit,
     tau_grid_s,
 };
-pub use study::{ModelSource, Study, StudyRequest, parse_rows, study, study_text};
+pub use study::{ModelSource, Study, parse_rows, study};
 
 use crate::error::ParseError;
 

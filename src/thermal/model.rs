@@ -138,6 +138,9 @@ pub enum Validation {
 }
 
 impl Validation {
+    /// Every validation, in the order `--validation` and the web form list them.
+    pub const ALL: [Validation; 3] = [Validation::Blocked, Validation::Forward, Validation::Late];
+
     /// The name the model file and `--validation` use.
     pub fn name(self) -> &'static str {
         match self {

@@ -1,11 +1,11 @@
 //! A thermal log studied as a whole: its ISO 230-3 view and, when there is
 //! a model (given, or fitted on the log), the model run over it. The one
 //! piece of work behind the report's thermal section, the web app's thermal
-//! page and `diagnose --thermal`.
+//! page and `diagnose --thermal` (`workflow::thermal` says what to study).
 
 use super::{
-    Application, FitOptions, Iso230_3, LogOptions, TestType, ThermalError, ThermalLog,
-    ThermalModel, apply, evaluate, fit, parse_log,
+    Application, FitOptions, Iso230_3, TestType, ThermalError, ThermalLog, ThermalModel, apply,
+    evaluate, fit,
 };
 
 /// Where the model comes from.
@@ -68,54 +68,4 @@ pub fn parse_rows(text: &str, rows: usize) -> Result<std::ops::Range<usize>, Str
             "rows {text}: expected FIRST-LAST, 1 ≤ FIRST < LAST ≤ {rows} (the log's rows)"
         )),
     }
-}
-
-/// What the user says about a log to study: the CLI's `--thermal…` flags,
-/// the web form's fields.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct StudyRequest {
-    /// The drift column (default: the model's).
-    pub drift: Option<String>,
-    /// Seconds between rows, for a log without a time column.
-    pub sample_interval_s: Option<f64>,
-    /// The model to run; without one, a model is fitted when the drift
-    /// column is named.
-    pub model: Option<ThermalModel>,
-    /// The rows to fit on, `FIRST-LAST` ([`parse_rows`]; default: all).
-    pub rows: Option<String>,
-    /// The sensors to choose from (empty: all).
-    pub sensors: Vec<String>,
-    /// The reference sensor.
-    pub reference: Option<String>,
-}
-
-/// Reads the log `text` and studies it as `request` says: with the model
-/// given (a log without its drift column is run for the prediction alone),
-/// or one fitted when the drift column is named, or none.
-pub fn study_text(text: &str, request: StudyRequest) -> Result<Study, ThermalError> {
-    let drift = request
-        .drift
-        .clone()
-        .or_else(|| request.model.as_ref().map(|m| m.fit.drift.clone()));
-    let options = LogOptions {
-        drift: drift.clone(),
-        sample_interval_s: request.sample_interval_s,
-        drift_optional: request.model.is_some() && request.drift.is_none(),
-    };
-    let log = parse_log(text, &options)?;
-    let source = match (request.model, drift) {
-        (Some(model), _) => ModelSource::Given(model),
-        (None, Some(_)) => {
-            let rows = match &request.rows {
-                Some(rows) => parse_rows(rows, log.len()).map_err(ThermalError::Request)?,
-                None => 0..log.len(),
-            };
-            let mut options = FitOptions::over(rows);
-            options.sensors = request.sensors;
-            options.reference = request.reference;
-            ModelSource::Fit(options)
-        }
-        (None, None) => ModelSource::None,
-    };
-    study(log, None, source)
 }

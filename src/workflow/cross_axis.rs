@@ -8,7 +8,7 @@
 use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::plan::{PlanContext, Request, plan};
 use crate::compensate::{CompensateError, grid_positions};
-use crate::emit::{self, Controller, MachineProfile, Provenance, sinumerik840d, tnc640};
+use crate::emit::{self, Controller, MachineProfile, Provenance, tnc640};
 use crate::evaluate::straightness::ReferenceLine;
 use crate::measurement::AxisKind;
 use crate::model::{ErrorComponent, ErrorName, GeometricErrors, Machine};
@@ -166,11 +166,7 @@ pub fn cross_axis(request: &CrossAxisRequest<'_>) -> Result<CrossAxis, WorkflowE
     let existing = request.existing.map(|(text, _)| text);
     let text = emit::write_cross_axis(request.controller, &table, profile, &options, existing)?;
     // The value as in the file: the CEC holds −error when it holds corrections.
-    let sign = emit::cross_axis_file_sign(request.controller, &options);
-    let values_are = match request.controller {
-        Controller::Sinumerik840d => sinumerik840d::value_name(&options),
-        _ => "error",
-    };
+    let values = emit::cross_axis_values(request.controller, &options);
     let activation = emit::cross_axis_activation(
         request.controller,
         &table,
@@ -194,7 +190,7 @@ pub fn cross_axis(request: &CrossAxisRequest<'_>) -> Result<CrossAxis, WorkflowE
             .iter()
             .map(|&p| CrossAxisPoint {
                 position_mm: p,
-                value_mm: sign * table.value_at(p),
+                value_mm: values.sign * table.value_at(p),
             })
             .collect(),
         activation,
@@ -207,7 +203,7 @@ pub fn cross_axis(request: &CrossAxisRequest<'_>) -> Result<CrossAxis, WorkflowE
             .optics
             .first()
             .map(|taken| (taken.optics.body.name().to_string(), taken.optics.offset_mm)),
-        values_are,
+        values_are: values.name,
     };
     Ok(CrossAxis {
         text,

@@ -17,6 +17,7 @@ pub mod report;
 pub mod retest;
 pub mod rotary;
 pub mod table;
+pub mod thermal;
 
 use crate::compensate::effects::build_table_with_effects;
 use crate::compensate::plan::{PlanContext, Request, plan};

@@ -403,7 +403,8 @@ fn every_golden_file_has_a_case() {
         for entry in std::fs::read_dir(&folder).unwrap() {
             let name = entry.unwrap().file_name().into_string().unwrap();
             let cross_axis = crate::cross_axis::GOLDENS.contains(&(controller.name(), &name))
-                || crate::fanuc::GOLDENS.contains(&name.as_str());
+                || crate::fanuc::GOLDENS.contains(&name.as_str())
+                || crate::thermal_hal::GOLDENS.contains(&(controller.name(), &name));
             assert!(
                 cross_axis || names.contains(&(controller.name().to_string(), name.clone())),
                 "{}/{name} is not produced by any case",

@@ -2,7 +2,7 @@
 //! a socket: chromedriver (WebDriver is JSON over HTTP, `browser::WebDriver`,
 //! the `system` target) and the one test of `axcomp serve` started as a
 //! process; the web app's API is tested in process (`server::App`). And the
-//! `multipart/form-data` body a browser's `FormData` sends.
+//! `multipart/form-data` body a browser's `FormData` sends (axum-test's).
 //!
 //! Why not a crate: a WebDriver crate (fantoccini, thirtyfour) or an HTTP
 //! client (reqwest) brings an async client stack with TLS into the test
@@ -11,6 +11,8 @@
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::time::Duration;
+
+use axum_test::multipart::{MultipartForm, Part};
 
 /// A response: status, headers (names lower case), body.
 pub struct Response {
@@ -152,51 +154,30 @@ fn dechunk(mut raw: &[u8]) -> Vec<u8> {
     }
 }
 
-/// A `multipart/form-data` body, as a browser's `FormData` sends it.
-pub struct Form {
-    boundary: String,
-    body: Vec<u8>,
-}
+/// A `multipart/form-data` body, as a browser's `FormData` sends it: a
+/// file part is `application/octet-stream` with its file name, a text part
+/// plain. Built by axum-test's form builder, for the app in process
+/// (`server::App::post`).
+pub struct Form(MultipartForm);
 
 impl Form {
     pub fn new() -> Form {
-        Form {
-            boundary: "axcomp-test-boundary-7MA4YWxkTrZu0gW".to_string(),
-            body: Vec::new(),
-        }
+        Form(MultipartForm::new())
     }
 
-    pub fn text(mut self, name: &str, value: &str) -> Form {
-        self.body.extend_from_slice(
-            format!(
-                "--{}\r\nContent-Disposition: form-data; name=\"{name}\"\r\n\r\n{value}\r\n",
-                self.boundary
-            )
-            .as_bytes(),
-        );
-        self
+    pub fn text(self, name: &str, value: &str) -> Form {
+        Form(self.0.add_text(name, value))
     }
 
-    pub fn file(mut self, name: &str, file_name: &str, bytes: &[u8]) -> Form {
-        self.body.extend_from_slice(
-            format!(
-                "--{}\r\nContent-Disposition: form-data; name=\"{name}\"; filename=\"{file_name}\"\r\nContent-Type: application/octet-stream\r\n\r\n",
-                self.boundary
-            )
-            .as_bytes(),
-        );
-        self.body.extend_from_slice(bytes);
-        self.body.extend_from_slice(b"\r\n");
-        self
-    }
-
-    /// The content type and the body.
-    pub fn finish(mut self) -> (String, Vec<u8>) {
-        self.body
-            .extend_from_slice(format!("--{}--\r\n", self.boundary).as_bytes());
-        (
-            format!("multipart/form-data; boundary={}", self.boundary),
-            self.body,
+    pub fn file(self, name: &str, file_name: &str, bytes: &[u8]) -> Form {
+        Form(
+            self.0
+                .add_part(name, Part::bytes(bytes.to_vec()).file_name(file_name)),
         )
+    }
+
+    /// The content type (with the boundary) and the body.
+    pub fn finish(self) -> (String, axum::body::Body) {
+        (self.0.content_type(), self.0.into())
     }
 }

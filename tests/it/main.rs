@@ -54,6 +54,8 @@ mod standards;
 mod survey;
 mod survey_optics;
 mod thermal;
+mod thermal_front;
+mod thermal_hal;
 mod together;
 mod units_wire;
 mod util;

@@ -42,6 +42,12 @@ impl App {
     /// A POST of `form` to `path` with extra `headers`.
     pub fn post(&self, path: &str, form: Form, headers: &[(&str, &str)]) -> Response {
         let (content_type, body) = form.finish();
+        // Whole, as a browser sends a form (its length known).
+        let body = self
+            .runtime
+            .block_on(axum::body::to_bytes(body, usize::MAX))
+            .unwrap()
+            .to_vec();
         let mut all = vec![("Content-Type", content_type.as_str())];
         all.extend_from_slice(headers);
         self.request("POST", path, &all, body)

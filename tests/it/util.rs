@@ -163,3 +163,18 @@ pub fn without_time(page: &str) -> String {
         .collect::<Vec<_>>()
         .join("\n")
 }
+
+/// The real spindle log (`../shared/data/thermal/`, SOURCES.md).
+pub const THERMAL_LOG: &str = "thermal/data__thermal expansion error original.csv";
+
+/// `thermal fit` on the real spindle log's warm-up (rows 1–1500, one-minute
+/// rows, drift "delta L") with `extra` flags, writing `model`; must succeed.
+pub fn fit_warm_up(model: &Path, extra: &[&str]) {
+    let log = shared_data(THERMAL_LOG);
+    let mut args = vec!["thermal", "fit", log.to_str().unwrap()];
+    args.extend(["--drift", "delta L", "--sample-interval", "60"]);
+    args.extend(["--rows", "1-1500", "-o", model.to_str().unwrap()]);
+    args.extend(extra);
+    let fit = axcomp(&args);
+    assert_eq!(fit.code, 0, "{}", fit.stderr);
+}

@@ -148,10 +148,6 @@ fn run_linuxcnc(
     comp_file: &str,
     comp_type: u8,
 ) -> serde_json::Value {
-    // A test that failed while holding the lock has already said why.
-    let _one = ONE_LINUXCNC
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let template = std::fs::read_to_string(test_data("linuxcnc/sim.ini")).unwrap();
     let ini = template
         .replace("@DRIVER@", &dir.join("driver.py").display().to_string())
@@ -160,7 +156,7 @@ fn run_linuxcnc(
         .replace("@COMP_FILE@", comp_file)
         .replace("@COMP_FILE_TYPE@", &comp_type.to_string());
     std::fs::write(dir.join("sim.ini"), ini).unwrap();
-    for file in ["sim.hal", "driver.py"] {
+    for file in ["sim.hal", "driver.py", "machine.py"] {
         std::fs::copy(test_data(&format!("linuxcnc/{file}")), dir.join(file)).unwrap();
     }
     let positions: Vec<&str> = moves.iter().map(|(p, _)| p.as_str()).collect();
@@ -169,6 +165,16 @@ fn run_linuxcnc(
         serde_json::json!({"axis": joint.axis, "positions": positions}).to_string(),
     )
     .unwrap();
+    run_config(dir, "sim.ini")
+}
+
+/// Runs LinuxCNC on the config `ini` in `dir` (its "display" a driver that
+/// writes `result.json` there and exits) and returns result.json.
+pub fn run_config(dir: &Path, ini: &str) -> serde_json::Value {
+    // A test that failed while holding the lock has already said why.
+    let _one = ONE_LINUXCNC
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let _ = std::fs::remove_file(dir.join("result.json"));
     // LinuxCNC runs as another user when we are root: let it write here.
     for entry in std::fs::read_dir(dir).unwrap() {
@@ -203,7 +209,7 @@ fn run_linuxcnc(
         c
     };
     command
-        .arg(dir.join("sim.ini"))
+        .arg(dir.join(ini))
         .current_dir(dir)
         .env_remove("DISPLAY");
     let log = std::fs::File::create(dir.join("linuxcnc.log")).unwrap();

@@ -11,7 +11,7 @@ import os
 import subprocess
 import time
 
-import linuxcnc
+import machine
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 result = {"points": []}
@@ -24,25 +24,7 @@ def getp(pin):
 try:
     moves = json.load(open(os.path.join(HERE, "positions.json")))
     axis, positions = moves["axis"], moves["positions"]
-    s = linuxcnc.stat()
-    c = linuxcnc.command()
-    c.state(linuxcnc.STATE_ESTOP_RESET)
-    c.wait_complete(20)
-    c.state(linuxcnc.STATE_ON)
-    c.wait_complete(20)
-    c.mode(linuxcnc.MODE_MANUAL)
-    c.wait_complete(20)
-    c.home(-1)
-    c.wait_complete(20)
-    for _ in range(400):
-        s.poll()
-        if all(s.homed[:3]):
-            break
-        time.sleep(0.05)
-    else:
-        raise RuntimeError("the joints did not home")
-    c.mode(linuxcnc.MODE_MDI)
-    c.wait_complete(20)
+    s, c = machine.ready_in_mdi()
     for x in positions:
         c.mdi("G1 %s%s F30000" % (axis, x))
         if c.wait_complete(60) == -1:
