@@ -307,7 +307,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     if args.controller == Controller::Fanuc
         && let Some(parameters) = &options.axes[0].fanuc
     {
-        fanuc_grid(&mut request, parameters, measurement.targets_mm())?;
+        fanuc_grid(&mut request, parameters, measurement.targets())?;
     }
     let Converted {
         bytes,

@@ -406,7 +406,7 @@ pub fn build_table(
     evaluation: &Evaluation,
     options: &TableOptions,
 ) -> Result<CompensationTable, CompensateError> {
-    let positions_mm = grid_positions(measurement.targets_mm(), options.grid)?;
+    let positions_mm = grid_positions(measurement.targets(), options.grid)?;
     let has = |d: Direction| measurement.run_count(d) > 0;
     let kind = measurement.kind();
     let source_curve = |pick: fn(&crate::evaluate::TargetStats) -> Option<f64>| {
@@ -479,7 +479,7 @@ fn shift_to_reference(
     zero_outside: bool,
     measurement: &Measurement,
 ) -> TableValues {
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let (first, last) = (targets[0], targets[targets.len() - 1]);
     let at_reference =
         |d: Direction| interpolate_hold(positions_mm, raw.for_direction(d), reference_mm);
@@ -577,7 +577,7 @@ pub fn add_existing_table(
     measurement: &Measurement,
     active: &CompensationTable,
 ) -> Result<Measurement, MeasurementError> {
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     measurement.map_readings(|run, i, v| v + active.value_at(targets[i], run.direction))
 }
 

@@ -134,7 +134,7 @@ pub struct TestConformance {
 /// use axcomp::evaluate::conformance::check_test;
 /// use axcomp::measurement::{Direction, Measurement, Run};
 /// let run = |direction, number| Run { direction, number, start_time_s: None,
-///     deviations_mm: vec![Some(0.0); 2] };
+///     deviations: vec![Some(0.0); 2] };
 /// let m = Measurement::new("X", vec![0.0, 1000.0], vec![
 ///     run(Direction::Up, 1), run(Direction::Down, 1),
 ///     run(Direction::Up, 2), run(Direction::Down, 2),
@@ -386,7 +386,7 @@ mod tests {
             direction,
             number,
             start_time_s: None,
-            deviations_mm: vec![Some(0.0); count],
+            deviations: vec![Some(0.0); count],
         };
         let mut runs: Vec<Run> = (1..=up).map(|n| run(Direction::Up, n)).collect();
         runs.extend((1..=down).map(|n| run(Direction::Down, n)));

@@ -208,7 +208,7 @@ impl Evaluation {
 /// use axcomp::measurement::{Direction, Measurement, Run};
 /// let run = |direction, number, values: [f64; 2]| Run {
 ///     direction, number, start_time_s: None,
-///     deviations_mm: values.iter().map(|v| Some(*v)).collect() };
+///     deviations: values.iter().map(|v| Some(*v)).collect() };
 /// let m = Measurement::new("X", vec![0.0, 100.0], vec![
 ///     run(Direction::Up, 1, [0.000, 0.004]), run(Direction::Down, 1, [-0.002, 0.002]),
 ///     run(Direction::Up, 2, [0.002, 0.006]), run(Direction::Down, 2, [0.000, 0.004]),

@@ -106,7 +106,7 @@ pub fn suspected_outliers(measurement: &Measurement) -> Vec<SuspectedOutlier> {
 pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<SuspectedOutlier> {
     let runs: Vec<&[Option<f64>]> = measurement
         .runs_in(direction)
-        .map(|run| run.deviations_mm.as_slice())
+        .map(|run| run.deviations.as_slice())
         .collect();
     if runs.len() < 3 {
         return Vec::new();
@@ -234,7 +234,7 @@ mod tests {
                 direction: Direction::Up,
                 number: j as u32 + 1,
                 start_time_s: None,
-                deviations_mm: values.iter().map(|v| Some(*v)).collect(),
+                deviations: values.iter().map(|v| Some(*v)).collect(),
             })
             .collect();
         Measurement::new(

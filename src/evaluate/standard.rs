@@ -406,7 +406,7 @@ mod tests {
             direction,
             number,
             start_time_s: None,
-            deviations_mm: values.iter().map(|v| Some(v / 1000.0)).collect(),
+            deviations: values.iter().map(|v| Some(v / 1000.0)).collect(),
         };
         Measurement::new(
             "X",

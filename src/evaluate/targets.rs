@@ -180,7 +180,7 @@ pub(super) fn per_target_stats<T>(
     let runs_of = |direction: Direction| -> Vec<&[Option<f64>]> {
         measurement
             .runs_in(direction)
-            .map(|run| run.deviations_mm.as_slice())
+            .map(|run| run.deviations.as_slice())
             .collect()
     };
     let runs_by_direction = [runs_of(Direction::Up), runs_of(Direction::Down)];
@@ -190,7 +190,7 @@ pub(super) fn per_target_stats<T>(
         readings.extend(
             runs_by_direction[usize::from(direction == Direction::Down)]
                 .iter()
-                .filter_map(|deviations_mm| deviations_mm[target_index]),
+                .filter_map(|deviations| deviations[target_index]),
         );
         DirectionStats::of(&readings)
     };

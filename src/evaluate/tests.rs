@@ -21,12 +21,12 @@ fn run(direction: Direction, number: u32, values_um: &[f64]) -> Run {
         direction,
         number,
         start_time_s: None,
-        deviations_mm: values_um.iter().map(|v| Some(v / 1000.0)).collect(),
+        deviations: values_um.iter().map(|v| Some(v / 1000.0)).collect(),
     }
 }
 
 fn measurement(runs: Vec<Run>) -> Measurement {
-    let count = runs[0].deviations_mm.len();
+    let count = runs[0].deviations.len();
     let targets = (0..count).map(|i| i as f64 * 100.0).collect();
     Measurement::new(
         "X",
@@ -209,7 +209,7 @@ fn a_target_read_once_leaves_a_and_r_unevaluated_and_says_where() {
         .map(|r| {
             let mut r = r.clone();
             if r.direction == Direction::Up && r.number > 1 {
-                r.deviations_mm[2] = None;
+                r.deviations[2] = None;
             }
             r
         })
@@ -267,8 +267,8 @@ fn shifted(m: &Measurement, offset_mm: f64) -> Measurement {
         .runs()
         .iter()
         .map(|r| Run {
-            deviations_mm: r
-                .deviations_mm
+            deviations: r
+                .deviations
                 .iter()
                 .map(|v| v.map(|v| v + offset_mm))
                 .collect(),

@@ -67,7 +67,7 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         let prediction = predict(&input(&machine, &errors, &measured, &tables, line)).unwrap();
         let known = KnownError::from_evaluation(&evaluate(&before)).unwrap();
         let retest = &prediction.retests[0];
-        for (t, target) in retest.per_target.iter().zip(before.targets_mm()) {
+        for (t, target) in retest.per_target.iter().zip(before.targets()) {
             for (direction, value) in [(Direction::Up, t.up_mm), (Direction::Down, t.down_mm)] {
                 let expected =
                     predicted_deviation_mm(&known, Applied::table(&tables[0]), *target, direction);

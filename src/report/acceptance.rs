@@ -275,7 +275,7 @@ fn series(label: Option<String>, color: Rgb, mark: Mark, points: Vec<(f64, f64)>
 /// x̄ ± 2s band of each direction.
 fn deviation_chart(test: &TestRecord<'_>, which: &str, angle: AngleUnit) -> Chart {
     let measurement = test.measurement;
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let per_target = &test.evaluation.per_target;
     let shown = shown(test, angle);
     let mut all = Vec::new();
@@ -305,7 +305,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str, angle: AngleUnit) -> Char
         for (index, run) in measurement.runs_in(direction).enumerate() {
             let points: Vec<(f64, f64)> = targets
                 .iter()
-                .zip(&run.deviations_mm)
+                .zip(&run.deviations)
                 .filter_map(|(x, value)| value.map(|v| (*x, shown.from_internal(v))))
                 .collect();
             lines.push(series(None, light, Mark::Line(1), points.clone()));
@@ -725,7 +725,7 @@ fn extent(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// Each accepted effect's contribution to every reading, in the order measured.
 fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
-    let first_target_mm = after.targets_mm().first().copied().unwrap_or(0.0);
+    let first_target_mm = after.targets().first().copied().unwrap_or(0.0);
     let mut all = Vec::new();
     for (index, accepted) in diagnosis.accepted.iter().enumerate() {
         // The Abbe effect needs the angular profile, which the report is not

@@ -313,7 +313,7 @@ fn to_measurement(
                 direction,
                 number: run,
                 start_time_s,
-                deviations_mm,
+                deviations: deviations_mm,
             });
         }
     }

@@ -254,7 +254,7 @@ pub fn convert(
         _ => None,
     };
     let plan = plan(
-        measurement.targets_mm(),
+        measurement.targets(),
         table.effects,
         &table.controller.capabilities(options.machine_unit),
         table.request,

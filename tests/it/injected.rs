@@ -166,7 +166,7 @@ fn found_like(d: &Diagnosis, put_in: &Effect) -> Option<Effect> {
 /// 10 s, a drift of 20 s over the test (per hour, or per run when the file records no times), a scale of 10 s over the span, and
 /// (with at least 9 targets) a periodic error of 5 s and a period of span/2.2 or 12 mm.
 fn effects_for(m: &Measurement, s_um: f64, duration_h: f64) -> Vec<Effect> {
-    let targets = m.targets_mm();
+    let targets = m.targets();
     let span_mm = targets[targets.len() - 1] - targets[0];
     let mut effects = vec![
         Effect::Reversal(Reversal { b_um: -10.0 * s_um }),

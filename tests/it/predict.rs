@@ -80,8 +80,8 @@ fn the_predicted_retest_is_the_table_applied_to_the_measurement() {
     let (controller, active) = emit::read_any(&text, &options, None).unwrap();
     assert_eq!(controller, Controller::Tnc640);
     let per_target = json["per_target"].as_array().unwrap();
-    assert_eq!(per_target.len(), measurement.targets_mm().len());
-    for (row, &x) in per_target.iter().zip(measurement.targets_mm()) {
+    assert_eq!(per_target.len(), measurement.targets().len());
+    for (row, &x) in per_target.iter().zip(measurement.targets()) {
         assert_eq!(row["target_mm"].as_f64().unwrap(), x);
         for (key, direction) in [
             ("predicted_up_um", Direction::Up),
