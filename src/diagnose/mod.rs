@@ -483,7 +483,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // The reversal's sentence says the B̄ the figures show; where the fitted
     // B differs from the change they show, it says why.
     if let (Some(predicted_mm), Some(measured_mm)) =
-        (figures.predicted.b_mean_mm, figures.measured.b_mean_mm)
+        (figures.predicted.b_mean, figures.measured.b_mean)
     {
         let context = Context {
             retest_mean_reversal_um: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),

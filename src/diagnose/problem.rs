@@ -274,7 +274,7 @@ pub(super) struct FirstTestVariances {
 pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
     let both = evaluation.runs_up > 0 && evaluation.runs_down > 0;
     let pooled_um2 = evaluation
-        .pooled_variance_mm2()
+        .pooled_variance()
         .map_or(0.0, crate::units::mm2_to_um2);
     let inverse = |n: usize| if n == 0 { 0.0 } else { 1.0 / n as f64 };
     let mut variances = FirstTestVariances {
@@ -284,15 +284,15 @@ pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
     };
     for t in &evaluation.per_target {
         let has_mean = if both {
-            t.mean_mm.is_some()
+            t.mean.is_some()
         } else {
-            t.up.mean_mm.or(t.down.mean_mm).is_some()
+            t.up.mean.or(t.down.mean).is_some()
         };
         if !has_mean {
             continue;
         }
         let sum_of_inverses = inverse(t.up.n) + inverse(t.down.n);
-        variances.positions_mm.push(t.target_mm);
+        variances.positions_mm.push(t.target);
         if both {
             variances.mean_um2.push(pooled_um2 * sum_of_inverses / 4.0);
             variances.reversal_um2.push(pooled_um2 * sum_of_inverses);

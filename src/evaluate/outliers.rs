@@ -35,9 +35,9 @@ pub struct SuspectedOutlier {
     pub score: f64,
     /// The target where it differs most, in the axis' unit (mm, or ° on a
     /// rotary axis: [`SuspectedOutlier::typed`]).
-    pub worst_target_mm: f64,
+    pub worst_target: f64,
     /// Its deviation there minus the mean of the other runs, in the axis' unit.
-    pub offset_mm: f64,
+    pub offset: f64,
 }
 
 impl SuspectedOutlier {
@@ -54,8 +54,8 @@ impl SuspectedOutlier {
             direction: self.direction,
             run: self.run,
             score: self.score,
-            worst_target: unit(self.worst_target_mm),
-            offset: unit(self.offset_mm),
+            worst_target: unit(self.worst_target),
+            offset: unit(self.offset),
         }
     }
 }
@@ -144,8 +144,8 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
                 direction,
                 run: run.number,
                 score,
-                worst_target_mm: targets[i],
-                offset_mm: offset,
+                worst_target: targets[i],
+                offset: offset,
             });
         }
     }
@@ -259,9 +259,9 @@ mod tests {
         ]);
         let flagged = suspected_outliers(&m);
         assert_eq!(flagged.len(), 1);
-        assert_eq!((flagged[0].run, flagged[0].worst_target_mm), (1, 1.0));
+        assert_eq!((flagged[0].run, flagged[0].worst_target), (1, 1.0));
         // Offset at target 2: 0.021 − mean(0, 0.001, −0.001, 0) = 0.021.
-        assert!((flagged[0].offset_mm - 0.021).abs() < 1e-12);
+        assert!((flagged[0].offset - 0.021).abs() < 1e-12);
         // Pooled s of runs 2–5 by hand: per-target sums of squares 2e-6, 2e-6,
         // 2e-6 with 3 degrees of freedom each: s² = 6e-6/9, s = 0.8165e-3.
         // Score = 0.021 / (0.8165e-3 · √(1 + 1/4)) = 23.0.

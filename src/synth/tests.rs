@@ -39,7 +39,7 @@ fn each_effect_by_hand() {
     let reversal = before(&truth("[[effect]]\nkind = \"reversal\"\nB_um = -3.0\n"), 1).unwrap();
     assert_eq!(deviations_um(&reversal, 0), vec![-1.5; 5]);
     assert_eq!(deviations_um(&reversal, 1), vec![1.5; 5]);
-    assert!((evaluate(&reversal).figures.b_mean_mm.unwrap() * 1000.0 + 3.0).abs() < 1e-9);
+    assert!((evaluate(&reversal).figures.b_mean.unwrap() * 1000.0 + 3.0).abs() < 1e-9);
 
     let outlier = before(
         &truth(

@@ -125,7 +125,7 @@ fn scatter_um(m: &Measurement) -> f64 {
     let s: Vec<f64> = evaluate(m)
         .per_target
         .iter()
-        .flat_map(|t| [t.up.s_mm, t.down.s_mm])
+        .flat_map(|t| [t.up.s, t.down.s])
         .flatten()
         .collect();
     1000.0 * (s.iter().map(|x| x * x).sum::<f64>() / s.len() as f64).sqrt()
