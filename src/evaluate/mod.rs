@@ -306,7 +306,7 @@ fn coverage_warnings(
             };
             warnings.push(Warning::TargetNotEvaluated {
                 kind,
-                target_mm: target.target,
+                target: target.target,
                 missing,
             });
         }

@@ -229,7 +229,7 @@ fn a_target_read_once_leaves_a_and_r_unevaluated_and_says_where() {
     // E and M need only the means, which exist everywhere.
     assert!(e.figures.e.is_some() && e.figures.m.is_some());
     assert!(
-        matches!(coverage(&e), [Warning::TargetNotEvaluated { target_mm, .. }] if *target_mm == 200.0)
+        matches!(coverage(&e), [Warning::TargetNotEvaluated { target: target_mm, .. }] if *target_mm == 200.0)
     );
 }
 
