@@ -38,6 +38,28 @@ fn drift_column_optional_reads_a_log_without_it_once() {
     assert_eq!(log.drift.unwrap().um, [0.0, 1.5]);
 }
 
+/// A sensor named `T` (or `t [°C]`) is a temperature; `t [min]` is the time.
+#[test]
+fn a_column_named_t_is_a_time_only_with_a_time_unit() {
+    let options = LogOptions {
+        drift: Some("d".to_string()),
+        sample_interval_s: Some(60.0),
+        drift_optional: false,
+    };
+    let log = parse_log("d,T,t [°C]\n0,20,21\n1.5,20.5,21.5\n", &options).unwrap();
+    assert_eq!(log.sensors.len(), 2);
+    assert_eq!(log.sensors[0].celsius, [20.0, 20.5]);
+    assert_eq!(log.sensors[1].celsius, [21.0, 21.5]);
+    let options = LogOptions {
+        sample_interval_s: None,
+        ..options
+    };
+    let log = parse_log("t [min],d,T\n0,0,20\n2,1.5,20.5\n", &options).unwrap();
+    assert_eq!(log.sensors.len(), 1);
+    assert_eq!(log.times_s, [0.0, 120.0]);
+    assert_eq!(log.drift.unwrap().um, [0.0, 1.5]);
+}
+
 /// With no sensor chosen the cross-validated rms is the drift's own rms
 /// over the rows predicted: all of them for the blocked validation, all
 /// but the first block for the forward one (it is never predicted).

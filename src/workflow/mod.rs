@@ -120,8 +120,18 @@ pub fn evaluation_report(
     } = options;
     warnings.extend(evaluation.warnings.iter().cloned());
     // The budget is the laser's, for lengths, and limits are µm: a rotary
-    // axis has neither yet.
-    rotary::check(measurement, &[(rotary::Use::Limits, !limits.is_empty())])?;
+    // axis has neither yet, and asking for either is refused, as `report`
+    // refuses it.
+    rotary::check(
+        measurement,
+        &[
+            (rotary::Use::Limits, !limits.is_empty()),
+            (
+                rotary::Use::Uncertainty,
+                equipment.is_some() || decision != Default::default(),
+            ),
+        ],
+    )?;
     let budget = match rotary::allows(measurement, rotary::Use::Uncertainty) {
         true => budget_of(measurement, equipment, warnings)?,
         false => None,
