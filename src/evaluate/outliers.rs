@@ -145,7 +145,7 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
                 run: run.number,
                 score,
                 worst_target: targets[i],
-                offset: offset,
+                offset,
             });
         }
     }

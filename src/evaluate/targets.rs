@@ -38,7 +38,7 @@ impl DirectionStats {
         DirectionStats {
             n,
             mean: Some(mean),
-            s: s,
+            s,
         }
     }
 
