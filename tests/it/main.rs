@@ -19,6 +19,7 @@ mod cross_axis;
 mod demo;
 mod diagnose;
 mod diagnose_periodic;
+mod diagnose_wire;
 mod doc_examples;
 mod evaluate_ecmc;
 mod fagor;
