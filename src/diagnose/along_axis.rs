@@ -20,7 +20,7 @@ use super::gates::{period_range, rotary_orders, set_rejection};
 use super::levels::{Fold, Level};
 use super::periodogram::{
     Screen, aliases, below_margin, bounded_gls_chi2, diagonal_gls_chi2, frequency_uncertainty,
-    may_be_lowest, period_sets,
+    lowest_bound, may_be_lowest, period_sets,
 };
 use super::problem::Problem;
 use super::selection::{Chosen, Search, ShapeSet, forward_selection, shapes};
@@ -390,8 +390,7 @@ impl Search for AlongAxis<'_> {
         }
         let screen = self.screen(model, &periods, tests?)?;
         // The period of the lowest bound, fitted exactly: no period whose bound is above its χ² can be the best.
-        let lowest =
-            (0..periods.len()).min_by(|a, b| screen.lower[*a].total_cmp(&screen.lower[*b]))?;
+        let lowest = lowest_bound(&screen.lower)?;
         let exact = self
             .fit_extended(model, &self.columns(set.shapes[lowest]))
             .chi2;

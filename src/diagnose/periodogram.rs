@@ -313,6 +313,14 @@ pub(super) fn may_be_lowest(lower: &[f64], exact: f64) -> Vec<bool> {
     lower.iter().map(|l| !(*l > exact)).collect()
 }
 
+/// The period with the lowest finite bound (the one to fit exactly for
+/// [`may_be_lowest`]), if any.
+pub(super) fn lowest_bound(lower: &[f64]) -> Option<usize> {
+    (0..lower.len())
+        .filter(|i| lower[*i].is_finite())
+        .min_by(|a, b| lower[*a].total_cmp(&lower[*b]))
+}
+
 /// What a scan's screen gives: a lower bound of the χ² at each period (−∞
 /// where there is none) and an upper bound of all of them (the χ² of the
 /// model without a period).
@@ -510,9 +518,7 @@ mod tests {
             assert!((v - e).abs() <= 1e-8 * e, "{p} mm: {v} vs {e}");
         }
         // The lowest is at 37 mm, and only the periods next to it are fitted exactly.
-        let lowest = (0..screened.len())
-            .min_by(|a, b| screened[*a].total_cmp(&screened[*b]))
-            .unwrap();
+        let lowest = lowest_bound(&screened).unwrap();
         let marks = may_be_lowest(&below_margin(&screened), exact(periods[lowest]));
         let kept: Vec<f64> = periods
             .iter()
@@ -629,9 +635,7 @@ mod tests {
                 assert!(l <= e, "{p} mm: bound {l} above the exact {e}");
             }
             // The best of the marked periods is the best of all, refined alike.
-            let lowest = (0..periods.len())
-                .min_by(|a, b| lower[*a].total_cmp(&lower[*b]))
-                .unwrap();
+            let lowest = lowest_bound(&lower).unwrap();
             let marks = may_be_lowest(&lower, every[lowest]);
             let set = ShapeSet {
                 shapes: periods
