@@ -178,7 +178,7 @@ pub(super) fn bounded_gls_chi2(
 ) -> Option<Vec<f64>> {
     let n = positions.len();
     let (chi2_base, v) = fit;
-    if n == 0 || periods.len() < 2 || !(kappa >= 1.0) || !chi2_base.is_finite() {
+    if n == 0 || periods.len() < 2 || kappa.is_nan() || kappa < 1.0 || !chi2_base.is_finite() {
         return None;
     }
     let reductions =
@@ -310,7 +310,10 @@ pub(super) fn below_margin(screened: &[f64]) -> Vec<f64> {
 /// the exact χ² `exact` of one of them: those whose bound is not above it
 /// (any other is beaten by that one).
 pub(super) fn may_be_lowest(lower: &[f64], exact: f64) -> Vec<bool> {
-    lower.iter().map(|l| !(*l > exact)).collect()
+    lower
+        .iter()
+        .map(|l| l.is_nan() || exact.is_nan() || *l <= exact)
+        .collect()
 }
 
 /// The period with the lowest finite bound (the one to fit exactly for
@@ -387,7 +390,7 @@ pub(super) fn aliases(
                 + SCREEN_MARGIN * (screen.upper.abs() + 1.0);
             let mut exact = vec![false; periods.len()];
             for (i, lower) in screen.lower.iter().enumerate() {
-                if !(*lower > threshold) {
+                if lower.is_nan() || threshold.is_nan() || *lower <= threshold {
                     exact[i.saturating_sub(1)..(i + 2).min(periods.len())].fill(true);
                 }
             }
