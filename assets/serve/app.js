@@ -4,7 +4,9 @@
 "use strict";
 
 const $ = (id) => document.getElementById(id);
-const files = { file: [], after: [], table: [], machine: [] };
+const files = { file: [], after: [], table: [], machine: [], fanuc_parameters: [] };
+// The rescaled Fanuc file of the last conversion (`--fanuc-rescaled`), for its download.
+let rescaled = null;
 // The limits typed next to the figures, µm, by figure key (`A`, `R_up`).
 const limits = {};
 let busy = 0;
@@ -45,7 +47,7 @@ function showError(id, message) {
 // The page's settings and files as a form for the API.
 function form(fields) {
   const data = new FormData();
-  for (const field of fields.concat(["machine"])) {
+  for (const field of fields.concat(["machine", "fanuc_parameters"])) {
     for (const file of files[field]) data.append(field, file, file.name);
   }
   for (const id of ["axis", "standard", "decision"]) {
@@ -62,6 +64,7 @@ function tableForm(fields) {
     const value = $(id).value.trim();
     if (value) data.append(id, value);
   }
+  if ($("fanuc_rescaled").checked) data.append("fanuc_rescaled", "1");
   return data;
 }
 
@@ -82,6 +85,18 @@ async function post(path, data) {
   }
 }
 
+// Saves `blob` as a download named `name`.
+function save(blob, name) {
+  const link = element("a");
+  link.href = URL.createObjectURL(blob);
+  link.download = name;
+  document.body.appendChild(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(link.href), 60000);
+  document.body.dataset.downloaded = link.download;
+}
+
 // Saves a response as a download under the server's name for it.
 async function download(path, data, errorId) {
   showError(errorId, "");
@@ -89,15 +104,7 @@ async function download(path, data, errorId) {
     const response = await post(path, data);
     const disposition = response.headers.get("Content-Disposition") || "";
     const match = /filename="([^"]+)"/.exec(disposition);
-    const blob = await response.blob();
-    const link = element("a");
-    link.href = URL.createObjectURL(blob);
-    link.download = match ? match[1] : "download";
-    document.body.appendChild(link);
-    link.click();
-    link.remove();
-    setTimeout(() => URL.revokeObjectURL(link.href), 60000);
-    document.body.dataset.downloaded = link.download;
+    save(await response.blob(), match ? match[1] : "download");
   } catch (error) {
     showError(errorId, error.message);
   }
@@ -263,6 +270,13 @@ async function convert() {
     $("table-plot").innerHTML = answer.table_svg || "";
     $("table-result").hidden = false;
     $("download").dataset.name = answer.file_name;
+    rescaled = answer.fanuc_rescaled;
+    if (rescaled) {
+      $("rescaled-name").textContent = rescaled.file_name;
+      $("rescaled-instruction").textContent = rescaled.instruction;
+      $("rescaled-preview").textContent = rescaled.text;
+    }
+    $("rescaled").hidden = !rescaled;
     document.body.dataset.converted = c.controller + ":" + answer.file_name;
   } catch (error) {
     $("table-result").hidden = true;
@@ -335,6 +349,11 @@ async function start() {
     $(id).addEventListener("change", () => { convert(); retest(); });
   }
   $("download").addEventListener("click", () => download("/api/table", tableForm(["file"]), "table-error"));
+  $("fanuc_parameters").addEventListener("change", (event) => pick("fanuc_parameters", event.target.files, () => { convert(); retest(); }));
+  $("fanuc_rescaled").addEventListener("change", convert);
+  $("download-rescaled").addEventListener("click", () => {
+    if (rescaled) save(new Blob([rescaled.text], { type: "application/octet-stream" }), rescaled.file_name);
+  });
   $("download-next").addEventListener("click", () => download("/api/table", tableForm(["file", "after", "table"]), "retest-error"));
   $("report").addEventListener("click", () => {
     const data = form(["file", "after", "table"]);

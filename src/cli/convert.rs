@@ -293,7 +293,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         || args.output.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let mut request = Request {
+    let request = Request {
         mode: args.mode,
         step_mm: args.step,
         start_mm: args.start,
@@ -301,18 +301,11 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
         reference_mm: args.reference,
         extrapolate: args.extrapolate,
     };
-    if args.fanuc_rescaled.is_some() && args.controller != Controller::Fanuc {
-        bail!("--fanuc-rescaled is for --controller fanuc");
-    }
-    if args.controller == Controller::Fanuc
-        && let Some(parameters) = &options.axes[0].fanuc
-    {
-        fanuc_grid(&mut request, parameters, measurement.targets_mm())?;
-    }
     let Converted {
         bytes,
         report,
-        table,
+        rescaled,
+        ..
     } = workflow::convert(
         &measurement,
         &mut warnings,
@@ -326,13 +319,11 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
             output: args.output.display().to_string(),
             file_name,
             also: args.also.clone(),
+            fanuc_rescaled: args.fanuc_rescaled.is_some(),
         },
     )?;
     write_new(&args.output, &bytes, &args.inputs(), args.overwrite.force)?;
-    if let Some(path) = &args.fanuc_rescaled {
-        let existing = existing_bytes.and_then(|b| axcomp::emit::decode_table(&b).ok());
-        let existing = existing.as_ref().map(|(text, _)| text.as_str());
-        let fine = axcomp::emit::fanuc::rescaled(existing, &table, &options, None)?;
+    if let (Some(path), Some(fine)) = (&args.fanuc_rescaled, rescaled) {
         write_new(
             path,
             fine.text.as_bytes(),
@@ -352,29 +343,6 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     } else {
         print_text(&report.summary())
     }
-}
-
-/// The grid of a Fanuc table: the control's points (3620–3624 of the
-/// parameter backup) inside the measured range, zero at its reference point.
-fn fanuc_grid(
-    request: &mut Request,
-    parameters: &axcomp::emit::fanuc::AxisParameters,
-    targets_mm: &[f64],
-) -> Result<()> {
-    if request.step_mm.is_some() || request.start_mm.is_some() || request.reference_mm.is_some() {
-        bail!(
-            "the Fanuc parameter backup fixes the compensation points and the reference ({}): leave out --step, --start, --count and --reference",
-            parameters.settings()
-        );
-    }
-    let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
-    let (start_mm, count) =
-        axcomp::emit::fanuc::points_in(parameters, first, last).map_err(anyhow::Error::msg)?;
-    request.step_mm = Some(parameters.interval);
-    request.start_mm = Some(start_mm);
-    request.count = Some(count);
-    request.reference_mm = Some(parameters.position(parameters.reference_point));
-    Ok(())
 }
 
 /// The name inside Heidenhain files: the output file name, upper case.

@@ -289,6 +289,7 @@ fn next_table(
             output: format!("tables/next/{file_name}"),
             file_name,
             also: Vec::new(),
+            fanuc_rescaled: false,
         },
     )?)
 }

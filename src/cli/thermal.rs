@@ -145,17 +145,20 @@ pub struct FitArgs {
     pub exclude: Vec<String>,
     /// The reference sensor: each term is a sensor's rise over it (the
     /// measuring loop's other end, e.g. the table), so a uniform change of
-    /// the loop's temperature moves nothing. `auto`: each sensor tried as
-    /// the reference (and none), the one that predicts best kept.
+    /// the loop's temperature moves nothing. `auto`: the coldest sensor
+    /// over the fit rows (the room or the table) or none, whichever
+    /// predicts better.
     #[arg(long, value_name = "SENSOR")]
     pub reference: Option<String>,
     /// At most this many sensors (the reference aside).
     #[arg(long = "max-sensors", value_name = "N", default_value_t = 4)]
     pub max_sensors: usize,
     /// How the cross-validation predicts its blocks: blocked (each from all
-    /// the others) or forward (each from the blocks before it only: what
-    /// the model does on the machine, predicting the hours after its fit).
-    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = ["blocked", "forward"])]
+    /// the others), forward (each from the blocks before it only: what
+    /// the model does on the machine, predicting the hours after its fit)
+    /// or late (forward over the last third of the rows: the blocks nearest
+    /// the steady state).
+    #[arg(long, value_name = "HOW", default_value = "blocked", value_parser = ["blocked", "forward", "late"])]
     pub validation: String,
     /// Write the drift, the model and the residual against time (.svg or .png).
     #[arg(long = "plot", value_name = "FILE", help_heading = "Output")]
@@ -247,9 +250,11 @@ fn fit(args: &FitArgs) -> Result<()> {
     options.auto_reference = args.reference.as_deref() == Some("auto");
     options.reference = args.reference.clone().filter(|r| r != "auto");
     options.max_sensors = args.max_sensors;
-    if args.validation == "forward" {
-        options.validation = thermal::Validation::Forward;
-    }
+    options.validation = match args.validation.as_str() {
+        "forward" => thermal::Validation::Forward,
+        "late" => thermal::Validation::Late,
+        _ => thermal::Validation::Blocked,
+    };
     let model = thermal::fit(&log, &options).map_err(|e| in_file_thermal(&args.log, e))?;
     write_new(
         &args.output,

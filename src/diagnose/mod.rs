@@ -345,16 +345,6 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     let (reversal, reversal_p) = select_reversal(&problem, &cells, &folds, &kinds, &mut rejected);
     let reversal_b = reversal.map_or(0.0, |r| r.b_um);
     let context = context(input, time_assumed);
-    // With a first test the prediction carries its reversal: a reversal found is a change.
-    if let (None, Some(before_um)) = (&reversal, context.first_test_reversal_um)
-        && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
-    {
-        entry.why = format!(
-            "no change since the first test, whose B̄ = {} the prediction carries ({})",
-            context.deviation(before_um),
-            entry.why
-        );
-    }
 
     // 3. Along the axis (scale, periodic, Abbe) on the pooled per-target levels, with a prediction only.
     let levels = target_levels(&problem, &cells);
@@ -523,6 +513,15 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             }
         }
     }
+    // With a first test the prediction carries its reversal (what the table
+    // leaves of it): a reversal found is a change, and none found is none.
+    if reversal.is_none()
+        && let Some(first_um) = context.first_test_reversal_um
+        && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
+    {
+        let predicted_um = figures.predicted.b_mean_mm.map(mm_to_um);
+        entry.why = no_reversal_change(&context, first_um, predicted_um, &entry.why);
+    }
     // A kind is either found or not: a second outlier run that fails a gate
     // after the first was accepted records a rejection of the same kind.
     rejected.retain(|r| !accepted.iter().any(|a| a.effect.kind() == r.kind));
@@ -551,6 +550,26 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             })
             .collect(),
     })
+}
+
+/// Why no reversal is reported when the re-test's B̄ is the predicted one:
+/// the first test's B̄ carried by the prediction, or, where the table took
+/// some of it out (a bidirectional table), the B̄ the prediction is left with.
+fn no_reversal_change(
+    context: &Context,
+    first_um: f64,
+    predicted_um: Option<f64>,
+    why: &str,
+) -> String {
+    let first = context.deviation(first_um);
+    match predicted_um.map(|p| context.deviation(p)) {
+        Some(predicted) if predicted != first => format!(
+            "no change since the first test: its B̄ = {first} less what the table takes out leaves the B̄ = {predicted} the prediction carries ({why})"
+        ),
+        _ => format!(
+            "no change since the first test, whose B̄ = {first} the prediction carries ({why})"
+        ),
+    }
 }
 
 /// What a user should know of a periodic error's period: that it is a known

@@ -97,15 +97,22 @@ impl Model for Drift {
         }
     }
 
-    fn explanation(&self, _: &Context) -> String {
-        match *self {
-            Drift::PerHour { rate_um_per_h } => format!(
-                "Deviation growing by {rate_um_per_h:.2} µm/h during the test: the machine was warming up; run the axis until it is warm before measuring and re-measure."
-            ),
-            Drift::PerRun { rate_um_per_run } => format!(
-                "Deviation growing by {rate_um_per_run:.2} µm per run during the test (per run, not per hour: the file records no times): the machine was warming up; run the axis until it is warm before measuring and re-measure."
-            ),
-        }
+    fn explanation(&self, context: &Context) -> String {
+        let (rate, _) = self.rate();
+        // The sign of a thermal drift depends on where the laser and the
+        // scale sit, not only on warming or cooling: the sentence says the
+        // deviation's direction and no more of the cause than that.
+        let change = if rate < 0.0 { "falling" } else { "growing" };
+        let amount = context.deviation(rate.abs());
+        let per = match self {
+            Drift::PerHour { .. } => "/h during the test",
+            Drift::PerRun { .. } => {
+                " per run during the test (per run, not per hour: the file records no times)"
+            }
+        };
+        format!(
+            "Deviation {change} by {amount}{per}: the machine's temperature was changing (most often, it is warming up); let it reach a steady temperature (run the axis until it is warm) before measuring, and re-measure."
+        )
     }
 
     fn parameters(&self) -> Vec<Parameter> {
@@ -141,5 +148,45 @@ impl Fit for Drift {
                 rate_um_per_run: coefficients[0],
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measurement::AxisKind;
+
+    fn context() -> Context {
+        Context {
+            kind: AxisKind::Linear,
+            angle: Default::default(),
+            table_step_mm: None,
+            target_spacing_mm: None,
+            expansion_coefficient_ppm_per_k: None,
+            material_change_k: None,
+            time_assumed: false,
+            first_test_reversal_um: None,
+            retest_mean_reversal_um: None,
+        }
+    }
+
+    #[test]
+    fn a_falling_deviation_is_said_falling_with_its_size() {
+        let text = Drift::PerHour {
+            rate_um_per_h: -3.0,
+        }
+        .explanation(&context());
+        assert!(
+            text.starts_with("Deviation falling by 3.00 µm/h during the test"),
+            "{text}"
+        );
+        let text = Drift::PerRun {
+            rate_um_per_run: 0.5,
+        }
+        .explanation(&context());
+        assert!(
+            text.starts_with("Deviation growing by 0.50 µm per run during the test (per run,"),
+            "{text}"
+        );
     }
 }

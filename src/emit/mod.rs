@@ -585,7 +585,7 @@ mod tests {
         #[test]
         fn every_controller_reads_back_what_it_writes((table, both) in arbitrary_table(), inch in any::<bool>()) {
             for controller in Controller::ALL {
-                // Fanuc points hold ±127 units each, which arbitrary values
+                // Fanuc points hold −128 … 127 units each, which arbitrary values
                 // exceed; its round trip is tested in `fanuc`.
                 if (both && !controller.supports_bidirectional()) || controller == Controller::Fanuc {
                     continue;

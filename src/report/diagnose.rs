@@ -39,15 +39,28 @@
 //! `down`) and `offset_um`. `residual_before_um` is the model's error before
 //! the effects are added, `residual_after_um` with them.
 //!
-//! A rotary axis adds `"axis_kind": "rotary"` and carries its
-//! units in the same keys: every `_um` key is `_arcsec` (″), every `_mm` key
-//! `_deg` (`residual_before_arcsec`, `figures_arcsec`, `noise_arcsec`,
+//! A rotary axis adds `"axis_kind": "rotary"` (after `table`) and carries
+//! its units in the same keys: every `_um` key is `_arcsec` (″), every `_mm`
+//! key `_deg` (`residual_before_arcsec`, `figures_arcsec`, `noise_arcsec`,
 //! `unexplained.where_deg`, `evidence.cv_rmse_with_arcsec`, a periodic
-//! effect's `period_deg` and `amplitude_arcsec`, a reversal's `B_arcsec`),
-//! and a periodic effect's `params` add `per_revolution`, its whole order
-//! (2: twice per revolution, period 180°). The terminal says ″ and °.
-//! With `--angle-unit urad` the same values are µrad and every such key
-//! ends in `_urad` (`residual_before_urad`, `amplitude_urad`) instead.
+//! effect's `period_deg` and `amplitude_arcsec`, a reversal's `B_arcsec`,
+//! an outlier run's `offset_arcsec`), and a periodic effect's `params` add
+//! `per_revolution`, its whole order (2: twice per revolution, period
+//! 180°). The terminal says ″ and °. With `--angle-unit urad` the same
+//! values are µrad and every such key ends in `_urad`
+//! (`residual_before_urad`, `amplitude_urad`) instead. A rotary axis is
+//! diagnosed for per-revolution harmonics, its reversal and outlier runs
+//! only; it has no `friction`.
+//!
+//! Each key's unit is the type of the value under it: the object, its
+//! evidence and its unexplained structure are one struct per pair of units
+//! (`LinearDiagnoseJson` with `residual_before_um: ResidualJson<Um>` and
+//! `unexplained.where_mm: Vec<Mm>`, `ArcsecDiagnoseJson`,
+//! `UradDiagnoseJson`), and so are a rotary axis' effect parameters
+//! (`ArcsecParameters`, `UradParameters`); a linear axis' `params` are the
+//! effect's own parameter definitions (`effects::Parameter`), keyed as they
+//! name themselves. No key is renamed at run time; every object's keys are
+//! in the order declared (`params` and `uncertainty` by key).
 
 use std::fmt::Write;
 
@@ -57,179 +70,392 @@ use serde_json::{Map, Value};
 use crate::diagnose::friction::ReversalFriction;
 use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
 use crate::effects::{Effect, ParameterValue};
+use crate::evaluate::StandardFigure;
 use crate::measurement::AxisKind;
 use crate::report::format::{pad_name, um};
 use crate::report::json::FiguresJson;
-use crate::units::{AngleUnit, DeviationUnit, um_to_mm};
+use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, um_to_mm};
 
-/// How a diagnosis' values are reported: µm and mm on a linear axis, ″ (or
-/// µrad, the [`AngleUnit`]) and ° on a rotary one (held inside as m°,
-/// 1/1000 °, and °).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Units(AxisKind, AngleUnit);
+/// A deviation as a diagnosis reports it: µm ([`Um`]) on a linear axis, ″
+/// ([`Arcsec`]) or µrad ([`Urad`]) on a rotary one. A diagnosis holds its
+/// deviations in µm, a rotary axis' in m° (1/1000 °).
+pub trait ReportedDeviation: Serialize + Copy {
+    /// The unit, for the terminal.
+    const UNIT: DeviationUnit;
 
-impl Units {
-    /// The unit a deviation is reported in.
-    fn shown(self) -> DeviationUnit {
-        self.0.deviation_unit(self.1)
+    /// A deviation as the diagnosis holds it (µm, or m°), in this unit.
+    fn from_held(value: f64) -> Self;
+
+    /// The number, in this unit.
+    fn number(self) -> f64;
+
+    /// A standard's figures (held in mm, or °) in this unit.
+    fn figures(figures: &[StandardFigure]) -> FiguresJson;
+}
+
+impl ReportedDeviation for Um {
+    const UNIT: DeviationUnit = DeviationUnit::Micrometre;
+
+    fn from_held(value_um: f64) -> Um {
+        Um(value_um)
     }
 
-    /// A deviation held in µm (m° on a rotary axis) in its reported unit.
-    fn deviation(self, value_um: f64) -> f64 {
-        match self.shown() {
-            DeviationUnit::Micrometre => value_um,
-            DeviationUnit::Angle(angle) => angle.from_deg(um_to_mm(value_um)),
-        }
+    fn number(self) -> f64 {
+        self.0
     }
 
-    /// A parameter by the unit its key carries: `_um` (and `_um_per_h`) a
-    /// deviation, anything else (mm: ° on a rotary axis, rad, a run) as it is.
-    fn parameter(self, key: &str, value: f64) -> f64 {
-        if key.ends_with("_um") || key.ends_with("_um_per_h") {
-            self.deviation(value)
-        } else {
-            value
-        }
+    fn figures(figures: &[StandardFigure]) -> FiguresJson {
+        FiguresJson::from_standard(figures)
     }
+}
 
-    /// A key with the unit it reports: `_um` → `_arcsec` (`_urad`), `_mm`
-    /// → `_deg` on a rotary axis; unchanged on a linear one.
-    fn key(self, key: &str) -> String {
-        if self.0 == AxisKind::Linear {
-            return key.to_string();
-        }
-        let angle = self.shown().key();
-        for (linear, rotary) in [
-            ("_um", angle),
-            ("_um_per_h", &format!("{angle}_per_h")),
-            ("_mm", "deg"),
-        ] {
-            if let Some(stem) = key.strip_suffix(linear) {
-                return format!("{stem}_{rotary}");
+/// [`ReportedDeviation`] for an angle unit: held in m°, reported in `$unit`.
+macro_rules! reported_angle {
+    ($quantity:ty, $unit:expr, $from_deg:expr) => {
+        impl ReportedDeviation for $quantity {
+            const UNIT: DeviationUnit = DeviationUnit::Angle($unit);
+
+            fn from_held(value_millideg: f64) -> $quantity {
+                $from_deg(Deg(um_to_mm(value_millideg)))
+            }
+
+            fn number(self) -> f64 {
+                self.0
+            }
+
+            fn figures(figures: &[StandardFigure]) -> FiguresJson {
+                FiguresJson::from_standard_deg(figures, $unit)
             }
         }
-        key.to_string()
+    };
+}
+
+reported_angle!(Arcsec, AngleUnit::Arcsec, Deg::to_arcsec);
+reported_angle!(Urad, AngleUnit::Urad, Deg::to_urad);
+
+/// A position as a diagnosis reports it: mm ([`Mm`]) on a linear axis, °
+/// ([`Deg`]) on a rotary one, as it is held.
+pub trait ReportedPosition: Serialize + Copy {
+    /// What follows the number in the terminal: ` mm` or `°`.
+    const SUFFIX: &'static str;
+
+    /// A position as the diagnosis holds it (mm, or °).
+    fn from_held(value: f64) -> Self;
+
+    /// The number, in this unit.
+    fn number(self) -> f64;
+}
+
+impl ReportedPosition for Mm {
+    const SUFFIX: &'static str = " mm";
+
+    fn from_held(value_mm: f64) -> Mm {
+        Mm(value_mm)
     }
 
-    /// The keys of a serialised object, renamed by [`Units::key`] at every depth.
-    fn keys(self, value: Value) -> Value {
-        match value {
-            Value::Object(map) => Value::Object(
-                map.into_iter()
-                    .map(|(k, v)| (self.key(&k), self.keys(v)))
-                    .collect(),
-            ),
-            Value::Array(items) => Value::Array(items.into_iter().map(|v| self.keys(v)).collect()),
-            other => other,
-        }
-    }
-
-    /// After a deviation in the terminal: ` µm`, `″` or ` µrad`.
-    fn deviation_suffix(self) -> &'static str {
-        self.shown().suffix()
-    }
-
-    /// After a position in the terminal: ` mm` or `°`.
-    fn position_suffix(self) -> &'static str {
-        match self.0 {
-            AxisKind::Linear => " mm",
-            AxisKind::Rotary => "°",
-        }
+    fn number(self) -> f64 {
+        self.0
     }
 }
 
-/// RMS and largest |value|, µm.
+impl ReportedPosition for Deg {
+    const SUFFIX: &'static str = "°";
+
+    fn from_held(value_deg: f64) -> Deg {
+        Deg(value_deg)
+    }
+
+    fn number(self) -> f64 {
+        self.0
+    }
+}
+
+/// RMS and largest |value| of a residual, in the unit its key names.
 #[derive(Clone, Copy, Debug, Serialize)]
-pub struct ResidualJson {
-    /// Root mean square, µm.
-    pub rms: f64,
-    /// Largest |value|, µm.
-    pub max_abs: f64,
+pub struct ResidualJson<D> {
+    /// Root mean square.
+    pub rms: D,
+    /// Largest |value|.
+    pub max_abs: D,
 }
 
-impl ResidualJson {
-    fn new(s: ResidualStats, units: Units) -> ResidualJson {
+impl<D: ReportedDeviation> ResidualJson<D> {
+    fn new(s: ResidualStats) -> ResidualJson<D> {
         ResidualJson {
-            rms: units.deviation(s.rms_um),
-            max_abs: units.deviation(s.max_abs_um),
+            rms: D::from_held(s.rms_um),
+            max_abs: D::from_held(s.max_abs_um),
         }
+    }
+
+    fn numbers(&self) -> (f64, f64) {
+        (self.rms.number(), self.max_abs.number())
     }
 }
 
-/// Why an effect was accepted.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct EvidenceJson {
-    /// Change of the BIC when it was added (negative is better).
-    pub delta_bic: f64,
-    /// Shapes tried (periods, runs).
-    pub trials: usize,
-    /// p-value of adding it.
-    pub p_value: f64,
-    /// Leave-one-run-out prediction error without it, µm.
-    pub cv_rmse_without_um: f64,
-    /// The same with it, µm.
-    pub cv_rmse_with_um: f64,
+/// One parameter of an effect as the terminal shows it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Cell {
+    /// A measured quantity, in the unit its key names.
+    Number(f64),
+    /// Anything else as JSON writes it (a run's number, `"up"`).
+    Text(String),
 }
 
-/// An accepted effect.
+/// An effect's parameters or their uncertainties as the terminal shows them.
+pub trait Cells {
+    /// (key, value), in the order written.
+    fn cells(&self) -> Vec<(String, Cell)>;
+}
+
+/// An effect's parameters on the wire, under keys with their units.
+pub trait EffectParameters: Cells + Serialize + Sized {
+    /// The standard uncertainties of the same parameters, under the same keys.
+    type Uncertainty: Cells + Serialize;
+
+    /// An accepted effect's parameters and their uncertainties.
+    fn of(accepted: &AcceptedEffect) -> (Self, Self::Uncertainty);
+}
+
+/// A linear axis' parameters: under the keys the effect's parameter
+/// definitions give (`effects::Parameter::key`: `period_mm`, `B_um`, `run`;
+/// its uncertainties by the same keys), in the order a JSON object keeps
+/// them (by key).
+impl EffectParameters for Map<String, Value> {
+    type Uncertainty = Map<String, Value>;
+
+    fn of(accepted: &AcceptedEffect) -> (Self, Self) {
+        let mut params = Map::new();
+        for parameter in accepted.effect.parameters() {
+            let value = match parameter.value {
+                ParameterValue::Run(run) => Value::from(run),
+                ParameterValue::Number(value) => Value::from(value),
+            };
+            params.insert(parameter.key.to_string(), value);
+        }
+        if let Effect::OutlierRun(run) = &accepted.effect {
+            params.insert("direction".into(), Value::from(run.direction.as_str()));
+        }
+        let uncertainty = accepted
+            .uncertainty
+            .iter()
+            .map(|(key, sigma)| (key.to_string(), Value::from(*sigma)))
+            .collect();
+        (params, uncertainty)
+    }
+}
+
+impl Cells for Map<String, Value> {
+    fn cells(&self) -> Vec<(String, Cell)> {
+        self.iter()
+            .map(|(key, value)| {
+                let cell = match value.as_f64() {
+                    Some(number) if value.is_f64() => Cell::Number(number),
+                    _ => Cell::Text(value.to_string()),
+                };
+                (key.clone(), cell)
+            })
+            .collect()
+    }
+}
+
+/// Declares a rotary axis' effect parameters and their uncertainties in one
+/// angle unit: each field's name is its JSON key, its type the unit the key
+/// names. Fields are declared in the order of their keys, the order a linear
+/// axis' parameters are written in. A rotary axis is diagnosed for its
+/// per-revolution harmonics, its reversal and its outlier runs only
+/// (`diagnose::gates`).
+macro_rules! rotary_parameters {
+    (
+        $(#[$doc:meta])*
+        $params:ident, $uncertainty:ident <$deviation:ty> { $amplitude:ident, $b:ident, $offset:ident $(,)? }
+    ) => {
+        $(#[$doc])*
+        #[allow(non_snake_case)]
+        #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+        #[serde(untagged)]
+        pub enum $params {
+            /// A harmonic: its amplitude, whole order per revolution (when
+            /// the period is one), period and phase.
+            Periodic {
+                /// Amplitude.
+                $amplitude: $deviation,
+                /// The whole order per revolution (2: twice, period 180°).
+                #[serde(skip_serializing_if = "Option::is_none")]
+                per_revolution: Option<u32>,
+                /// Period, °.
+                period_deg: Deg,
+                /// Phase, rad.
+                phase_rad: f64,
+            },
+            /// A direction-dependent offset B (↑ − ↓).
+            Reversal {
+                /// B.
+                $b: $deviation,
+            },
+            /// A run off the others.
+            OutlierRun {
+                /// `up` or `down`.
+                direction: &'static str,
+                /// How far off.
+                $offset: $deviation,
+                /// Its number within its direction.
+                run: u32,
+            },
+        }
+
+        /// The standard uncertainties of the parameters of the same name.
+        #[allow(non_snake_case)]
+        #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+        #[serde(untagged)]
+        pub enum $uncertainty {
+            /// A harmonic's amplitude, and its period where it is not a whole order.
+            Periodic {
+                /// Amplitude.
+                $amplitude: $deviation,
+                /// Period, °.
+                #[serde(skip_serializing_if = "Option::is_none")]
+                period_deg: Option<Deg>,
+            },
+            /// B.
+            Reversal {
+                /// B.
+                $b: $deviation,
+            },
+            /// The offset.
+            OutlierRun {
+                /// The offset.
+                $offset: $deviation,
+            },
+        }
+
+        impl EffectParameters for $params {
+            type Uncertainty = $uncertainty;
+
+            fn of(accepted: &AcceptedEffect) -> ($params, $uncertainty) {
+                // The uncertainties under the keys of the effect's definitions.
+                let sigma = |key: &str| {
+                    accepted
+                        .uncertainty
+                        .iter()
+                        .find(|(k, _)| *k == key)
+                        .map_or(f64::NAN, |(_, sigma)| *sigma)
+                };
+                let angle = <$deviation>::from_held;
+                match &accepted.effect {
+                    Effect::Periodic(p) => (
+                        $params::Periodic {
+                            $amplitude: angle(p.amplitude_um),
+                            per_revolution: p.per_revolution(),
+                            period_deg: Deg(p.period_mm),
+                            phase_rad: p.phase_rad,
+                        },
+                        $uncertainty::Periodic {
+                            $amplitude: angle(sigma("amplitude_um")),
+                            period_deg: accepted
+                                .uncertainty
+                                .iter()
+                                .find(|(k, _)| *k == "period_mm")
+                                .map(|(_, sigma)| Deg(*sigma)),
+                        },
+                    ),
+                    Effect::Reversal(r) => (
+                        $params::Reversal { $b: angle(r.b_um) },
+                        $uncertainty::Reversal { $b: angle(sigma("B_um")) },
+                    ),
+                    Effect::OutlierRun(o) => (
+                        $params::OutlierRun {
+                            direction: o.direction.as_str(),
+                            $offset: angle(o.offset_um),
+                            run: o.run,
+                        },
+                        $uncertainty::OutlierRun {
+                            $offset: angle(sigma("offset_um")),
+                        },
+                    ),
+                    other => unreachable!(
+                        "{} is not looked for on a rotary axis (diagnose::gates)",
+                        other.kind().name()
+                    ),
+                }
+            }
+        }
+
+        impl Cells for $params {
+            fn cells(&self) -> Vec<(String, Cell)> {
+                let angle = |key: &str, value: $deviation| (key.to_string(), Cell::Number(value.number()));
+                match *self {
+                    $params::Periodic { $amplitude, per_revolution, period_deg, phase_rad } => {
+                        let mut cells = vec![angle(stringify!($amplitude), $amplitude)];
+                        cells.extend(per_revolution.map(|order| ("per_revolution".to_string(), Cell::Text(order.to_string()))));
+                        cells.push(("period_deg".to_string(), Cell::Number(period_deg.0)));
+                        cells.push(("phase_rad".to_string(), Cell::Number(phase_rad)));
+                        cells
+                    }
+                    $params::Reversal { $b } => vec![angle(stringify!($b), $b)],
+                    $params::OutlierRun { direction, $offset, run } => vec![
+                        ("direction".to_string(), Cell::Text(format!("\"{direction}\""))),
+                        angle(stringify!($offset), $offset),
+                        ("run".to_string(), Cell::Text(run.to_string())),
+                    ],
+                }
+            }
+        }
+
+        impl Cells for $uncertainty {
+            fn cells(&self) -> Vec<(String, Cell)> {
+                let angle = |key: &str, value: $deviation| (key.to_string(), Cell::Number(value.number()));
+                match *self {
+                    $uncertainty::Periodic { $amplitude, period_deg } => {
+                        let mut cells = vec![angle(stringify!($amplitude), $amplitude)];
+                        cells.extend(period_deg.map(|period| ("period_deg".to_string(), Cell::Number(period.0))));
+                        cells
+                    }
+                    $uncertainty::Reversal { $b } => vec![angle(stringify!($b), $b)],
+                    $uncertainty::OutlierRun { $offset } => vec![angle(stringify!($offset), $offset)],
+                }
+            }
+        }
+    };
+}
+
+rotary_parameters!(
+    /// A rotary axis' effect parameters, deviations in ″.
+    ArcsecParameters, ArcsecUncertainty<Arcsec> { amplitude_arcsec, B_arcsec, offset_arcsec }
+);
+
+rotary_parameters!(
+    /// A rotary axis' effect parameters, deviations in µrad.
+    UradParameters, UradUncertainty<Urad> { amplitude_urad, B_urad, offset_urad }
+);
+
+/// An accepted effect: its parameters `P` and their uncertainties `U` under
+/// keys with their units, and the evidence `E` for it.
 #[derive(Clone, Debug, Serialize)]
-pub struct EffectJson {
+pub struct EffectJson<P, U, E> {
     /// `reversal`, `scale`, `drift`, `periodic`, `outlier-run` or `abbe`.
     pub kind: &'static str,
     /// Its parameters, keys with units.
-    pub params: Map<String, Value>,
+    pub params: P,
     /// Standard uncertainty of the parameters, same keys.
-    pub uncertainty: Map<String, Value>,
+    pub uncertainty: U,
     /// Why it was accepted.
-    pub evidence: EvidenceJson,
+    pub evidence: E,
     /// What it is and what to do, one sentence.
     pub explanation: String,
     /// Caveats (aliasing, assumed times).
     pub warnings: Vec<String>,
 }
 
-impl EffectJson {
-    /// From an accepted effect, in `units`.
-    fn new(a: &AcceptedEffect, units: Units) -> EffectJson {
-        let mut params = Map::new();
-        for parameter in a.effect.parameters() {
-            let value = match parameter.value {
-                ParameterValue::Run(run) => Value::from(run),
-                ParameterValue::Number(value) => Value::from(units.parameter(parameter.key, value)),
-            };
-            params.insert(parameter.key.to_string(), value);
-        }
-        match &a.effect {
-            Effect::OutlierRun(run) => {
-                params.insert("direction".into(), Value::from(run.direction.as_str()));
-            }
-            Effect::Periodic(periodic) if units.0 == AxisKind::Rotary => {
-                if let Some(order) = periodic.per_revolution() {
-                    params.insert("per_revolution".into(), Value::from(order));
-                }
-            }
-            _ => {}
-        }
-        let uncertainty = a
-            .uncertainty
-            .iter()
-            .map(|(k, v)| (k.to_string(), Value::from(units.parameter(k, *v))))
-            .collect();
-        EffectJson {
-            kind: a.effect.kind().name(),
-            params,
-            uncertainty,
-            evidence: EvidenceJson {
-                delta_bic: a.evidence.delta_bic,
-                trials: a.evidence.trials,
-                p_value: a.evidence.p_value,
-                cv_rmse_without_um: units.deviation(a.evidence.cv_rmse_without_um),
-                cv_rmse_with_um: units.deviation(a.evidence.cv_rmse_with_um),
-            },
-            explanation: a.explanation.clone(),
-            warnings: a.warnings.clone(),
-        }
-    }
+/// An effect as the terminal shows it, whatever its units.
+struct EffectShown<'a> {
+    kind: &'static str,
+    /// (key, value, its uncertainty), in the order written.
+    params: Vec<(String, Cell, Option<f64>)>,
+    delta_bic: f64,
+    cv_rmse_without: f64,
+    cv_rmse_with: f64,
+    explanation: &'a str,
+    warnings: &'a [String],
 }
 
 /// A kind looked for and not accepted.
@@ -241,7 +467,7 @@ pub struct RejectedJson {
     pub why: String,
 }
 
-/// The figures of the re-test three ways, µm.
+/// The figures of the re-test three ways, in the unit of the key that holds them.
 #[derive(Clone, Debug, Serialize)]
 pub struct FigureSetJson {
     /// As measured.
@@ -252,81 +478,363 @@ pub struct FigureSetJson {
     pub predicted_with_effects: FiguresJson,
 }
 
-/// What no effect explains.
-#[derive(Clone, Debug, Serialize)]
-pub struct UnexplainedJson {
-    /// Significant (lack-of-fit p < 0.001).
-    pub significant: bool,
-    /// Where it is largest, mm.
-    pub where_mm: Vec<f64>,
-    /// RMS of the per-target mean residual, µm.
-    pub rms_um: f64,
-    /// p-value of the lack-of-fit test.
-    pub p_value: f64,
-}
-
-/// The whole `diagnose --json` object: the fields as a linear axis' keys
-/// name them, with a rotary axis' values already in ″ and ° (module doc),
-/// serialised under the keys of its unit.
-#[derive(Clone, Debug)]
-pub struct DiagnoseJson {
-    fields: DiagnoseFields,
-    units: Units,
-}
-
-impl Serialize for DiagnoseJson {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        if self.units.0 == AxisKind::Linear {
-            return self.fields.serialize(serializer);
+impl FigureSetJson {
+    fn new<D: ReportedDeviation>(diagnosis: &Diagnosis) -> FigureSetJson {
+        let figures = &diagnosis.standard_figures;
+        FigureSetJson {
+            measured: D::figures(&figures.measured),
+            predicted: D::figures(&figures.predicted),
+            predicted_with_effects: D::figures(&figures.predicted_with_effects),
         }
-        let Value::Object(fields) =
-            serde_json::to_value(&self.fields).map_err(serde::ser::Error::custom)?
-        else {
-            unreachable!("a struct serialises as an object")
-        };
-        let mut object = Map::new();
-        object.insert("axis_kind".into(), Value::from(AxisKind::Rotary.as_str()));
-        object.extend(fields);
-        self.units.keys(Value::Object(object)).serialize(serializer)
     }
 }
 
-/// [`DiagnoseJson`]'s fields.
+/// What no effect explains, whatever its units.
+struct UnexplainedShown {
+    significant: bool,
+    places: Vec<f64>,
+    rms: f64,
+    p_value: f64,
+}
+
+/// The files a diagnosis is of, as given.
+struct Files {
+    after: String,
+    before: Option<String>,
+    table: Option<String>,
+}
+
+/// A whole diagnosis as the terminal shows it, whatever its units.
+struct Shown<'a> {
+    after: &'a str,
+    before: Option<&'a str>,
+    table: Option<&'a str>,
+    standard_name: &'static str,
+    definitions_reconstructed: bool,
+    residual_before: (f64, f64),
+    residual_after: (f64, f64),
+    noise: f64,
+    effects: Vec<EffectShown<'a>>,
+    rejected: &'a [RejectedJson],
+    unexplained: UnexplainedShown,
+    figures: &'a FigureSetJson,
+    friction: Option<&'a FrictionJson>,
+    deviation: DeviationUnit,
+    position_suffix: &'static str,
+}
+
+/// Declares the `diagnose --json` object in one pair of units with its
+/// evidence and unexplained-structure objects: each field's name is its
+/// JSON key, its type the unit the key names. `head` fields follow the
+/// files, `tail` fields end the object.
+macro_rules! diagnose_json {
+    (
+        $(#[$doc:meta])*
+        $name:ident, $evidence:ident, $unexplained:ident
+            <$position:ty, $deviation:ty, $params:ty> {
+            $residual_before:ident, $residual_after:ident, $figures:ident, $noise:ident,
+            $cv_without:ident, $cv_with:ident, $where_:ident, $rms:ident $(,)?
+        }
+        head { $($(#[$head_meta:meta])* $head:ident: $head_ty:ty = $head_value:expr),* $(,)? }
+        tail { $($(#[$tail_meta:meta])* $tail:ident: $tail_ty:ty = $tail_value:expr),* $(,)? }
+    ) => {
+        /// Why an effect was accepted.
+        #[derive(Clone, Copy, Debug, Serialize)]
+        pub struct $evidence {
+            /// Change of the BIC when it was added (negative is better).
+            pub delta_bic: f64,
+            /// Shapes tried (periods, runs).
+            pub trials: usize,
+            /// p-value of adding it.
+            pub p_value: f64,
+            /// Leave-one-run-out prediction error without it.
+            pub $cv_without: $deviation,
+            /// The same with it.
+            pub $cv_with: $deviation,
+        }
+
+        /// What no effect explains.
+        #[derive(Clone, Debug, Serialize)]
+        pub struct $unexplained {
+            /// Significant (lack-of-fit p < 0.001).
+            pub significant: bool,
+            /// Where it is largest.
+            pub $where_: Vec<$position>,
+            /// RMS of the per-target mean residual.
+            pub $rms: $deviation,
+            /// p-value of the lack-of-fit test.
+            pub p_value: f64,
+        }
+
+        $(#[$doc])*
+        #[derive(Clone, Debug, Serialize)]
+        pub struct $name {
+            /// The re-test file.
+            pub after: String,
+            /// The first test file, if given.
+            pub before: Option<String>,
+            /// The table file, if given.
+            pub table: Option<String>,
+            $($(#[$head_meta])* pub $head: $head_ty,)*
+            /// The `--standard` the figures follow (`iso230-2:2014`, `vdi3441`).
+            pub standard: &'static str,
+            /// Its name and edition.
+            pub standard_name: &'static str,
+            /// Whether its definitions are reconstructed from public sources.
+            pub definitions_reconstructed: bool,
+            /// Whether the prediction came from a first test.
+            pub predicted_from_first_test: bool,
+            /// The model's error before adding effects.
+            pub $residual_before: ResidualJson<$deviation>,
+            /// Effects found.
+            pub effects: Vec<EffectJson<$params, <$params as EffectParameters>::Uncertainty, $evidence>>,
+            /// Effects looked for and not found.
+            pub rejected: Vec<RejectedJson>,
+            /// The model's error with the effects.
+            pub $residual_after: ResidualJson<$deviation>,
+            /// Figures.
+            pub $figures: FigureSetJson,
+            /// What none of the effects explains.
+            pub unexplained: $unexplained,
+            /// Scatter of one reading left at the end.
+            pub $noise: $deviation,
+            /// Whether the reading times were assumed from a typical cycle.
+            pub time_assumed: bool,
+            $($(#[$tail_meta])* pub $tail: $tail_ty,)*
+        }
+
+        impl $name {
+            fn new(diagnosis: &Diagnosis, files: Files) -> $name {
+                let deviation = <$deviation>::from_held;
+                $name {
+                    after: files.after,
+                    before: files.before,
+                    table: files.table,
+                    $($head: $head_value,)*
+                    standard: diagnosis.standard.key,
+                    standard_name: diagnosis.standard.name,
+                    definitions_reconstructed: diagnosis.standard.reconstructed,
+                    predicted_from_first_test: diagnosis.predicted_from_first_test,
+                    $residual_before: ResidualJson::new(diagnosis.residual_before),
+                    effects: diagnosis
+                        .accepted
+                        .iter()
+                        .map(|accepted| {
+                            let (params, uncertainty) = <$params>::of(accepted);
+                            let evidence = &accepted.evidence;
+                            EffectJson {
+                                kind: accepted.effect.kind().name(),
+                                params,
+                                uncertainty,
+                                evidence: $evidence {
+                                    delta_bic: evidence.delta_bic,
+                                    trials: evidence.trials,
+                                    p_value: evidence.p_value,
+                                    $cv_without: deviation(evidence.cv_rmse_without_um),
+                                    $cv_with: deviation(evidence.cv_rmse_with_um),
+                                },
+                                explanation: accepted.explanation.clone(),
+                                warnings: accepted.warnings.clone(),
+                            }
+                        })
+                        .collect(),
+                    rejected: rejected(diagnosis),
+                    $residual_after: ResidualJson::new(diagnosis.residual_after),
+                    $figures: FigureSetJson::new::<$deviation>(diagnosis),
+                    unexplained: $unexplained {
+                        significant: diagnosis.unexplained.significant,
+                        $where_: diagnosis
+                            .unexplained
+                            .where_mm
+                            .iter()
+                            .map(|place| <$position>::from_held(*place))
+                            .collect(),
+                        $rms: deviation(diagnosis.unexplained.rms_um),
+                        p_value: diagnosis.unexplained.p_value,
+                    },
+                    $noise: deviation(diagnosis.noise_um),
+                    time_assumed: diagnosis.time_assumed,
+                    $($tail: $tail_value,)*
+                }
+            }
+
+            fn shown<'a>(&'a self, friction: Option<&'a FrictionJson>) -> Shown<'a> {
+                Shown {
+                    after: &self.after,
+                    before: self.before.as_deref(),
+                    table: self.table.as_deref(),
+                    standard_name: self.standard_name,
+                    definitions_reconstructed: self.definitions_reconstructed,
+                    residual_before: self.$residual_before.numbers(),
+                    residual_after: self.$residual_after.numbers(),
+                    noise: self.$noise.number(),
+                    effects: self
+                        .effects
+                        .iter()
+                        .map(|effect| EffectShown {
+                            kind: effect.kind,
+                            params: with_uncertainty(
+                                effect.params.cells(),
+                                effect.uncertainty.cells(),
+                            ),
+                            delta_bic: effect.evidence.delta_bic,
+                            cv_rmse_without: effect.evidence.$cv_without.number(),
+                            cv_rmse_with: effect.evidence.$cv_with.number(),
+                            explanation: &effect.explanation,
+                            warnings: &effect.warnings,
+                        })
+                        .collect(),
+                    rejected: &self.rejected,
+                    unexplained: UnexplainedShown {
+                        significant: self.unexplained.significant,
+                        places: self
+                            .unexplained
+                            .$where_
+                            .iter()
+                            .map(|place| place.number())
+                            .collect(),
+                        rms: self.unexplained.$rms.number(),
+                        p_value: self.unexplained.p_value,
+                    },
+                    figures: &self.$figures,
+                    friction,
+                    deviation: <$deviation as ReportedDeviation>::UNIT,
+                    position_suffix: <$position as ReportedPosition>::SUFFIX,
+                }
+            }
+        }
+    };
+}
+
+diagnose_json!(
+    /// `diagnose --json` of a linear axis: positions in mm, deviations in µm.
+    LinearDiagnoseJson, LinearEvidenceJson, LinearUnexplainedJson
+        <Mm, Um, Map<String, Value>> {
+        residual_before_um, residual_after_um, figures_um, noise_um,
+        cv_rmse_without_um, cv_rmse_with_um, where_mm, rms_um,
+    }
+    head {}
+    tail {
+        /// The friction behind the reversal found (with a servo description).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        friction: Option<FrictionJson> = None,
+    }
+);
+
+diagnose_json!(
+    /// `diagnose --json` of a rotary axis: positions in °, deviations in ″.
+    ArcsecDiagnoseJson, ArcsecEvidenceJson, ArcsecUnexplainedJson
+        <Deg, Arcsec, ArcsecParameters> {
+        residual_before_arcsec, residual_after_arcsec, figures_arcsec, noise_arcsec,
+        cv_rmse_without_arcsec, cv_rmse_with_arcsec, where_deg, rms_arcsec,
+    }
+    head {
+        /// `rotary`.
+        axis_kind: &'static str = AxisKind::Rotary.as_str(),
+    }
+    tail {}
+);
+
+diagnose_json!(
+    /// `diagnose --json` of a rotary axis: positions in °, deviations in µrad.
+    UradDiagnoseJson, UradEvidenceJson, UradUnexplainedJson
+        <Deg, Urad, UradParameters> {
+        residual_before_urad, residual_after_urad, figures_urad, noise_urad,
+        cv_rmse_without_urad, cv_rmse_with_urad, where_deg, rms_urad,
+    }
+    head {
+        /// `rotary`.
+        axis_kind: &'static str = AxisKind::Rotary.as_str(),
+    }
+    tail {}
+);
+
+/// The kinds looked for and not accepted.
+fn rejected(diagnosis: &Diagnosis) -> Vec<RejectedJson> {
+    diagnosis
+        .rejected
+        .iter()
+        .map(|r| RejectedJson {
+            kind: r.kind.name(),
+            why: r.why.clone(),
+        })
+        .collect()
+}
+
+/// Each parameter with the uncertainty under its key, if any.
+fn with_uncertainty(
+    params: Vec<(String, Cell)>,
+    uncertainty: Vec<(String, Cell)>,
+) -> Vec<(String, Cell, Option<f64>)> {
+    params
+        .into_iter()
+        .map(|(key, cell)| {
+            let sigma = uncertainty.iter().find_map(|(k, u)| match u {
+                Cell::Number(u) if *k == key => Some(*u),
+                _ => None,
+            });
+            (key, cell, sigma)
+        })
+        .collect()
+}
+
+/// The whole `diagnose --json` object in the units of its axis and of
+/// `--angle-unit`; each form's keys name its units (module doc).
 #[derive(Clone, Debug, Serialize)]
-struct DiagnoseFields {
-    /// The re-test file.
-    pub after: String,
-    /// The first test file, if given.
-    pub before: Option<String>,
-    /// The table file, if given.
-    pub table: Option<String>,
-    /// The `--standard` the figures follow (`iso230-2:2014`, `vdi3441`).
-    pub standard: &'static str,
-    /// Its name and edition.
-    pub standard_name: &'static str,
-    /// Whether its definitions are reconstructed from public sources.
-    pub definitions_reconstructed: bool,
-    /// Whether the prediction came from a first test.
-    pub predicted_from_first_test: bool,
-    /// The model's error before adding effects, µm.
-    pub residual_before_um: ResidualJson,
-    /// Effects found.
-    pub effects: Vec<EffectJson>,
-    /// Effects looked for and not found.
-    pub rejected: Vec<RejectedJson>,
-    /// The model's error with the effects, µm.
-    pub residual_after_um: ResidualJson,
-    /// Figures.
-    pub figures_um: FigureSetJson,
-    /// What none of the effects explains.
-    pub unexplained: UnexplainedJson,
-    /// Scatter of one reading left at the end, µm.
-    pub noise_um: f64,
-    /// Whether the reading times were assumed from a typical cycle.
-    pub time_assumed: bool,
-    /// The friction behind the reversal found (with a servo description).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub friction: Option<FrictionJson>,
+#[serde(untagged)]
+pub enum DiagnoseJson {
+    /// A linear axis: mm and µm.
+    Linear(LinearDiagnoseJson),
+    /// A rotary axis: ° and ″.
+    Arcsec(ArcsecDiagnoseJson),
+    /// A rotary axis: ° and µrad.
+    Urad(UradDiagnoseJson),
+}
+
+impl DiagnoseJson {
+    /// Builds the wire object.
+    /// A rotary axis' deviations are in `angle`.
+    pub fn new(
+        diagnosis: &Diagnosis,
+        after: String,
+        before: Option<String>,
+        table: Option<String>,
+        angle: AngleUnit,
+    ) -> DiagnoseJson {
+        let files = Files {
+            after,
+            before,
+            table,
+        };
+        match (diagnosis.kind, angle) {
+            (AxisKind::Linear, _) => {
+                DiagnoseJson::Linear(LinearDiagnoseJson::new(diagnosis, files))
+            }
+            (AxisKind::Rotary, AngleUnit::Arcsec) => {
+                DiagnoseJson::Arcsec(ArcsecDiagnoseJson::new(diagnosis, files))
+            }
+            (AxisKind::Rotary, AngleUnit::Urad) => {
+                DiagnoseJson::Urad(UradDiagnoseJson::new(diagnosis, files))
+            }
+        }
+    }
+
+    /// The friction behind the reversal found (`--servo-axis`; a linear
+    /// axis' only: its keys are µm and N).
+    pub fn set_friction(&mut self, friction: Option<FrictionJson>) {
+        match self {
+            DiagnoseJson::Linear(linear) => linear.friction = friction,
+            DiagnoseJson::Arcsec(_) | DiagnoseJson::Urad(_) => debug_assert!(friction.is_none()),
+        }
+    }
+
+    fn shown(&self) -> Shown<'_> {
+        match self {
+            DiagnoseJson::Linear(linear) => linear.shown(linear.friction.as_ref()),
+            DiagnoseJson::Arcsec(arcsec) => arcsec.shown(None),
+            DiagnoseJson::Urad(urad) => urad.shown(None),
+        }
+    }
 }
 
 /// The friction force a found reversal means (module doc).
@@ -414,91 +922,26 @@ impl FrictionJson {
     }
 }
 
-impl DiagnoseJson {
-    /// Builds the wire object.
-    /// A rotary axis' deviations are in `angle`.
-    pub fn new(
-        diagnosis: &Diagnosis,
-        after: String,
-        before: Option<String>,
-        table: Option<String>,
-        angle: AngleUnit,
-    ) -> DiagnoseJson {
-        let units = Units(diagnosis.kind, angle);
-        let figures = |figures: &[crate::evaluate::StandardFigure]| match units.0 {
-            AxisKind::Linear => FiguresJson::from_standard(figures),
-            AxisKind::Rotary => FiguresJson::from_standard_deg(figures, angle),
-        };
-        let fields = DiagnoseFields {
-            after,
-            before,
-            table,
-            standard: diagnosis.standard.key,
-            standard_name: diagnosis.standard.name,
-            definitions_reconstructed: diagnosis.standard.reconstructed,
-            predicted_from_first_test: diagnosis.predicted_from_first_test,
-            residual_before_um: ResidualJson::new(diagnosis.residual_before, units),
-            effects: diagnosis
-                .accepted
-                .iter()
-                .map(|a| EffectJson::new(a, units))
-                .collect(),
-            rejected: diagnosis
-                .rejected
-                .iter()
-                .map(|r| RejectedJson {
-                    kind: r.kind.name(),
-                    why: r.why.clone(),
-                })
-                .collect(),
-            residual_after_um: ResidualJson::new(diagnosis.residual_after, units),
-            figures_um: FigureSetJson {
-                measured: figures(&diagnosis.standard_figures.measured),
-                predicted: figures(&diagnosis.standard_figures.predicted),
-                predicted_with_effects: figures(&diagnosis.standard_figures.predicted_with_effects),
-            },
-            unexplained: UnexplainedJson {
-                significant: diagnosis.unexplained.significant,
-                where_mm: diagnosis.unexplained.where_mm.clone(),
-                rms_um: units.deviation(diagnosis.unexplained.rms_um),
-                p_value: diagnosis.unexplained.p_value,
-            },
-            noise_um: units.deviation(diagnosis.noise_um),
-            time_assumed: diagnosis.time_assumed,
-            friction: None,
-        };
-        DiagnoseJson { fields, units }
-    }
-
-    /// The friction behind the reversal found (`--servo-axis`; a linear
-    /// axis' only: its keys are µm and N).
-    pub fn set_friction(&mut self, friction: Option<FrictionJson>) {
-        debug_assert!(friction.is_none() || self.units.0 == AxisKind::Linear);
-        self.fields.friction = friction;
-    }
-}
-
 /// The terminal report.
 pub fn render(report: &DiagnoseJson) -> String {
-    let units = report.units;
-    let (dev, pos) = (units.deviation_suffix(), units.position_suffix());
-    let report = &report.fields;
+    let report = report.shown();
+    let (dev, pos) = (report.deviation.suffix(), report.position_suffix);
     let mut out = String::new();
-    let source = match (&report.before, &report.table) {
+    let source = match (report.before, report.table) {
         (Some(before), Some(table)) => format!("predicted from {before} with {table}"),
         (Some(before), None) => format!("predicted from {before} (no table)"),
         _ => "no first test: structure between runs only".to_string(),
     };
     let _ = writeln!(out, "Re-test      {} ({source})", report.after);
-    let (b, a) = (&report.residual_before_um, &report.residual_after_um);
+    let (b, a) = (report.residual_before, report.residual_after);
     let _ = writeln!(
         out,
         "Residual     rms {}{dev}, max {}{dev}; with the effects rms {}{dev}, max {}{dev}; noise {}{dev}",
-        um(Some(b.rms)),
-        um(Some(b.max_abs)),
-        um(Some(a.rms)),
-        um(Some(a.max_abs)),
-        um(Some(report.noise_um)),
+        um(Some(b.0)),
+        um(Some(b.1)),
+        um(Some(a.0)),
+        um(Some(a.1)),
+        um(Some(report.noise)),
     );
     let _ = writeln!(out, "\nFound");
     if report.effects.is_empty() {
@@ -508,54 +951,48 @@ pub fn render(report: &DiagnoseJson) -> String {
         let params: Vec<String> = effect
             .params
             .iter()
-            .map(
-                |(key, value)| match (value.as_f64(), effect.uncertainty.get(key)) {
-                    // A run has no uncertainty: it is shown as it is.
-                    (Some(v), Some(u)) => format!(
-                        "{} = {v:.2} ± {:.2}",
-                        units.key(key),
-                        u.as_f64().unwrap_or(f64::NAN)
-                    ),
-                    // A number without an uncertainty (a phase): 4 decimals, as the effects file.
-                    (Some(v), None) if value.is_f64() => format!("{} = {v:.4}", units.key(key)),
-                    _ => format!("{} = {value}", units.key(key)),
-                },
-            )
+            .map(|(key, cell, sigma)| match (cell, sigma) {
+                // A run has no uncertainty: it is shown as it is.
+                (Cell::Number(v), Some(u)) => format!("{key} = {v:.2} ± {u:.2}"),
+                // A number without an uncertainty (a phase): 4 decimals, as the effects file.
+                (Cell::Number(v), None) => format!("{key} = {v:.4}"),
+                (Cell::Text(text), _) => format!("{key} = {text}"),
+            })
             .collect();
         let _ = writeln!(
             out,
             "  {:<12} {}   (ΔBIC {:.1}; runs left out predicted {:.2} → {:.2}{dev})",
             effect.kind,
             params.join(", "),
-            effect.evidence.delta_bic,
-            effect.evidence.cv_rmse_without_um,
-            effect.evidence.cv_rmse_with_um,
+            effect.delta_bic,
+            effect.cv_rmse_without,
+            effect.cv_rmse_with,
         );
         let _ = writeln!(out, "  {:<12} {}", "", effect.explanation);
         if effect.kind == "reversal"
-            && let Some(friction) = &report.friction
+            && let Some(friction) = report.friction
         {
             for line in friction.lines() {
                 let _ = writeln!(out, "  {:<12} {line}", "");
             }
         }
-        for warning in &effect.warnings {
+        for warning in effect.warnings {
             let _ = writeln!(out, "  {:<12} warning: {warning}", "");
         }
     }
     let _ = writeln!(out, "\nNot found");
-    for rejected in &report.rejected {
+    for rejected in report.rejected {
         let _ = writeln!(out, "  {:<12} {}", rejected.kind, rejected.why);
     }
     let u = &report.unexplained;
     let _ = writeln!(out);
     if u.significant {
-        let places: Vec<String> = u.where_mm.iter().map(|x| format!("{x}")).collect();
+        let places: Vec<String> = u.places.iter().map(|x| format!("{x}")).collect();
         let _ = writeln!(
             out,
             "Unexplained  significant structure (p = {:.1e}), rms {}{dev}, largest at {}{pos}: no known effect describes it",
             u.p_value,
-            um(Some(u.rms_um)),
+            um(Some(u.rms)),
             places.join(", ")
         );
     } else {
@@ -563,7 +1000,7 @@ pub fn render(report: &DiagnoseJson) -> String {
             out,
             "Unexplained  nothing significant (p = {:.2}), rms {}{dev}",
             u.p_value,
-            um(Some(u.rms_um))
+            um(Some(u.rms))
         );
     }
     // The first column fits its heading: `Figures [µrad]` is wider than `Figures [µm]`.
@@ -584,7 +1021,7 @@ pub fn render(report: &DiagnoseJson) -> String {
         "{}+-----------+-----------+-----------------------",
         "-".repeat(width + 1)
     );
-    let f = &report.figures_um;
+    let f = report.figures;
     for (name, key) in f.measured.terminal_rows() {
         let _ = writeln!(
             out,
@@ -596,4 +1033,66 @@ pub fn render(report: &DiagnoseJson) -> String {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::Evidence;
+    use crate::effects::outlier_run::OutlierRun;
+    use crate::measurement::Direction;
+
+    /// Run 1↓ 10 m° (0.01°) off the others, σ 1 m°.
+    fn outlier_run() -> AcceptedEffect {
+        AcceptedEffect {
+            effect: Effect::OutlierRun(OutlierRun {
+                run: 1,
+                direction: Direction::Down,
+                offset_um: 10.0,
+            }),
+            uncertainty: vec![("offset_um", 1.0)],
+            evidence: Evidence {
+                delta_bic: -20.0,
+                trials: 5,
+                p_value: 0.001,
+                cv_rmse_without_um: 2.0,
+                cv_rmse_with_um: 1.0,
+            },
+            explanation: String::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_rotary_outlier_run_is_in_its_angle_unit_under_its_key() {
+        // 0.01° = 36″ = 174.532 925 µrad; 0.001° = 3.6″.
+        let (params, uncertainty) = ArcsecParameters::of(&outlier_run());
+        assert_eq!(
+            serde_json::to_string(&params).unwrap(),
+            r#"{"direction":"down","offset_arcsec":36.0,"run":1}"#
+        );
+        assert_eq!(
+            serde_json::to_string(&uncertainty).unwrap(),
+            r#"{"offset_arcsec":3.6}"#
+        );
+        let (params, _) = UradParameters::of(&outlier_run());
+        let UradParameters::OutlierRun { offset_urad, .. } = params else {
+            panic!("{params:?}")
+        };
+        assert!((offset_urad.0 - 174.532_925_199_432_95).abs() < 1e-9);
+        // The same effect on a linear axis: the effect's own keys, µm.
+        let (params, uncertainty) = Map::<String, Value>::of(&outlier_run());
+        assert_eq!(
+            serde_json::to_string(&params).unwrap(),
+            r#"{"direction":"down","offset_um":10.0,"run":1}"#
+        );
+        assert_eq!(
+            with_uncertainty(params.cells(), uncertainty.cells()),
+            [
+                ("direction".to_string(), Cell::Text("\"down\"".into()), None),
+                ("offset_um".to_string(), Cell::Number(10.0), Some(1.0)),
+                ("run".to_string(), Cell::Text("1".into()), None),
+            ]
+        );
+    }
 }

@@ -202,6 +202,9 @@ fn validation_words(validation: Validation) -> &'static str {
     match validation {
         Validation::Blocked => "",
         Validation::Forward => " (each block predicted from the blocks before it)",
+        Validation::Late => {
+            " (the blocks in the last third of the rows, each predicted from every row before it)"
+        }
     }
 }
 

@@ -63,6 +63,34 @@ pub struct ConvertAnswer {
     pub text: String,
     /// The report's plot of the table.
     pub table_svg: Option<String>,
+    /// Fanuc, when asked (`--fanuc-rescaled`): the file at a finer magnification.
+    pub fanuc_rescaled: Option<RescaledAnswer>,
+}
+
+/// `--fanuc-rescaled`'s file: its name, its text and the parameter change.
+#[derive(Serialize)]
+pub struct RescaledAnswer {
+    /// The name the download gets: the table's, with the new 3623.
+    pub file_name: String,
+    /// The file as text.
+    pub text: String,
+    /// The new magnification (3623).
+    pub magnification: i64,
+    /// What to set with it, as `convert` prints it.
+    pub instruction: String,
+}
+
+impl RescaledAnswer {
+    /// The rescaled file of the table `file_name`.
+    pub fn new(file_name: &str, fine: &crate::emit::fanuc::Rescaled) -> RescaledAnswer {
+        let (stem, extension) = file_name.rsplit_once('.').unwrap_or((file_name, "TXT"));
+        RescaledAnswer {
+            file_name: format!("{stem}-3623-{}.{extension}", fine.magnification),
+            text: fine.text.clone(),
+            magnification: fine.magnification,
+            instruction: fine.instruction.clone(),
+        }
+    }
 }
 
 /// `POST /api/retest`'s answer.

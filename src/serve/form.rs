@@ -9,12 +9,13 @@ use axum::extract::multipart::MultipartError;
 use axum::http::StatusCode;
 
 /// The file fields: `file` (one, or two of one axis: API forward and
-/// reverse), `after` (the re-test), `table` (the table that was active)
-/// and `machine` (the machine profile, as `--machine`).
-const FILE_FIELDS: [&str; 4] = ["file", "after", "table", "machine"];
+/// reverse), `after` (the re-test), `table` (the table that was active),
+/// `machine` (the machine profile, as `--machine`) and `fanuc_parameters`
+/// (a Fanuc parameter backup, as `--fanuc-parameters`).
+const FILE_FIELDS: [&str; 5] = ["file", "after", "table", "machine", "fanuc_parameters"];
 
 /// The settings the page sends, each at most once.
-const TEXT_FIELDS: [&str; 14] = [
+const TEXT_FIELDS: [&str; 15] = [
     "format",
     "axis",
     "standard",
@@ -29,6 +30,7 @@ const TEXT_FIELDS: [&str; 14] = [
     "diagnose",
     "limits",
     "decision",
+    "fanuc_rescaled",
 ];
 
 /// A file sent with the form: its name as the browser gives it, reduced

@@ -5,6 +5,7 @@
 
 use crate::compensate::plan::Request as TableGrid;
 use crate::compensate::{Extrapolate, TableMode};
+use crate::emit::fanuc::ParameterBackup;
 use crate::emit::{Controller, MachineProfile};
 use crate::error::Warning;
 use crate::evaluate::verdict::{AcceptanceProfile, Decision, Figure, Limit, parse_limit};
@@ -67,8 +68,22 @@ pub struct Profile {
     pub acceptance: Option<AcceptanceProfile>,
 }
 
-/// The form's machine profile ([`Profile`]).
+/// The form's machine profile ([`Profile`]), with the Fanuc parameter
+/// backup of `fanuc_parameters` (as `--fanuc-parameters`).
 pub fn profile(form: &Form) -> Result<Profile, ApiError> {
+    let mut profile = machine_profile(form)?;
+    if let Some((name, bytes)) = form.one_file("fanuc_parameters")? {
+        let file = name.display().to_string();
+        let text = String::from_utf8_lossy(bytes);
+        let backup = ParameterBackup::parse(&text, &file)
+            .map_err(|error| ApiError::bad(format!("{file}:{error}")))?;
+        profile.machine.fanuc = Some(backup);
+    }
+    Ok(profile)
+}
+
+/// The `machine` field's profile.
+fn machine_profile(form: &Form) -> Result<Profile, ApiError> {
     let Some((name, bytes)) = form.one_file("machine")? else {
         return Ok(Profile {
             file: String::new(),
@@ -193,4 +208,16 @@ pub fn grid(form: &Form) -> Result<TableGrid, ApiError> {
             .transpose()
             .map_err(|e| format!("extrapolate: {e}"))?,
     })
+}
+
+/// The form's `fanuc_rescaled` (`--fanuc-rescaled`): on when sent as
+/// `1`, `on` or `true`.
+pub fn fanuc_rescaled(form: &Form) -> Result<bool, ApiError> {
+    match form.text("fanuc_rescaled") {
+        None | Some("0" | "off" | "false") => Ok(false),
+        Some("1" | "on" | "true") => Ok(true),
+        Some(other) => Err(ApiError::bad(format!(
+            "fanuc_rescaled: expected 1 or 0, found {other:?}"
+        ))),
+    }
 }

@@ -11,7 +11,7 @@ use crate::evaluate;
 use crate::report::acceptance::{ReportInput, TableRecord, charts};
 use crate::report::chart::chart;
 use crate::report::plot::PlotFormat;
-use crate::report::web::ConvertAnswer;
+use crate::report::web::{ConvertAnswer, RescaledAnswer};
 use crate::workflow::report::{Report, ReportParts};
 use crate::workflow::{Converted, Test};
 
@@ -57,6 +57,11 @@ pub fn convert_answer(table: &Table) -> Result<ConvertAnswer, ApiError> {
         file_name: table.file_name.clone(),
         text,
         table_svg: svg_of(&report.input(), "table")?,
+        fanuc_rescaled: table
+            .converted
+            .rescaled
+            .as_ref()
+            .map(|fine| RescaledAnswer::new(&table.file_name, fine)),
     })
 }
 

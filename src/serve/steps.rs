@@ -24,8 +24,8 @@ use super::UPLOAD_LIMIT;
 use super::error::ApiError;
 use super::form::Form;
 use super::inputs::{
-    active_table, controller, decision, file_label, grid, limits, linuxcnc_type, measurement,
-    profile, standard, test,
+    active_table, controller, decision, fanuc_rescaled, file_label, grid, limits, linuxcnc_type,
+    measurement, profile, standard, test,
 };
 use super::present::{Table, attachment, convert_answer, svg_of};
 
@@ -126,6 +126,7 @@ fn table_of(form: &Form, field: &str, effects: &[Effect]) -> Result<Table, ApiEr
             output: file_name.clone(),
             file_name: file_name.clone(),
             also: Vec::new(),
+            fanuc_rescaled: fanuc_rescaled(form)?,
         },
     )?;
     Ok(Table {

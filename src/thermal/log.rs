@@ -2,9 +2,10 @@
 //!
 //! One header line names the columns; a unit may follow a name in brackets
 //! or parentheses (`time [min]`, `drift (mm)`, `T3 [°C]`). The time column is
-//! `time`/`t` with a unit s, min or h, or `timestamp`/`date`/`datetime` with
-//! ISO 8601 date-times (`2024-05-01 12:00:00` or `…T…`). A log without a time
-//! column needs the sample interval (`LogOptions::sample_interval_s`). The
+//! `time` or `elapsed` (or `t`) with a unit s, min or h, or
+//! `timestamp`/`date`/`datetime` with ISO 8601 date-times (`2024-05-01
+//! 12:00:00` or `…T…`); a bare `T` or `t` is a temperature. A log
+//! without a time column needs the sample interval (`LogOptions::sample_interval_s`). The
 //! drift column is the one the user names; every other column is a
 //! temperature (°C unless its header says K or °F). The delimiter is a
 //! comma, or `;` or a tab when the header has no comma.
@@ -299,6 +300,11 @@ fn time_unit(name: &str, unit: Option<&str>) -> Option<Result<TimeUnit, String>>
         "timestamp" | "date" | "datetime" | "date time"
     ) {
         return Some(Ok(TimeUnit::Timestamp));
+    }
+    // `t` is a time only with a time unit: `T` or `t [°C]` is a temperature.
+    let time_units = ["s", "min", "h"];
+    if lower == "t" && !unit.is_some_and(|u| time_units.contains(&u)) {
+        return None;
     }
     if !matches!(lower.as_str(), "time" | "t" | "elapsed") {
         return None;

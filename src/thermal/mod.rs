@@ -26,7 +26,8 @@ mod study;
 pub use iso::{Iso230_3, SensorRise, TestType, evaluate};
 pub use log::{LogOptions, parse_log, write_log};
 pub use model::{
-    Application, FitOptions, FitSummary, Term, ThermalModel, Validation, apply, fit, tau_grid_s,
+    Application, FitOptions, FitSummary, Term, ThermalModel, Validation, apply, coldest, fit,
+    tau_grid_s,
 };
 pub use study::{ModelSource, Study, StudyRequest, parse_rows, study, study_text};
 

@@ -120,8 +120,18 @@ pub fn evaluation_report(
     } = options;
     warnings.extend(evaluation.warnings.iter().cloned());
     // The budget is the laser's, for lengths, and limits are µm: a rotary
-    // axis has neither yet.
-    rotary::check(measurement, &[(rotary::Use::Limits, !limits.is_empty())])?;
+    // axis has neither yet, and asking for either is refused, as `report`
+    // refuses it.
+    rotary::check(
+        measurement,
+        &[
+            (rotary::Use::Limits, !limits.is_empty()),
+            (
+                rotary::Use::Uncertainty,
+                equipment.is_some() || decision != Default::default(),
+            ),
+        ],
+    )?;
     let budget = match rotary::allows(measurement, rotary::Use::Uncertainty) {
         true => budget_of(measurement, equipment, warnings)?,
         false => None,
@@ -213,6 +223,8 @@ pub struct TableRequest<'a> {
     pub file_name: String,
     /// Coupled axes written the same table (`--also`).
     pub also: Vec<String>,
+    /// Fanuc: also the table at a finer magnification (`--fanuc-rescaled`).
+    pub fanuc_rescaled: bool,
 }
 
 /// A table: the file's bytes and `convert --json`'s object.
@@ -223,6 +235,9 @@ pub struct Converted {
     pub report: ConvertJson,
     /// The table, for its chart.
     pub table: CompensationTable,
+    /// Fanuc, when asked: the file at a finer magnification (3623) and the
+    /// parameter change that goes with it.
+    pub rescaled: Option<emit::fanuc::Rescaled>,
 }
 
 /// `convert`: the table of `measurement` (named, runs left out, an active
@@ -253,11 +268,20 @@ pub fn convert(
         [false, true] => Some(Direction::Down),
         _ => None,
     };
+    if table.fanuc_rescaled && table.controller != Controller::Fanuc {
+        return Err(EmitError::Profile("--fanuc-rescaled is for --controller fanuc".into()).into());
+    }
+    let request = table::fanuc_grid(
+        table.controller,
+        table.request,
+        options,
+        measurement.targets_mm(),
+    )?;
     let plan = plan(
         measurement.targets_mm(),
         table.effects,
         &table.controller.capabilities(options.machine_unit),
-        table.request,
+        &request,
         &PlanContext {
             only_direction,
             existing: table.active,
@@ -278,6 +302,14 @@ pub fn convert(
             summary
         });
     let bytes = emit::write_bytes(table.controller, &compensation, options, table.existing)?;
+    let rescaled = match table.fanuc_rescaled {
+        true => Some(table::fanuc_rescaled(
+            table.existing,
+            &compensation,
+            options,
+        )?),
+        false => None,
+    };
     let activation = emit::activation(table.controller, &compensation, &table.file_name, options);
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
     let mut report = ConvertJson::new(
@@ -293,7 +325,7 @@ pub fn convert(
     report.notes = plan.table_notes;
     if table.controller == Controller::Fanuc {
         report
-            .effects
+            .notes
             .extend(emit::fanuc::notes(&compensation, options));
     }
     if measurement.kind() == AxisKind::Linear {
@@ -311,6 +343,7 @@ pub fn convert(
         bytes,
         report,
         table: compensation,
+        rescaled,
     })
 }
 

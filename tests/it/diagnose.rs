@@ -729,3 +729,83 @@ fn at_higher_noise_every_kind_is_still_found() {
         );
     }
 }
+
+/// With a bidirectional table the prediction does not carry the first
+/// test's B̄ but what the table leaves of it: a reversal unchanged is said
+/// against that, not against the first test's B̄.
+#[test]
+fn an_unchanged_reversal_under_a_bidirectional_table_quotes_the_predicted_b() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let truth_file = path("truth.toml");
+    std::fs::write(
+        &truth_file,
+        truth(0.3, "", "[[effect]]\nkind = \"reversal\"\nB_um = -3.0\n"),
+    )
+    .unwrap();
+    let ok = |args: &[&str]| {
+        let run = crate::util::axcomp(args);
+        assert_eq!(run.code, 0, "axcomp {}: {}", args.join(" "), run.stderr);
+        run
+    };
+    let (before, table, after) = (path("before.rtl"), path("X.COM"), path("after.rtl"));
+    ok(&[
+        "synth",
+        "--truth",
+        &truth_file,
+        "--seed",
+        "3",
+        "-o",
+        &before,
+    ]);
+    ok(&[
+        "convert",
+        &before,
+        "--controller",
+        "tnc640",
+        "--mode",
+        "bidirectional",
+        "-o",
+        &table,
+        "-q",
+    ]);
+    ok(&[
+        "synth",
+        "--truth",
+        &truth_file,
+        "--seed",
+        "3",
+        "-o",
+        &path("before2.rtl"),
+        "--table",
+        &table,
+        "--o2",
+        &after,
+    ]);
+    let run = ok(&[
+        "diagnose", "--after", &after, "--before", &before, "--table", &table, "--json",
+    ]);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let predicted = json["figures_um"]["predicted"]["B_mean"].as_f64().unwrap();
+    let first = crate::numbers::mean_reversal_um(
+        &read_path(std::path::Path::new(&before), None)
+            .unwrap()
+            .measurement,
+    );
+    // By hand: the first test's −3 µm is in the table, the prediction near 0.
+    assert!((first + 3.0).abs() < 0.3, "{first}");
+    assert!(predicted.abs() < 0.3, "{predicted}");
+    let why = json["rejected"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["kind"] == "reversal")
+        .expect("the reversal is looked for")["why"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let expected = format!(
+        "no change since the first test: its B̄ = {first:.2} µm less what the table takes out leaves the B̄ = {predicted:.2} µm the prediction carries ("
+    );
+    assert!(why.starts_with(&expected), "{why}\nexpected {expected}");
+}

@@ -534,3 +534,50 @@ fn diagnose_and_predict_take_the_real_pitch_file() {
     ]);
     assert!(run.stdout.contains("with the table"), "{}", run.stdout);
 }
+
+/// 3605 = 00000010 on every axis of the real backup: bit 1, whose meaning no
+/// public manual page gave, is said (a note, not an effect of --effects)
+/// with what to check; a backup with 3605 = 00000000 on X gets no such
+/// note. The activation says the file's unit: 1820 = 20 (CMR 10) gives a
+/// detection unit of 0.001 / 10 = 0.0001 mm, × 3623 = 10: 0.001 mm.
+#[test]
+fn the_unknown_bit_of_3605_is_said() {
+    // convert --existing of the synthetic X under `backup`: its JSON.
+    let convert_with = |backup: &dyn Fn(&Path) -> String| {
+        let directory = tempfile::tempdir().unwrap();
+        let output = directory.path().join("NEW.TXT").display().to_string();
+        let parameters = backup(directory.path());
+        let (_, run) = update_x(
+            directory.path(),
+            &parameters,
+            "30",
+            &["-o", &output, "--json", "-q"],
+        );
+        serde_json::from_str::<serde_json::Value>(&run.stdout).unwrap()
+    };
+    let json = convert_with(&|_| data("CNC-PARA.TXT"));
+    let notes = json["notes"].to_string();
+    assert!(
+        notes.contains("3605 of axis X is 00000010 in the parameter backup (")
+            && notes.contains("HM100TS__CNC-PARA.TXT:1411:12): bit #1 set besides #0")
+            && notes.contains("check 3605#1 in the control's parameter manual"),
+        "{notes}"
+    );
+    assert!(!json["effects"].to_string().contains("3605"), "{json:#}");
+    let activation = json["activation"].as_str().unwrap();
+    assert!(
+        activation.contains(
+            "its values are increments per section in units of 0.001 mm (detection unit 0.0001 mm × 3623 = 10)"
+        ),
+        "{activation}"
+    );
+    let json = convert_with(&|directory| {
+        let text = std::fs::read_to_string(data("CNC-PARA.TXT")).unwrap();
+        let cleared = text.replace("N03605Q1A1P00000010A2", "N03605Q1A1P00000000A2");
+        assert_ne!(cleared, text);
+        let path = directory.join("CNC-PARA.TXT");
+        std::fs::write(&path, cleared).unwrap();
+        path.display().to_string()
+    });
+    assert!(!json["notes"].to_string().contains("3605"), "{json:#}");
+}

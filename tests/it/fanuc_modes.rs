@@ -43,7 +43,7 @@ fn read(path: &str) -> Measurement {
 /// The real backup with X's bidirectional pitch error compensation on
 /// (3605 = 00000011) and its table for travel in the negative direction at
 /// points 50 … 90 (3626 = 50; the real pitch file holds 0 there), 3627 = 0.
-fn bidirectional_backup(directory: &Path) -> String {
+pub(crate) fn bidirectional_backup(directory: &Path) -> String {
     let text = std::fs::read_to_string(data("CNC-PARA.TXT")).unwrap();
     let changed = text
         .replace("N03605Q1A1P00000010A2", "N03605Q1A1P00000011A2")
@@ -75,7 +75,9 @@ fn bidirectional_compensation_needs_3605_and_goes_to_3626() {
     ]);
     assert_eq!(run.code, 2, "{}", run.stdout);
     assert!(
-        run.stderr.contains("3605#0 of axis X is 0")
+        run.stderr
+            .contains("3605#0 of axis X is 0 in the parameter backup (3605 = 00000010 at ")
+            && run.stderr.contains("HM100TS__CNC-PARA.TXT:1411:12)")
             && run.stderr.contains("set 3605#0 = 1 and 3626"),
         "{}",
         run.stderr
@@ -178,7 +180,7 @@ fn the_rescaled_alternative_keeps_the_compensation_in_a_finer_unit() {
     // sections (at most 5 units × 10 = 50 of 0.1 µm) is 1.
     assert!(
         run.stdout
-            .contains("set 3623 of axis X to 1 (it is 10: units of 0.0001 instead of 0.001 mm)"),
+            .contains("set 3623 of axis X to 1 (it is 10: units of 0.0001 mm instead of 0.001 mm)"),
         "{}",
         run.stdout
     );
@@ -320,6 +322,12 @@ fn a_rotary_axis_turn_sums_to_zero_and_its_backlash_is_in_degrees() {
         "{note}"
     );
     assert!(note.contains("negative an axis that overshoots"), "{note}");
+    // B's unit in degrees: 1820 = 20 (CMR 10), 0.001° / 10 × 3623 = 1.
+    let activation = json["activation"].as_str().unwrap();
+    assert!(
+        activation.contains("in units of 0.0001° (detection unit 0.0001° × 3623 = 1)"),
+        "{activation}"
+    );
     // Half a turn updated into the real file: B's old points 307 … 312 with
     // the new 301 … 306 no longer sum to zero over the turn: refused.
     let half = axcomp::synth::rotary_test(&truth(180.0, 7), 8).unwrap();

@@ -1,7 +1,8 @@
 //! Every relative link in README.md, CONTRIBUTING.md and the guide
 //! (docs/src/) points at a file that exists, and at a heading of it where it
 //! names one; the guide's SUMMARY.md lists every page of docs/src, so the
-//! book built from it has them all.
+//! book built from it has them all; the Windows zip (`scripts/dist-files`)
+//! ships every file its Markdown links.
 
 use std::path::{Path, PathBuf};
 
@@ -196,4 +197,57 @@ fn the_readme_stays_a_front_page() {
     ] {
         assert!(readme.contains(needle), "README.md lacks {what} ({needle})");
     }
+}
+
+/// The paths `scripts/dist` puts in the Windows zip beside `axcomp.exe`.
+fn shipped_in_the_zip() -> Vec<PathBuf> {
+    let list = std::fs::read_to_string(root().join("scripts/dist-files")).unwrap();
+    list.lines()
+        .filter(|line| !line.is_empty() && !line.starts_with('#'))
+        .map(|line| root().join(line))
+        .collect()
+}
+
+#[test]
+fn the_windows_zip_ships_every_file_its_documents_link() {
+    let shipped = shipped_in_the_zip();
+    let is_shipped = |path: &Path| shipped.iter().any(|s| path.starts_with(s));
+    let documents: Vec<PathBuf> = shipped
+        .iter()
+        .flat_map(|path| match path.is_dir() {
+            true => markdown_under(path),
+            false => vec![path.clone()],
+        })
+        .collect();
+    assert!(documents.contains(&root().join("README.md")));
+    assert!(is_shipped(&root().join("fixtures/sample-x.rtl")));
+    let mut failures = Vec::new();
+    for file in &documents {
+        assert!(file.exists(), "{} is listed but missing", file.display());
+        if file.extension().is_none_or(|e| e != "md") {
+            continue;
+        }
+        let text = std::fs::read_to_string(file).unwrap();
+        for (line, target) in link_targets(&text) {
+            let path = target.split('#').next().unwrap_or_default();
+            if target.contains("://") || target.starts_with("mailto:") || path.is_empty() {
+                continue;
+            }
+            // Lexically: `..` in a link must not climb out of the zip.
+            let mut linked = file.parent().unwrap().to_path_buf();
+            for part in Path::new(path).components() {
+                match part {
+                    std::path::Component::ParentDir => {
+                        linked.pop();
+                    }
+                    other => linked.push(other),
+                }
+            }
+            if !is_shipped(&linked) {
+                let name = file.strip_prefix(root()).unwrap().display();
+                failures.push(format!("{name}:{line}: {target} is not in the zip"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
 }

@@ -35,7 +35,7 @@ fn text(path: &Path) -> String {
 
 /// B̄ = mean over targets of (x̄_i↑ − x̄_i↓), µm, from the readings (ISO
 /// 230-2 §3.2.8's mean reversal value, by hand).
-fn mean_reversal_um(m: &Measurement) -> f64 {
+pub(crate) fn mean_reversal_um(m: &Measurement) -> f64 {
     let mean = |i: usize, direction: Direction| {
         let values: Vec<f64> = m
             .runs()

@@ -13,7 +13,7 @@ use crate::util::{axcomp, root, without_time};
 
 /// Runs the CLI in `dir` (so files are named by their base names, as the
 /// app names uploads) and returns the run.
-fn cli(dir: &Path, args: &[&str]) -> crate::util::Run {
+pub(crate) fn cli(dir: &Path, args: &[&str]) -> crate::util::Run {
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_axcomp"))
         .args(args)
         .current_dir(dir)

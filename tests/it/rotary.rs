@@ -245,6 +245,7 @@ fn an_ecmc_file_in_degrees_is_a_rotary_axis() {
 #[test]
 fn commands_for_linear_axes_only_refuse_a_rotary_one() {
     let path = test_data("rotary/ecmc-deg.dat");
+    let equipment = crate::util::root().join("fixtures/equipment/hene-default.toml");
     for args in [
         vec![
             "report".as_ref(),
@@ -261,6 +262,20 @@ fn commands_for_linear_axes_only_refuse_a_rotary_one() {
             path.as_os_str(),
             "--limit".as_ref(),
             "E=5".as_ref(),
+        ],
+        // The budget is a length laser's: asked for on a rotary axis, it is
+        // refused, not left out without a word.
+        vec![
+            "evaluate".as_ref(),
+            path.as_os_str(),
+            "--equipment".as_ref(),
+            equipment.as_os_str(),
+        ],
+        vec![
+            "evaluate".as_ref(),
+            path.as_os_str(),
+            "--decision".as_ref(),
+            "iso14253-1".as_ref(),
         ],
     ] {
         let run = axcomp(&args);

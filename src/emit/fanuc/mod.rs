@@ -34,7 +34,7 @@ pub use parameters::{AxisParameters, ParameterBackup, looks_like_parameters};
 use pitch::{absolute_units, data_line, increments, parse_pitch};
 pub use pitch::{looks_like, read};
 pub use rescale::{Rescaled, rescaled};
-use table::{check_turn, new_increments, wanted};
+use table::{check_turn, finest_for_sections, new_increments, wanted};
 pub use table::{notes, parameters_for, points_in, write};
 use update::replace_lines;
 pub use update::{check_read_back, update};
@@ -46,11 +46,23 @@ use crate::measurement::AxisKind;
 /// \[file\] Data number of compensation point 0 (`N10000` … in the real `PITCH.TXT`).
 pub const DATA_NUMBER_OFFSET: i64 = 10_000;
 
-/// \[reconstructed\] Largest |value| of one point, in units of detection unit ×
-/// magnification: no public manual page giving it was found; a signed byte
-/// (−128 … 127) is assumed, the range of the other controllers' incremental
-/// tables of this kind (Mitsubishi E68 manual p. II-292: "Range: –128 to 127").
-pub const POINT_LIMIT: i64 = 127;
+/// \[file\] The values one point holds, in units of detection unit ×
+/// magnification: one signed byte, −128 … 127 (Fanuc's FOCAS library header
+/// `fwlib32.h`, `IODBPI`: the incremental pitch data of `cnc_rdpitchr` /
+/// `cnc_wrpitchr` are `char data[]`); no manual page stating it was found.
+pub const POINT_RANGE: std::ops::RangeInclusive<i64> = -128..=127;
+
+/// The smallest magnification (≥ 1) at which a point holds `units` counted
+/// at magnification 1 (detection units, signed): |units| / 128 for a
+/// negative value, / 127 for a positive one, rounded up.
+fn magnification_for(units: f64) -> i64 {
+    let limit = if units < 0.0 {
+        -*POINT_RANGE.start()
+    } else {
+        *POINT_RANGE.end()
+    };
+    ((units.abs() / limit as f64).ceil() as i64).max(1)
+}
 
 /// \[manual, secondary\] The number of points between the extremes an axis
 /// may use (cnc.wiki "Setup Guide for Fanuc Pitch Error Compensation
@@ -118,7 +130,13 @@ pub fn activation(file_name: &str, table: &CompensationTable, options: &EmitOpti
             } else {
                 ""
             };
-            format!("{} ({what}){backlash}", p.settings())
+            format!(
+                "{} ({what}); its values are increments per section in units of {} (detection unit {} × 3623 = {}){backlash}",
+                p.settings(),
+                p.unit_text(p.unit()),
+                p.unit_text(p.detection_unit),
+                p.magnification
+            )
         },
     );
     format!(
@@ -208,6 +226,25 @@ mod tests {
         let p = AxisParameters::default_for("X", 2, 100.0, 0, 0.0);
         let error = write(&t, &options_with(p)).unwrap_err().to_string();
         assert!(error.contains("needs 200"), "{error}");
+        assert!(error.contains("set 3623 = 2"), "{error}");
+    }
+
+    #[test]
+    fn a_point_holds_one_signed_byte() {
+        // FOCAS fwlib32.h: a point's increment is a `char`, −128 … 127. In
+        // 1 µm units an error rising 0.128 mm over a section is a
+        // compensation of −128 units: held. Falling 0.128 mm is +128: one
+        // beyond, and 3623 = 2 holds it (128 / 2 = 64 units).
+        let p = AxisParameters::default_for("X", 2, 100.0, 0, 0.0);
+        let t = table(vec![0.0, 100.0], vec![0.0, 0.128]);
+        assert_eq!(
+            write(&t, &options_with(p.clone())).unwrap(),
+            "%\nN10000Q0P0\nN10001Q0P-128 \n%"
+        );
+        let t = table(vec![0.0, 100.0], vec![0.0, -0.128]);
+        let error = write(&t, &options_with(p)).unwrap_err().to_string();
+        assert!(error.contains("needs 128"), "{error}");
+        assert!(error.contains("beyond the -128 … 127 units"), "{error}");
         assert!(error.contains("set 3623 = 2"), "{error}");
     }
 

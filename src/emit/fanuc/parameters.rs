@@ -48,6 +48,12 @@ pub struct AxisParameters {
     pub travel_per_turn: f64,
     /// 3605#0: bidirectional pitch error compensation.
     pub bidirectional: bool,
+    /// 3605 as the backup has it (8 bits, `#7 … #0`; empty without a
+    /// backup): its other bits are not known to axcomp (`notes` says so).
+    pub bits_3605: String,
+    /// Where 3605 of the axis stands in the backup (`FILE:LINE:COL`; empty
+    /// without a backup).
+    pub at_3605: String,
     /// 3626: with 3605#0, the most negative point of the table for travel
     /// in the negative direction (its points 3626 … 3626 + 3622 − 3621).
     pub negative_first: i64,
@@ -85,6 +91,8 @@ impl AxisParameters {
             interval: step,
             travel_per_turn: 0.0,
             bidirectional: false,
+            bits_3605: String::new(),
+            at_3605: String::new(),
             negative_first: 0,
             reference_negative: 0,
             reference_position: at,
@@ -101,6 +109,15 @@ impl AxisParameters {
         self.detection_unit * self.magnification as f64
     }
 
+    /// `value` (mm or °) as the user reads it: `0.001 mm`, `0.0001°`.
+    pub fn unit_text(&self, value: f64) -> String {
+        let number = crate::emit::minimal(value, 7);
+        match self.rotary {
+            true => format!("{number}°"),
+            false => format!("{number} mm"),
+        }
+    }
+
     /// The unit of the axis' positions: `°` on a rotary axis, else `mm`.
     pub fn length_unit(&self) -> &'static str {
         if self.rotary { "°" } else { "mm" }
@@ -114,6 +131,17 @@ impl AxisParameters {
     /// The first point of the axis' curve: the start of the section of 3621.
     pub fn first_point(&self) -> i64 {
         self.most_negative - 1
+    }
+
+    /// The bits of 3605 set besides #0, whose meaning axcomp does not know.
+    pub fn unknown_3605_bits(&self) -> Vec<usize> {
+        self.bits_3605
+            .bytes()
+            .rev()
+            .enumerate()
+            .filter(|(bit, b)| *bit > 0 && *b == b'1')
+            .map(|(bit, _)| bit)
+            .collect()
     }
 
     /// The directions the axis has a table for: ↑, and ↓ with 3605#0.
@@ -339,6 +367,10 @@ impl ParameterBackup {
             interval: self.real(3624, a)?,
             travel_per_turn: self.real(3625, a).unwrap_or(0.0),
             bidirectional: self.bit(3605, a, 0)?,
+            bits_3605: self.value(3605, a)?.value.clone(),
+            at_3605: self
+                .value(3605, a)
+                .map(|e| format!("{}:{}:{}", self.source, e.line, e.column))?,
             // [manual] A-77810E table (a); absent on a control without the function.
             negative_first: self.integer(3626, a).unwrap_or(0),
             reference_negative: self.integer(3627, a).unwrap_or(0),

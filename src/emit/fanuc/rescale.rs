@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use super::{
-    AxisParameters, POINT_LIMIT, absolute_units, data_line, increments, parameters_for,
-    parse_pitch, replace_lines, update, write,
+    AxisParameters, POINT_RANGE, absolute_units, data_line, finest_for_sections, increments,
+    magnification_for, parameters_for, parse_pitch, replace_lines, update, write,
 };
 use crate::compensate::CompensationTable;
 use crate::emit::{EmitError, EmitOptions};
@@ -23,18 +23,15 @@ pub struct Rescaled {
 }
 
 /// The finest magnification whose points hold both the table's sections
-/// and the old increments of `existing`, rescaled: ±`POINT_LIMIT` units a point.
+/// and the old increments of `existing`, rescaled ([`POINT_RANGE`]).
 fn finest(table: &CompensationTable, p: &AxisParameters, old: &[i64]) -> i64 {
-    let values = table.values.for_direction(Direction::Up);
-    let down = table.values.for_direction(Direction::Down);
-    let largest_step = [values, down]
+    let columns = [Direction::Up, Direction::Down].map(|d| table.values.for_direction(d));
+    let new = finest_for_sections(&columns, p.detection_unit);
+    let kept = old
         .iter()
-        .flat_map(|c| c.windows(2).map(|w| (w[1] - w[0]).abs()))
-        .fold(0.0, f64::max);
-    let new = (largest_step / p.detection_unit / POINT_LIMIT as f64).ceil() as i64;
-    let largest_old = old.iter().map(|v| v.unsigned_abs()).max().unwrap_or(0) as i64;
-    let kept = (largest_old * p.magnification + POINT_LIMIT - 1) / POINT_LIMIT;
-    new.max(kept).max(1)
+        .map(|v| magnification_for(*v as f64 * p.magnification as f64))
+        .fold(1, i64::max);
+    new.max(kept)
 }
 
 /// `existing` (or a new file) with every point of the axis at magnification
@@ -57,8 +54,11 @@ pub fn rescaled(
     let m = magnification.unwrap_or_else(|| finest(table, &p, &flat));
     if m < 1 || m == p.magnification {
         return Err(EmitError::Profile(format!(
-            "3623 of axis {} is {}: no finer magnification holds the table (±{POINT_LIMIT} units a point)",
-            p.axis, p.magnification
+            "3623 of axis {} is {}: no finer magnification holds the table ({} … {} units a point)",
+            p.axis,
+            p.magnification,
+            POINT_RANGE.start(),
+            POINT_RANGE.end()
         )));
     }
     let fine = AxisParameters {
@@ -75,11 +75,11 @@ pub fn rescaled(
         None => write(table, &fine_options)?,
     };
     let instruction = format!(
-        "set 3623 of axis {} to {m} (it is {}: units of {} instead of {} mm) together with loading this file, in place of the one at 3623 = {}; then turn the power off and on and return the axis to the reference position",
+        "set 3623 of axis {} to {m} (it is {}: units of {} instead of {}) together with loading this file, in place of the one at 3623 = {}; then turn the power off and on and return the axis to the reference position",
         p.axis,
         p.magnification,
-        crate::emit::minimal(fine.unit(), 7),
-        crate::emit::minimal(p.unit(), 7),
+        p.unit_text(fine.unit()),
+        p.unit_text(p.unit()),
         p.magnification
     );
     Ok(Rescaled {
@@ -125,10 +125,14 @@ fn rescale_lines(
         for point in p.most_negative..=p.most_positive {
             let value = absolute[&point] - absolute[&(point - 1)];
             let at = p.data_point(*direction, point);
-            if value.unsigned_abs() > POINT_LIMIT as u64 {
+            if !POINT_RANGE.contains(&value) {
                 return Err(EmitError::Profile(format!(
-                    "point {at} of axis {} holds {} units at 3623 = {}: beyond ±{POINT_LIMIT}",
-                    p.axis, value, fine.magnification
+                    "point {at} of axis {} holds {} units at 3623 = {}: beyond {} … {}",
+                    p.axis,
+                    value,
+                    fine.magnification,
+                    POINT_RANGE.start(),
+                    POINT_RANGE.end()
                 )));
             }
             changed.insert(data[&at].line.number, data_line(at, value));

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use super::{AxisParameters, POINT_LIMIT, data_line};
+use super::{AxisParameters, POINT_RANGE, data_line, magnification_for};
 use crate::compensate::{CompensationTable, TableMode};
 use crate::emit::{EmitError, EmitOptions};
 use crate::measurement::{AxisKind, Direction};
@@ -61,12 +61,8 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
         .iter()
         .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
     let range = high - low;
-    let largest_step = values
-        .windows(2)
-        .map(|w| (w[1] - w[0]).abs())
-        .fold(0.0, f64::max);
     // The finest magnification whose points still hold every section's change.
-    let finest = ((largest_step / p.detection_unit / POINT_LIMIT as f64).ceil() as i64).max(1);
+    let finest = finest_for_sections(&[values], p.detection_unit);
     let mut notes = Vec::new();
     let all = (p.most_positive - p.first_point() + 1) as usize;
     if p.from_backup && table.positions_mm.len() * 2 < all {
@@ -79,6 +75,9 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
             p.length_unit()
         ));
     }
+    if let Some(note) = unknown_bits_note(&p) {
+        notes.push(note);
+    }
     if let Some(k) = closing_point(table, &p) {
         let closure = values[k] - values[0];
         if closure.abs() > p.unit() / 2.0 {
@@ -90,15 +89,39 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     }
     if p.unit() > range / 10.0 && finest < p.magnification {
         notes.push(format!(
-            "Fanuc: 3623 = {} gives steps of {} mm, coarse for an error of {} mm peak to valley; 3623 = {finest} would give {} mm steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data: convert --fanuc-rescaled FILE writes it)",
+            "Fanuc: 3623 = {} gives steps of {}, coarse for an error of {} peak to valley; 3623 = {finest} would give {} steps (every point of the axis rescaled by {}/{finest}, the parameter changed with the data: convert --fanuc-rescaled FILE writes it)",
             p.magnification,
-            crate::emit::minimal(p.unit(), 7),
-            crate::emit::minimal(range, 4),
-            crate::emit::minimal(p.detection_unit * finest as f64, 7),
+            p.unit_text(p.unit()),
+            p.unit_text((range * 1e4).round() / 1e4),
+            p.unit_text(p.detection_unit * finest as f64),
             p.magnification
         ));
     }
     notes
+}
+
+/// The bits of 3605 besides #0 the backup sets, said: their meaning on the
+/// control was not found (`formats/fanuc/README.md`), so the user checks
+/// them before loading a table axcomp computed without them.
+fn unknown_bits_note(p: &AxisParameters) -> Option<String> {
+    let bits = p.unknown_3605_bits();
+    if bits.is_empty() {
+        return None;
+    }
+    let list: Vec<String> = bits.iter().map(|b| format!("#{b}")).collect();
+    Some(format!(
+        "Fanuc: 3605 of axis {} is {} in the parameter backup ({}): {} {} set besides #0 (bidirectional pitch error compensation); axcomp does not know what {} changes (no public Fanuc manual page giving it was found) and wrote the data as 3620–3627 alone describe them: check {} in the control's parameter manual before loading the file",
+        p.axis,
+        p.bits_3605,
+        p.at_3605,
+        if bits.len() == 1 { "bit" } else { "bits" },
+        list.join(", "),
+        if bits.len() == 1 { "it" } else { "they" },
+        list.iter()
+            .map(|b| format!("3605{b}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
 }
 
 /// The parameters a table is written with: the backup's, or axcomp's
@@ -240,9 +263,10 @@ fn check_mode(table: &CompensationTable, p: &AxisParameters) -> Result<(), EmitE
     match (table.values.mode(), p.bidirectional) {
         (TableMode::Mean, false) | (TableMode::Bidirectional, true) => Ok(()),
         (TableMode::Bidirectional, false) => Err(EmitError::Profile(format!(
-            "3605#0 of axis {} is 0 in the parameter backup ({}): the control compensates pitch error the same in both directions; for a table per direction (if the control has bidirectional pitch error compensation) set 3605#0 = 1 and 3626 to the first of {} free points, give the changed backup and convert again; else use --mode mean and set the backlash parameters 1851/1852",
+            "3605#0 of axis {} is 0 in the parameter backup (3605 = {} at {}): the control compensates pitch error the same in both directions; for a table per direction (if the control has bidirectional pitch error compensation) set 3605#0 = 1 and 3626 to the first of {} free points, give the changed backup and convert again; else use --mode mean and set the backlash parameters 1851/1852",
             p.axis,
-            p.source,
+            p.bits_3605,
+            p.at_3605,
             p.most_positive - p.most_negative + 1
         ))),
         (TableMode::Mean, true) => Err(EmitError::Profile(format!(
@@ -325,23 +349,36 @@ fn closing_point(table: &CompensationTable, p: &AxisParameters) -> Option<usize>
         .position(|x| (x - first - turn).abs() < 1e-6)
 }
 
-/// Refuses increments beyond a point's limit, naming the magnification that would hold them.
+/// The finest magnification whose points hold every section of `columns`
+/// (errors, mm or °): a section's increment is the change of the
+/// compensation, the negative of the error's, in detection units.
+pub(super) fn finest_for_sections(columns: &[&[f64]], detection_unit: f64) -> i64 {
+    columns
+        .iter()
+        .flat_map(|c| c.windows(2).map(|w| -(w[1] - w[0]) / detection_unit))
+        .map(magnification_for)
+        .fold(1, i64::max)
+}
+
+/// Refuses increments beyond a point's range ([`POINT_RANGE`]), naming the
+/// magnification that would hold them.
 fn check_limits(increments: &BTreeMap<i64, i64>, p: &AxisParameters) -> Result<(), EmitError> {
-    let Some((&point, &value)) = increments.iter().max_by_key(|(_, v)| v.unsigned_abs()) else {
+    let Some((&point, &value)) = increments.iter().find(|(_, v)| !POINT_RANGE.contains(v)) else {
         return Ok(());
     };
-    if value.unsigned_abs() <= POINT_LIMIT as u64 {
-        return Ok(());
-    }
-    let needed =
-        (value.unsigned_abs() as f64 * p.magnification as f64 / POINT_LIMIT as f64).ceil() as i64;
+    let needed = increments
+        .values()
+        .map(|v| magnification_for(*v as f64 * p.magnification as f64))
+        .fold(1, i64::max);
     Err(EmitError::Profile(format!(
-        "point {point} of axis {} needs {value} × {} = {} mm, beyond ±{POINT_LIMIT} units a point holds (3623 = {}): set 3623 = {needed} (every point rescaled; units of {} mm) and convert again",
+        "point {point} of axis {} needs {value} × {} = {}, beyond the {} … {} units a point holds (3623 = {}): set 3623 = {needed} (every point rescaled; units of {}) and convert again",
         p.axis,
-        crate::emit::minimal(p.unit(), 7),
-        crate::emit::minimal(value as f64 * p.unit(), 7),
+        p.unit_text(p.unit()),
+        p.unit_text(value as f64 * p.unit()),
+        POINT_RANGE.start(),
+        POINT_RANGE.end(),
         p.magnification,
-        crate::emit::minimal(p.detection_unit * needed as f64, 7)
+        p.unit_text(p.detection_unit * needed as f64)
     )))
 }
 
