@@ -4,7 +4,9 @@
 //! the first test, a mean table at its targets and the re-test with it
 //! applied, as `axcomp synth` and `axcomp convert` make them. Measured: the
 //! diagnosis alone (`diagnose::diagnose`), from the two measurements and the
-//! table to the `Diagnosis`.
+//! table to the `Diagnosis`. Two groups: the re-test at the first test's
+//! targets (`diagnose`), and between them (`diagnose_between`: n − 1 targets
+//! at the midpoints, whose levels share the prediction's uncertainty).
 //!
 //! The whole process (`axcomp diagnose` and `axcomp report --diagnose` on
 //! files made with `synth` and `convert --controller linuxcnc`) is in README,
@@ -23,20 +25,35 @@ use axcomp::synth::{self, Truth};
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-fn truth(count: usize) -> Truth {
+fn truth(count: usize, between: bool) -> Truth {
     let demo = include_str!("../fixtures/demo/truth.toml")
         .replace("count = 16", &format!("count = {count}"));
-    let text = format!(
+    let mut text = format!(
         "{demo}\n[[effect]]\nkind = \"periodic\"\nperiod_mm = 47.0\namplitude_um = 1.2\nphase_rad = 1.0\ntests = [\"after\"]\n"
     );
+    if between {
+        // The demo's axis is 0 … 750 mm: the midpoints of its targets.
+        let half = 750.0 / (2.0 * (count - 1) as f64);
+        text += &format!(
+            "\n[cycle.after]\nstart_mm = {half:?}\nend_mm = {:?}\ncount = {}\n",
+            750.0 - half,
+            count - 1
+        );
+    }
     Truth::from_toml_str(&text).expect("the demo's truth")
 }
 
 fn bench(c: &mut Criterion) {
-    let mut group = c.benchmark_group("diagnose");
+    for (name, between) in [("diagnose", false), ("diagnose_between", true)] {
+        bench_group(c, name, between);
+    }
+}
+
+fn bench_group(c: &mut Criterion, name: &str, between: bool) {
+    let mut group = c.benchmark_group(name);
     group.sample_size(10);
     for count in [100, 1_000, 10_000] {
-        let truth = truth(count);
+        let truth = truth(count, between);
         let before = synth::before(&truth, 2026).unwrap();
         let options = TableOptions {
             mode: TableMode::Mean,

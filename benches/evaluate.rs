@@ -53,7 +53,7 @@ fn large_measurement() -> Measurement {
             },
             number: k / 2 + 1,
             start_time_s: None,
-            deviations_mm: targets
+            deviations: targets
                 .iter()
                 .map(|x| {
                     let mm = 0.005 * (x / 50.0).sin() + 1e-4 * f64::from(k) * (x * 7.0).cos();

@@ -39,7 +39,7 @@ impl CycleTiming {
 /// `[run][target]` (run order and target order of the measurement). The axis
 /// starts at the first target minus the overrun.
 pub fn reading_times(measurement: &Measurement, timing: CycleTiming) -> Vec<Vec<f64>> {
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let directions: Vec<Direction> = measurement.runs().iter().map(|run| run.direction).collect();
     reading_times_for(targets, &directions, timing)
 }

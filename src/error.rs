@@ -192,8 +192,8 @@ pub enum Warning {
         kind: AxisKind,
         /// Targets measured.
         targets: usize,
-        /// Travel, mm (° on a rotary axis).
-        length_mm: f64,
+        /// Travel, in the axis' unit (mm, or ° on a rotary axis).
+        length: f64,
         /// Targets the standard asks for this travel.
         required: usize,
     },
@@ -213,8 +213,8 @@ pub enum Warning {
     TargetNotEvaluated {
         /// Linear or rotary.
         kind: AxisKind,
-        /// The target, mm (° on a rotary axis).
-        target_mm: f64,
+        /// The target, in the axis' unit (mm, or ° on a rotary axis).
+        target: f64,
         /// Which quantity is missing there.
         missing: String,
     },
@@ -422,18 +422,18 @@ impl fmt::Display for Warning {
             Warning::TooFewTargets {
                 kind: AxisKind::Rotary,
                 targets,
-                length_mm,
+                length: range_deg,
                 required,
             } => write!(
                 f,
                 "{targets} target(s) over {}°: ISO 230-2 asks for at least {required}; measure at least {required}, \
                  with 0°, 90°, 180° and 270° among them where in range",
-                mm_text(*length_mm)
+                mm_text(*range_deg)
             ),
             Warning::TooFewTargets {
                 kind: AxisKind::Linear,
                 targets,
-                length_mm,
+                length: length_mm,
                 required,
             } => write!(
                 f,
@@ -467,11 +467,11 @@ impl fmt::Display for Warning {
             ),
             Warning::TargetNotEvaluated {
                 kind,
-                target_mm,
+                target,
                 missing,
             } => write!(
                 f,
-                "target {target_mm} {} has no {missing}; the axis figures that need it are not evaluated",
+                "target {target} {} has no {missing}; the axis figures that need it are not evaluated",
                 kind.position_unit()
             ),
             Warning::RotaryOverFullTurn { range_deg } => write!(

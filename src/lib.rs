@@ -43,7 +43,7 @@
 //! let (measurement, _warnings) = read::parse_str(csv, SourceFormat::Csv).unwrap();
 //! let evaluation = evaluate(&measurement);
 //! // B_i = x̄↑ − x̄↓ = 2 µm at both targets.
-//! assert!((evaluation.figures.b_mm.unwrap() - 0.002).abs() < 1e-12);
+//! assert!((evaluation.figures.b.unwrap() - 0.002).abs() < 1e-12);
 //! ```
 
 #![forbid(unsafe_code)]

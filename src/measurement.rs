@@ -4,14 +4,14 @@
 //! are bare `f64`s in the axis' unit: mm on a linear axis, degrees on a
 //! rotary one (`../shared/spec/standards.md` §6: targets in degrees,
 //! deviations reported in ″), as the statistics are the same arithmetic in
-//! either. A value leaves them typed: [`Measurement::positions`] and
+//! either; their names ([`Measurement::targets`], [`Run::deviations`]) name
+//! no unit, since the unit is the axis'. A value leaves them typed:
+//! [`Measurement::positions`], [`Measurement::deviations_of`] and
 //! [`AxisKind::position`] give a [`Position`] (`Mm` or `Deg`,
 //! `crate::units`), so a stage that prints or serialises a value cannot take
-//! a degree for a millimetre. (`Run::deviations_mm` and
-//! [`Measurement::targets_mm`] keep their names from before rotary axes;
-//! they hold degrees on a rotary axis.)
+//! a degree for a millimetre.
 //!
-//! A [`Measurement`] holds the targets (mm, strictly increasing), the runs
+//! A [`Measurement`] holds the targets (strictly increasing), the runs
 //! (each with its direction and one deviation per target, `None` where a
 //! reading is missing), the environment record and the metadata. It can only
 //! be built through [`Measurement::new`], which checks the invariants that
@@ -179,9 +179,9 @@ pub struct Run {
     /// When the run started, in seconds after the test started, if known.
     pub start_time_s: Option<f64>,
     /// One deviation per target (same order as the targets), in the axis'
-    /// unit: mm, or ° on a rotary axis (the name is older than rotary axes);
-    /// `None` is a missing reading.
-    pub deviations_mm: Vec<Option<f64>>,
+    /// unit: mm, or ° on a rotary axis ([`Measurement::deviations_of`] gives
+    /// them typed); `None` is a missing reading.
+    pub deviations: Vec<Option<f64>>,
 }
 
 impl Run {
@@ -494,16 +494,14 @@ pub enum MeasurementError {
         index: usize,
     },
     /// Targets not strictly increasing.
-    #[error(
-        "targets must be strictly increasing: target {index} ({value_mm} mm) follows {previous_mm} mm"
-    )]
+    #[error("targets must be strictly increasing: target {index} ({value}) follows {previous}")]
     TargetsNotIncreasing {
         /// 1-based target number.
         index: usize,
-        /// Its value.
-        value_mm: f64,
+        /// Its value, in the axis' unit (mm, or °).
+        value: f64,
         /// The value before it.
-        previous_mm: f64,
+        previous: f64,
     },
     /// No runs.
     #[error("no runs")]
@@ -600,10 +598,10 @@ impl Measurement {
     /// ```
     /// use axcomp::measurement::{Direction, Measurement, Run};
     /// let run = Run { direction: Direction::Up, number: 1, start_time_s: None,
-    ///                 deviations_mm: vec![Some(0.0), Some(0.002)] };
+    ///                 deviations: vec![Some(0.0), Some(0.002)] };
     /// let m = Measurement::new("X", vec![0.0, 100.0], vec![run],
     ///                          Default::default(), Default::default()).unwrap();
-    /// assert_eq!(m.targets_mm(), &[0.0, 100.0]);
+    /// assert_eq!(m.targets(), &[0.0, 100.0]);
     /// assert!(Measurement::new("X", vec![100.0, 0.0], vec![], Default::default(),
     ///                          Default::default()).is_err());
     /// ```
@@ -655,7 +653,7 @@ impl Measurement {
     /// ```
     /// use axcomp::measurement::{AxisKind, Direction, Measurement, Run};
     /// let run = Run { direction: Direction::Up, number: 1, start_time_s: None,
-    ///                 deviations_mm: vec![Some(0.0), Some(0.001)] };
+    ///                 deviations: vec![Some(0.0), Some(0.001)] };
     /// let c = Measurement::new("C", vec![0.0, 90.0], vec![run],
     ///                          Default::default(), Default::default()).unwrap()
     ///     .with_kind(AxisKind::Rotary);
@@ -672,18 +670,30 @@ impl Measurement {
         &self.targets
     }
 
-    /// The targets P_i in the axis' unit: [`Measurement::targets`] under
-    /// its name from before rotary axes (degrees on a rotary axis; the stages
-    /// that call it handle linear axes, or both alike).
-    pub fn targets_mm(&self) -> &[f64] {
-        &self.targets
-    }
-
     /// The targets P_i, typed by the axis' kind ([`Position`]: `Mm` or `Deg`).
     pub fn positions(&self) -> impl Iterator<Item = Position> + '_ {
         self.targets
             .iter()
             .map(|&target| self.kind.position(target))
+    }
+
+    /// One run's deviations, typed by the axis' kind ([`Position`]: `Mm` or
+    /// `Deg`); `None` where a reading is missing. A deviation of a rotary
+    /// axis is a [`Deg`], which no `Mm` slot takes:
+    /// ```compile_fail
+    /// # use axcomp::measurement::{AxisKind, Direction, Measurement, Run};
+    /// # use axcomp::units::Mm;
+    /// # let run = Run { direction: Direction::Up, number: 1, start_time_s: None,
+    /// #                 deviations: vec![Some(0.001)] };
+    /// # let c = Measurement::new("C", vec![90.0], vec![run], Default::default(),
+    /// #                          Default::default()).unwrap().with_kind(AxisKind::Rotary);
+    /// let first: Mm = c.deviations_of(&c.runs()[0]).next().unwrap().unwrap();
+    /// ```
+    pub fn deviations_of<'a>(&self, run: &'a Run) -> impl Iterator<Item = Option<Position>> + 'a {
+        let kind = self.kind;
+        run.deviations
+            .iter()
+            .map(move |deviation| deviation.map(|value| kind.position(value)))
     }
 
     /// The runs, in the order measured.
@@ -744,8 +754,8 @@ impl Measurement {
             .runs
             .iter()
             .map(|run| Run {
-                deviations_mm: run
-                    .deviations_mm
+                deviations: run
+                    .deviations
                     .iter()
                     .enumerate()
                     .map(|(i, value)| value.map(|v| reading(run, i, v)))
@@ -769,7 +779,8 @@ impl Measurement {
     /// and reverse `.pos` files of one test). Runs of `other` follow those of
     /// `self` and are renumbered after them, per direction.
     pub fn merge(&self, other: &Measurement) -> Result<Measurement, MeasurementError> {
-        const SAME_TARGET_MM: f64 = 1e-6;
+        // In the axis' unit: 1 nm, or 1e-6° (0.0036″).
+        const SAME_TARGET: f64 = 1e-6;
         if self.kind != other.kind {
             return Err(MeasurementError::KindsDiffer {
                 first: self.kind,
@@ -781,14 +792,14 @@ impl Measurement {
                 .targets
                 .iter()
                 .zip(&other.targets)
-                .any(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
+                .any(|(a, b)| (a - b).abs() > SAME_TARGET)
         {
             let first_difference = (self.targets.len() == other.targets.len())
                 .then(|| {
                     self.targets
                         .iter()
                         .zip(&other.targets)
-                        .position(|(a, b)| (a - b).abs() > SAME_TARGET_MM)
+                        .position(|(a, b)| (a - b).abs() > SAME_TARGET)
                         .map(|i| (i + 1, self.targets[i], other.targets[i]))
                 })
                 .flatten();
@@ -822,19 +833,19 @@ impl Measurement {
     }
 }
 
-fn check_targets(targets_mm: &[f64]) -> Result<(), MeasurementError> {
-    if targets_mm.is_empty() {
+fn check_targets(targets: &[f64]) -> Result<(), MeasurementError> {
+    if targets.is_empty() {
         return Err(MeasurementError::NoTargets);
     }
-    for (index, target) in targets_mm.iter().enumerate() {
+    for (index, target) in targets.iter().enumerate() {
         if !target.is_finite() {
             return Err(MeasurementError::NonFiniteTarget { index: index + 1 });
         }
-        if index > 0 && targets_mm[index - 1] >= *target {
+        if index > 0 && targets[index - 1] >= *target {
             return Err(MeasurementError::TargetsNotIncreasing {
                 index: index + 1,
-                value_mm: *target,
-                previous_mm: targets_mm[index - 1],
+                value: *target,
+                previous: targets[index - 1],
             });
         }
     }
@@ -846,15 +857,15 @@ fn check_runs(runs: &[Run], target_count: usize) -> Result<(), MeasurementError>
         return Err(MeasurementError::NoRuns);
     }
     for run in runs {
-        if run.deviations_mm.len() != target_count {
+        if run.deviations.len() != target_count {
             return Err(MeasurementError::RunLength {
                 run: run.label(),
                 expected: target_count,
-                found: run.deviations_mm.len(),
+                found: run.deviations.len(),
             });
         }
         if let Some(index) = run
-            .deviations_mm
+            .deviations
             .iter()
             .position(|value| value.is_some_and(|v| !v.is_finite()))
         {
@@ -863,7 +874,7 @@ fn check_runs(runs: &[Run], target_count: usize) -> Result<(), MeasurementError>
                 index: index + 1,
             });
         }
-        if run.deviations_mm.iter().all(Option::is_none) {
+        if run.deviations.iter().all(Option::is_none) {
             return Err(MeasurementError::EmptyRun { run: run.label() });
         }
     }
@@ -896,7 +907,7 @@ mod tests {
             direction,
             number,
             start_time_s: None,
-            deviations_mm: values.to_vec(),
+            deviations: values.to_vec(),
         }
     }
 
@@ -1027,6 +1038,16 @@ mod tests {
         assert_eq!(
             quarter.positions().collect::<Vec<_>>(),
             [ByKind::Rotary(Deg(0.0)), ByKind::Rotary(Deg(90.0))]
+        );
+        // 0.001° at 90°: a degree, not a millimetre.
+        assert_eq!(
+            quarter
+                .deviations_of(&quarter.runs()[0])
+                .collect::<Vec<_>>(),
+            [
+                Some(ByKind::Rotary(Deg(0.0))),
+                Some(ByKind::Rotary(Deg(0.001)))
+            ]
         );
         assert_eq!(AxisKind::Linear.position(90.0), ByKind::Linear(Mm(90.0)));
         assert_eq!(

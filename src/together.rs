@@ -62,7 +62,7 @@ pub struct Input<'a> {
 impl<'a> Input<'a> {
     /// A measurement, named `label` in messages.
     pub fn measurement(measurement: &'a Measurement, label: impl Into<String>) -> Input<'a> {
-        let targets = measurement.targets_mm();
+        let targets = measurement.targets();
         Input {
             label: label.into(),
             axis: measurement.axis_recorded().then(|| measurement.axis()),
@@ -368,7 +368,7 @@ pub fn check_together(
 
 /// The same targets and the same runs, reading for reading.
 fn same_readings(a: &Measurement, b: &Measurement) -> bool {
-    a.targets_mm() == b.targets_mm() && a.runs() == b.runs()
+    a.targets() == b.targets() && a.runs() == b.runs()
 }
 
 #[cfg(test)]
@@ -383,7 +383,7 @@ mod tests {
                 direction,
                 number: 1,
                 start_time_s: None,
-                deviations_mm: targets.iter().map(|_| Some(offset_mm)).collect(),
+                deviations: targets.iter().map(|_| Some(offset_mm)).collect(),
             })
             .collect();
         let metadata = Metadata {

@@ -12,6 +12,6 @@ fuzz_target!(|bytes: &[u8]| {
     let Ok(text) = decode(bytes) else { return };
     if let Ok((measurement, _warnings)) = parse_str(&text, SourceFormat::ApiPos) {
         let evaluation = evaluate(&measurement);
-        assert_eq!(evaluation.per_target.len(), measurement.targets_mm().len());
+        assert_eq!(evaluation.per_target.len(), measurement.targets().len());
     }
 });

@@ -13,13 +13,13 @@ fuzz_target!(|bytes: &[u8]| {
     let Ok(text) = decode(bytes) else { return };
     let Ok((measurement, _warnings)) = parse_str(&text, SourceFormat::Rtl) else { return };
     let evaluation = evaluate(&measurement);
-    assert_eq!(evaluation.per_target.len(), measurement.targets_mm().len());
+    assert_eq!(evaluation.per_target.len(), measurement.targets().len());
     let written = rtl::write(&measurement);
     let (again, _) = parse_str(&written, SourceFormat::Rtl).expect("what axcomp writes, it reads");
-    assert_eq!(again.targets_mm(), measurement.targets_mm());
+    assert_eq!(again.targets(), measurement.targets());
     for (a, b) in again.runs().iter().zip(measurement.runs()) {
-        assert_eq!(a.deviations_mm.len(), b.deviations_mm.len());
-        for (x, y) in a.deviations_mm.iter().zip(&b.deviations_mm) {
+        assert_eq!(a.deviations.len(), b.deviations.len());
+        for (x, y) in a.deviations.iter().zip(&b.deviations) {
             match (x, y) {
                 (Some(x), Some(y)) => assert!((x - y).abs() <= 1e-15 * y.abs().max(1.0)),
                 (None, None) => {}

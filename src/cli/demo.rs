@@ -364,10 +364,10 @@ fn summary(s: &Summary<'_>) -> String {
     let _ = writeln!(
         out,
         " 1 first test    before.rtl: A {} µm, E {} µm, R {} µm, B {} µm (evaluate.json)",
-        um(f.a_mm),
-        um(f.e_mm),
-        um(f.r_mm),
-        um(f.b_mm)
+        um(f.a),
+        um(f.e),
+        um(f.r),
+        um(f.b)
     );
     let _ = writeln!(
         out,
@@ -378,19 +378,19 @@ fn summary(s: &Summary<'_>) -> String {
     let _ = writeln!(
         out,
         " 3 prediction    re-test A {} µm, E {} µm, B {} µm (the measured reversal stays with a mean table); volumetric max {:.2} → {:.2} µm (predict.json)",
-        um(retest.a_mm),
-        um(retest.e_mm),
-        um(retest.b_mm),
+        um(retest.a),
+        um(retest.e),
+        um(retest.b),
         mm_to_um(s.prediction.volumetric_before.max_mm),
         mm_to_um(s.prediction.volumetric_after.max_mm)
     );
     let _ = writeln!(
         out,
         " 4 re-test       after.rtl: A {} µm, E {} µm, R {} µm, B {} µm: not what was predicted",
-        um(a.a_mm),
-        um(a.e_mm),
-        um(a.r_mm),
-        um(a.b_mm)
+        um(a.a),
+        um(a.e),
+        um(a.r),
+        um(a.b)
     );
     let _ = writeln!(
         out,
@@ -405,7 +405,7 @@ fn summary(s: &Summary<'_>) -> String {
     let next_reason = match s.next.values.mode() {
         TableMode::Bidirectional => format!(
             "the reversal B̄ {} µm the re-test measured, the residual and the effects",
-            um(s.after.figures.b_mean_mm)
+            um(s.after.figures.b_mean)
         ),
         TableMode::Mean => "the residual and the effects".to_string(),
     };

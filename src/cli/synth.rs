@@ -141,7 +141,7 @@ pub fn run(args: &SynthArgs) -> Result<()> {
     let mut summary = format!(
         "Wrote {} ({} targets, {} runs)\n",
         output.display(),
-        first.targets_mm().len(),
+        first.targets().len(),
         first.runs().len()
     );
     if let Some((path, _)) = &second {
@@ -172,7 +172,7 @@ fn run_rotary(args: &SynthArgs, truth_path: &Path, output: &Path) -> Result<()> 
     print_text(&format!(
         "Wrote {} (rotary axis, {} targets, {} runs)\n",
         output.display(),
-        test.targets_mm().len(),
+        test.targets().len(),
         test.runs().len()
     ))
 }

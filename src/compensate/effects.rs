@@ -59,7 +59,7 @@ pub fn build_table_with_effects(
         .sum();
     let mut table = if finest_step_mm(effects).is_some() {
         // The readings less the periodic error at their targets.
-        let targets = measurement.targets_mm();
+        let targets = measurement.targets();
         let smooth = measurement.map_readings(|_, i, v| v - um_to_mm(periodic_um(targets[i])))?;
         build_table(&smooth, &evaluate(&smooth), options)?
     } else {
@@ -106,7 +106,7 @@ mod tests {
             direction,
             number: 1 + i as u32 / 2,
             start_time_s: None,
-            deviations_mm: targets.iter().map(|&x| Some(value(x))).collect(),
+            deviations: targets.iter().map(|&x| Some(value(x))).collect(),
         })
         .collect();
         Measurement::new("X", targets, runs, Default::default(), Default::default()).unwrap()

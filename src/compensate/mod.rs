@@ -57,8 +57,8 @@ const REVERSAL_STANDARD_ERRORS: f64 = 3.0;
 /// over every target and direction. `None` for a unidirectional test, one
 /// without repeated runs (no σ) or a reversal within the noise.
 pub fn measured_reversal_mm(evaluation: &Evaluation) -> Option<f64> {
-    let b_mean = evaluation.figures.b_mean_mm?;
-    let variance_mm2 = evaluation.pooled_variance_mm2()?;
+    let b_mean = evaluation.figures.b_mean?;
+    let variance_mm2 = evaluation.pooled_variance()?;
     let (mut sum_of_inverses, mut targets) = (0.0, 0usize);
     for t in evaluation
         .per_target
@@ -406,7 +406,7 @@ fn source_curve(
     evaluation
         .per_target
         .iter()
-        .filter_map(|t| pick(t).map(|value| (t.target_mm, value)))
+        .filter_map(|t| pick(t).map(|value| (t.target, value)))
         .unzip()
 }
 
@@ -454,7 +454,7 @@ pub fn build_table(
     evaluation: &Evaluation,
     options: &TableOptions,
 ) -> Result<CompensationTable, CompensateError> {
-    let positions_mm = grid_positions(measurement.targets_mm(), options.grid)?;
+    let positions_mm = grid_positions(measurement.targets(), options.grid)?;
     let has = |d: Direction| measurement.run_count(d) > 0;
     let kind = measurement.kind();
     let source_curve = |pick: fn(&crate::evaluate::TargetStats) -> Option<f64>| {
@@ -463,12 +463,12 @@ pub fn build_table(
     let (raw, suggested_backlash_mm) = match options.mode {
         TableMode::Mean => {
             let curve = match (has(Direction::Up), has(Direction::Down)) {
-                (true, true) => source_curve(|t| t.mean_mm),
-                (true, false) => source_curve(|t| t.up.mean_mm),
-                _ => source_curve(|t| t.down.mean_mm),
+                (true, true) => source_curve(|t| t.mean),
+                (true, false) => source_curve(|t| t.up.mean),
+                _ => source_curve(|t| t.down.mean),
             };
             let column = resample(&curve, &positions_mm, options.extrapolate)?;
-            let backlash = evaluation.figures.b_mean_mm.map(|b| -b);
+            let backlash = evaluation.figures.b_mean.map(|b| -b);
             (TableValues::Mean(column), backlash)
         }
         TableMode::Bidirectional => {
@@ -478,12 +478,12 @@ pub fn build_table(
                 }
             }
             let up = resample(
-                &source_curve(|t| t.up.mean_mm),
+                &source_curve(|t| t.up.mean),
                 &positions_mm,
                 options.extrapolate,
             )?;
             let down = resample(
-                &source_curve(|t| t.down.mean_mm),
+                &source_curve(|t| t.down.mean),
                 &positions_mm,
                 options.extrapolate,
             )?;
@@ -528,7 +528,7 @@ fn shift_to_reference(
     zero_outside: bool,
     measurement: &Measurement,
 ) -> TableValues {
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let (first, last) = (targets[0], targets[targets.len() - 1]);
     let at_reference =
         |d: Direction| interpolate_hold(positions_mm, raw.for_direction(d), reference_mm);
@@ -626,7 +626,7 @@ pub fn add_existing_table(
     measurement: &Measurement,
     active: &CompensationTable,
 ) -> Result<Measurement, MeasurementError> {
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     measurement.map_readings(|run, i, v| v + active.value_at(targets[i], run.direction))
 }
 

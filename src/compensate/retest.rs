@@ -58,12 +58,12 @@ impl KnownError {
         let (mut up_mm, mut down_mm) = (Vec::new(), Vec::new());
         for t in &evaluation.per_target {
             let means = if bidirectional {
-                t.up.mean_mm.zip(t.down.mean_mm)
+                t.up.mean.zip(t.down.mean)
             } else {
-                t.up.mean_mm.or(t.down.mean_mm).map(|m| (m, m))
+                t.up.mean.or(t.down.mean).map(|m| (m, m))
             };
             if let Some((up, down)) = means {
-                positions_mm.push(t.target_mm);
+                positions_mm.push(t.target);
                 up_mm.push(up);
                 down_mm.push(down);
             }
@@ -243,7 +243,7 @@ pub fn with_scatter(
     test.map_readings(|run, i, value| {
         let cell = evaluation.per_target[i].direction(run.direction);
         // A reading's cell has a mean: the reading itself is in it.
-        systematic(i, run.direction) + (value - cell.mean_mm.unwrap_or(value))
+        systematic(i, run.direction) + (value - cell.mean.unwrap_or(value))
     })
 }
 

@@ -12,7 +12,7 @@ fn measurement(up_um: [f64; 3], down_um: Option<[f64; 3]>) -> Measurement {
         direction,
         number: 1,
         start_time_s: None,
-        deviations_mm: values.iter().map(|v| Some(v / 1000.0)).collect(),
+        deviations: values.iter().map(|v| Some(v / 1000.0)).collect(),
     };
     let mut runs = vec![run(Direction::Up, up_um)];
     if let Some(down) = down_um {
@@ -251,7 +251,7 @@ fn existing_table_is_added_back_per_direction() {
     let raw = add_existing_table(&m, &active).unwrap();
     assert_um(
         &raw.runs()[0]
-            .deviations_mm
+            .deviations
             .iter()
             .map(|v| v.unwrap())
             .collect::<Vec<_>>(),
@@ -259,7 +259,7 @@ fn existing_table_is_added_back_per_direction() {
     );
     assert_um(
         &raw.runs()[1]
-            .deviations_mm
+            .deviations
             .iter()
             .map(|v| v.unwrap())
             .collect::<Vec<_>>(),

@@ -10,7 +10,7 @@
 //! smooth background (a regression spline with knots every span / 6), with the
 //! background's misfit counted as noise.
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use nalgebra::{DMatrix, DVector};
 
@@ -19,7 +19,8 @@ use super::fit::{Design, GlsBase, WeightedFit, fit_gls};
 use super::gates::{period_range, rotary_orders, set_rejection};
 use super::levels::{Fold, Level};
 use super::periodogram::{
-    aliases, diagonal_gls_chi2, frequency_uncertainty, may_be_lowest, period_sets,
+    Screen, aliases, below_margin, bounded_gls_chi2, diagonal_gls_chi2, frequency_uncertainty,
+    lowest_bound, may_be_lowest, period_sets,
 };
 use super::problem::Problem;
 use super::selection::{Chosen, Search, ShapeSet, forward_selection, shapes};
@@ -176,6 +177,7 @@ pub(super) fn select_along_axis(
         min_periods,
         known,
         base_fit: Mutex::new(None),
+        diagonal_bound: OnceLock::new(),
     };
     let (mut chosen, mut model_fit) = forward_selection(&search, base.clone(), kinds, rejected);
     // Never the nearest kind: what is accepted along the axis must leave no
@@ -243,6 +245,8 @@ struct AlongAxis<'a> {
     known: &'a [KnownPeriod],
     /// The fit of the model the candidates extend, kept between them.
     base_fit: Mutex<Option<Arc<GlsBase>>>,
+    /// `Covariance::diagonal_bound` of the covariance, once.
+    diagonal_bound: OnceLock<Option<(Vec<f64>, f64)>>,
 }
 
 impl AlongAxis<'_> {
@@ -251,17 +255,49 @@ impl AlongAxis<'_> {
         targets[targets.len() - 1] - targets[0]
     }
 
-    /// χ² of `model` with a periodic error at each of `periods` (a scan),
-    /// within [`periodogram::SCREEN_MARGIN`](super::periodogram::SCREEN_MARGIN):
-    /// only for a periodic error new in the re-test on independent levels
-    /// (the sums need plain sines and a diagonal covariance).
-    fn screen(&self, model: &Design, periods: &[f64], tests: PeriodicIn) -> Option<Vec<f64>> {
+    /// Bounds of the χ² of `model` with a periodic error at each of
+    /// `periods` (a scan), from the periodogram's sums: only for a periodic
+    /// error new in the re-test (the sums need plain sines). With independent
+    /// levels the sums give each χ² within [`SCREEN_MARGIN`](super::periodogram::SCREEN_MARGIN);
+    /// with levels that share the prediction's uncertainty (C = S + W D Wᵀ)
+    /// they bound it from below through C ≤ κ·S (`bounded_gls_chi2`).
+    fn screen(&self, model: &Design, periods: &[f64], tests: PeriodicIn) -> Option<Screen> {
         if tests != PeriodicIn::ReTest || model.groups.is_some() {
             return None;
         }
-        let weights = self.covariance.inverse_diagonal()?;
         let positions: Vec<f64> = self.levels.iter().map(|l| l.target_mm).collect();
-        diagonal_gls_chi2(&positions, self.values, &weights, &model.columns, periods)
+        let fit = self.fit_extended(model, &[]);
+        if let Some(weights) = self.covariance.inverse_diagonal() {
+            let screened =
+                diagonal_gls_chi2(&positions, self.values, &weights, &model.columns, periods)?;
+            return Some(Screen {
+                lower: below_margin(&screened),
+                upper: fit.chi2,
+            });
+        }
+        let (weights, kappa) = self
+            .diagonal_bound
+            .get_or_init(|| self.covariance.diagonal_bound())
+            .as_ref()?;
+        let residual: Vec<f64> = self
+            .values
+            .iter()
+            .zip(&fit.fitted)
+            .map(|(y, f)| y - f)
+            .collect();
+        let v = self.covariance.solve(&residual)?;
+        let lower = bounded_gls_chi2(
+            &positions,
+            weights,
+            *kappa,
+            &model.columns,
+            (fit.chi2, &v),
+            periods,
+        )?;
+        Some(Screen {
+            lower,
+            upper: fit.chi2,
+        })
     }
 }
 
@@ -352,8 +388,13 @@ impl Search for AlongAxis<'_> {
             }
             periods.push(p);
         }
-        let screened = self.screen(model, &periods, tests?)?;
-        Some(may_be_lowest(&screened))
+        let screen = self.screen(model, &periods, tests?)?;
+        // The period of the lowest bound, fitted exactly: no period whose bound is above its χ² can be the best.
+        let lowest = lowest_bound(&screen.lower)?;
+        let exact = self
+            .fit_extended(model, &self.columns(set.shapes[lowest]))
+            .chi2;
+        Some(may_be_lowest(&screen.lower, exact))
     }
 
     fn statistic(fit: &WeightedFit) -> f64 {

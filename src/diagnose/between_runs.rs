@@ -111,7 +111,7 @@ fn runs_of(problem: &Problem) -> Vec<Run> {
                 direction: r.direction,
                 number: r.run,
                 start_time_s: None,
-                deviations_mm: Vec::new(),
+                deviations: Vec::new(),
             });
         }
     }

@@ -31,7 +31,7 @@ pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context 
         kind: input.after.kind(),
         angle: input.angle,
         table_step_mm: input.table.and_then(CompensationTable::regular_step),
-        target_spacing_mm: crate::compensate::regular_step(input.after.targets_mm()),
+        target_spacing_mm: crate::compensate::regular_step(input.after.targets()),
         expansion_coefficient_ppm_per_k: input.after.environment.expansion_coefficient_ppm_per_k,
         material_change_k,
         time_assumed,
@@ -99,17 +99,17 @@ pub(super) fn figures(
             .runs()
             .iter()
             .map(|run| Run {
-                deviations_mm: vec![None; after.targets_mm().len()],
+                deviations: vec![None; after.targets().len()],
                 ..run.clone()
             })
             .collect();
         for (i, reading) in problem.readings.iter().enumerate() {
-            runs[reading.run_index].deviations_mm[reading.target_index] =
+            runs[reading.run_index].deviations[reading.target_index] =
                 Some(um_to_mm(value(i, with_effects)));
         }
         Measurement::new(
             after.axis(),
-            after.targets_mm().to_vec(),
+            after.targets().to_vec(),
             runs,
             after.environment.clone(),
             after.metadata.clone(),

@@ -26,7 +26,7 @@ pub(super) fn applicable_kinds(
             Kind::Scale | Kind::Drift | Kind::Abbe if rotary => Some(
                 "not looked for on a rotary axis: modelled for linear axes only so far".to_string(),
             ),
-            Kind::Periodic if rotary && rotary_orders(after.targets_mm(), input.before.is_some()).is_none() => Some(
+            Kind::Periodic if rotary && rotary_orders(after.targets(), input.before.is_some()).is_none() => Some(
                 "the targets are too coarse, or the range too short, to hold a whole order per revolution".to_string(),
             ),
             Kind::Periodic if rotary => None,
@@ -37,7 +37,7 @@ pub(super) fn applicable_kinds(
                 "needs a prediction (--before and --table): in a test alone a position-dependent error is part of the systematic curve the table compensates".to_string(),
             ),
             Kind::Abbe if input.angular.is_none() => Some("needs the axis' angular error along the stroke (--angular)".to_string()),
-            Kind::Periodic if period_range(after.targets_mm(), min_periods(input)).is_none() && !knows_a_period(input) => Some(format!(
+            Kind::Periodic if period_range(after.targets(), min_periods(input)).is_none() && !knows_a_period(input) => Some(format!(
                 "the targets are too coarse to resolve a period shorter than 1/{} of the measured span",
                 min_periods(input)
             )),
@@ -56,7 +56,7 @@ pub(super) fn applicable_kinds(
 
 /// Whether a known period of the axis fits enough times in the re-test's span.
 fn knows_a_period(input: &DiagnoseInput<'_>) -> bool {
-    let targets = input.after.targets_mm();
+    let targets = input.after.targets();
     let span = targets[targets.len() - 1] - targets[0];
     input
         .known_periods

@@ -473,7 +473,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // The reversal's sentence says the B̄ the figures show; where the fitted
     // B differs from the change they show, it says why.
     if let (Some(predicted_mm), Some(measured_mm)) =
-        (figures.predicted.b_mean_mm, figures.measured.b_mean_mm)
+        (figures.predicted.b_mean, figures.measured.b_mean)
     {
         let context = Context {
             retest_mean_reversal_um: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),
@@ -519,7 +519,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         && let Some(first_um) = context.first_test_reversal_um
         && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
     {
-        let predicted_um = figures.predicted.b_mean_mm.map(mm_to_um);
+        let predicted_um = figures.predicted.b_mean.map(mm_to_um);
         entry.why = no_reversal_change(&context, first_um, predicted_um, &entry.why);
     }
     // A kind is either found or not: a second outlier run that fails a gate

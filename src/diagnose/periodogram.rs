@@ -138,101 +138,198 @@ pub(super) fn diagonal_gls_chi2(
     base: &[Vec<f64>],
     periods: &[f64],
 ) -> Option<Vec<f64>> {
-    let (n, count) = (positions.len(), periods.len());
-    if n == 0 || count < 2 {
-        return None;
-    }
-    let f0 = 1.0 / periods[0];
-    let df = (1.0 / periods[count - 1] - f0) / (count - 1) as f64;
-    let evenly = periods
-        .iter()
-        .enumerate()
-        .all(|(k, p)| (1.0 / p - (f0 + k as f64 * df)).abs() <= 1e-9 * df.abs());
-    if !evenly || df <= 0.0 {
+    let n = positions.len();
+    if n == 0 || periods.len() < 2 {
         return None;
     }
     // The base fit: β = (XᵀWX)⁺ XᵀWy, r = y − Xβ, v = W r.
-    let p = base.len();
-    let weighted =
-        |column: &[f64]| -> Vec<f64> { column.iter().zip(weights).map(|(c, w)| c * w).collect() };
-    let weighted_base: Vec<Vec<f64>> = base.iter().map(|c| weighted(c)).collect();
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-    let gram = DMatrix::from_fn(p, p, |a, b| dot(&base[a], &weighted_base[b]));
-    let gram = (&gram + gram.transpose()) * 0.5;
-    let b0 = DVector::from_iterator(p, weighted_base.iter().map(|c| dot(c, values)));
-    let (beta, inverse) = if p == 0 {
-        (DVector::zeros(0), DMatrix::zeros(0, 0))
-    } else {
-        let (beta, _, inverse) = solve_normal(gram, &b0, n.max(p + 2));
-        (beta, inverse)
-    };
+    let weighted_fit = WeightedBase::new(base, weights, n);
+    let b0 = DVector::from_iterator(
+        base.len(),
+        weighted_fit.weighted.iter().map(|c| dot(c, values)),
+    );
+    let beta = &weighted_fit.inverse * &b0;
     let residual: Vec<f64> = (0..n)
-        .map(|i| values[i] - (0..p).map(|j| base[j][i] * beta[j]).sum::<f64>())
+        .map(|i| values[i] - (0..base.len()).map(|j| base[j][i] * beta[j]).sum::<f64>())
         .collect();
-    let v = weighted(&residual);
+    let v: Vec<f64> = residual.iter().zip(weights).map(|(r, w)| r * w).collect();
     let chi2_base = dot(&residual, &v);
-    let total_weight: f64 = weights.iter().sum();
-    let origin = positions.iter().copied().fold(f64::INFINITY, f64::min);
-    let complex = |values: &[f64]| -> Vec<Complex<f64>> {
-        values.iter().map(|v| Complex::new(*v, 0.0)).collect()
-    };
-    let sums = |h: &[f64], twice: f64| {
-        trig_sums(
-            positions,
-            &complex(h),
-            origin,
-            twice * f0,
-            twice * df,
-            count,
-        )
-    };
-    let double = sums(weights, 2.0)?;
-    let data = sums(&v, 1.0)?;
-    let columns: Vec<Vec<Complex<f64>>> = weighted_base
-        .iter()
-        .map(|c| sums(c, 1.0))
-        .collect::<Option<_>>()?;
+    let reductions = weighted_fit.reductions(positions, weights, &v, periods)?;
+    Some(reductions.iter().map(|r| chi2_base - r).collect())
+}
+
+/// Lower bounds of the χ² of the generalised least-squares fit of the `base`
+/// columns with a sine and a cosine of each of `periods` (evenly spaced in
+/// frequency) when the covariance C is not diagonal but C ≤ κ·S for a
+/// diagonal S with inverse `weights` (`Covariance::diagonal_bound`). From the
+/// base fit under C, its χ² `chi2_base` and v = C⁻¹r of its residual, a
+/// period lowers χ² by bᵀA_C⁻¹b with b = Zᵀv exact (one transform of v), and
+/// A_C = min over the base's coefficients of ZᵀC⁻¹Z ≥ A_S / κ, A_S the same
+/// with S (the diagonal periodogram's): so by at most κ·bᵀA_S⁻¹b. These are
+/// rigorous lower bounds, not estimates: a period whose bound is above the
+/// exact χ² of another cannot be the best.
+pub(super) fn bounded_gls_chi2(
+    positions: &[f64],
+    weights: &[f64],
+    kappa: f64,
+    base: &[Vec<f64>],
+    fit: (f64, &[f64]),
+    periods: &[f64],
+) -> Option<Vec<f64>> {
+    let n = positions.len();
+    let (chi2_base, v) = fit;
+    if n == 0 || periods.len() < 2 || kappa.is_nan() || kappa < 1.0 || !chi2_base.is_finite() {
+        return None;
+    }
+    let reductions =
+        WeightedBase::new(base, weights, n).reductions(positions, weights, v, periods)?;
     Some(
-        (0..count)
-            .map(|k| {
-                // (cos, sin) against the base columns: XᵀC⁻¹Z.
-                let cross: Vec<[f64; 2]> = columns.iter().map(|c| [c[k].re, c[k].im]).collect();
-                let through = |a: usize, b: usize| -> f64 {
-                    (0..p)
-                        .map(|i| {
-                            (0..p)
-                                .map(|j| cross[i][a] * inverse[(i, j)] * cross[j][b])
-                                .sum::<f64>()
-                        })
-                        .sum()
-                };
-                let cc = (total_weight + double[k].re) / 2.0 - through(0, 0);
-                let ss = (total_weight - double[k].re) / 2.0 - through(1, 1);
-                let cs = double[k].im / 2.0 - through(0, 1);
-                let det = cc * ss - cs * cs;
-                // Either column nearly in the span of the others: the exact fit's rank decides.
-                let smallest = (cc + ss) / 2.0 - (((cc - ss) / 2.0).powi(2) + cs * cs).sqrt();
-                if smallest.is_nan() || smallest <= 1e-8 * total_weight || !det.is_finite() {
-                    return f64::NEG_INFINITY;
-                }
-                let (bc, bs) = (data[k].re, data[k].im);
-                chi2_base - (ss * bc * bc - 2.0 * cs * bc * bs + cc * bs * bs) / det
-            })
+        reductions
+            .iter()
+            .map(|r| chi2_base - kappa * r - SCREEN_MARGIN * (chi2_base.abs() + 1.0))
             .collect(),
     )
 }
 
-/// Which of a scan's screened χ² (`diagonal_gls_chi2`) may be the lowest
-/// once fitted exactly: those within [`SCREEN_MARGIN`] of the lowest, and
-/// those not screened (−∞).
-pub(super) fn may_be_lowest(screened: &[f64]) -> Vec<bool> {
-    let lowest = screened
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>()
+}
+
+/// The base columns X weighted by W (diagonal), XᵀWX and its pseudo-inverse.
+struct WeightedBase {
+    weighted: Vec<Vec<f64>>,
+    inverse: DMatrix<f64>,
+}
+
+impl WeightedBase {
+    fn new(base: &[Vec<f64>], weights: &[f64], n: usize) -> WeightedBase {
+        let p = base.len();
+        let weighted: Vec<Vec<f64>> = base
+            .iter()
+            .map(|c| c.iter().zip(weights).map(|(c, w)| c * w).collect())
+            .collect();
+        let gram = DMatrix::from_fn(p, p, |a, b| dot(&base[a], &weighted[b]));
+        let gram = (&gram + gram.transpose()) * 0.5;
+        let inverse = if p == 0 {
+            DMatrix::zeros(0, 0)
+        } else {
+            solve_normal(gram, &DVector::zeros(p), n.max(p + 2)).2
+        };
+        WeightedBase { weighted, inverse }
+    }
+
+    /// bᵀA⁻¹b at each period: b = Zᵀv, A = ZᵀWZ − ZᵀWX (XᵀWX)⁺ XᵀWZ, with
+    /// Z = (cos θ, sin θ), θ = 2πx/p; ZᵀWZ from the sums of the weights at
+    /// twice the frequency (cos²θ = (1 + cos 2θ)/2; Press & Rybicki 1989),
+    /// the rest from sums at the frequency. +∞ where A is nearly singular
+    /// (the exact fit's rank decides there). `None` when the periods are not
+    /// evenly spaced in frequency.
+    fn reductions(
+        &self,
+        positions: &[f64],
+        weights: &[f64],
+        v: &[f64],
+        periods: &[f64],
+    ) -> Option<Vec<f64>> {
+        let count = periods.len();
+        let f0 = 1.0 / periods[0];
+        let df = (1.0 / periods[count - 1] - f0) / (count - 1) as f64;
+        let evenly = periods
+            .iter()
+            .enumerate()
+            .all(|(k, p)| (1.0 / p - (f0 + k as f64 * df)).abs() <= 1e-9 * df.abs());
+        if !evenly || df <= 0.0 {
+            return None;
+        }
+        let p = self.weighted.len();
+        let inverse = &self.inverse;
+        let total_weight: f64 = weights.iter().sum();
+        let origin = positions.iter().copied().fold(f64::INFINITY, f64::min);
+        let complex = |values: &[f64]| -> Vec<Complex<f64>> {
+            values.iter().map(|v| Complex::new(*v, 0.0)).collect()
+        };
+        let sums = |h: &[f64], twice: f64| {
+            trig_sums(
+                positions,
+                &complex(h),
+                origin,
+                twice * f0,
+                twice * df,
+                count,
+            )
+        };
+        let double = sums(weights, 2.0)?;
+        let data = sums(v, 1.0)?;
+        let columns: Vec<Vec<Complex<f64>>> = self
+            .weighted
+            .iter()
+            .map(|c| sums(c, 1.0))
+            .collect::<Option<_>>()?;
+        Some(
+            (0..count)
+                .map(|k| {
+                    // (cos, sin) against the base columns: XᵀWZ.
+                    let cross: Vec<[f64; 2]> = columns.iter().map(|c| [c[k].re, c[k].im]).collect();
+                    let through = |a: usize, b: usize| -> f64 {
+                        (0..p)
+                            .map(|i| {
+                                (0..p)
+                                    .map(|j| cross[i][a] * inverse[(i, j)] * cross[j][b])
+                                    .sum::<f64>()
+                            })
+                            .sum()
+                    };
+                    let cc = (total_weight + double[k].re) / 2.0 - through(0, 0);
+                    let ss = (total_weight - double[k].re) / 2.0 - through(1, 1);
+                    let cs = double[k].im / 2.0 - through(0, 1);
+                    let det = cc * ss - cs * cs;
+                    // Either column nearly in the span of the others: the exact fit's rank decides.
+                    let smallest = (cc + ss) / 2.0 - (((cc - ss) / 2.0).powi(2) + cs * cs).sqrt();
+                    if smallest.is_nan() || smallest <= 1e-8 * total_weight || !det.is_finite() {
+                        return f64::INFINITY;
+                    }
+                    let (bc, bs) = (data[k].re, data[k].im);
+                    (ss * bc * bc - 2.0 * cs * bc * bs + cc * bs * bs) / det
+                })
+                .collect(),
+        )
+    }
+}
+
+/// Lower bounds of χ² from values within [`SCREEN_MARGIN`] of it
+/// (`diagonal_gls_chi2`'s); −∞ stays −∞.
+pub(super) fn below_margin(screened: &[f64]) -> Vec<f64> {
+    screened
         .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .fold(f64::INFINITY, f64::min);
-    let bound = lowest + SCREEN_MARGIN * (lowest.abs() + 1.0);
-    screened.iter().map(|v| v.is_nan() || *v <= bound).collect()
+        .map(|v| v - SCREEN_MARGIN * (v.abs() + 1.0))
+        .collect()
+}
+
+/// Which of a scan's periods may have the lowest χ² once fitted exactly,
+/// from a lower bound of each one's χ² (`lower`; −∞ where there is none) and
+/// the exact χ² `exact` of one of them: those whose bound is not above it
+/// (any other is beaten by that one).
+pub(super) fn may_be_lowest(lower: &[f64], exact: f64) -> Vec<bool> {
+    lower
+        .iter()
+        .map(|l| l.is_nan() || exact.is_nan() || *l <= exact)
+        .collect()
+}
+
+/// The period with the lowest finite bound (the one to fit exactly for
+/// [`may_be_lowest`]), if any.
+pub(super) fn lowest_bound(lower: &[f64]) -> Option<usize> {
+    (0..lower.len())
+        .filter(|i| lower[*i].is_finite())
+        .min_by(|a, b| lower[*a].total_cmp(&lower[*b]))
+}
+
+/// What a scan's screen gives: a lower bound of the χ² at each period (−∞
+/// where there is none) and an upper bound of all of them (the χ² of the
+/// model without a period).
+pub(super) struct Screen {
+    pub(super) lower: Vec<f64>,
+    pub(super) upper: f64,
 }
 
 /// The periods of the scan of `range`, mm (every shape of [`scan`] is a period).
@@ -269,44 +366,49 @@ pub(super) fn frequency_uncertainty(
 
 /// The periods of the scan of `range` whose fit the targets cannot tell from
 /// the one at `found_mm` (`chi2` of the model with the periodic error at a
-/// period): local minima of χ² more than a peak's width away from it and
-/// within [`MIN_DELTA_BIC`] of its χ², best first, mm. `screened` gives the
-/// χ² at every period of the scan within [`SCREEN_MARGIN`] (or −∞ where it
-/// cannot): then only the periods near a minimum that may count are fitted
-/// exactly, with their neighbours.
+/// period): local minima of χ² more than a peak's width away from it whose
+/// parabola through the neighbours is within [`MIN_DELTA_BIC`] of its χ²,
+/// best first, mm. `screened` bounds the χ² at every period of the scan
+/// (`Screen`): then only the periods whose bound leaves them a chance, with
+/// their neighbours, are fitted exactly; the result is that of every period
+/// fitted.
 pub(super) fn aliases(
     found_mm: f64,
     range: (f64, f64),
     span_mm: f64,
     chi2: impl Fn(f64) -> f64 + Sync,
-    screened: impl FnOnce(&[f64]) -> Option<Vec<f64>>,
+    screened: impl FnOnce(&[f64]) -> Option<Screen>,
 ) -> Vec<f64> {
     let at_found = chi2(found_mm);
     let periods = scan_periods(range, span_mm);
-    let values: Vec<f64> = match screened(&periods) {
-        Some(mut values) => {
-            let bound = at_found + MIN_DELTA_BIC + SCREEN_MARGIN * (at_found.abs() + 1.0);
-            let mut exact = vec![false; values.len()];
-            for (i, v) in values.iter().enumerate() {
-                if v.is_nan() || *v <= bound {
-                    exact[i.saturating_sub(1)..(i + 2).min(values.len())].fill(true);
+    let exact: Vec<bool> = match screened(&periods) {
+        Some(screen) => {
+            // The parabola through a lowest m and neighbours l, r ≤ upper dips at most
+            // (r − l)²/(8(l + r − 2m)) ≤ (upper − m)/8 below m: it cannot reach within
+            // MIN_DELTA_BIC of the found χ² when m is above this.
+            let threshold = (8.0 * (at_found + MIN_DELTA_BIC) + screen.upper) / 9.0
+                + SCREEN_MARGIN * (screen.upper.abs() + 1.0);
+            let mut exact = vec![false; periods.len()];
+            for (i, lower) in screen.lower.iter().enumerate() {
+                if lower.is_nan() || threshold.is_nan() || *lower <= threshold {
+                    exact[i.saturating_sub(1)..(i + 2).min(periods.len())].fill(true);
                 }
             }
-            let fitted: Vec<(usize, f64)> = (0..values.len())
-                .into_par_iter()
-                .filter(|i| exact[*i])
-                .map(|i| (i, chi2(periods[i])))
-                .collect();
-            for (i, v) in fitted {
-                values[i] = v;
-            }
-            values
+            exact
         }
-        None => periods.par_iter().map(|&p| chi2(p)).collect(),
+        None => vec![true; periods.len()],
     };
+    let values: Vec<Option<f64>> = (0..periods.len())
+        .into_par_iter()
+        .map(|i| exact[i].then(|| chi2(periods[i])))
+        .collect();
     let mut found: Vec<(f64, f64)> = Vec::new();
     for i in 1..values.len().saturating_sub(1) {
-        let (left, middle, right) = (values[i - 1], values[i], values[i + 1]);
+        // A period not fitted with both neighbours cannot be one (above).
+        let (Some(left), Some(middle), Some(right)) = (values[i - 1], values[i], values[i + 1])
+        else {
+            continue;
+        };
         if !(middle <= left && middle <= right) {
             continue;
         }
@@ -335,6 +437,7 @@ pub(super) fn aliases(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::covariance::Covariance;
     use std::f64::consts::TAU as TAU_;
 
     #[test]
@@ -382,7 +485,6 @@ mod tests {
 
     #[test]
     fn the_screened_chi2_is_the_exact_fit_of_every_period() {
-        use crate::diagnose::covariance::Covariance;
         use crate::diagnose::fit::{Design, fit_gls};
         // 120 irregular levels over 600 mm with unequal variances: a constant, a slope and
         // a 37 mm sine in them; the base is the constant and the slope.
@@ -419,7 +521,8 @@ mod tests {
             assert!((v - e).abs() <= 1e-8 * e, "{p} mm: {v} vs {e}");
         }
         // The lowest is at 37 mm, and only the periods next to it are fitted exactly.
-        let marks = may_be_lowest(&screened);
+        let lowest = lowest_bound(&screened).unwrap();
+        let marks = may_be_lowest(&below_margin(&screened), exact(periods[lowest]));
         let kept: Vec<f64> = periods
             .iter()
             .zip(&marks)
@@ -450,6 +553,136 @@ mod tests {
         };
         assert_eq!(a, b);
         assert_eq!(chi2_a, chi2_b);
+    }
+
+    /// 99 levels between the targets of a first test of 100 (7.5 mm apart, as a
+    /// re-test between them): each level interpolates the first test's means by the
+    /// spline, so the levels share their uncertainty (C = S + W D Wᵀ, D as large as S).
+    /// A constant and a slope, a 47 mm sine and noise in them.
+    fn correlated_levels(amplitude: f64) -> (Vec<f64>, Vec<f64>, Covariance, Vec<Vec<f64>>) {
+        let first: Vec<f64> = (0..100).map(|k| 7.5 * k as f64).collect();
+        let positions: Vec<f64> = (0..99).map(|j| 7.5 * j as f64 + 3.75).collect();
+        let weights = crate::spline::basis_rows(&first, &positions);
+        let own: Vec<f64> = (0..99).map(|j| 0.01 + 0.004 * (j % 4) as f64).collect();
+        let shared: Vec<f64> = (0..100).map(|k| 0.012 + 0.003 * (k % 3) as f64).collect();
+        let covariance = Covariance::new(own, weights, shared);
+        let values: Vec<f64> = positions
+            .iter()
+            .enumerate()
+            .map(|(j, x)| {
+                0.4 + 0.002 * x
+                    + amplitude * (TAU_ * x / 47.0 + 1.0).sin()
+                    + 0.15 * (j as f64 * 12.9).sin()
+                    + 0.1 * (j as f64 * 0.37).cos()
+            })
+            .collect();
+        let base = vec![
+            vec![1.0; 99],
+            positions.iter().map(|x| x / 1000.0).collect(),
+        ];
+        (positions, values, covariance, base)
+    }
+
+    #[test]
+    fn the_bounds_on_correlated_levels_are_below_every_exact_fit_and_keep_the_best() {
+        use crate::diagnose::fit::{Design, fit_gls};
+        for amplitude in [0.6, 0.0] {
+            let (positions, values, covariance, base) = correlated_levels(amplitude);
+            let (weights, kappa) = covariance.diagonal_bound().unwrap();
+            // C ≤ κ·S: κ − 1 is λ_max of D^½WᵀS⁻¹WD^½, about D/S here (≈ 1.2); by the
+            // dense matrices, no vector has vᵀC⁻¹v below vᵀS⁻¹v / κ.
+            assert!(kappa > 1.5 && kappa < 3.5, "{kappa}");
+            let m = positions.len();
+            let dense = DMatrix::from_fn(m, m, |a, b| covariance.at(a, b));
+            let s_half =
+                DMatrix::from_fn(m, m, |a, b| if a == b { weights[a].sqrt() } else { 0.0 });
+            let largest = (&s_half * &dense * &s_half)
+                .symmetric_eigen()
+                .eigenvalues
+                .max();
+            assert!(
+                kappa >= largest && kappa <= 1.1 * largest,
+                "{kappa} vs {largest}"
+            );
+            let model = Design::of_columns(base.clone());
+            let fitted = fit_gls(&model, &values, &covariance, None);
+            let residual: Vec<f64> = values
+                .iter()
+                .zip(&fitted.fitted)
+                .map(|(y, f)| y - f)
+                .collect();
+            let v = covariance.solve(&residual).unwrap();
+            let span = positions[m - 1] - positions[0];
+            let periods = scan_periods((15.0, span / 2.0), span);
+            let lower = bounded_gls_chi2(
+                &positions,
+                &weights,
+                kappa,
+                &base,
+                (fitted.chi2, &v),
+                &periods,
+            )
+            .unwrap();
+            let exact = |p: f64| {
+                let sine = |f: fn(f64) -> f64| positions.iter().map(|x| f(TAU_ * x / p)).collect();
+                fit_gls(
+                    &model.with(&[sine(f64::sin), sine(f64::cos)]),
+                    &values,
+                    &covariance,
+                    None,
+                )
+                .chi2
+            };
+            let every: Vec<f64> = periods.iter().map(|p| exact(*p)).collect();
+            for ((p, l), e) in periods.iter().zip(&lower).zip(&every) {
+                assert!(l <= e, "{p} mm: bound {l} above the exact {e}");
+            }
+            // The best of the marked periods is the best of all, refined alike.
+            let lowest = lowest_bound(&lower).unwrap();
+            let marks = may_be_lowest(&lower, every[lowest]);
+            let set = ShapeSet {
+                shapes: periods
+                    .iter()
+                    .map(|p| Shape::Period(*p, PeriodicIn::ReTest))
+                    .collect(),
+                trials: 1.0,
+                refine: Some((15.0, span / 2.0)),
+            };
+            let score = |shape: Shape| {
+                let Shape::Period(p, _) = shape else {
+                    unreachable!()
+                };
+                (exact(p), ())
+            };
+            let screened = crate::diagnose::selection::best_of(&set, Some(&marks), score);
+            let all = crate::diagnose::selection::best_of(&set, None, score);
+            let (Some((a, chi2_a, _)), Some((b, chi2_b, _))) = (screened, all) else {
+                panic!("no best")
+            };
+            assert_eq!(a, b);
+            assert_eq!(chi2_a, chi2_b);
+            let kept = marks.iter().filter(|m| **m).count();
+            if amplitude > 0.0 {
+                // A clear 47 mm error: only the periods of its peak are fitted.
+                let Shape::Period(p, _) = a else {
+                    unreachable!()
+                };
+                assert!((p - 47.0).abs() < 0.5, "{p}");
+                assert!(kept <= 8, "{kept} of {}", periods.len());
+                // The aliases from the bounds are those of every period fitted.
+                let bounds = |_: &[f64]| {
+                    Some(Screen {
+                        lower: lower.clone(),
+                        upper: fitted.chi2,
+                    })
+                };
+                let range = (15.0, span / 2.0);
+                assert_eq!(
+                    aliases(p, range, span, exact, bounds),
+                    aliases(p, range, span, exact, |_| None)
+                );
+            }
+        }
     }
 
     #[test]

@@ -144,7 +144,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     let first_test_prediction = match (input.before, &first) {
         (Some(before), Some((known, _))) => Some(
             with_scatter(before, &evaluate(before), |i, direction| {
-                predicted_deviation_mm(known, applied, before.targets_mm()[i], direction)
+                predicted_deviation_mm(known, applied, before.targets()[i], direction)
             })
             .map_err(|e| DiagnoseError::Internal(e.to_string()))?,
         ),
@@ -155,7 +155,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     let mut predicted_um = Vec::new();
     for (run_index, run) in after.runs().iter().enumerate() {
         for (target_index, (value, &target_mm)) in
-            run.deviations_mm.iter().zip(after.targets_mm()).enumerate()
+            run.deviations.iter().zip(after.targets()).enumerate()
         {
             let Some(value) = value else { continue };
             readings.push(Reading {
@@ -188,13 +188,13 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         first_test_reversal_variance_um2,
     ) = match &first {
         Some((_, variances)) => (
-            interpolation_weights(&variances.positions_mm, after.targets_mm()),
+            interpolation_weights(&variances.positions_mm, after.targets()),
             variances.positions_mm.clone(),
             variances.mean_um2.clone(),
             variances.reversal_um2.clone(),
         ),
         None => (
-            vec![Vec::new(); after.targets_mm().len()],
+            vec![Vec::new(); after.targets().len()],
             Vec::new(),
             Vec::new(),
             Vec::new(),
@@ -202,7 +202,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     };
     // The cells in column order (target, then ↑ before ↓), and each reading's.
     let direction_index = |d: Direction| usize::from(d != Direction::BOTH[0]);
-    let mut cell_of = vec![[None; 2]; after.targets_mm().len()];
+    let mut cell_of = vec![[None; 2]; after.targets().len()];
     for r in &readings {
         cell_of[r.target_index][direction_index(r.direction)] = Some(0);
     }
@@ -228,7 +228,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     };
     let angle_urad = input.angular.map(|profile| {
         after
-            .targets_mm()
+            .targets()
             .iter()
             .map(|&x| interpolate_hold(&profile.positions_mm, &profile.angle_urad, x))
             .collect()
@@ -245,7 +245,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         run_count: after.runs().len(),
         time_assumed,
         run_h: cycle::run_h(&times),
-        targets_mm: after.targets_mm().to_vec(),
+        targets_mm: after.targets().to_vec(),
         kind: after.kind(),
         deviation: after.kind().deviation_unit(input.angle),
         angle_urad,
@@ -274,7 +274,7 @@ pub(super) struct FirstTestVariances {
 pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
     let both = evaluation.runs_up > 0 && evaluation.runs_down > 0;
     let pooled_um2 = evaluation
-        .pooled_variance_mm2()
+        .pooled_variance()
         .map_or(0.0, crate::units::mm2_to_um2);
     let inverse = |n: usize| if n == 0 { 0.0 } else { 1.0 / n as f64 };
     let mut variances = FirstTestVariances {
@@ -284,15 +284,15 @@ pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
     };
     for t in &evaluation.per_target {
         let has_mean = if both {
-            t.mean_mm.is_some()
+            t.mean.is_some()
         } else {
-            t.up.mean_mm.or(t.down.mean_mm).is_some()
+            t.up.mean.or(t.down.mean).is_some()
         };
         if !has_mean {
             continue;
         }
         let sum_of_inverses = inverse(t.up.n) + inverse(t.down.n);
-        variances.positions_mm.push(t.target_mm);
+        variances.positions_mm.push(t.target);
         if both {
             variances.mean_um2.push(pooled_um2 * sum_of_inverses / 4.0);
             variances.reversal_um2.push(pooled_um2 * sum_of_inverses);

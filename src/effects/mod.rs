@@ -467,7 +467,7 @@ impl Effect {
         measurement: &Measurement,
         times_h: &[Vec<f64>],
     ) -> Result<Measurement, MeasurementError> {
-        let targets_mm = measurement.targets_mm();
+        let targets_mm = measurement.targets();
         let line = Line {
             first_target_mm: targets_mm.first().copied().unwrap_or(0.0),
             angle_urad: None,

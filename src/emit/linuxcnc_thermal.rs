@@ -80,7 +80,7 @@ pub fn write_hal(
         "# axcomp thermal model as HAL: offset ({}) = -sum over terms of\n\
          #   c * (lowpass(T, tau) - T_ref), c in um/K written in {}/K, T in degC.\n\
          # For a machine in {} ([TRAJ]LINEAR_UNITS): the external offset is in machine units.\n\
-         # Fitted on rows {}-{} of the drift {:?}; prediction uncertainty {:.2} um (1 sigma).\n\
+         # Fitted on rows {}-{} of the drift {:?}; prediction uncertainty {:.2} um (1 sigma, in the fit rows' conditions).\n\
          # Connect each temperature (degC) to its signal, e.g. net thermal-T0 <= <sensor pin>.\n\
          # Hold thermal-load TRUE for the first period: the lags start at the first reading.\n\
          # Needs [AXIS_{}]OFFSET_AV_RATIO in the INI (external offsets, LinuxCNC 2.8+).\n\

@@ -134,7 +134,7 @@ pub struct TestConformance {
 /// use axcomp::evaluate::conformance::check_test;
 /// use axcomp::measurement::{Direction, Measurement, Run};
 /// let run = |direction, number| Run { direction, number, start_time_s: None,
-///     deviations_mm: vec![Some(0.0); 2] };
+///     deviations: vec![Some(0.0); 2] };
 /// let m = Measurement::new("X", vec![0.0, 1000.0], vec![
 ///     run(Direction::Up, 1), run(Direction::Down, 1),
 ///     run(Direction::Up, 2), run(Direction::Down, 2),
@@ -145,16 +145,16 @@ pub struct TestConformance {
 ///     does not meet ISO 230-2's 5 runs, 5 targets and 5 targets per metre");
 /// ```
 pub fn check_test(measurement: &Measurement) -> TestConformance {
-    let targets_mm = measurement.targets();
+    let targets = measurement.targets();
     let runs_up = measurement.run_count(Direction::Up);
     let runs_down = measurement.run_count(Direction::Down);
     let length = measurement
         .kind()
-        .position(match (targets_mm.first(), targets_mm.last()) {
+        .position(match (targets.first(), targets.last()) {
             (Some(first), Some(last)) => last - first,
             _ => 0.0,
         });
-    let targets = targets_mm.len();
+    let target_count = targets.len();
     let fewest_runs = [runs_up, runs_down]
         .into_iter()
         .filter(|n| *n > 0)
@@ -169,11 +169,11 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
     // Targets per metre and even spacing are asked of a linear axis only.
     let per_metre = match length {
         ByKind::Linear(Mm(length_mm)) if length_mm > 0.0 => {
-            Some(targets as f64 / (length_mm / MM_PER_M))
+            Some(target_count as f64 / (length_mm / MM_PER_M))
         }
         _ => None,
     };
-    let step = constant_step_mm(targets_mm);
+    let step = constant_step(targets);
     let mut checks = vec![
         Check {
             requirement: Requirement::Runs,
@@ -189,8 +189,8 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
         },
         Check {
             requirement: Requirement::Targets,
-            met: targets >= MIN_TARGETS,
-            found: Some(targets as f64),
+            met: target_count >= MIN_TARGETS,
+            found: Some(target_count as f64),
             required: Some(MIN_TARGETS as f64),
         },
         Check {
@@ -217,7 +217,7 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
     }
     TestConformance {
         length,
-        targets,
+        targets: target_count,
         runs_up,
         runs_down,
         checks,
@@ -226,15 +226,15 @@ pub fn check_test(measurement: &Measurement) -> TestConformance {
 
 /// The step between targets when every step is the same (within
 /// [`SAME_STEP_MM`]) and there are at least two; `None` otherwise.
-fn constant_step_mm(targets_mm: &[f64]) -> Option<f64> {
-    if targets_mm.len() < 3 {
+fn constant_step(targets: &[f64]) -> Option<f64> {
+    if targets.len() < 3 {
         return None;
     }
-    let steps: Vec<f64> = targets_mm.windows(2).map(|w| w[1] - w[0]).collect();
+    let steps: Vec<f64> = targets.windows(2).map(|w| w[1] - w[0]).collect();
     let low = steps.iter().copied().fold(f64::INFINITY, f64::min);
     let high = steps.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     (high - low < SAME_STEP_MM)
-        .then(|| (targets_mm[targets_mm.len() - 1] - targets_mm[0]) / steps.len() as f64)
+        .then(|| (targets[targets.len() - 1] - targets[0]) / steps.len() as f64)
 }
 
 impl TestConformance {
@@ -355,7 +355,7 @@ impl TestConformance {
             warnings.push(Warning::TooFewTargets {
                 kind: self.kind(),
                 targets: self.targets,
-                length_mm: self.length_in_axis_unit(),
+                length: self.length_in_axis_unit(),
                 required: MIN_TARGETS.max(for_length as usize),
             });
         }
@@ -386,7 +386,7 @@ mod tests {
             direction,
             number,
             start_time_s: None,
-            deviations_mm: vec![Some(0.0); count],
+            deviations: vec![Some(0.0); count],
         };
         let mut runs: Vec<Run> = (1..=up).map(|n| run(Direction::Up, n)).collect();
         runs.extend((1..=down).map(|n| run(Direction::Down, n)));
@@ -442,7 +442,7 @@ mod tests {
             vec![Warning::TooFewTargets {
                 kind: AxisKind::Linear,
                 targets: 6,
-                length_mm: 1500.0,
+                length: 1500.0,
                 required: 8
             }]
         );

@@ -19,9 +19,9 @@
 //! rule over 360°, the principal angles, the two ends of a full turn).
 //!
 //! Pure: no I/O, no printing. All lengths in mm, angles in degrees: the
-//! statistics are bare numbers in the axis' unit (fields named `…_mm` hold
-//! degrees on a rotary axis; the names are older than rotary axes), and
-//! leave typed by the axis' kind ([`TargetStats::typed`],
+//! statistics are bare numbers in the axis' unit, under names that say no
+//! unit (`target`, `mean`, `a`, …: the unit is the axis'), and leave typed
+//! by the axis' kind ([`TargetStats::typed`],
 //! [`SuspectedOutlier::typed`], [`crate::measurement::AxisKind::position`]).
 
 pub mod conformance;
@@ -43,51 +43,52 @@ pub use standard::{ISO_230_2, SUPPORTED, Standard, StandardFigure, UnknownStanda
 use targets::per_target_stats;
 pub use targets::{DirectionStats, TargetIn, TargetStats};
 
-/// The axis figures of ISO 230-2, mm; `None` where not evaluated.
+/// The axis figures of ISO 230-2, in the axis' unit (mm, or ° on a rotary
+/// axis); `None` where not evaluated.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AxisFigures {
     /// Bidirectional accuracy of positioning A.
-    pub a_mm: Option<f64>,
+    pub a: Option<f64>,
     /// Unidirectional accuracy A↑.
-    pub a_up_mm: Option<f64>,
+    pub a_up: Option<f64>,
     /// Unidirectional accuracy A↓.
-    pub a_down_mm: Option<f64>,
+    pub a_down: Option<f64>,
     /// Bidirectional systematic positional deviation E.
-    pub e_mm: Option<f64>,
+    pub e: Option<f64>,
     /// Unidirectional systematic positional deviation E↑.
-    pub e_up_mm: Option<f64>,
+    pub e_up: Option<f64>,
     /// Unidirectional systematic positional deviation E↓.
-    pub e_down_mm: Option<f64>,
+    pub e_down: Option<f64>,
     /// Mean bidirectional positional deviation M.
-    pub m_mm: Option<f64>,
+    pub m: Option<f64>,
     /// Bidirectional repeatability R = max R_i.
-    pub r_mm: Option<f64>,
+    pub r: Option<f64>,
     /// Unidirectional repeatability R↑ = max R_i↑.
-    pub r_up_mm: Option<f64>,
+    pub r_up: Option<f64>,
     /// Unidirectional repeatability R↓ = max R_i↓.
-    pub r_down_mm: Option<f64>,
+    pub r_down: Option<f64>,
     /// Reversal value B = max |B_i|.
-    pub b_mm: Option<f64>,
+    pub b: Option<f64>,
     /// Mean reversal value B̄ = mean of B_i (signed).
-    pub b_mean_mm: Option<f64>,
+    pub b_mean: Option<f64>,
 }
 
 impl AxisFigures {
     /// The figures with their keys in `figures_um` and `--limit`, in order.
     pub fn keyed(&self) -> [(&'static str, Option<f64>); 12] {
         [
-            ("A", self.a_mm),
-            ("A_up", self.a_up_mm),
-            ("A_down", self.a_down_mm),
-            ("E", self.e_mm),
-            ("E_up", self.e_up_mm),
-            ("E_down", self.e_down_mm),
-            ("M", self.m_mm),
-            ("R", self.r_mm),
-            ("R_up", self.r_up_mm),
-            ("R_down", self.r_down_mm),
-            ("B", self.b_mm),
-            ("B_mean", self.b_mean_mm),
+            ("A", self.a),
+            ("A_up", self.a_up),
+            ("A_down", self.a_down),
+            ("E", self.e),
+            ("E_up", self.e_up),
+            ("E_down", self.e_down),
+            ("M", self.m),
+            ("R", self.r),
+            ("R_up", self.r_up),
+            ("R_down", self.r_down),
+            ("B", self.b),
+            ("B_mean", self.b_mean),
         ]
     }
 }
@@ -151,14 +152,15 @@ impl Evaluation {
     }
 
     /// The variance of one reading about its target's mean, pooled over
-    /// every target and direction, s² = Σ (n − 1)·s_i² / Σ (n − 1), mm²;
+    /// every target and direction, s² = Σ (n − 1)·s_i² / Σ (n − 1), in the
+    /// axis' unit squared (mm², or deg²);
     /// `None` without repeated runs. (Each target's own s rests on a handful
     /// of readings; where one σ serves the whole test, this is it.)
-    pub fn pooled_variance_mm2(&self) -> Option<f64> {
+    pub fn pooled_variance(&self) -> Option<f64> {
         let (mut sum_sq, mut degrees) = (0.0, 0usize);
         for t in &self.per_target {
             for stats in [&t.up, &t.down] {
-                if let Some(s) = stats.s_mm {
+                if let Some(s) = stats.s {
                     sum_sq += s * s * (stats.n - 1) as f64;
                     degrees += stats.n - 1;
                 }
@@ -208,15 +210,15 @@ impl Evaluation {
 /// use axcomp::measurement::{Direction, Measurement, Run};
 /// let run = |direction, number, values: [f64; 2]| Run {
 ///     direction, number, start_time_s: None,
-///     deviations_mm: values.iter().map(|v| Some(*v)).collect() };
+///     deviations: values.iter().map(|v| Some(*v)).collect() };
 /// let m = Measurement::new("X", vec![0.0, 100.0], vec![
 ///     run(Direction::Up, 1, [0.000, 0.004]), run(Direction::Down, 1, [-0.002, 0.002]),
 ///     run(Direction::Up, 2, [0.002, 0.006]), run(Direction::Down, 2, [0.000, 0.004]),
 /// ], Default::default(), Default::default()).unwrap();
 /// let e = evaluate(&m);
 /// // x̄↑ = 1, 5 µm; x̄↓ = −1, 3 µm: B_i = 2 µm at both targets, E = 5 − (−1) = 6 µm.
-/// assert!((e.figures.b_mm.unwrap() - 0.002).abs() < 1e-12);
-/// assert!((e.figures.e_mm.unwrap() - 0.006).abs() < 1e-12);
+/// assert!((e.figures.b.unwrap() - 0.002).abs() < 1e-12);
+/// assert!((e.figures.e.unwrap() - 0.006).abs() < 1e-12);
 /// ```
 pub fn evaluate(measurement: &Measurement) -> Evaluation {
     evaluate_with(measurement, &ISO_230_2)
@@ -224,8 +226,8 @@ pub fn evaluate(measurement: &Measurement) -> Evaluation {
 
 /// Evaluates a measurement per `standard`.
 pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Evaluation {
-    let per_target = per_target_stats(measurement, |target_mm, up, down| {
-        standard.target_stats(target_mm, up, down)
+    let per_target = per_target_stats(measurement, |target, up, down| {
+        standard.target_stats(target, up, down)
     });
     let runs_up = measurement.run_count(Direction::Up);
     let runs_down = measurement.run_count(Direction::Down);
@@ -240,18 +242,18 @@ pub fn evaluate_with(measurement: &Measurement, standard: &dyn Standard) -> Eval
         if rotary::over_full_turn(measurement.targets()) {
             // ISO 230-2's n = 1 rule: the scatter figures are not evaluated.
             for figure in [
-                &mut figures.a_mm,
-                &mut figures.a_up_mm,
-                &mut figures.a_down_mm,
-                &mut figures.r_mm,
-                &mut figures.r_up_mm,
-                &mut figures.r_down_mm,
+                &mut figures.a,
+                &mut figures.a_up,
+                &mut figures.a_down,
+                &mut figures.r,
+                &mut figures.r_up,
+                &mut figures.r_down,
             ] {
                 *figure = None;
             }
             for figure in &mut standard_figures {
                 if rotary::FIGURES_NEEDING_REPEATS.contains(&figure.key) {
-                    figure.value_mm = None;
+                    figure.value = None;
                 }
             }
         }
@@ -304,7 +306,7 @@ fn coverage_warnings(
             };
             warnings.push(Warning::TargetNotEvaluated {
                 kind,
-                target_mm: target.target_mm,
+                target: target.target,
                 missing,
             });
         }

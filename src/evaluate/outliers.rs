@@ -35,9 +35,9 @@ pub struct SuspectedOutlier {
     pub score: f64,
     /// The target where it differs most, in the axis' unit (mm, or ° on a
     /// rotary axis: [`SuspectedOutlier::typed`]).
-    pub worst_target_mm: f64,
+    pub worst_target: f64,
     /// Its deviation there minus the mean of the other runs, in the axis' unit.
-    pub offset_mm: f64,
+    pub offset: f64,
 }
 
 impl SuspectedOutlier {
@@ -54,8 +54,8 @@ impl SuspectedOutlier {
             direction: self.direction,
             run: self.run,
             score: self.score,
-            worst_target: unit(self.worst_target_mm),
-            offset: unit(self.offset_mm),
+            worst_target: unit(self.worst_target),
+            offset: unit(self.offset),
         }
     }
 }
@@ -106,7 +106,7 @@ pub fn suspected_outliers(measurement: &Measurement) -> Vec<SuspectedOutlier> {
 pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<SuspectedOutlier> {
     let runs: Vec<&[Option<f64>]> = measurement
         .runs_in(direction)
-        .map(|run| run.deviations_mm.as_slice())
+        .map(|run| run.deviations.as_slice())
         .collect();
     if runs.len() < 3 {
         return Vec::new();
@@ -144,8 +144,8 @@ pub fn run_scores(measurement: &Measurement, direction: Direction) -> Vec<Suspec
                 direction,
                 run: run.number,
                 score,
-                worst_target_mm: targets[i],
-                offset_mm: offset,
+                worst_target: targets[i],
+                offset,
             });
         }
     }
@@ -234,7 +234,7 @@ mod tests {
                 direction: Direction::Up,
                 number: j as u32 + 1,
                 start_time_s: None,
-                deviations_mm: values.iter().map(|v| Some(*v)).collect(),
+                deviations: values.iter().map(|v| Some(*v)).collect(),
             })
             .collect();
         Measurement::new(
@@ -259,9 +259,9 @@ mod tests {
         ]);
         let flagged = suspected_outliers(&m);
         assert_eq!(flagged.len(), 1);
-        assert_eq!((flagged[0].run, flagged[0].worst_target_mm), (1, 1.0));
+        assert_eq!((flagged[0].run, flagged[0].worst_target), (1, 1.0));
         // Offset at target 2: 0.021 − mean(0, 0.001, −0.001, 0) = 0.021.
-        assert!((flagged[0].offset_mm - 0.021).abs() < 1e-12);
+        assert!((flagged[0].offset - 0.021).abs() < 1e-12);
         // Pooled s of runs 2–5 by hand: per-target sums of squares 2e-6, 2e-6,
         // 2e-6 with 3 degrees of freedom each: s² = 6e-6/9, s = 0.8165e-3.
         // Score = 0.021 / (0.8165e-3 · √(1 + 1/4)) = 23.0.

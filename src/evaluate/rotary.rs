@@ -37,7 +37,7 @@ pub fn over_full_turn(targets_deg: &[f64]) -> bool {
 /// The rotary warnings for a test with these per-target statistics: over a
 /// full turn, principal angles missing, the two ends of a turn disagreeing.
 pub fn warnings(per_target: &[TargetStats]) -> Vec<Warning> {
-    let targets_deg: Vec<f64> = per_target.iter().map(|t| t.target_mm).collect();
+    let targets_deg: Vec<f64> = per_target.iter().map(|t| t.target).collect();
     let mut warnings = Vec::new();
     if over_full_turn(&targets_deg) {
         warnings.push(Warning::RotaryOverFullTurn {
@@ -85,21 +85,20 @@ fn full_turn_ends(per_target: &[TargetStats]) -> Vec<Warning> {
     let mut warnings = Vec::new();
     for (index, first) in per_target.iter().enumerate() {
         for last in &per_target[index + 1..] {
-            if (last.target_mm - first.target_mm - FULL_TURN_DEG).abs() >= SAME_ANGLE_DEG {
+            if (last.target - first.target - FULL_TURN_DEG).abs() >= SAME_ANGLE_DEG {
                 continue;
             }
-            let (Some(mean_first_deg), Some(mean_last_deg)) = (first.mean_mm, last.mean_mm) else {
+            let (Some(mean_first_deg), Some(mean_last_deg)) = (first.mean, last.mean) else {
                 continue;
             };
-            let (Some(r_first), Some(r_last)) = (first.repeatability_mm, last.repeatability_mm)
-            else {
+            let (Some(r_first), Some(r_last)) = (first.repeatability, last.repeatability) else {
                 continue;
             };
             let repeatability_deg = r_first.max(r_last);
             if (mean_last_deg - mean_first_deg).abs() > repeatability_deg {
                 warnings.push(Warning::FullTurnEndsDisagree {
-                    first_deg: first.target_mm,
-                    last_deg: last.target_mm,
+                    first_deg: first.target,
+                    last_deg: last.target,
                     mean_first_deg,
                     mean_last_deg,
                     repeatability_deg,

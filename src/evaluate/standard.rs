@@ -43,8 +43,7 @@ pub trait Standard: Sync + std::fmt::Debug {
     fn k(&self) -> f64;
 
     /// What it defines at one target from the statistics of each direction.
-    fn target_stats(&self, target_mm: f64, up: DirectionStats, down: DirectionStats)
-    -> TargetStats;
+    fn target_stats(&self, target: f64, up: DirectionStats, down: DirectionStats) -> TargetStats;
 
     /// The ISO 230-2 axis figures from every target's (±k·s; VDI 3441 gives
     /// ISO 230-2:2014's beside its own).
@@ -59,8 +58,8 @@ pub trait Standard: Sync + std::fmt::Debug {
 pub struct StandardFigure {
     /// Its key in `figures_um` and in `--limit` (`A`, `Ps_max`).
     pub key: &'static str,
-    /// The value, mm; `None` where not evaluated.
-    pub value_mm: Option<f64>,
+    /// The value, in the axis' unit (mm, or °); `None` where not evaluated.
+    pub value: Option<f64>,
 }
 
 /// A `--standard` name that is not one of [`SUPPORTED`].
@@ -172,13 +171,8 @@ impl Standard for Iso230_2 {
         self.k
     }
 
-    fn target_stats(
-        &self,
-        target_mm: f64,
-        up: DirectionStats,
-        down: DirectionStats,
-    ) -> TargetStats {
-        target_stats(self.k, target_mm, up, down)
+    fn target_stats(&self, target: f64, up: DirectionStats, down: DirectionStats) -> TargetStats {
+        target_stats(self.k, target, up, down)
     }
 
     fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures {
@@ -188,7 +182,7 @@ impl Standard for Iso230_2 {
     fn figures(&self, _: &[TargetStats], axis: &AxisFigures) -> Vec<StandardFigure> {
         axis.keyed()
             .into_iter()
-            .map(|(key, value_mm)| StandardFigure { key, value_mm })
+            .map(|(key, value)| StandardFigure { key, value })
             .collect()
     }
 }
@@ -212,13 +206,8 @@ impl Standard for Vdi3441 {
 
     /// The per-target table stays ISO 230-2:2014's (x̄, s, B_i: what VDI's
     /// figures are made of).
-    fn target_stats(
-        &self,
-        target_mm: f64,
-        up: DirectionStats,
-        down: DirectionStats,
-    ) -> TargetStats {
-        ISO_230_2.target_stats(target_mm, up, down)
+    fn target_stats(&self, target: f64, up: DirectionStats, down: DirectionStats) -> TargetStats {
+        ISO_230_2.target_stats(target, up, down)
     }
 
     fn axis_figures(&self, per_target: &[TargetStats]) -> AxisFigures {
@@ -237,7 +226,7 @@ impl Standard for Vdi3441 {
         ];
         keyed
             .into_iter()
-            .map(|(key, value_mm)| StandardFigure { key, value_mm })
+            .map(|(key, value)| StandardFigure { key, value })
             .collect()
     }
 }
@@ -256,7 +245,7 @@ pub fn vdi_figure_name(key: &str) -> &'static str {
     }
 }
 
-/// VDI 3441's axis figures, mm.
+/// VDI 3441's axis figures, in the axis' unit.
 #[derive(Clone, Copy, Debug)]
 struct VdiFigures {
     p: f64,
@@ -273,9 +262,9 @@ fn vdi_figures(per_target: &[TargetStats]) -> Option<VdiFigures> {
     // (x̄_i, U_i, Ps_i) per target.
     let cells = every_target(per_target, |t| {
         Some((
-            t.mean_mm?,
-            t.reversal_mm?.abs(),
-            6.0 * (t.up.s_mm? + t.down.s_mm?) / 2.0,
+            t.mean?,
+            t.reversal?.abs(),
+            6.0 * (t.up.s? + t.down.s?) / 2.0,
         ))
     })?;
     let count = cells.len() as f64;
@@ -292,10 +281,10 @@ fn vdi_figures(per_target: &[TargetStats]) -> Option<VdiFigures> {
     })
 }
 
-fn target_stats(k: f64, target_mm: f64, up: DirectionStats, down: DirectionStats) -> TargetStats {
-    let both_means = up.mean_mm.zip(down.mean_mm);
-    let reversal_mm = both_means.map(|(u, d)| u - d);
-    let repeatability_mm = match (up.s_mm, down.s_mm, reversal_mm) {
+fn target_stats(k: f64, target: f64, up: DirectionStats, down: DirectionStats) -> TargetStats {
+    let both_means = up.mean.zip(down.mean);
+    let reversal = both_means.map(|(u, d)| u - d);
+    let repeatability = match (up.s, down.s, reversal) {
         (Some(s_up), Some(s_down), Some(b)) => Some(
             (k * s_up + k * s_down + b.abs())
                 .max(2.0 * k * s_up)
@@ -304,12 +293,12 @@ fn target_stats(k: f64, target_mm: f64, up: DirectionStats, down: DirectionStats
         _ => None,
     };
     TargetStats {
-        target_mm,
-        mean_mm: both_means.map(|(u, d)| (u + d) / 2.0),
-        reversal_mm,
-        repeatability_up_mm: up.repeatability(k),
-        repeatability_down_mm: down.repeatability(k),
-        repeatability_mm,
+        target,
+        mean: both_means.map(|(u, d)| (u + d) / 2.0),
+        reversal,
+        repeatability_up: up.repeatability(k),
+        repeatability_down: down.repeatability(k),
+        repeatability,
         up,
         down,
     }
@@ -336,8 +325,7 @@ fn span(intervals: impl IntoIterator<Item = (f64, f64)>) -> Option<f64> {
 }
 
 fn axis_figures(k: f64, per_target: &[TargetStats]) -> AxisFigures {
-    let points =
-        |d: Direction| bounds_every(per_target, |t| t.direction(d).mean_mm.map(|m| (m, m)));
+    let points = |d: Direction| bounds_every(per_target, |t| t.direction(d).mean.map(|m| (m, m)));
     let bands = |d: Direction| bounds_every(per_target, |t| t.direction(d).band(k));
     let max_every = |value: fn(&TargetStats) -> Option<f64>| {
         bounds_every(per_target, |t| value(t).map(|v| (v, v))).map(|(_, high)| high)
@@ -346,20 +334,20 @@ fn axis_figures(k: f64, per_target: &[TargetStats]) -> AxisFigures {
     let (bands_up, bands_down) = (bands(Direction::Up), bands(Direction::Down));
     let (points_up, points_down) = (points(Direction::Up), points(Direction::Down));
     AxisFigures {
-        a_mm: union(bands_up, bands_down).map(width),
-        a_up_mm: bands_up.map(width),
-        a_down_mm: bands_down.map(width),
-        e_mm: union(points_up, points_down).map(width),
-        e_up_mm: points_up.map(width),
-        e_down_mm: points_down.map(width),
-        m_mm: bounds_every(per_target, |t| t.mean_mm.map(|m| (m, m))).map(width),
-        r_mm: max_every(|t| t.repeatability_mm),
-        r_up_mm: max_every(|t| t.repeatability_up_mm),
-        r_down_mm: max_every(|t| t.repeatability_down_mm),
-        b_mm: max_every(|t| t.reversal_mm.map(f64::abs)),
-        b_mean_mm: per_target
+        a: union(bands_up, bands_down).map(width),
+        a_up: bands_up.map(width),
+        a_down: bands_down.map(width),
+        e: union(points_up, points_down).map(width),
+        e_up: points_up.map(width),
+        e_down: points_down.map(width),
+        m: bounds_every(per_target, |t| t.mean.map(|m| (m, m))).map(width),
+        r: max_every(|t| t.repeatability),
+        r_up: max_every(|t| t.repeatability_up),
+        r_down: max_every(|t| t.repeatability_down),
+        b: max_every(|t| t.reversal.map(f64::abs)),
+        b_mean: per_target
             .iter()
-            .map(|t| t.reversal_mm)
+            .map(|t| t.reversal)
             .sum::<Option<f64>>()
             .map(|sum| sum / per_target.len() as f64),
     }
@@ -406,7 +394,7 @@ mod tests {
             direction,
             number,
             start_time_s: None,
-            deviations_mm: values.iter().map(|v| Some(v / 1000.0)).collect(),
+            deviations: values.iter().map(|v| Some(v / 1000.0)).collect(),
         };
         Measurement::new(
             "X",
@@ -437,17 +425,13 @@ mod tests {
             let f = evaluate_with(&two_by_two(), &standard).figures;
             let um = |v: Option<f64>| v.unwrap() * 1000.0;
             // R_i↑ = 2k·s; R_i = max(k·s + k·s + |B_i|, 2k·s) = 2k·s + 2.
-            assert!(
-                (um(f.r_up_mm) - 2.0 * k * s).abs() < 1e-9,
-                "{}",
-                standard.name
-            );
-            assert!((um(f.r_mm) - (2.0 * k * s + 2.0)).abs() < 1e-9);
+            assert!((um(f.r_up) - 2.0 * k * s).abs() < 1e-9, "{}", standard.name);
+            assert!((um(f.r) - (2.0 * k * s + 2.0)).abs() < 1e-9);
             // A: from x̄↓ − k·s at 0 mm (−1 µm) to x̄↑ + k·s at 100 mm (5 µm).
-            assert!((um(f.a_mm) - (6.0 + 2.0 * k * s)).abs() < 1e-9);
+            assert!((um(f.a) - (6.0 + 2.0 * k * s)).abs() < 1e-9);
             // E and B do not depend on k.
-            assert!((um(f.e_mm) - 6.0).abs() < 1e-9);
-            assert!((um(f.b_mm) - 2.0).abs() < 1e-9);
+            assert!((um(f.e) - 6.0).abs() < 1e-9);
+            assert!((um(f.b) - 2.0).abs() < 1e-9);
         }
     }
 }

@@ -17,10 +17,10 @@ use crate::units::{Deg, Mm};
 pub struct DirectionStats {
     /// Number of readings n.
     pub n: usize,
-    /// Mean positional deviation x̄, mm (`None` when n = 0).
-    pub mean_mm: Option<f64>,
-    /// Estimator of the standard uncertainty s, mm (`None` when n < 2).
-    pub s_mm: Option<f64>,
+    /// Mean positional deviation x̄, in the axis' unit (`None` when n = 0).
+    pub mean: Option<f64>,
+    /// Estimator of the standard uncertainty s (`None` when n < 2).
+    pub s: Option<f64>,
 }
 
 impl DirectionStats {
@@ -37,45 +37,45 @@ impl DirectionStats {
         });
         DirectionStats {
             n,
-            mean_mm: Some(mean),
-            s_mm: s,
+            mean: Some(mean),
+            s,
         }
     }
 
-    /// The band x̄ ± k·s, as (low, high), mm: A spans it (k = 2 in ISO
+    /// The band x̄ ± k·s, as (low, high): A spans it (k = 2 in ISO
     /// 230-2 since 1997, 3 in 1988: [`super::standard::Iso230_2::k`]).
     pub fn band(&self, k: f64) -> Option<(f64, f64)> {
-        let (mean, s) = (self.mean_mm?, self.s_mm?);
+        let (mean, s) = (self.mean?, self.s?);
         Some((mean - k * s, mean + k * s))
     }
 
     /// The unidirectional repeatability R_i = 2k·s_i (4 s_i for k = 2).
     pub(super) fn repeatability(&self, k: f64) -> Option<f64> {
-        self.s_mm.map(|s| 2.0 * k * s)
+        self.s.map(|s| 2.0 * k * s)
     }
 }
 
 /// Everything ISO 230-2 defines at one target (with the standard's k), in
-/// the axis' unit: every `…_mm` here is ° on a rotary axis (the names are
-/// older than rotary axes); [`TargetStats::typed`] says which.
+/// the axis' unit (mm, or ° on a rotary axis; no name here says which):
+/// [`TargetStats::typed`] gives them their unit as a type.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TargetStats {
-    /// Target P_i, mm.
-    pub target_mm: f64,
+    /// Target P_i.
+    pub target: f64,
     /// ↑ statistics.
     pub up: DirectionStats,
     /// ↓ statistics.
     pub down: DirectionStats,
-    /// Mean bidirectional positional deviation x̄_i = (x̄_i↑ + x̄_i↓)/2, mm.
-    pub mean_mm: Option<f64>,
-    /// Reversal value B_i = x̄_i↑ − x̄_i↓, mm (signed).
-    pub reversal_mm: Option<f64>,
-    /// R_i↑ = 4 s_i↑, mm.
-    pub repeatability_up_mm: Option<f64>,
-    /// R_i↓ = 4 s_i↓, mm.
-    pub repeatability_down_mm: Option<f64>,
-    /// R_i = max(2 s_i↑ + 2 s_i↓ + |B_i|; R_i↑; R_i↓), mm.
-    pub repeatability_mm: Option<f64>,
+    /// Mean bidirectional positional deviation x̄_i = (x̄_i↑ + x̄_i↓)/2.
+    pub mean: Option<f64>,
+    /// Reversal value B_i = x̄_i↑ − x̄_i↓ (signed).
+    pub reversal: Option<f64>,
+    /// R_i↑ = 4 s_i↑.
+    pub repeatability_up: Option<f64>,
+    /// R_i↓ = 4 s_i↓.
+    pub repeatability_down: Option<f64>,
+    /// R_i = max(2 s_i↑ + 2 s_i↓ + |B_i|; R_i↑; R_i↓).
+    pub repeatability: Option<f64>,
 }
 
 impl TargetStats {
@@ -99,18 +99,18 @@ impl TargetStats {
     fn in_unit<U>(&self, unit: fn(f64) -> U) -> TargetIn<U> {
         let typed = |value: Option<f64>| value.map(unit);
         TargetIn {
-            target: unit(self.target_mm),
+            target: unit(self.target),
             n_up: self.up.n,
             n_down: self.down.n,
-            mean_up: typed(self.up.mean_mm),
-            mean_down: typed(self.down.mean_mm),
-            mean: typed(self.mean_mm),
-            s_up: typed(self.up.s_mm),
-            s_down: typed(self.down.s_mm),
-            reversal: typed(self.reversal_mm),
-            repeatability_up: typed(self.repeatability_up_mm),
-            repeatability_down: typed(self.repeatability_down_mm),
-            repeatability: typed(self.repeatability_mm),
+            mean_up: typed(self.up.mean),
+            mean_down: typed(self.down.mean),
+            mean: typed(self.mean),
+            s_up: typed(self.up.s),
+            s_down: typed(self.down.s),
+            reversal: typed(self.reversal),
+            repeatability_up: typed(self.repeatability_up),
+            repeatability_down: typed(self.repeatability_down),
+            repeatability: typed(self.repeatability),
         }
     }
 }
@@ -180,7 +180,7 @@ pub(super) fn per_target_stats<T>(
     let runs_of = |direction: Direction| -> Vec<&[Option<f64>]> {
         measurement
             .runs_in(direction)
-            .map(|run| run.deviations_mm.as_slice())
+            .map(|run| run.deviations.as_slice())
             .collect()
     };
     let runs_by_direction = [runs_of(Direction::Up), runs_of(Direction::Down)];
@@ -190,15 +190,15 @@ pub(super) fn per_target_stats<T>(
         readings.extend(
             runs_by_direction[usize::from(direction == Direction::Down)]
                 .iter()
-                .filter_map(|deviations_mm| deviations_mm[target_index]),
+                .filter_map(|deviations| deviations[target_index]),
         );
         DirectionStats::of(&readings)
     };
     let mut per_target = Vec::with_capacity(measurement.targets().len());
-    for (index, &target_mm) in measurement.targets().iter().enumerate() {
+    for (index, &target) in measurement.targets().iter().enumerate() {
         let up = stats_of(index, Direction::Up);
         let down = stats_of(index, Direction::Down);
-        per_target.push(at_target(target_mm, up, down));
+        per_target.push(at_target(target, up, down));
     }
     per_target
 }
@@ -211,14 +211,14 @@ mod tests {
     fn statistics_are_typed_by_the_axis_kind() {
         let up = DirectionStats::of(&[0.001, 0.003]);
         let stats = TargetStats {
-            target_mm: 90.0,
+            target: 90.0,
             up,
             down: DirectionStats::default(),
-            mean_mm: None,
-            reversal_mm: None,
-            repeatability_up_mm: Some(0.004),
-            repeatability_down_mm: None,
-            repeatability_mm: None,
+            mean: None,
+            reversal: None,
+            repeatability_up: Some(0.004),
+            repeatability_down: None,
+            repeatability: None,
         };
         let ByKind::Rotary(rotary) = stats.typed(AxisKind::Rotary) else {
             panic!("a rotary axis' statistics are in degrees")

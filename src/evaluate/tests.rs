@@ -21,12 +21,12 @@ fn run(direction: Direction, number: u32, values_um: &[f64]) -> Run {
         direction,
         number,
         start_time_s: None,
-        deviations_mm: values_um.iter().map(|v| Some(v / 1000.0)).collect(),
+        deviations: values_um.iter().map(|v| Some(v / 1000.0)).collect(),
     }
 }
 
 fn measurement(runs: Vec<Run>) -> Measurement {
-    let count = runs[0].deviations_mm.len();
+    let count = runs[0].deviations.len();
     let targets = (0..count).map(|i| i as f64 * 100.0).collect();
     Measurement::new(
         "X",
@@ -88,18 +88,18 @@ fn worked_example_per_target() {
     ];
     for (t, want) in e.per_target.iter().zip(expected) {
         let got = [
-            t.up.mean_mm,
-            t.down.mean_mm,
-            t.up.s_mm,
-            t.down.s_mm,
-            t.mean_mm,
-            t.reversal_mm,
-            t.repeatability_up_mm,
-            t.repeatability_down_mm,
-            t.repeatability_mm,
+            t.up.mean,
+            t.down.mean,
+            t.up.s,
+            t.down.s,
+            t.mean,
+            t.reversal,
+            t.repeatability_up,
+            t.repeatability_down,
+            t.repeatability,
         ];
         for (g, w) in got.into_iter().zip(want) {
-            assert_um(g, Some(w), &format!("target {}", t.target_mm));
+            assert_um(g, Some(w), &format!("target {}", t.target));
         }
         assert_eq!((t.up.n, t.down.n), (3, 3));
     }
@@ -109,18 +109,18 @@ fn worked_example_per_target() {
 fn worked_example_axis_figures() {
     let f = evaluate(&worked_example()).figures;
     let expected = [
-        (f.a_mm, 15.0, "A"),
-        (f.a_up_mm, 12.0, "A↑"),
-        (f.a_down_mm, 7.0, "A↓"),
-        (f.e_mm, 9.0, "E"),
-        (f.e_up_mm, 6.0, "E↑"),
-        (f.e_down_mm, 5.0, "E↓"),
-        (f.m_mm, 5.5, "M"),
-        (f.r_mm, 8.0, "R"),
-        (f.r_up_mm, 8.0, "R↑"),
-        (f.r_down_mm, 4.0, "R↓"),
-        (f.b_mm, 4.0, "B"),
-        (f.b_mean_mm, 3.0, "B̄"),
+        (f.a, 15.0, "A"),
+        (f.a_up, 12.0, "A↑"),
+        (f.a_down, 7.0, "A↓"),
+        (f.e, 9.0, "E"),
+        (f.e_up, 6.0, "E↑"),
+        (f.e_down, 5.0, "E↓"),
+        (f.m, 5.5, "M"),
+        (f.r, 8.0, "R"),
+        (f.r_up, 8.0, "R↑"),
+        (f.r_down, 4.0, "R↓"),
+        (f.b, 4.0, "B"),
+        (f.b_mean, 3.0, "B̄"),
     ];
     for (actual, want, name) in expected {
         assert_um(actual, Some(want), name);
@@ -135,19 +135,19 @@ fn unidirectional_test_has_no_bidirectional_figures() {
     );
     let e = evaluate(&m);
     let f = e.figures;
-    assert_um(f.a_up_mm, Some(12.0), "A↑");
-    assert_um(f.e_up_mm, Some(6.0), "E↑");
-    assert_um(f.r_up_mm, Some(8.0), "R↑");
+    assert_um(f.a_up, Some(12.0), "A↑");
+    assert_um(f.e_up, Some(6.0), "E↑");
+    assert_um(f.r_up, Some(8.0), "R↑");
     for (value, name) in [
-        (f.a_mm, "A"),
-        (f.a_down_mm, "A↓"),
-        (f.e_mm, "E"),
-        (f.e_down_mm, "E↓"),
-        (f.m_mm, "M"),
-        (f.r_mm, "R"),
-        (f.r_down_mm, "R↓"),
-        (f.b_mm, "B"),
-        (f.b_mean_mm, "B̄"),
+        (f.a, "A"),
+        (f.a_down, "A↓"),
+        (f.e, "E"),
+        (f.e_down, "E↓"),
+        (f.m, "M"),
+        (f.r, "R"),
+        (f.r_down, "R↓"),
+        (f.b, "B"),
+        (f.b_mean, "B̄"),
     ] {
         assert_eq!(value, None, "{name} must be null, never 0");
     }
@@ -168,24 +168,24 @@ fn one_run_per_direction_evaluates_b_e_m_only() {
     let m = bidirectional(&[&[1.0, 4.0, -1.0]], &[&[-1.0, 2.0, -4.0]]);
     let e = evaluate(&m);
     let f = e.figures;
-    assert_um(f.b_mm, Some(3.0), "B");
-    assert_um(f.b_mean_mm, Some(7.0 / 3.0), "B̄");
-    assert_um(f.e_mm, Some(8.0), "E");
-    assert_um(f.e_up_mm, Some(5.0), "E↑");
-    assert_um(f.m_mm, Some(5.5), "M");
+    assert_um(f.b, Some(3.0), "B");
+    assert_um(f.b_mean, Some(7.0 / 3.0), "B̄");
+    assert_um(f.e, Some(8.0), "E");
+    assert_um(f.e_up, Some(5.0), "E↑");
+    assert_um(f.m, Some(5.5), "M");
     for (value, name) in [
-        (f.a_mm, "A"),
-        (f.a_up_mm, "A↑"),
-        (f.r_mm, "R"),
-        (f.r_up_mm, "R↑"),
-        (f.r_down_mm, "R↓"),
+        (f.a, "A"),
+        (f.a_up, "A↑"),
+        (f.r, "R"),
+        (f.r_up, "R↑"),
+        (f.r_down, "R↓"),
     ] {
         assert_eq!(value, None, "{name}");
     }
     assert!(
         e.per_target
             .iter()
-            .all(|t| t.up.s_mm.is_none() && t.repeatability_mm.is_none())
+            .all(|t| t.up.s.is_none() && t.repeatability.is_none())
     );
     assert_eq!(
         coverage(&e),
@@ -209,7 +209,7 @@ fn a_target_read_once_leaves_a_and_r_unevaluated_and_says_where() {
         .map(|r| {
             let mut r = r.clone();
             if r.direction == Direction::Up && r.number > 1 {
-                r.deviations_mm[2] = None;
+                r.deviations[2] = None;
             }
             r
         })
@@ -224,12 +224,12 @@ fn a_target_read_once_leaves_a_and_r_unevaluated_and_says_where() {
     .unwrap();
     let e = evaluate(&m);
     assert_eq!(e.per_target[2].up.n, 1);
-    assert_eq!(e.figures.a_mm, None);
-    assert_eq!(e.figures.r_up_mm, None);
+    assert_eq!(e.figures.a, None);
+    assert_eq!(e.figures.r_up, None);
     // E and M need only the means, which exist everywhere.
-    assert!(e.figures.e_mm.is_some() && e.figures.m_mm.is_some());
+    assert!(e.figures.e.is_some() && e.figures.m.is_some());
     assert!(
-        matches!(coverage(&e), [Warning::TargetNotEvaluated { target_mm, .. }] if *target_mm == 200.0)
+        matches!(coverage(&e), [Warning::TargetNotEvaluated { target: target_mm, .. }] if *target_mm == 200.0)
     );
 }
 
@@ -237,13 +237,7 @@ fn a_target_read_once_leaves_a_and_r_unevaluated_and_says_where() {
 fn zero_spread_and_single_target() {
     let m = bidirectional(&[&[5.0], &[5.0]], &[&[5.0], &[5.0]]);
     let f = evaluate(&m).figures;
-    for (value, name) in [
-        (f.a_mm, "A"),
-        (f.e_mm, "E"),
-        (f.m_mm, "M"),
-        (f.r_mm, "R"),
-        (f.b_mm, "B"),
-    ] {
+    for (value, name) in [(f.a, "A"), (f.e, "E"), (f.m, "M"), (f.r, "R"), (f.b, "B")] {
         assert_um(value, Some(0.0), name);
     }
 }
@@ -267,8 +261,8 @@ fn shifted(m: &Measurement, offset_mm: f64) -> Measurement {
         .runs()
         .iter()
         .map(|r| Run {
-            deviations_mm: r
-                .deviations_mm
+            deviations: r
+                .deviations
                 .iter()
                 .map(|v| v.map(|v| v + offset_mm))
                 .collect(),
@@ -308,13 +302,13 @@ proptest! {
     #[test]
     fn ordering_of_figures(m in arbitrary_measurement()) {
         let f = evaluate(&m).figures;
-        let (a, e, mm, r, b) = (f.a_mm.unwrap(), f.e_mm.unwrap(), f.m_mm.unwrap(), f.r_mm.unwrap(), f.b_mm.unwrap());
+        let (a, e, mm, r, b) = (f.a.unwrap(), f.e.unwrap(), f.m.unwrap(), f.r.unwrap(), f.b.unwrap());
         prop_assert!(mm <= e + TOLERANCE_MM, "M {mm} > E {e}");
         prop_assert!(e <= a + TOLERANCE_MM, "E {e} > A {a}");
-        prop_assert!(r + TOLERANCE_MM >= f.r_up_mm.unwrap().max(f.r_down_mm.unwrap()));
+        prop_assert!(r + TOLERANCE_MM >= f.r_up.unwrap().max(f.r_down.unwrap()));
         prop_assert!(r + TOLERANCE_MM >= b, "R {r} < B {b}");
-        prop_assert!(f.e_up_mm.unwrap() <= e + TOLERANCE_MM && f.a_up_mm.unwrap() <= a + TOLERANCE_MM);
-        prop_assert!(f.b_mean_mm.unwrap().abs() <= b + TOLERANCE_MM);
+        prop_assert!(f.e_up.unwrap() <= e + TOLERANCE_MM && f.a_up.unwrap() <= a + TOLERANCE_MM);
+        prop_assert!(f.b_mean.unwrap().abs() <= b + TOLERANCE_MM);
     }
 
     #[test]
@@ -322,8 +316,8 @@ proptest! {
         let before = evaluate(&m).figures;
         let after = evaluate(&shifted(&m, offset)).figures;
         for (x, y) in [
-            (before.a_mm, after.a_mm), (before.e_mm, after.e_mm), (before.m_mm, after.m_mm),
-            (before.r_mm, after.r_mm), (before.b_mm, after.b_mm), (before.b_mean_mm, after.b_mean_mm),
+            (before.a, after.a), (before.e, after.e), (before.m, after.m),
+            (before.r, after.r), (before.b, after.b), (before.b_mean, after.b_mean),
         ] {
             prop_assert!((x.unwrap() - y.unwrap()).abs() < 1e-9);
         }
@@ -333,9 +327,9 @@ proptest! {
     fn swapping_directions_negates_mean_reversal(m in arbitrary_measurement()) {
         let before = evaluate(&m).figures;
         let after = evaluate(&swapped(&m)).figures;
-        prop_assert!((before.b_mean_mm.unwrap() + after.b_mean_mm.unwrap()).abs() < 1e-12);
-        prop_assert!((before.a_up_mm.unwrap() - after.a_down_mm.unwrap()).abs() < 1e-12);
-        prop_assert!((before.e_mm.unwrap() - after.e_mm.unwrap()).abs() < 1e-12);
-        prop_assert!((before.r_mm.unwrap() - after.r_mm.unwrap()).abs() < 1e-12);
+        prop_assert!((before.b_mean.unwrap() + after.b_mean.unwrap()).abs() < 1e-12);
+        prop_assert!((before.a_up.unwrap() - after.a_down.unwrap()).abs() < 1e-12);
+        prop_assert!((before.e.unwrap() - after.e.unwrap()).abs() < 1e-12);
+        prop_assert!((before.r.unwrap() - after.r.unwrap()).abs() < 1e-12);
     }
 }

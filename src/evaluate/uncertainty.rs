@@ -234,7 +234,7 @@ impl Equipment {
         let readings = drift_test
             .runs()
             .iter()
-            .flat_map(|run| run.deviations_mm.iter().flatten().copied());
+            .flat_map(|run| run.deviations.iter().flatten().copied());
         let (low, high) = readings.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
             (lo.min(x), hi.max(x))
         });
@@ -254,7 +254,7 @@ impl Equipment {
 /// use axcomp::evaluate::uncertainty::{Equipment, budget};
 /// use axcomp::measurement::{Direction, Measurement, Run};
 /// let run = |direction| Run { direction, number: 1, start_time_s: None,
-///     deviations_mm: vec![Some(0.0), Some(0.001)] };
+///     deviations: vec![Some(0.0), Some(0.001)] };
 /// let m = Measurement::new("X", vec![0.0, 1000.0], vec![run(Direction::Up), run(Direction::Down)],
 ///     Default::default(), Default::default()).unwrap();
 /// let b = budget(&m, &Equipment::bundled()).unwrap();
@@ -519,7 +519,7 @@ mod tests {
             direction,
             number,
             start_time_s: None,
-            deviations_mm: vec![Some(0.0), Some(0.002), Some(0.001)],
+            deviations: vec![Some(0.0), Some(0.002), Some(0.001)],
         };
         Measurement::new(
             "X",

@@ -403,7 +403,7 @@ fn largest_with_offset(map: &crate::model::ErrorMap, offset_mm: [f64; 3]) -> Vol
 fn within_stroke(machine: &Machine, measurement: &Measurement) -> Result<(), PredictError> {
     let axis = axis_named("a measurement", measurement.axis())?;
     let [low_mm, high_mm] = machine.axis(axis).stroke_mm;
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let (from_mm, to_mm) = (targets[0], targets[targets.len() - 1]);
     let slack_mm = 1e-3;
     if from_mm < low_mm - slack_mm || to_mm > high_mm + slack_mm {

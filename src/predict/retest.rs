@@ -96,7 +96,7 @@ pub(super) fn predicted_retest(
     let (effects, backlash_set, standard) = (input.effects, input.backlash_set, input.standard);
     let sign = positioning_sign(machine, axis)?;
     let targets: Vec<f64> = match measured {
-        Some(m) => m.targets_mm().to_vec(),
+        Some(m) => m.targets().to_vec(),
         None => table.positions.clone(),
     };
     // The first test's own error, per direction: the reversal it measured.
@@ -184,7 +184,7 @@ pub(super) fn one_run_each_way(
             direction,
             number: 1,
             start_time_s: None,
-            deviations_mm: per_target
+            deviations: per_target
                 .iter()
                 .map(|t| Some(value(t, direction)))
                 .collect(),

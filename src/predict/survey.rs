@@ -777,7 +777,7 @@ fn positioning_measurement(
             direction: run.direction,
             number: u32::try_from(run.number).unwrap_or(u32::MAX),
             start_time_s: None,
-            deviations_mm: run.values.clone(),
+            deviations: run.values.clone(),
         })
         .collect();
     let metadata = Metadata {

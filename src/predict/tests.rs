@@ -67,7 +67,7 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         let prediction = predict(&input(&machine, &errors, &measured, &tables, line)).unwrap();
         let known = KnownError::from_evaluation(&evaluate(&before)).unwrap();
         let retest = &prediction.retests[0];
-        for (t, target) in retest.per_target.iter().zip(before.targets_mm()) {
+        for (t, target) in retest.per_target.iter().zip(before.targets()) {
             for (direction, value) in [(Direction::Up, t.up_mm), (Direction::Down, t.down_mm)] {
                 let expected =
                     predicted_deviation_mm(&known, Applied::table(&tables[0]), *target, direction);
@@ -82,16 +82,16 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         }
         // The predicted re-test keeps the first test's scatter: the same R per direction.
         let first = evaluate(&before).figures;
-        assert!((retest.figures.r_up_mm.unwrap() - first.r_up_mm.unwrap()).abs() < 1e-12);
-        assert!((retest.figures.r_down_mm.unwrap() - first.r_down_mm.unwrap()).abs() < 1e-12);
+        assert!((retest.figures.r_up.unwrap() - first.r_up.unwrap()).abs() < 1e-12);
+        assert!((retest.figures.r_down.unwrap() - first.r_down.unwrap()).abs() < 1e-12);
         // Without the table the model's line is the measurement: the same M and B̄.
-        assert!((retest.figures_before.m_mm.unwrap() - first.m_mm.unwrap()).abs() < 1e-9);
-        assert!((retest.figures_before.b_mean_mm.unwrap() - first.b_mean_mm.unwrap()).abs() < 1e-9);
+        assert!((retest.figures_before.m.unwrap() - first.m.unwrap()).abs() < 1e-9);
+        assert!((retest.figures_before.b_mean.unwrap() - first.b_mean.unwrap()).abs() < 1e-9);
         // The measured reversal (−3 µm in the truth) is carried: a mean table leaves it,
         // a bidirectional table takes it out. An effect's reversal (a change found by
         // diagnose) adds to it.
-        let b = retest.figures.b_mean_mm.unwrap() * 1000.0;
-        let b_measured = first.b_mean_mm.unwrap() * 1000.0;
+        let b = retest.figures.b_mean.unwrap() * 1000.0;
+        let b_measured = first.b_mean.unwrap() * 1000.0;
         assert!((retest.measured_mean_reversal_mm.unwrap() * 1000.0 - b_measured).abs() < 1e-9);
         let b_with_effect = predict(&PredictInput {
             effects: &[Effect::Reversal(Reversal { b_um: -1.0 })],
@@ -100,7 +100,7 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         .unwrap()
         .retests[0]
             .figures
-            .b_mean_mm
+            .b_mean
             .unwrap()
             * 1000.0;
         match mode {
@@ -230,10 +230,7 @@ fn a_scale_error_compensated_exactly_leaves_its_square() {
     assert!(!retest.with_measured_scatter);
     assert_eq!(retest.per_target.len(), 2);
     assert!((retest.per_target[1].up_mm + k * k * 750.0).abs() < 1e-13);
-    assert_eq!(
-        retest.figures.r_mm, None,
-        "one run each way: no repeatability"
-    );
+    assert_eq!(retest.figures.r, None, "one run each way: no repeatability");
 }
 
 #[test]

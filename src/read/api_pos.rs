@@ -379,7 +379,7 @@ fn assemble(runs_of_rows: &[&[Row]]) -> Result<(Vec<f64>, Vec<Run>), ParseError>
             direction,
             number: numbers[slot],
             start_time_s: None,
-            deviations_mm,
+            deviations: deviations_mm,
         });
     }
     Ok((targets_mm, runs))
@@ -621,8 +621,8 @@ mod tests {
     fn millimetre_file_reads_as_is() {
         let (m, warnings) = parse(&file(ROWS, "")).unwrap();
         assert_eq!(m.axis(), "Z");
-        assert_eq!(m.targets_mm(), &[0.0, 10.0]);
-        assert_eq!(m.runs()[0].deviations_mm, vec![Some(0.001), Some(0.002)]);
+        assert_eq!(m.targets(), &[0.0, 10.0]);
+        assert_eq!(m.runs()[0].deviations, vec![Some(0.001), Some(0.002)]);
         assert_eq!(m.runs()[0].direction, Direction::Up);
         assert_eq!(
             m.environment.air_temperature_c,
@@ -662,7 +662,7 @@ mod tests {
         let rows = "10.0\t10\t-0.002\t0\t20\t101\t20\t-1\t-1\r\n0.0\t0\t-0.001\t0\t20\t101\t20\t-1\t-1\r\n";
         let (m, _) = parse(&file(rows, "")).unwrap();
         assert_eq!(m.runs()[0].direction, Direction::Down);
-        assert_eq!(m.runs()[0].deviations_mm, vec![Some(-0.001), Some(-0.002)]);
+        assert_eq!(m.runs()[0].deviations, vec![Some(-0.001), Some(-0.002)]);
     }
 
     #[test]

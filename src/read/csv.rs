@@ -264,7 +264,7 @@ pub fn write(measurement: &Measurement) -> String {
     });
     out.push('\n');
     for run in measurement.runs() {
-        for (target_mm, deviation_mm) in measurement.targets_mm().iter().zip(&run.deviations_mm) {
+        for (target_mm, deviation_mm) in measurement.targets().iter().zip(&run.deviations) {
             let deviation = deviation_mm
                 .map(|value| match kind {
                     AxisKind::Linear => um_text(value),
@@ -412,7 +412,7 @@ fn assemble_runs(
                     direction,
                     number: index as u32 + 1,
                     start_time_s: None,
-                    deviations_mm,
+                    deviations: deviations_mm,
                 },
             ));
         }
@@ -432,9 +432,9 @@ mod tests {
         let (m, warnings) = parse(text).unwrap();
         assert_eq!(m.axis(), "Y");
         assert_eq!(m.metadata.machine.as_deref(), Some("Test mill"));
-        assert_eq!(m.targets_mm(), &[0.0, 100.0]);
-        assert_eq!(m.runs()[0].deviations_mm, vec![Some(0.0), Some(0.0025)]);
-        assert_eq!(m.runs()[1].deviations_mm, vec![Some(0.001), None]);
+        assert_eq!(m.targets(), &[0.0, 100.0]);
+        assert_eq!(m.runs()[0].deviations, vec![Some(0.0), Some(0.0025)]);
+        assert_eq!(m.runs()[1].deviations, vec![Some(0.001), None]);
         assert!(matches!(
             warnings[0],
             Warning::MissingReadings { count: 1, .. }
@@ -456,7 +456,7 @@ mod tests {
         let text = "# axis: Z\ntarget_mm,run,direction,deviation_um\n0,1,up,0.1\n50.5,1,up,-3.25\n0,1,down,\n50.5,1,down,7\n";
         let (m, _) = parse(text).unwrap();
         let (again, _) = parse(&write(&m)).unwrap();
-        assert_eq!(again.targets_mm(), m.targets_mm());
+        assert_eq!(again.targets(), m.targets());
         assert_eq!(again.runs(), m.runs());
         assert_eq!(again.axis_source(), &AxisSource::file("# axis"));
         // An axis the file did not record is not written as if it had been.
@@ -474,9 +474,9 @@ mod tests {
             warnings[0].to_string().contains("run 1↓ at 90°"),
             "{warnings:?}"
         );
-        assert_eq!(c.targets_mm(), &[0.0, 90.0]);
+        assert_eq!(c.targets(), &[0.0, 90.0]);
         // 1.8″ = 0.0005°, −3.6″ = −0.001° (1° = 3600″, by hand).
-        let up = &c.runs()[0].deviations_mm;
+        let up = &c.runs()[0].deviations;
         assert!((up[0].unwrap() - 0.0005).abs() < 1e-15 && (up[1].unwrap() + 0.001).abs() < 1e-15);
         let written = write(&c);
         assert!(
@@ -504,7 +504,7 @@ mod tests {
         for text in [semicolon, tab] {
             let (m, _) = parse(text).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(m.axis(), "Y");
-            assert_eq!(m.targets_mm(), &[0.0, 12.5]);
+            assert_eq!(m.targets(), &[0.0, 12.5]);
             assert_eq!(m.runs(), expected.runs());
         }
         assert_eq!(

@@ -350,7 +350,7 @@ impl EcmcFile {
                     direction,
                     number: numbers[slot],
                     start_time_s: None,
-                    deviations_mm: order.iter().map(|&p| by_position[p]).collect(),
+                    deviations: order.iter().map(|&p| by_position[p]).collect(),
                 });
             }
         }
@@ -664,12 +664,12 @@ mod tests {
     #[test]
     fn values_are_actual_positions_and_fwd_is_up() {
         let m = parse_ok(SMALL);
-        assert_eq!(m.targets_mm(), &[10.0, 20.0]);
+        assert_eq!(m.targets(), &[10.0, 20.0]);
         let labels: Vec<String> = m.runs().iter().map(|r| r.label()).collect();
         assert_eq!(labels, ["1↑", "1↓", "2↑", "2↓"]);
-        let first = m.runs()[0].deviations_mm[0].unwrap();
+        let first = m.runs()[0].deviations[0].unwrap();
         assert!((first - 0.001).abs() < 1e-12);
-        let down = m.runs()[3].deviations_mm[1].unwrap();
+        let down = m.runs()[3].deviations[1].unwrap();
         assert!((down + 0.004).abs() < 1e-12);
     }
 
@@ -722,9 +722,9 @@ mod tests {
             REF_DATA_FWD[1,1]=0.001\nREF_DATA_FWD[2,1]=89.998\n";
         let c = parse_ok(text);
         assert_eq!(c.kind(), AxisKind::Rotary);
-        assert_eq!(c.targets_mm(), &[0.0, 90.0]);
+        assert_eq!(c.targets(), &[0.0, 90.0]);
         // 89.998° − 90° = −0.002° = −7.2″, kept in degrees.
-        let second = c.runs()[0].deviations_mm[1].unwrap();
+        let second = c.runs()[0].deviations[1].unwrap();
         assert!((second + 0.002).abs() < 1e-12, "{second}");
         assert_eq!(parse_ok(SMALL).kind(), AxisKind::Linear);
     }

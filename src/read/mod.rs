@@ -424,7 +424,7 @@ pub(crate) fn missing_readings_warning_of(
     let mut count = 0;
     let mut examples = Vec::new();
     for run in runs {
-        for (target_mm, value) in targets_mm.iter().zip(&run.deviations_mm) {
+        for (target_mm, value) in targets_mm.iter().zip(&run.deviations) {
             if value.is_none() {
                 count += 1;
                 if examples.len() < 3 {

@@ -275,14 +275,14 @@ fn series(label: Option<String>, color: Rgb, mark: Mark, points: Vec<(f64, f64)>
 /// x̄ ± 2s band of each direction.
 fn deviation_chart(test: &TestRecord<'_>, which: &str, angle: AngleUnit) -> Chart {
     let measurement = test.measurement;
-    let targets = measurement.targets_mm();
+    let targets = measurement.targets();
     let per_target = &test.evaluation.per_target;
     let shown = shown(test, angle);
     let mut all = Vec::new();
     for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
         let (lower, upper): (Vec<(f64, f64)>, Vec<f64>) = per_target
             .iter()
-            .filter_map(|t| band(t.target_mm, t.direction(direction), shown))
+            .filter_map(|t| band(t.target, t.direction(direction), shown))
             .map(|(x, low, high)| ((x, low), high))
             .unzip();
         if !lower.is_empty() {
@@ -305,7 +305,7 @@ fn deviation_chart(test: &TestRecord<'_>, which: &str, angle: AngleUnit) -> Char
         for (index, run) in measurement.runs_in(direction).enumerate() {
             let points: Vec<(f64, f64)> = targets
                 .iter()
-                .zip(&run.deviations_mm)
+                .zip(&run.deviations)
                 .filter_map(|(x, value)| value.map(|v| (*x, shown.from_internal(v))))
                 .collect();
             lines.push(series(None, light, Mark::Line(1), points.clone()));
@@ -349,7 +349,7 @@ fn mean_lines(per_target: &[TargetStats], shown: DeviationUnit) -> Vec<Series> {
     }
     let bidirectional: Vec<(f64, f64)> = per_target
         .iter()
-        .filter_map(|t| t.mean_mm.map(|m| (t.target_mm, shown.from_internal(m))))
+        .filter_map(|t| t.mean.map(|m| (t.target, shown.from_internal(m))))
         .collect();
     if !bidirectional.is_empty() {
         lines.push(series(
@@ -372,8 +372,8 @@ fn means_in(
     per_target
         .iter()
         .filter_map(|t| {
-            let mean = t.direction(direction).mean_mm?;
-            Some((t.target_mm, shown.from_internal(mean)))
+            let mean = t.direction(direction).mean?;
+            Some((t.target, shown.from_internal(mean)))
         })
         .collect()
 }
@@ -396,7 +396,7 @@ fn largest_mean(test: &TestRecord<'_>, angle: AngleUnit) -> Option<f64> {
     let per_target = &test.evaluation.per_target;
     per_target
         .iter()
-        .flat_map(|t| [t.up.mean_mm, t.down.mean_mm, t.mean_mm])
+        .flat_map(|t| [t.up.mean, t.down.mean, t.mean])
         .flatten()
         .map(|mean| angle.from_deg(mean).abs())
         .reduce(f64::max)
@@ -432,8 +432,8 @@ fn polar_chart(
 /// mean shifted to zero at the reference (what the table should follow).
 fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
     let mut all = Vec::new();
-    let first_target = before.per_target.first().map(|t| t.target_mm);
-    let last_target = before.per_target.last().map(|t| t.target_mm);
+    let first_target = before.per_target.first().map(|t| t.target);
+    let last_target = before.per_target.last().map(|t| t.target);
     if let Some(known) = KnownError::from_evaluation(before) {
         let at_reference = known.mean_at(table.reference);
         let points = known
@@ -725,7 +725,7 @@ fn extent(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// Each accepted effect's contribution to every reading, in the order measured.
 fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
-    let first_target_mm = after.targets_mm().first().copied().unwrap_or(0.0);
+    let first_target_mm = after.targets().first().copied().unwrap_or(0.0);
     let mut all = Vec::new();
     for (index, accepted) in diagnosis.accepted.iter().enumerate() {
         // The Abbe effect needs the angular profile, which the report is not

@@ -420,7 +420,7 @@ impl FiguresJson {
         FiguresJson {
             values: figures
                 .iter()
-                .map(|f| (f.key, opt_mm_to_um(f.value_mm)))
+                .map(|f| (f.key, opt_mm_to_um(f.value)))
                 .collect(),
         }
     }
@@ -452,7 +452,7 @@ impl FiguresJson {
         FiguresJson {
             values: figures
                 .iter()
-                .map(|f| (f.key, f.value_mm.map(|value_deg| angle.from_deg(value_deg))))
+                .map(|f| (f.key, f.value.map(|value_deg| angle.from_deg(value_deg))))
                 .collect(),
         }
     }
@@ -786,14 +786,14 @@ mod tests {
         let up = DirectionStats::of(&[0.0005, 0.0015]);
         let down = DirectionStats::of(&[-0.0005, -0.0015]);
         TargetStats {
-            target_mm: at,
+            target: at,
             up,
             down,
-            mean_mm: Some(0.0),
-            reversal_mm: Some(0.002),
-            repeatability_up_mm: up.s_mm.map(|s| 4.0 * s),
-            repeatability_down_mm: down.s_mm.map(|s| 4.0 * s),
-            repeatability_mm: Some(0.004),
+            mean: Some(0.0),
+            reversal: Some(0.002),
+            repeatability_up: up.s.map(|s| 4.0 * s),
+            repeatability_down: down.s.map(|s| 4.0 * s),
+            repeatability: Some(0.004),
         }
     }
 
@@ -876,8 +876,8 @@ mod tests {
             direction: Direction::Down,
             run: 1,
             score: 6.5,
-            worst_target_mm: 90.0,
-            offset_mm: 0.01,
+            worst_target: 90.0,
+            offset: 0.01,
         };
         // 0.01° = 36″; 0.01 mm = 10 µm.
         let rotary = OutlierJson::from_outlier(&outlier, AxisKind::Rotary, AngleUnit::Arcsec);
@@ -913,7 +913,7 @@ mod tests {
         assert_eq!(length(AxisKind::Rotary), (None, Some(360.0.into())));
         let figures = [StandardFigure {
             key: "E",
-            value_mm: Some(0.002),
+            value: Some(0.002),
         }];
         // 0.002 mm = 2 µm; 0.002° = 7.2″.
         let key = |kind, angle| {

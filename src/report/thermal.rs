@@ -79,7 +79,7 @@ pub fn model_toml(model: &ThermalModel) -> String {
         "# axcomp thermal model: drift_um(t) = sum over terms of\n\
          #   coefficient_um_per_k * (lag(sensor, tau_s)(t) - reference_c),\n\
          # each lag a first-order low-pass started at the log's first row.\n\
-         # cv_rms_um is the prediction's standard uncertainty (time-blocked cross-validation).\n{body}"
+         # cv_rms_um is the prediction's standard uncertainty in the fit rows' conditions (time-blocked cross-validation); beyond them it can be larger.\n{body}"
     )
 }
 
@@ -171,7 +171,7 @@ pub fn apply_json(model: &ThermalModel, log: &ThermalLog, applied: &Application)
 /// The apply report for the terminal.
 pub fn apply_text(model: &ThermalModel, json: &ApplyJson) -> String {
     let mut text = format!(
-        "Thermal model: {} term(s), fitted on rows {}–{} ({:.0}–{:.0} min); prediction uncertainty {:.2} µm (1σ, time-blocked cross-validation)\n",
+        "Thermal model: {} term(s), fitted on rows {}–{} ({:.0}–{:.0} min); prediction uncertainty {:.2} µm (1σ, time-blocked cross-validation, in the fit rows' conditions; beyond them it can be larger)\n",
         model.terms.len(),
         model.fit.first_row,
         model.fit.last_row,
@@ -238,7 +238,7 @@ pub fn fit_text(model: &ThermalModel) -> String {
         ));
     }
     text.push_str(&format!(
-        "  fit rms {:.2} µm; cross-validated rms {:.2} µm (the prediction's standard uncertainty)\n",
+        "  fit rms {:.2} µm; cross-validated rms {:.2} µm (the prediction's standard uncertainty in the fit rows' conditions; beyond them it can be larger)\n",
         f.fit_rms_um, f.cv_rms_um
     ));
     text
@@ -501,7 +501,7 @@ fn model_html(model: &ThermalModel, json: &ApplyJson) -> String {
     }
     html.push_str("</tbody></table>\n");
     html.push_str(&format!(
-        "<p>Fit rms <span data-key=\"thermal.fit_rms_um\" data-um=\"{0}\">{0:.2}</span> µm; cross-validated rms <span data-key=\"thermal.cv_rms_um\" data-um=\"{1}\">{1:.2}</span> µm (the prediction's standard uncertainty).</p>\n",
+        "<p>Fit rms <span data-key=\"thermal.fit_rms_um\" data-um=\"{0}\">{0:.2}</span> µm; cross-validated rms <span data-key=\"thermal.cv_rms_um\" data-um=\"{1}\">{1:.2}</span> µm (the prediction's standard uncertainty in the fit rows' conditions; beyond them it can be larger).</p>\n",
         f.fit_rms_um, f.cv_rms_um
     ));
     let rows = [

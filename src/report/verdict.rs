@@ -481,8 +481,8 @@ mod tests {
     #[test]
     fn headlines_name_the_failing_figures() {
         let figures = AxisFigures {
-            a_mm: Some(0.013),
-            e_mm: Some(0.004),
+            a: Some(0.013),
+            e: Some(0.004),
             ..Default::default()
         };
         let evaluation = crate::evaluate::Evaluation::of_figures(figures, Vec::new(), 1, 0.0);

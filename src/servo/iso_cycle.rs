@@ -232,7 +232,7 @@ impl IsoCycle {
 /// let result = run_iso_cycle(&axis, axis.friction(FrictionKind::Classic), &cycle, options, &mut |_| {})
 ///     .unwrap();
 /// // Classic friction holds about F_C = 90 N after each approach: B ≈ 2·90/100 = 1.8 µm.
-/// let b_um = result.evaluation.figures.b_mm.unwrap() * 1000.0;
+/// let b_um = result.evaluation.figures.b.unwrap() * 1000.0;
 /// assert!(b_um > 1.0 && b_um < 3.0, "{b_um}");
 /// ```
 pub fn run_iso_cycle(
@@ -313,7 +313,7 @@ fn to_measurement(
                 direction,
                 number: run,
                 start_time_s,
-                deviations_mm,
+                deviations: deviations_mm,
             });
         }
     }

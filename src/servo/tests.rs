@@ -254,7 +254,7 @@ fn iso_reversal_is_the_held_friction_through_the_compliance() {
         );
     }
     let b_mean =
-        |r: &crate::servo::iso_cycle::IsoResult| r.evaluation.figures.b_mean_mm.unwrap() * 1e3;
+        |r: &crate::servo::iso_cycle::IsoResult| r.evaluation.figures.b_mean.unwrap() * 1e3;
     let rigid = b_mean(&run(FrictionKind::Classic, None));
     let stiff = b_mean(&classic);
     let soft = b_mean(&run(FrictionKind::Classic, Some(50.0)));

@@ -244,7 +244,7 @@ fn simulate(
             direction: *direction,
             number: numbers[slot],
             start_time_s: Some(times[index].iter().copied().fold(f64::INFINITY, f64::min)),
-            deviations_mm,
+            deviations: deviations_mm,
         });
     }
     let duration_s = cycle::duration_s(&times);

@@ -166,7 +166,7 @@ fn simulate(
     let mut runs = Vec::with_capacity(2 * spec.runs);
     for number in 1..=spec.runs as u32 {
         for direction in Direction::BOTH {
-            let deviations_mm = targets
+            let deviations = targets
                 .iter()
                 .map(|&angle| {
                     let applied_deg = table.map_or(0.0, |t| t.value_at(angle, direction));
@@ -183,7 +183,7 @@ fn simulate(
                 direction,
                 number,
                 start_time_s: None,
-                deviations_mm,
+                deviations,
             });
         }
     }

@@ -16,7 +16,7 @@ fn truth(extra: &str) -> Truth {
 
 fn deviations_um(m: &Measurement, run: usize) -> Vec<f64> {
     m.runs()[run]
-        .deviations_mm
+        .deviations
         .iter()
         .map(|v| v.unwrap() * 1000.0)
         .collect()
@@ -26,7 +26,7 @@ fn deviations_um(m: &Measurement, run: usize) -> Vec<f64> {
 fn declared_error_is_zeroed_at_the_first_target() {
     // 10 µm/m over 0 … 400 mm: 0, 1, 2, 3, 4 µm at 0, 100, 200, 300, 400.
     let m = before(&truth("[error]\nscale_um_per_m = 10.0\n"), 1).unwrap();
-    assert_eq!(m.targets_mm(), &[0.0, 100.0, 200.0, 300.0, 400.0]);
+    assert_eq!(m.targets(), &[0.0, 100.0, 200.0, 300.0, 400.0]);
     for run in 0..6 {
         assert_eq!(deviations_um(&m, run), vec![0.0, 1.0, 2.0, 3.0, 4.0]);
     }
@@ -39,7 +39,7 @@ fn each_effect_by_hand() {
     let reversal = before(&truth("[[effect]]\nkind = \"reversal\"\nB_um = -3.0\n"), 1).unwrap();
     assert_eq!(deviations_um(&reversal, 0), vec![-1.5; 5]);
     assert_eq!(deviations_um(&reversal, 1), vec![1.5; 5]);
-    assert!((evaluate(&reversal).figures.b_mean_mm.unwrap() * 1000.0 + 3.0).abs() < 1e-9);
+    assert!((evaluate(&reversal).figures.b_mean.unwrap() * 1000.0 + 3.0).abs() < 1e-9);
 
     let outlier = before(
         &truth(
@@ -96,7 +96,7 @@ fn effects_act_only_in_their_tests() {
         first
             .runs()
             .iter()
-            .all(|r| r.deviations_mm.iter().all(|v| *v == Some(0.0)))
+            .all(|r| r.deviations.iter().all(|v| *v == Some(0.0)))
     );
     let zero = CompensationTable {
         axis: "X".into(),
@@ -131,7 +131,7 @@ fn the_table_is_applied_as_the_controller_does() {
         retest
             .runs()
             .iter()
-            .all(|r| r.deviations_mm.iter().all(|v| v.unwrap().abs() < 1e-9))
+            .all(|r| r.deviations.iter().all(|v| v.unwrap().abs() < 1e-9))
     );
     // A bidirectional table acts per direction: ↓ gets 2 µm more correction everywhere.
     let both = CompensationTable {
@@ -155,13 +155,13 @@ fn seeded_and_reproducible() {
     assert_eq!(a, before(&t, 42).unwrap());
     assert_ne!(a.runs(), before(&t, 43).unwrap().runs());
     // Jittered interior targets, ends fixed, 0.001 mm resolution.
-    assert_eq!((a.targets_mm()[0], a.targets_mm()[15]), (0.0, 750.0));
+    assert_eq!((a.targets()[0], a.targets()[15]), (0.0, 750.0));
     assert!(
-        a.targets_mm()
+        a.targets()
             .iter()
             .all(|t| (t * 1000.0 - (t * 1000.0).round()).abs() < 1e-6)
     );
-    assert!(a.targets_mm().windows(2).all(|p| p[1] - p[0] > 50.0 - 18.0));
+    assert!(a.targets().windows(2).all(|p| p[1] - p[0] > 50.0 - 18.0));
 }
 
 #[test]
@@ -173,9 +173,9 @@ fn written_files_read_back_exactly() {
     .unwrap();
     let m = before(&t, 5).unwrap();
     let (back, _) = parse_str(&rtl::write(&m), SourceFormat::Rtl).unwrap();
-    assert_eq!(back.targets_mm(), m.targets_mm());
+    assert_eq!(back.targets(), m.targets());
     for (a, b) in back.runs().iter().zip(m.runs()) {
-        assert_eq!(a.deviations_mm, b.deviations_mm);
+        assert_eq!(a.deviations, b.deviations);
         assert_eq!((a.direction, a.number), (b.direction, b.number));
     }
     assert_eq!(back.environment, m.environment);

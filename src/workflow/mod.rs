@@ -276,10 +276,10 @@ pub fn convert(
         table.controller,
         table.request,
         options,
-        measurement.targets_mm(),
+        measurement.targets(),
     )?;
     let plan = plan(
-        measurement.targets_mm(),
+        measurement.targets(),
         table.effects,
         &table.controller.capabilities(options.machine_unit),
         &request,

@@ -111,7 +111,7 @@ pub fn predicted_retest(
     standard: &dyn Standard,
 ) -> Option<Prediction> {
     let known = KnownError::from_evaluation(before.evaluation)?;
-    let targets_mm = before.measurement.targets_mm();
+    let targets_mm = before.measurement.targets();
     let retest = with_scatter(before.measurement, before.evaluation, |i, direction| {
         predicted_deviation_mm(&known, Applied::table(table), targets_mm[i], direction)
     })

@@ -31,7 +31,7 @@ fn run(truth_text: &str, seed: u64, angular: bool) -> Diagnosis {
     let truth = Truth::from_toml_str(truth_text).unwrap_or_else(|e| panic!("{e}\n{truth_text}"));
     let (before, table, after) = synth_loop(&truth, seed);
     let profile = angular.then(|| {
-        let targets = before.targets_mm();
+        let targets = before.targets();
         let stroke = (targets[0], targets[targets.len() - 1]);
         let positions_mm: Vec<f64> = (0..=15)
             .map(|k| stroke.0 + (stroke.1 - stroke.0) * f64::from(k) / 15.0)

@@ -260,12 +260,12 @@ fn x_of_the_real_backup_is_updated_from_a_synthetic_test() {
     let after = axcomp::read::read_path(Path::new(&path("after.rtl")), None)
         .unwrap()
         .measurement;
-    let targets = after.targets_mm().to_vec();
+    let targets = after.targets().to_vec();
     let mean_um = |i: usize| {
         let readings: Vec<f64> = after
             .runs()
             .iter()
-            .filter_map(|r| r.deviations_mm[i])
+            .filter_map(|r| r.deviations[i])
             .collect();
         readings.iter().sum::<f64>() / readings.len() as f64 * 1000.0
     };

@@ -19,7 +19,7 @@ fn mean_um(m: &Measurement, i: usize, direction: Option<Direction>) -> f64 {
         .runs()
         .iter()
         .filter(|r| direction.is_none_or(|d| r.direction == d))
-        .filter_map(|r| r.deviations_mm[i])
+        .filter_map(|r| r.deviations[i])
         .collect();
     readings.iter().sum::<f64>() / readings.len() as f64 * 1000.0
 }
@@ -122,7 +122,7 @@ fn bidirectional_compensation_needs_3605_and_goes_to_3626() {
         at_reference + absolute(&shifted, n)
     };
     let after = read(&after);
-    let targets = after.targets_mm().to_vec();
+    let targets = after.targets().to_vec();
     let reference = targets.iter().position(|t| *t == 0.0).unwrap();
     let up_at_reference = mean_um(&after, reference, Some(Direction::Up));
     for (i, target) in targets.iter().enumerate() {
@@ -208,7 +208,7 @@ fn the_rescaled_alternative_keeps_the_compensation_in_a_finer_unit() {
     // Inside: the same compensation as the update at 3623 = 10 asks for,
     // old − (e − e(ref)), within half the new unit (0.05 µm).
     let after = read(&after);
-    let targets = after.targets_mm().to_vec();
+    let targets = after.targets().to_vec();
     let reference = targets.iter().position(|t| *t == 0.0).unwrap();
     for (i, target) in targets.iter().enumerate() {
         let n = 40 + (target / 40.0).round() as i64;
@@ -306,7 +306,7 @@ fn a_rotary_axis_turn_sums_to_zero_and_its_backlash_is_in_degrees() {
     // The reversal −B̄, B̄ the mean over the targets of x̄↑ − x̄↓, in
     // detection units of 0.0001°, added to the backup's −4 (active during
     // the test).
-    let count = test.targets_mm().len();
+    let count = test.targets().len();
     let reversal_deg = (0..count)
         .map(|i| {
             (mean_um(&test, i, Some(Direction::Up)) - mean_um(&test, i, Some(Direction::Down)))

@@ -125,7 +125,7 @@ fn scatter_um(m: &Measurement) -> f64 {
     let s: Vec<f64> = evaluate(m)
         .per_target
         .iter()
-        .flat_map(|t| [t.up.s_mm, t.down.s_mm])
+        .flat_map(|t| [t.up.s, t.down.s])
         .flatten()
         .collect();
     1000.0 * (s.iter().map(|x| x * x).sum::<f64>() / s.len() as f64).sqrt()
@@ -166,7 +166,7 @@ fn found_like(d: &Diagnosis, put_in: &Effect) -> Option<Effect> {
 /// 10 s, a drift of 20 s over the test (per hour, or per run when the file records no times), a scale of 10 s over the span, and
 /// (with at least 9 targets) a periodic error of 5 s and a period of span/2.2 or 12 mm.
 fn effects_for(m: &Measurement, s_um: f64, duration_h: f64) -> Vec<Effect> {
-    let targets = m.targets_mm();
+    let targets = m.targets();
     let span_mm = targets[targets.len() - 1] - targets[0];
     let mut effects = vec![
         Effect::Reversal(Reversal { b_um: -10.0 * s_um }),

@@ -41,11 +41,11 @@ pub(crate) fn mean_reversal_um(m: &Measurement) -> f64 {
             .runs()
             .iter()
             .filter(|r| r.direction == direction)
-            .filter_map(|r| r.deviations_mm[i])
+            .filter_map(|r| r.deviations[i])
             .collect();
         values.iter().sum::<f64>() / values.len() as f64
     };
-    let n = m.targets_mm().len();
+    let n = m.targets().len();
     let sum: f64 = (0..n)
         .map(|i| mean(i, Direction::Up) - mean(i, Direction::Down))
         .sum();

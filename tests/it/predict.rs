@@ -80,8 +80,8 @@ fn the_predicted_retest_is_the_table_applied_to_the_measurement() {
     let (controller, active) = emit::read_any(&text, &options, None).unwrap();
     assert_eq!(controller, Controller::Tnc640);
     let per_target = json["per_target"].as_array().unwrap();
-    assert_eq!(per_target.len(), measurement.targets_mm().len());
-    for (row, &x) in per_target.iter().zip(measurement.targets_mm()) {
+    assert_eq!(per_target.len(), measurement.targets().len());
+    for (row, &x) in per_target.iter().zip(measurement.targets()) {
         assert_eq!(row["target_mm"].as_f64().unwrap(), x);
         for (key, direction) in [
             ("predicted_up_um", Direction::Up),
@@ -99,18 +99,18 @@ fn the_predicted_retest_is_the_table_applied_to_the_measurement() {
     // The re-test keeps the sample's repeatability per direction; the mean table takes M
     // from 8.06 µm to what the 4-decimal table and the spline leave (< 0.2 µm).
     let figures = &json["predicted_figures_um"];
-    let r_up = evaluation.figures.r_up_mm.unwrap() * 1000.0;
+    let r_up = evaluation.figures.r_up.unwrap() * 1000.0;
     assert!((figures["R_up"].as_f64().unwrap() - r_up).abs() < 1e-9);
     assert!(figures["M"].as_f64().unwrap() < 0.2, "{}", figures["M"]);
     // Without the table the line reads the measurement itself (evaluate's figures:
     // E 11.21, B 3.44, B̄ −3.18 µm in README), reversal included.
     let before = &json["figures_before_um"];
     for (key, measured) in [
-        ("A", evaluation.figures.a_mm),
-        ("E", evaluation.figures.e_mm),
-        ("M", evaluation.figures.m_mm),
-        ("B", evaluation.figures.b_mm),
-        ("B_mean", evaluation.figures.b_mean_mm),
+        ("A", evaluation.figures.a),
+        ("E", evaluation.figures.e),
+        ("M", evaluation.figures.m),
+        ("B", evaluation.figures.b),
+        ("B_mean", evaluation.figures.b_mean),
     ] {
         let measured = measured.unwrap() * 1000.0;
         assert!(

@@ -16,7 +16,7 @@ fn x_forward_rows_by_hand() {
     let result = read_path(&path, None).unwrap();
     let m = result.measurement;
     assert_eq!(m.axis(), "X");
-    assert_eq!(m.targets_mm().len(), 27);
+    assert_eq!(m.targets().len(), 27);
     assert_eq!(m.metadata.length_unit.as_str(), "inch");
     let run = &m.runs()[0];
     assert_eq!(run.direction, Direction::Up, "positions 0 → 130 in: ↑");
@@ -30,7 +30,7 @@ fn x_forward_rows_by_hand() {
         (130.0, -130.000026, 0.000026),
     ] {
         let index = m
-            .targets_mm()
+            .targets()
             .iter()
             .position(|t| (t - position * 25.4).abs() < 1e-9)
             .unwrap();
@@ -39,7 +39,7 @@ fn x_forward_rows_by_hand() {
             (actual_minus_target_in - linear_error).abs() < 1e-9,
             "the file is self-consistent at {position}"
         );
-        let deviation_um = run.deviations_mm[index].unwrap() * 1000.0;
+        let deviation_um = run.deviations[index].unwrap() * 1000.0;
         assert!(
             (deviation_um - linear_error * INCH_UM).abs() < 1e-9,
             "{position} in: {deviation_um} µm"
@@ -60,11 +60,11 @@ fn y_forward_counts_the_other_way_and_moves_down() {
     assert_eq!(run.direction, Direction::Down);
     // Here actual = +LasRead: at −5 in LasRead −5.000178, LinearError −0.000178.
     let index = m
-        .targets_mm()
+        .targets()
         .iter()
         .position(|t| (t + 127.0).abs() < 1e-9)
         .unwrap();
-    assert!((run.deviations_mm[index].unwrap() * 1000.0 - (-0.000178 * INCH_UM)).abs() < 1e-9);
+    assert!((run.deviations[index].unwrap() * 1000.0 - (-0.000178 * INCH_UM)).abs() < 1e-9);
     // The file says TestAxis (X) but is named "Y Axis Forward.pos": said, not hidden.
     assert!(
         result

@@ -168,7 +168,7 @@ fn the_retest_report_shows_evaluate_and_diagnose_numbers_and_writes_pngs() {
     let readings: usize = after_measurement
         .runs()
         .iter()
-        .map(|r| r.deviations_mm.iter().flatten().count())
+        .map(|r| r.deviations.iter().flatten().count())
         .sum();
     assert_eq!(diagnosis.readings.len(), readings);
     let rms = (diagnosis

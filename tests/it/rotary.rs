@@ -512,7 +512,7 @@ fn the_synthetic_rotary_test_evaluates_to_an_independent_computation() {
         bundled,
         "regenerate as truth.toml says"
     );
-    assert_eq!(measurement.targets_mm().len(), 25);
+    assert_eq!(measurement.targets().len(), 25);
     assert_eq!(measurement.runs().len(), 10);
 
     let (json, _) = json_of(&csv_path);

@@ -26,7 +26,7 @@ fn cells_of(path: &std::path::Path) -> Vec<(f64, f64, f64, f64)> {
     let stats = |direction: Direction, index: usize| {
         let values: Vec<f64> = measurement
             .runs_in(direction)
-            .filter_map(|run| run.deviations_mm[index])
+            .filter_map(|run| run.deviations[index])
             .map(|mm| mm * 1000.0)
             .collect();
         let n = values.len() as f64;
@@ -34,7 +34,7 @@ fn cells_of(path: &std::path::Path) -> Vec<(f64, f64, f64, f64)> {
         let s = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
         (mean, s)
     };
-    (0..measurement.targets_mm().len())
+    (0..measurement.targets().len())
         .map(|i| {
             let (up, s_up) = stats(Direction::Up, i);
             let (down, s_down) = stats(Direction::Down, i);

@@ -182,7 +182,7 @@ impl Figure {
     /// error). `None` when the figure is not evaluated or not the standard's
     /// ([`check_standard`] refuses such a limit first).
     pub fn value_mm(self, figures: &[StandardFigure]) -> Option<f64> {
-        let value = figures.iter().find(|f| f.key == self.name())?.value_mm?;
+        let value = figures.iter().find(|f| f.key == self.name())?.value?;
         Some(match self {
             Figure::BMean => value.abs(),
             _ => value,
@@ -559,7 +559,7 @@ impl Verdict {
 /// use axcomp::measurement::{Direction, Measurement, Run};
 /// let run = |direction, number, values: [f64; 2]| Run {
 ///     direction, number, start_time_s: None,
-///     deviations_mm: values.iter().map(|v| Some(*v)).collect() };
+///     deviations: values.iter().map(|v| Some(*v)).collect() };
 /// let m = Measurement::new("X", vec![0.0, 100.0], vec![
 ///     run(Direction::Up, 1, [0.000, 0.004]), run(Direction::Down, 1, [-0.002, 0.002]),
 ///     run(Direction::Up, 2, [0.002, 0.006]), run(Direction::Down, 2, [0.000, 0.004]),
@@ -587,7 +587,7 @@ pub fn verdict(evaluation: &Evaluation, limits: &[Limit]) -> Option<Verdict> {
 /// use axcomp::measurement::{Direction, Measurement, Run};
 /// let run = |direction, number, values: [f64; 2]| Run {
 ///     direction, number, start_time_s: None,
-///     deviations_mm: values.iter().map(|v| Some(*v)).collect() };
+///     deviations: values.iter().map(|v| Some(*v)).collect() };
 /// let m = Measurement::new("X", vec![0.0, 1000.0], vec![
 ///     run(Direction::Up, 1, [0.000, 0.004]), run(Direction::Down, 1, [-0.002, 0.002]),
 ///     run(Direction::Up, 2, [0.002, 0.006]), run(Direction::Down, 2, [0.000, 0.004]),
@@ -609,7 +609,7 @@ pub fn verdict_with(
         return None;
     }
     let travel_mm = match (evaluation.per_target.first(), evaluation.per_target.last()) {
-        (Some(first), Some(last)) => last.target_mm - first.target_mm,
+        (Some(first), Some(last)) => last.target - first.target,
         _ => 0.0,
     };
     let mut ordered: Vec<&Limit> = limits.iter().collect();
@@ -681,14 +681,14 @@ mod tests {
 
     fn evaluation(first_mm: f64, last_mm: f64, figures: AxisFigures) -> Evaluation {
         let target = |target_mm| TargetStats {
-            target_mm,
+            target: target_mm,
             up: Default::default(),
             down: Default::default(),
-            mean_mm: None,
-            reversal_mm: None,
-            repeatability_up_mm: None,
-            repeatability_down_mm: None,
-            repeatability_mm: None,
+            mean: None,
+            reversal: None,
+            repeatability_up: None,
+            repeatability_down: None,
+            repeatability: None,
         };
         Evaluation::of_figures(
             figures,
@@ -728,8 +728,8 @@ mod tests {
         // R not evaluated (one run): a failed check, never an implied pass.
         // B̄ = −3 µm against 2 µm: |B̄| = 3 µm exceeds.
         let figures = AxisFigures {
-            a_mm: Some(0.007),
-            b_mean_mm: Some(-0.003),
+            a: Some(0.007),
+            b_mean: Some(-0.003),
             ..Default::default()
         };
         let evaluation = evaluation(100.0, 850.0, figures);
@@ -781,8 +781,8 @@ mod tests {
         // E = 11.96 µm, R = 3 µm over 1000 mm; a budget with U = 3.49 µm
         // (standards.md §4's U(E) to two decimals), applying to E, M, A only.
         let figures = AxisFigures {
-            e_mm: Some(0.011_96),
-            r_mm: Some(0.003),
+            e: Some(0.011_96),
+            r: Some(0.003),
             ..Default::default()
         };
         let evaluation = evaluation(0.0, 1000.0, figures);

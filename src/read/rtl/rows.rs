@@ -269,7 +269,7 @@ impl RtlParser {
                 direction,
                 number: numbers[slot],
                 start_time_s: None,
-                deviations_mm: rows.deviations_mm,
+                deviations: rows.deviations_mm,
             });
         }
         Ok(runs)

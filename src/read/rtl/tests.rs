@@ -69,15 +69,15 @@ fn composite_example_reads_with_directions_from_row_order() {
     let (m, warnings) = parse_ok(COMPOSITE);
     assert!(warnings.is_empty(), "{warnings:?}");
     assert_eq!(m.axis(), "X");
-    assert_eq!(m.targets_mm(), &[0.0, 50.0, 100.0]);
+    assert_eq!(m.targets(), &[0.0, 50.0, 100.0]);
     let runs = m.runs();
     assert_eq!((runs[0].direction, runs[0].number), (Direction::Up, 1));
     assert_eq!((runs[1].direction, runs[1].number), (Direction::Down, 1));
     // µm in the file, mm inside: 1.270 µm = 0.00127 mm.
-    assert_abs_diff_eq!(runs[0].deviations_mm[1].unwrap(), 0.00127, epsilon = 1e-12);
+    assert_abs_diff_eq!(runs[0].deviations[1].unwrap(), 0.00127, epsilon = 1e-12);
     // Run 2 lists target 1 last: keyed on the target column, not the row.
-    assert_abs_diff_eq!(runs[1].deviations_mm[0].unwrap(), -0.00006, epsilon = 1e-12);
-    assert_abs_diff_eq!(runs[1].deviations_mm[2].unwrap(), 0.00198, epsilon = 1e-12);
+    assert_abs_diff_eq!(runs[1].deviations[0].unwrap(), -0.00006, epsilon = 1e-12);
+    assert_abs_diff_eq!(runs[1].deviations[2].unwrap(), 0.00198, epsilon = 1e-12);
 }
 
 #[test]
@@ -127,19 +127,15 @@ fn leniencies_of_the_spec() {
                 EQUIPMENT::\nLaser : XL-80\nenvironment::\nair TEMP : 20 21\neof::\n";
     let (m, warnings) = parse_ok(text);
     assert_eq!(m.axis(), "Z");
-    assert_eq!(m.targets_mm(), &[-10.5, -5.25, 0.0, 10.0, 20.0, 30.0]);
+    assert_eq!(m.targets(), &[-10.5, -5.25, 0.0, 10.0, 20.0, 30.0]);
     // Run 1 visits −10.5, −5.25, 0, 10 mm: ↑. Run 2 visits 10, −10.5 mm: ↓.
     let up = &m.runs()[0];
     assert_eq!(up.direction, Direction::Up);
-    assert_abs_diff_eq!(up.deviations_mm[1].unwrap(), -0.00025, epsilon = 1e-12);
-    assert_abs_diff_eq!(up.deviations_mm[2].unwrap(), 0.0015, epsilon = 1e-12);
-    assert_eq!(up.deviations_mm[4], None);
+    assert_abs_diff_eq!(up.deviations[1].unwrap(), -0.00025, epsilon = 1e-12);
+    assert_abs_diff_eq!(up.deviations[2].unwrap(), 0.0015, epsilon = 1e-12);
+    assert_eq!(up.deviations[4], None);
     assert_eq!(m.runs()[1].direction, Direction::Down);
-    assert_abs_diff_eq!(
-        m.runs()[1].deviations_mm[0].unwrap(),
-        0.005,
-        epsilon = 1e-12
-    );
+    assert_abs_diff_eq!(m.runs()[1].deviations[0].unwrap(), 0.005, epsilon = 1e-12);
     assert_eq!(
         m.environment.air_temperature_c,
         StartEnd::new(Some(20.0), Some(21.0))
@@ -189,7 +185,7 @@ fn single_row_runs_fall_back_to_odd_up_even_down() {
 fn a_missing_pair_is_a_missing_reading_not_zero() {
     let text = COMPOSITE.replace("2   2      1.310\r\n", "");
     let (m, warnings) = parse_ok(&text);
-    assert_eq!(m.runs()[1].deviations_mm[1], None);
+    assert_eq!(m.runs()[1].deviations[1], None);
     assert!(matches!(
         warnings.as_slice(),
         [Warning::MissingReadings { count: 1, .. }]
@@ -201,15 +197,11 @@ fn descending_target_list_gives_physical_directions() {
     // Targets listed 100, 50, 0: a run visiting target numbers 1, 2, 3 moves −, so ↓.
     let text = COMPOSITE.replace("0.0000  50.0000  100.0000", "100  50  0");
     let (m, _) = parse_ok(&text);
-    assert_eq!(m.targets_mm(), &[0.0, 50.0, 100.0]);
+    assert_eq!(m.targets(), &[0.0, 50.0, 100.0]);
     assert_eq!(m.runs()[0].direction, Direction::Down);
     // File run 1, target number 2 (= 50 mm) is 1.270 µm.
-    assert_abs_diff_eq!(
-        m.runs()[0].deviations_mm[1].unwrap(),
-        0.00127,
-        epsilon = 1e-12
-    );
-    assert_abs_diff_eq!(m.runs()[0].deviations_mm[2].unwrap(), 0.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(m.runs()[0].deviations[1].unwrap(), 0.00127, epsilon = 1e-12);
+    assert_abs_diff_eq!(m.runs()[0].deviations[2].unwrap(), 0.0, epsilon = 1e-12);
 }
 
 /// Each bad variant of the composite example, with where and what the error must say.
@@ -355,7 +347,7 @@ fn write_then_parse_round_trips_the_composite() {
     let (m, _) = parse_ok(COMPOSITE);
     let (again, warnings) = parse_ok(&write(&m));
     assert!(warnings.is_empty(), "{warnings:?}");
-    assert_eq!(again.targets_mm(), m.targets_mm());
+    assert_eq!(again.targets(), m.targets());
     assert_eq!(again.runs(), m.runs());
     assert_eq!(again.axis(), m.axis());
     assert_eq!(again.environment, m.environment);
@@ -382,7 +374,7 @@ fn arbitrary_measurement() -> impl Strategy<Value = Measurement> {
                     direction,
                     number: number as u32,
                     start_time_s: None,
-                    deviations_mm: row.iter().map(|v| v.map(um_to_mm)).collect(),
+                    deviations: row.iter().map(|v| v.map(um_to_mm)).collect(),
                 });
             }
             Measurement::new(
@@ -402,14 +394,14 @@ proptest! {
     fn write_then_parse_gives_the_same_runs(m in arbitrary_measurement()) {
         let text = write(&m);
         let (again, _) = parse(&text).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
-        prop_assert_eq!(again.targets_mm(), m.targets_mm());
+        prop_assert_eq!(again.targets(), m.targets());
         prop_assert_eq!(again.runs().len(), m.runs().len());
         for (a, b) in again.runs().iter().zip(m.runs()) {
             // Runs with a single reading fall back to odd/even directions.
-            if b.deviations_mm.iter().flatten().count() > 1 {
+            if b.deviations.iter().flatten().count() > 1 {
                 prop_assert_eq!(a.direction, b.direction);
             }
-            for (x, y) in a.deviations_mm.iter().zip(&b.deviations_mm) {
+            for (x, y) in a.deviations.iter().zip(&b.deviations) {
                 prop_assert_eq!(x.is_some(), y.is_some());
                 if let (Some(x), Some(y)) = (x, y) {
                     prop_assert!((x - y).abs() <= 1e-15 * y.abs().max(1.0));

@@ -27,9 +27,9 @@ pub fn write(measurement: &Measurement) -> String {
     line("");
     line("TARGET DATA::");
     line("Filetype  : ISO");
-    line(&format!("Target-count: {}", measurement.targets_mm().len()));
+    line(&format!("Target-count: {}", measurement.targets().len()));
     line("Targets :");
-    for chunk in measurement.targets_mm().chunks(5) {
+    for chunk in measurement.targets().chunks(5) {
         let texts: Vec<String> = chunk.iter().map(|t| format!("{t}")).collect();
         line(&texts.join("  "));
     }
@@ -66,11 +66,11 @@ pub fn write(measurement: &Measurement) -> String {
     line("Run Target Data:");
     for (run_index, run) in measurement.runs().iter().enumerate() {
         let order: Vec<usize> = match run.direction {
-            Direction::Up => (0..measurement.targets_mm().len()).collect(),
-            Direction::Down => (0..measurement.targets_mm().len()).rev().collect(),
+            Direction::Up => (0..measurement.targets().len()).collect(),
+            Direction::Down => (0..measurement.targets().len()).rev().collect(),
         };
         for target_index in order {
-            if let Some(deviation_mm) = run.deviations_mm[target_index] {
+            if let Some(deviation_mm) = run.deviations[target_index] {
                 line(&format!(
                     "{:<3} {:<6} {}",
                     run_index + 1,

@@ -125,7 +125,7 @@ pub(super) fn test_rows(tests: &[(&str, &TestRecord<'_>)]) -> Vec<Row> {
             )))
         }),
         wide_row(tests, "Targets", position_unit(tests), &|t| {
-            let targets = t.measurement.targets_mm();
+            let targets = t.measurement.targets();
             text(Some(format!(
                 "{} from {} to {}",
                 targets.len(),

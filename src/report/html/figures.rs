@@ -132,7 +132,7 @@ pub(super) fn figures(input: &ReportInput<'_>) -> Figures {
                             .standard_figures
                             .iter()
                             .find(|f| f.key == figure.key)
-                            .and_then(|f| f.value_mm);
+                            .and_then(|f| f.value);
                         Some(SourcedUm::new(
                             format!("{prefix}.figures_um.{}", figure.key),
                             value.map(mm_to_um),

@@ -99,7 +99,7 @@ pub(super) fn source_line(measurement: &Measurement) -> SourceLine {
             AxisKind::Linear => metadata.length_unit.as_str(),
             AxisKind::Rotary => "°",
         },
-        targets: measurement.targets_mm().len(),
+        targets: measurement.targets().len(),
         runs_up: measurement.run_count(Direction::Up),
         runs_down: measurement.run_count(Direction::Down),
     }

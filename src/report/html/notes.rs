@@ -40,10 +40,10 @@ pub(super) fn notes(input: &ReportInput<'_>) -> Vec<Note> {
                     score: format!("{:.1}", outlier.score),
                     offset_um: signed_plus(
                         deviation_shown(record.measurement, input.angle)
-                            .from_internal(outlier.offset_mm),
+                            .from_internal(outlier.offset),
                         2,
                     ),
-                    worst_target_mm: outlier.worst_target_mm,
+                    worst_target_mm: outlier.worst_target,
                 },
             });
         }

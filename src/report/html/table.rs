@@ -49,7 +49,7 @@ pub(super) fn table_view(
                 .filter(|f| !iso_family || ["A", "E", "B"].contains(&f.key))
                 .map(|f| {
                     let key = format!("prediction.figures_um.{}", f.key);
-                    (f.key, SourcedUm::new(key, f.value_mm.map(mm_to_um)))
+                    (f.key, SourcedUm::new(key, f.value.map(mm_to_um)))
                 })
                 .collect(),
             plot: plot("predicted"),
