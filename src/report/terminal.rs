@@ -421,7 +421,7 @@ mod tests {
             direction,
             number,
             start_time_s: None,
-            deviations_mm: deviations_mm.to_vec(),
+            deviations: deviations_mm.to_vec(),
         }
     }
 
