@@ -373,7 +373,7 @@ fn summary(s: &Summary<'_>) -> String {
         out,
         " 2 tables        {} tables for iTNC 530, TNC 640, Sinumerik 840D, LinuxCNC, Fagor 8055: {} points (tables/; Fagor 8065 and Fanuc: convert --existing updates the control's own file)",
         s.table.values.mode().as_str(),
-        s.table.positions_mm.len()
+        s.table.positions.len()
     );
     let _ = writeln!(
         out,

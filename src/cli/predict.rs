@@ -215,7 +215,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         doubts.extend(check_together(
             Pairing::TableOnTest,
             &Input::measurement(measurement, test_name),
-            &Input::table(&table.axis, &table.positions_mm, format!("--table {spec}")),
+            &Input::table(&table.axis, &table.positions, format!("--table {spec}")),
         )?);
     }
     print_warnings(&doubts, args.verbosity.quiet);

@@ -50,10 +50,11 @@ impl CrossAxisTable {
             table_axis: table_axis.to_string(),
             table: CompensationTable {
                 axis: column_axis.to_string(),
-                positions_mm,
+                kind: crate::measurement::AxisKind::Linear,
+                positions: positions_mm,
                 values: TableValues::Mean(values),
-                reference_mm,
-                suggested_backlash_mm: None,
+                reference: reference_mm,
+                suggested_backlash: None,
             },
         }
     }

@@ -65,14 +65,14 @@ pub fn build_table_with_effects(
     } else {
         build_table(measurement, evaluation, options)?
     };
-    let reference = table.reference_mm;
+    let reference = table.reference;
     // What the effects add at a point, relative to the reference, mm.
     let added = |p: f64| {
         um_to_mm(
             periodic_um(p) - periodic_um(reference) - per_m_over_mm(scale_um_per_m, p - reference),
         )
     };
-    let positions = table.positions_mm.clone();
+    let positions = table.positions.clone();
     table.values = table.values.map(|column| {
         column
             .iter()

@@ -44,7 +44,7 @@ pub mod update;
 
 use crate::evaluate::Evaluation;
 use crate::evaluate::conformance::FULL_TURN_DEG;
-use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError};
+use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError, Position};
 
 /// How many standard errors B̄ must be from zero to count as a measured
 /// reversal: at 3σ a reversal-free axis passes for one in 0.3 % of tests.
@@ -197,46 +197,89 @@ impl TableValues {
 }
 
 /// A compensation table in axcomp's convention (see the module doc).
+///
+/// Its numbers are bare `f64`s in the unit of its axis' [`AxisKind`]: mm on a
+/// linear axis, degrees on a rotary one. They leave the table typed through
+/// [`CompensationTable::positions_typed`] and its siblings ([`Position`]:
+/// `Mm` or `Deg`), so a degree cannot be taken for a millimetre:
+/// ```compile_fail
+/// # use axcomp::compensate::{CompensationTable, TableValues};
+/// # use axcomp::measurement::AxisKind;
+/// use axcomp::units::Mm;
+/// let table = CompensationTable {
+///     axis: "C".into(),
+///     kind: AxisKind::Rotary,
+///     positions: vec![0.0, 90.0],
+///     values: TableValues::Mean(vec![0.0, 0.001]),
+///     reference: 0.0,
+///     suggested_backlash: None,
+/// };
+/// let start: Mm = table.reference_typed();
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompensationTable {
     /// The compensated axis.
     pub axis: String,
-    /// Compensation points, mm, strictly increasing.
-    pub positions_mm: Vec<f64>,
-    /// Axis error at each point, mm, zero at the reference.
+    /// Linear or rotary: the unit of every number below (mm or °).
+    pub kind: AxisKind,
+    /// Compensation points, in the axis' unit, strictly increasing.
+    pub positions: Vec<f64>,
+    /// Axis error at each point, in the axis' unit, zero at the reference.
     pub values: TableValues,
-    /// Where the table is zero, mm.
-    pub reference_mm: f64,
-    /// Suggested backlash parameter, mm (mean mode): −B̄, positive for the usual
-    /// lost motion (the axis falls short in the direction it moves).
-    pub suggested_backlash_mm: Option<f64>,
+    /// Where the table is zero, in the axis' unit.
+    pub reference: f64,
+    /// Suggested backlash parameter, in the axis' unit (mean mode): −B̄,
+    /// positive for the usual lost motion (the axis falls short in the
+    /// direction it moves).
+    pub suggested_backlash: Option<f64>,
 }
 
 impl CompensationTable {
-    /// The axis error the table holds at `position_mm` when moving in
-    /// `direction`, as controllers apply tables: linear between points, the
-    /// end values held outside (Siemens K3 §4.4, LinuxCNC `control.c`,
-    /// Heidenhain).
-    pub fn value_at(&self, position_mm: f64, direction: Direction) -> f64 {
+    /// The axis error the table holds at `position` (in the axis' unit) when
+    /// moving in `direction`, as controllers apply tables: linear between
+    /// points, the end values held outside (Siemens K3 §4.4, LinuxCNC
+    /// `control.c`, Heidenhain).
+    pub fn value_at(&self, position: f64, direction: Direction) -> f64 {
         interpolate_hold(
-            &self.positions_mm,
+            &self.positions,
             self.values.for_direction(direction),
-            position_mm,
+            position,
         )
     }
 
-    /// The spacing if the points are evenly spaced (within 1 nm), else `None`.
-    pub fn regular_step_mm(&self) -> Option<f64> {
-        regular_step(&self.positions_mm)
+    /// The spacing in the axis' unit if the points are evenly spaced (within
+    /// 1 nm), else `None`.
+    pub fn regular_step(&self) -> Option<f64> {
+        regular_step(&self.positions)
     }
 
-    /// The largest |value| of the table, mm.
-    pub fn max_abs_mm(&self) -> f64 {
+    /// The largest |value| of the table, in the axis' unit.
+    pub fn max_abs(&self) -> f64 {
         let all = match &self.values {
             TableValues::Mean(values) => values.clone(),
             TableValues::Bidirectional { up, down } => up.iter().chain(down).copied().collect(),
         };
         all.iter().fold(0.0, |max: f64, v| max.max(v.abs()))
+    }
+
+    /// The compensation points, typed by the axis' kind (`Mm` or `Deg`).
+    pub fn positions_typed(&self) -> impl Iterator<Item = Position> + '_ {
+        self.positions.iter().map(|&p| self.kind.position(p))
+    }
+
+    /// Where the table is zero, typed by the axis' kind.
+    pub fn reference_typed(&self) -> Position {
+        self.kind.position(self.reference)
+    }
+
+    /// The spacing of evenly spaced points, typed by the axis' kind.
+    pub fn regular_step_typed(&self) -> Option<Position> {
+        self.regular_step().map(|step| self.kind.position(step))
+    }
+
+    /// The suggested backlash parameter, typed by the axis' kind.
+    pub fn suggested_backlash_typed(&self) -> Option<Position> {
+        self.suggested_backlash.map(|b| self.kind.position(b))
     }
 }
 
@@ -390,7 +433,8 @@ fn join_full_turn(curve: (Vec<f64>, Vec<f64>), kind: AxisKind) -> (Vec<f64>, Vec
 /// use axcomp::compensate::{build_table, Extrapolate, GridSpec, TableMode, TableOptions, TableValues};
 /// use axcomp::evaluate::evaluate;
 /// use axcomp::read::parse_str;
-/// use axcomp::measurement::SourceFormat;
+/// use axcomp::measurement::{ByKind, SourceFormat};
+/// use axcomp::units::Mm;
 /// let csv = "target_mm,run,direction,deviation_um\n0,1,up,1\n100,1,up,-2\n0,1,down,3\n100,1,down,0\n";
 /// let (m, _) = parse_str(csv, SourceFormat::Csv).unwrap();
 /// let options = TableOptions { mode: TableMode::Mean, grid: GridSpec::Targets,
@@ -399,7 +443,11 @@ fn join_full_turn(curve: (Vec<f64>, Vec<f64>), kind: AxisKind) -> (Vec<f64>, Vec
 /// // x̄ = 2, −1 µm; shifted to zero at 0 mm: 0, −3 µm.
 /// assert_eq!(table.values, TableValues::Mean(vec![0.0, -0.003]));
 /// // −B̄ = mean(x̄↓ − x̄↑) = mean(2, 2) µm.
-/// assert!((table.suggested_backlash_mm.unwrap() - 0.002).abs() < 1e-15);
+/// // A linear axis' table: its numbers leave it as millimetres.
+/// let Some(ByKind::Linear(Mm(backlash_mm))) = table.suggested_backlash_typed() else {
+///     panic!("a linear axis' backlash is in mm")
+/// };
+/// assert!((backlash_mm - 0.002).abs() < 1e-15);
 /// ```
 pub fn build_table(
     measurement: &Measurement,
@@ -460,10 +508,11 @@ pub fn build_table(
     );
     Ok(CompensationTable {
         axis: measurement.axis().to_string(),
-        positions_mm,
+        kind,
+        positions: positions_mm,
         values,
-        reference_mm,
-        suggested_backlash_mm,
+        reference: reference_mm,
+        suggested_backlash: suggested_backlash_mm,
     })
 }
 

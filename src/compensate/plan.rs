@@ -152,7 +152,7 @@ fn check_update_grid(
     positions.extend(
         update
             .existing
-            .positions_mm
+            .positions
             .iter()
             .filter(|&&p| p < first - 1e-9 || p > last + 1e-9),
     );
@@ -161,7 +161,7 @@ fn check_update_grid(
     if regular_step(&positions).is_some() {
         return Ok(());
     }
-    let old = &update.existing.positions_mm;
+    let old = &update.existing.positions;
     Err(CompensateError::Grid(format!(
         "the update keeps the existing table's points outside the measured range {first} … {last} mm, and with them the points are unevenly spaced, which {} cannot take: put the new points on the existing table's grid ({} points from {} to {} mm; --start, --step, --count)",
         controller.name,
@@ -421,10 +421,11 @@ mod tests {
     fn existing() -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![-100.0, 0.0, 250.0, 600.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![-100.0, 0.0, 250.0, 600.0],
             values: crate::compensate::TableValues::Mean(vec![0.01, 0.0, 0.002, 0.003]),
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         }
     }
 
@@ -444,7 +445,7 @@ mod tests {
         assert_eq!(update.update.unwrap().measured_mm, (0.0, 500.0));
         // A zero the test did not measure cannot refer the update.
         let mut shifted = existing();
-        shifted.reference_mm = 600.0;
+        shifted.reference = 600.0;
         let context = PlanContext {
             only_direction: None,
             existing: Some(&shifted),

@@ -266,10 +266,11 @@ mod tests {
     fn mean_table(positions_mm: Vec<f64>, values_mm: Vec<f64>) -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            positions_mm,
+            kind: crate::measurement::AxisKind::Linear,
+            positions: positions_mm,
             values: TableValues::Mean(values_mm),
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         }
     }
 

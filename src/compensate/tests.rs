@@ -74,14 +74,14 @@ fn mean_curve_interpolated_onto_a_grid_by_hand() {
         Extrapolate::Refuse,
     )
     .unwrap();
-    assert_eq!(table.positions_mm, vec![0.0, 25.0, 50.0, 75.0, 100.0]);
+    assert_eq!(table.positions, vec![0.0, 25.0, 50.0, 75.0, 100.0]);
     let TableValues::Mean(values) = &table.values else {
         panic!("mean mode gives one column")
     };
     assert_um(values, &[0.0, 3.75, 5.5, 4.25, 3.0]);
-    assert_eq!(table.reference_mm, 0.0);
+    assert_eq!(table.reference, 0.0);
     // B_i = 2, 4, 2 µm: B̄ = 8/3 µm, suggested backlash −B̄.
-    assert!((table.suggested_backlash_mm.unwrap() * 1000.0 + 8.0 / 3.0).abs() < 1e-9);
+    assert!((table.suggested_backlash.unwrap() * 1000.0 + 8.0 / 3.0).abs() < 1e-9);
 }
 
 #[test]
@@ -160,7 +160,7 @@ fn bidirectional_keeps_the_reversal_and_centres_the_reference() {
         table.values.for_direction(Direction::Down),
         &[-1.0, 4.0, 2.0],
     );
-    assert_eq!(table.suggested_backlash_mm, None);
+    assert_eq!(table.suggested_backlash, None);
     let at_40 = build(
         &m,
         TableMode::Bidirectional,
@@ -192,7 +192,7 @@ fn unidirectional_tests() {
     .unwrap();
     assert_um(mean.values.for_direction(Direction::Up), &[0.0, 7.0, 3.0]);
     assert_eq!(
-        mean.suggested_backlash_mm, None,
+        mean.suggested_backlash, None,
         "no reversal measured, no backlash suggested"
     );
     let both = build(
@@ -239,13 +239,14 @@ fn existing_table_is_added_back_per_direction() {
     let m = measurement([0.0, 1.0, -1.0], Some([0.0, 1.0, -1.0]));
     let active = CompensationTable {
         axis: "X".into(),
-        positions_mm: vec![0.0, 50.0, 100.0],
+        kind: crate::measurement::AxisKind::Linear,
+        positions: vec![0.0, 50.0, 100.0],
         values: TableValues::Bidirectional {
             up: vec![0.0, 0.010, 0.020],
             down: vec![0.0, 0.012, 0.022],
         },
-        reference_mm: 0.0,
-        suggested_backlash_mm: None,
+        reference: 0.0,
+        suggested_backlash: None,
     };
     let raw = add_existing_table(&m, &active).unwrap();
     assert_um(
@@ -296,4 +297,41 @@ proptest! {
         let (lo, hi) = if x < xs[0] { (ys[0], ys[0]) } else if x > xs[xs.len() - 1] { (ys[ys.len() - 1], ys[ys.len() - 1]) } else { (lo, hi) };
         prop_assert!(v >= lo - 1e-15 && v <= hi + 1e-15);
     }
+}
+
+#[test]
+fn a_table_carries_its_axis_kind_and_types_its_numbers_by_it() {
+    use crate::measurement::ByKind;
+    use crate::units::{Deg, Mm};
+    // The same numbers as a linear X (mm) and as a rotary C (°): x̄ = 1.5,
+    // 0, 1 (×10⁻³); −B̄ = mean(x̄↓ − x̄↑) = mean(1, −2, 2)·10⁻³ = 1/3·10⁻³.
+    let linear = measurement([1.0, 1.0, 0.0], Some([2.0, -1.0, 2.0]));
+    let rotary = linear.clone().with_kind(AxisKind::Rotary);
+    let mean = |m: &Measurement| {
+        build(
+            m,
+            TableMode::Mean,
+            GridSpec::Targets,
+            None,
+            Extrapolate::Refuse,
+        )
+        .unwrap()
+    };
+    let (x, c) = (mean(&linear), mean(&rotary));
+    assert_eq!((x.kind, c.kind), (AxisKind::Linear, AxisKind::Rotary));
+    assert_eq!(
+        c.positions_typed().collect::<Vec<_>>(),
+        [0.0, 40.0, 100.0].map(|p| ByKind::Rotary(Deg(p)))
+    );
+    assert_eq!(x.reference_typed(), ByKind::Linear(Mm(0.0)));
+    assert_eq!(c.reference_typed(), ByKind::Rotary(Deg(0.0)));
+    assert_eq!(c.regular_step_typed(), None);
+    let Some(ByKind::Rotary(Deg(backlash))) = c.suggested_backlash_typed() else {
+        panic!("a rotary axis' backlash is in degrees");
+    };
+    assert!((backlash - 1.0 / 3000.0).abs() < 1e-15);
+    assert!(matches!(
+        x.suggested_backlash_typed(),
+        Some(ByKind::Linear(Mm(_)))
+    ));
 }

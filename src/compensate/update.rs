@@ -77,7 +77,7 @@ impl UpdatePlan {
         given_reference_mm: Option<f64>,
     ) -> Result<UpdatePlan, CompensateError> {
         let measured_mm = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
-        let reference_mm = given_reference_mm.unwrap_or(existing.reference_mm);
+        let reference_mm = given_reference_mm.unwrap_or(existing.reference);
         if reference_mm < measured_mm.0 - 1e-9 || reference_mm > measured_mm.1 + 1e-9 {
             return Err(CompensateError::UpdateReference {
                 reference_mm,
@@ -119,7 +119,7 @@ impl UpdatePlan {
         // (position, ↑, ↓) of every point of the updated table.
         let mut rows: Vec<(f64, f64, f64)> = Vec::new();
         let mut updated = 0;
-        for (index, &p) in new.positions_mm.iter().enumerate() {
+        for (index, &p) in new.positions.iter().enumerate() {
             let value = |d: Direction| {
                 if self.inside(p) {
                     new.values.for_direction(d)[index] + at_reference
@@ -132,11 +132,8 @@ impl UpdatePlan {
         }
         let mut kept = Vec::new();
         let mut dropped_mm = Vec::new();
-        for (index, &p) in old.positions_mm.iter().enumerate() {
-            let on_new_grid = new
-                .positions_mm
-                .iter()
-                .any(|q| (q - p).abs() < SAME_POINT_MM);
+        for (index, &p) in old.positions.iter().enumerate() {
+            let on_new_grid = new.positions.iter().any(|q| (q - p).abs() < SAME_POINT_MM);
             if self.inside(p) {
                 if !on_new_grid {
                     dropped_mm.push(p);
@@ -152,9 +149,7 @@ impl UpdatePlan {
                 None => rows.push((p, value(Direction::Up), value(Direction::Down))),
             }
             match kept.last_mut() {
-                Some(KeptRange { last_mm, count, .. })
-                    if old.positions_mm[index - 1] == *last_mm =>
-                {
+                Some(KeptRange { last_mm, count, .. }) if old.positions[index - 1] == *last_mm => {
                     *last_mm = p;
                     *count += 1;
                 }
@@ -167,14 +162,10 @@ impl UpdatePlan {
         }
         rows.sort_by(|a, b| a.0.total_cmp(&b.0));
         let added_mm = new
-            .positions_mm
+            .positions
             .iter()
             .copied()
-            .filter(|p| {
-                !old.positions_mm
-                    .iter()
-                    .any(|q| (q - p).abs() < SAME_POINT_MM)
-            })
+            .filter(|p| !old.positions.iter().any(|q| (q - p).abs() < SAME_POINT_MM))
             .collect();
         let positions_mm: Vec<f64> = rows.iter().map(|r| r.0).collect();
         let up: Vec<f64> = rows.iter().map(|r| r.1).collect();
@@ -187,14 +178,14 @@ impl UpdatePlan {
             TableValues::Mean(up)
         };
         let table = CompensationTable {
-            positions_mm,
+            positions: positions_mm,
             values,
-            reference_mm: self.reference_mm,
+            reference: self.reference_mm,
             ..new
         };
         let summary = UpdateSummary {
             kept_points_mm: old
-                .positions_mm
+                .positions
                 .iter()
                 .copied()
                 .filter(|&p| !self.inside(p))
@@ -219,10 +210,11 @@ mod tests {
     fn table(positions_mm: Vec<f64>, values: TableValues) -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            positions_mm,
+            kind: crate::measurement::AxisKind::Linear,
+            positions: positions_mm,
             values,
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         }
     }
 
@@ -242,7 +234,7 @@ mod tests {
         );
         let (merged, summary) = update.apply(new);
         assert_eq!(
-            merged.positions_mm,
+            merged.positions,
             vec![-200.0, -100.0, 0.0, 100.0, 200.0, 300.0, 400.0]
         );
         assert_eq!(

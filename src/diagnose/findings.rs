@@ -30,7 +30,7 @@ pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context 
     Context {
         kind: input.after.kind(),
         angle: input.angle,
-        table_step_mm: input.table.and_then(CompensationTable::regular_step_mm),
+        table_step_mm: input.table.and_then(CompensationTable::regular_step),
         target_spacing_mm: crate::compensate::regular_step(input.after.targets()),
         expansion_coefficient_ppm_per_k: input.after.environment.expansion_coefficient_ppm_per_k,
         material_change_k,

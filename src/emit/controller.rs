@@ -149,7 +149,7 @@ impl Controller {
     /// What to do on this controller with the reversal a mean table leaves:
     /// the backlash parameter to set, in the controller's own name, unit,
     /// resolution and sign, or why there is none. `backlash_mm` is the
-    /// suggested backlash −B̄ (`CompensationTable::suggested_backlash_mm`),
+    /// suggested backlash −B̄ (`CompensationTable::suggested_backlash`),
     /// positive for the usual lost motion; the knowledge of each parameter
     /// lives in its controller's file.
     pub fn backlash_parameter(self, backlash_mm: f64, options: &EmitOptions) -> BacklashAdvice {

@@ -8,7 +8,8 @@ use crate::compensate::CompensationTable;
 use crate::error::ParseError;
 
 /// Reads a table written by any supported controller format, detected from
-/// the content: the table of `options.axes[0]`, in machine units
+/// the content: the table of `options.axes[0]`, of an axis of
+/// `options.kind` (its numbers in mm, or ° on a rotary axis), in machine units
 /// `options.machine_unit` (LinuxCNC) and with the profile's CEC sign.
 /// `linuxcnc_type` must be given for LinuxCNC files whose type the numbers
 /// do not tell.
@@ -59,6 +60,8 @@ pub fn read_any(
         }
     };
     table.axis = axis.axis.clone();
+    // A file does not say whether its numbers are mm or degrees: the axis does.
+    table.kind = options.kind;
     Ok((controller, table))
 }
 

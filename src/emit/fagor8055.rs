@@ -48,7 +48,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     let (positive, negative) = fagor::columns_mm(table);
     let number = |mm: f64| fagor::fixed(unit.from_mm(mm), places);
     let mut out = String::new();
-    for (index, position_mm) in table.positions_mm.iter().enumerate() {
+    for (index, position_mm) in table.positions.iter().enumerate() {
         out.push_str(&format!(
             "      {:<14}{axis}{:>11}{:>9}{:>11}{:>10}{:>11}\r\n",
             format!("P{:04}", index + 1),
@@ -246,7 +246,7 @@ mod tests {
         // −0.00127 in = −0.032258 mm.
         let text = "      P001          X    0.00000       EX    0.00000        EX    0.00000\n      P002          X    5.00000       EX   -0.00127        EX    0.00000\n      P003          X   10.00000       EX   -0.00276        EX    0.00000\n";
         let table = read(text, "X", LengthUnit::Inch).unwrap();
-        assert_eq!(table.positions_mm, vec![0.0, 127.0, 254.0]);
+        assert_eq!(table.positions, vec![0.0, 127.0, 254.0]);
         let TableValues::Mean(values) = &table.values else {
             panic!("a zero negative column is a mean table")
         };
@@ -265,13 +265,14 @@ mod tests {
     fn bidirectional_tables_use_both_columns() {
         let table = CompensationTable {
             axis: "Y".into(),
-            positions_mm: vec![-100.0, 0.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![-100.0, 0.0],
             values: TableValues::Bidirectional {
                 up: vec![0.0123, 0.0],
                 down: vec![0.0223, 0.001],
             },
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         };
         let text = write(&table, &options("Y", LengthUnit::Millimetre)).unwrap();
         assert_eq!(

@@ -79,7 +79,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
             "Parameter", "Value"
         ),
         parameter("2", "/LSCRWCOMP", "1", Some("Yes")),
-        parameter("2", NPOINTS, &table.positions_mm.len().to_string(), None),
+        parameter("2", NPOINTS, &table.positions.len().to_string(), None),
         parameter("2", "/LSCRWDATA/TYPCROSS", "1", Some("Theoretical")),
         parameter(
             "2",
@@ -146,7 +146,7 @@ pub fn update(existing: &str, table: &CompensationTable) -> Result<String, EmitE
             key if key == NPOINTS => {
                 out.push_str(&replace_cells(
                     content,
-                    &table.positions_mm.len().to_string(),
+                    &table.positions.len().to_string(),
                     None,
                 ));
             }
@@ -221,10 +221,7 @@ fn data_lines(level: &str, table: &CompensationTable) -> Vec<String> {
     let (positive, negative) = fagor::columns_mm(table);
     let mm = |value: f64| fagor::fixed(value, DECIMALS);
     let mut lines = Vec::with_capacity(3 * positive.len());
-    for (list, values) in LISTS
-        .iter()
-        .zip([&table.positions_mm, &positive, &negative])
-    {
+    for (list, values) in LISTS.iter().zip([&table.positions, &positive, &negative]) {
         for (index, value) in values.iter().enumerate() {
             let path = format!("{DATA}{list} {}", index + 1);
             lines.push(parameter(level, &path, &mm(*value), None));
@@ -415,9 +412,9 @@ mod tests {
     #[test]
     fn a_fragment_reads_by_hand() {
         let table = read(FRAGMENT, "X").unwrap();
-        assert_eq!(table.positions_mm, vec![-127.0, 0.0, 127.0]);
+        assert_eq!(table.positions, vec![-127.0, 0.0, 127.0]);
         assert_eq!(table.values, TableValues::Mean(vec![-0.0127, 0.0, 0.0028]));
-        assert_eq!(table.reference_mm, 0.0);
+        assert_eq!(table.reference, 0.0);
         assert!(
             read(FRAGMENT, "Y")
                 .unwrap_err()
@@ -430,13 +427,14 @@ mod tests {
     fn an_update_changes_only_the_table_lines() {
         let table = CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![0.0, 127.0, 254.0, 381.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 127.0, 254.0, 381.0],
             values: TableValues::Bidirectional {
                 up: vec![0.0, 0.001, 0.002, 0.003],
                 down: vec![0.0005, 0.0015, 0.0025, -0.00001],
             },
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         };
         let updated = update(FRAGMENT, &table).unwrap();
         let lines: Vec<&str> = updated.split("\r\n").collect();

@@ -32,7 +32,7 @@ const DECIMALS: usize = 4;
 
 /// Writes the `.COM` table (regular spacing and zero at the datum checked by `emit::check_table`).
 pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String, EmitError> {
-    let step = table.regular_step_mm().ok_or(EmitError::UnevenSpacing {
+    let step = table.regular_step().ok_or(EmitError::UnevenSpacing {
         controller: "itnc530",
     })?;
     let columns: Vec<u32> = options.axes.iter().map(|a| a.itnc530_column).collect();
@@ -50,7 +50,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     line(format!(
         "BEGIN {}  DATUM:{} DISTANCE:{}",
         options.table_name,
-        signed_fixed(table.positions_mm[0], DECIMALS),
+        signed_fixed(table.positions[0], DECIMALS),
         signed_fixed(step, DECIMALS)
     ));
     let mut header = format!("{:<NR_WIDTH$}{:<POSITION_WIDTH$}", "NR", "");
@@ -59,7 +59,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     }
     line(header);
     let values = table.values.for_direction(Direction::Up);
-    for (index, (position, value)) in table.positions_mm.iter().zip(values).enumerate() {
+    for (index, (position, value)) in table.positions.iter().zip(values).enumerate() {
         let mut row = format!(
             "{index:<NR_WIDTH$}{:<POSITION_WIDTH$}",
             signed_fixed(*position, DECIMALS)
@@ -162,10 +162,11 @@ pub fn read(input: &str, column: u32) -> Result<CompensationTable, ParseError> {
     }
     Ok(CompensationTable {
         axis: String::new(),
-        reference_mm: positions_mm[0],
-        positions_mm,
+        kind: crate::measurement::AxisKind::Linear,
+        reference: positions_mm[0],
+        positions: positions_mm,
         values: TableValues::Mean(values),
-        suggested_backlash_mm: None,
+        suggested_backlash: None,
     })
 }
 
@@ -224,10 +225,11 @@ mod tests {
     fn table() -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![0.0, 100.0, 200.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 100.0, 200.0],
             values: TableValues::Mean(vec![0.0, -0.0023, -0.0042]),
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         }
     }
 
@@ -244,8 +246,8 @@ mod tests {
         assert_eq!(lines[5], "[END]");
         let back = read(&text, 1).unwrap();
         assert_eq!(
-            (back.positions_mm, back.values),
-            (table().positions_mm, table().values)
+            (back.positions, back.values),
+            (table().positions, table().values)
         );
     }
 

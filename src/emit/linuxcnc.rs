@@ -48,7 +48,7 @@ pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String,
     let rounded = |mm: f64| (unit.from_mm(mm) * scale).round() / scale;
     let text = |value: f64| minimal(value, places);
     let mut out = String::new();
-    for (index, &position_mm) in table.positions_mm.iter().enumerate() {
+    for (index, &position_mm) in table.positions.iter().enumerate() {
         let nominal = rounded(position_mm);
         let error = |d: Direction| rounded(table.values.for_direction(d)[index]);
         let (forward, reverse) = match options.linuxcnc_type {
@@ -238,13 +238,14 @@ mod tests {
     fn table() -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![0.0, 100.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 100.0],
             values: TableValues::Bidirectional {
                 up: vec![0.0, 0.010],
                 down: vec![0.0, -0.010],
             },
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         }
     }
 
@@ -304,7 +305,7 @@ mod tests {
         let mut inch = options(0);
         inch.machine_unit = LengthUnit::Inch;
         let t = CompensationTable {
-            positions_mm: vec![0.0, 25.4],
+            positions: vec![0.0, 25.4],
             values: TableValues::Mean(vec![0.0, 0.00254]),
             ..table()
         };

@@ -116,8 +116,7 @@ impl EmitOptions {
     /// Whether the table is a rotary axis' full turn from 0° to 360°, which
     /// a Sinumerik writes as a modulo table.
     pub fn is_full_turn(&self, table: &CompensationTable) -> bool {
-        let (Some(first), Some(last)) = (table.positions_mm.first(), table.positions_mm.last())
-        else {
+        let (Some(first), Some(last)) = (table.positions.first(), table.positions.last()) else {
             return false;
         };
         self.kind == AxisKind::Rotary && (last - first - FULL_TURN_DEG).abs() < 1e-9
@@ -254,11 +253,11 @@ fn check_read_back(
         ))
     })?;
     let tolerance_mm = resolution_mm(controller, options.file_unit()) / 2.0 + 1e-12;
-    let same_points = back.positions_mm.len() == table.positions_mm.len()
+    let same_points = back.positions.len() == table.positions.len()
         && back
-            .positions_mm
+            .positions
             .iter()
-            .zip(&table.positions_mm)
+            .zip(&table.positions)
             .all(|(a, b)| (a - b).abs() <= tolerance_mm);
     let same_values = crate::measurement::Direction::BOTH.iter().all(|d| {
         back.values
@@ -383,7 +382,9 @@ pub fn cross_axis_values(controller: Controller, options: &EmitOptions) -> Cross
 
 /// A table as a controller file holds it: `values` at `positions_mm`, its
 /// reference the first point where it is zero (else the first point), no
-/// backlash suggestion. Every reader returns its table through this.
+/// backlash suggestion, of a linear axis until [`read_any`] gives it the
+/// axis' kind (a file does not tell mm from degrees). Every reader returns
+/// its table through this.
 pub(crate) fn table_as_read(
     axis: &str,
     positions_mm: Vec<f64>,
@@ -392,10 +393,11 @@ pub(crate) fn table_as_read(
     let reference_mm = reference_of(&positions_mm, &values);
     CompensationTable {
         axis: axis.to_string(),
-        positions_mm,
+        kind: crate::measurement::AxisKind::Linear,
+        positions: positions_mm,
         values,
-        reference_mm,
-        suggested_backlash_mm: None,
+        reference: reference_mm,
+        suggested_backlash: None,
     }
 }
 
@@ -500,10 +502,11 @@ mod tests {
                     };
                     let table = CompensationTable {
                         axis: "X".into(),
-                        positions_mm,
+                        kind: crate::measurement::AxisKind::Linear,
+                        positions: positions_mm,
                         values,
-                        reference_mm: start,
-                        suggested_backlash_mm: None,
+                        reference: start,
+                        suggested_backlash: None,
                     };
                     (table, both)
                 })
@@ -514,10 +517,11 @@ mod tests {
     fn a_step_the_format_would_round_is_refused() {
         let table = CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![0.0, 31.70933479667853, 63.41866959335706],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 31.70933479667853, 63.41866959335706],
             values: TableValues::Mean(vec![0.0, 0.001, 0.002]),
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         };
         let error = write(
             Controller::Itnc530,
@@ -547,13 +551,14 @@ mod tests {
         // 14-character column when written.
         let table = CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![0.0, 58.557, 1.0055e28],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 58.557, 1.0055e28],
             values: TableValues::Bidirectional {
                 up: vec![0.0014, 0.0031, 0.0013],
                 down: vec![-0.0014, -0.0003, 0.0],
             },
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         };
         let options = options(Controller::Tnc640, LengthUnit::Millimetre);
         let error = write(Controller::Tnc640, &table, &options).unwrap_err();
@@ -562,7 +567,7 @@ mod tests {
             "compensation point 10055000000000000000000000000 mm is beyond the tnc640 position range of ±99999.9999 mm"
         );
         let mut near = table.clone();
-        near.positions_mm[2] = 99_999.999_9;
+        near.positions[2] = 99_999.999_9;
         let text = write(Controller::Tnc640, &near, &options).unwrap();
         assert!(text.contains("+99999.9999"), "{text}");
     }
@@ -573,10 +578,11 @@ mod tests {
         // value lost its last digits in the double.
         let mut table = CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![0.0, 8e17],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 8e17],
             values: TableValues::Mean(vec![0.0, 0.001]),
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         };
         let options = options(Controller::LinuxCnc, LengthUnit::Millimetre);
         let error = write(Controller::LinuxCnc, &table, &options).unwrap_err();
@@ -585,7 +591,7 @@ mod tests {
             "compensation point 800000000000000000 mm is beyond the linuxcnc position range of ±1000000000 mm"
         );
         // At the limit, point and value both at 10¹⁵ resolutions, it still round-trips.
-        table.positions_mm[1] = 1e9;
+        table.positions[1] = 1e9;
         table.values = TableValues::Mean(vec![0.0, -1e9]);
         write(Controller::LinuxCnc, &table, &options).unwrap();
         table.values = TableValues::Mean(vec![0.0, -1.000_000_001e9]);

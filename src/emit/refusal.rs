@@ -178,7 +178,7 @@ pub fn check_table(
 ) -> Result<(), EmitError> {
     let name = controller.name();
     check_rotary(controller, table, options)?;
-    let count = table.positions_mm.len();
+    let count = table.positions.len();
     let limit = match (controller.max_points(), options.max_points) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
@@ -192,7 +192,7 @@ pub fn check_table(
             count,
         });
     }
-    for pair in table.positions_mm.windows(2) {
+    for pair in table.positions.windows(2) {
         if pair[1] <= pair[0] {
             return Err(EmitError::NotIncreasing {
                 position_mm: pair[1],
@@ -201,7 +201,7 @@ pub fn check_table(
         }
     }
     if !controller.accepts_free_positions() {
-        let Some(step) = table.regular_step_mm() else {
+        let Some(step) = table.regular_step() else {
             return Err(EmitError::UnevenSpacing { controller: name });
         };
         // One step for the whole table, written to the format's resolution:
@@ -233,7 +233,7 @@ pub fn check_table(
     }
     let (position_limit_mm, value_limit) = format_limits_mm(controller, options.file_unit());
     if let Some(position_mm) = table
-        .positions_mm
+        .positions
         .iter()
         .find(|position| position.abs() > position_limit_mm)
     {
@@ -249,7 +249,7 @@ pub fn check_table(
             let column = table.values.for_direction(direction);
             if let Some((value, position)) = column
                 .iter()
-                .zip(&table.positions_mm)
+                .zip(&table.positions)
                 .find(|(value, _)| value.abs() > limit_mm)
             {
                 return Err(EmitError::ValueOutOfRange {
@@ -285,8 +285,8 @@ fn check_rotary(
         }
     }
     let (first, last) = (
-        table.positions_mm[0],
-        table.positions_mm[table.positions_mm.len() - 1],
+        table.positions[0],
+        table.positions[table.positions.len() - 1],
     );
     if !options.is_full_turn(table) {
         return Ok(());

@@ -77,11 +77,11 @@ fn own_cec_table(axis: &AxisProfile) -> Result<usize, EmitError> {
 
 /// Writes LEC for a mean table, CEC for a bidirectional one.
 pub fn write(table: &CompensationTable, options: &EmitOptions) -> Result<String, EmitError> {
-    let step = table.regular_step_mm().ok_or(EmitError::UnevenSpacing {
+    let step = table.regular_step().ok_or(EmitError::UnevenSpacing {
         controller: "sinumerik840d",
     })?;
-    let first = table.positions_mm[0];
-    let last = table.positions_mm[table.positions_mm.len() - 1];
+    let first = table.positions[0];
+    let last = table.positions[table.positions.len() - 1];
     // A rotary axis' full turn repeats: the table is cyclic, MIN 0°, MAX 360°
     // with equal end values (checked by `emit::check_table`).
     let modulo = u8::from(options.is_full_turn(table));
@@ -157,7 +157,7 @@ pub fn write_cross_axis(
     options: &EmitOptions,
 ) -> Result<String, EmitError> {
     let table = &cross.table;
-    let step = table.regular_step_mm().ok_or(EmitError::UnevenSpacing {
+    let step = table.regular_step().ok_or(EmitError::UnevenSpacing {
         controller: "sinumerik840d",
     })?;
     let output = options.axes.first().ok_or_else(|| {
@@ -171,8 +171,8 @@ pub fn write_cross_axis(
     for (n, value) in values.iter().enumerate() {
         out.push_str(&format!("$AN_CEC[{t},{n}]={}\n", number(sign * value)));
     }
-    let first = table.positions_mm[0];
-    let last = table.positions_mm[table.positions_mm.len() - 1];
+    let first = table.positions[0];
+    let last = table.positions[table.positions.len() - 1];
     for (key, value) in [
         ("INPUT_AXIS", format!("({input_axis})")),
         ("OUTPUT_AXIS", format!("({})", output.sinumerik_axis)),
@@ -299,7 +299,7 @@ pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAd
 /// power on). The CEC sign is \[reconstructed\], so the text says how to
 /// check it with one move.
 pub fn activation(table: &CompensationTable, file_name: &str, options: &EmitOptions) -> String {
-    let points = table.positions_mm.len();
+    let points = table.positions.len();
     match &table.values {
         TableValues::Mean(_) => {
             let axes: Vec<String> = options
@@ -361,7 +361,7 @@ pub fn cross_axis_activation(
     cec_activation(
         file_name,
         &[(t, output)],
-        table.positions_mm.len(),
+        table.positions.len(),
         &format!("table {t} ({output} = F({input}), both directions)"),
         &check,
     )
@@ -424,7 +424,7 @@ fn sign_check(
     options: &EmitOptions,
 ) -> String {
     let (position, error) = table
-        .positions_mm
+        .positions
         .iter()
         .zip(errors_mm)
         .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
@@ -691,10 +691,11 @@ mod tests {
     fn table(values: TableValues) -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![-200.0, -199.0, -198.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![-200.0, -199.0, -198.0],
             values,
-            reference_mm: -200.0,
-            suggested_backlash_mm: None,
+            reference: -200.0,
+            suggested_backlash: None,
         }
     }
 
@@ -709,10 +710,7 @@ mod tests {
              $AA_ENC_COMP_STEP[0,X1]=1.0\n$AA_ENC_COMP_MIN[0,X1]=-200.0\n$AA_ENC_COMP_MAX[0,X1]=-198.0\n$AA_ENC_COMP_IS_MODULO[0,X1]=0\nM17\n"
         );
         let back = read(&text, "X1", true).unwrap();
-        assert_eq!(
-            (back.positions_mm, back.values),
-            (lec.positions_mm, lec.values)
-        );
+        assert_eq!((back.positions, back.values), (lec.positions, lec.values));
     }
 
     #[test]

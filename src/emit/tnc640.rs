@@ -179,7 +179,7 @@ fn com_table(table: &CompensationTable, options: &EmitOptions) -> Result<ComTabl
         TableValues::Bidirectional { down, .. } => down.iter().copied().map(Some).collect(),
     };
     Ok(ComTable {
-        positions_mm: table.positions_mm.clone(),
+        positions_mm: table.positions.clone(),
         backlash,
         columns: columns
             .into_iter()
@@ -219,7 +219,7 @@ pub fn update(
     if others.is_empty() {
         return write(table, options);
     }
-    same_points(&old.positions_mm, &table.positions_mm, &others)?;
+    same_points(&old.positions_mm, &table.positions, &others)?;
     let mut new = com_table(table, options)?;
     for name in &others {
         let cells = old
@@ -325,11 +325,11 @@ pub fn write_cross_axis(
             let old =
                 parse(text).map_err(|e| EmitError::Profile(format!("the existing table: {e}")))?;
             let others = old.filled_others(std::slice::from_ref(&output.tnc640_column));
-            same_points(&old.positions_mm, &table.positions_mm, &others)?;
+            same_points(&old.positions_mm, &table.positions, &others)?;
             old
         }
         None => ComTable {
-            positions_mm: table.positions_mm.clone(),
+            positions_mm: table.positions.clone(),
             backlash: vec![None; values.len()],
             columns: vec![(table_column.to_string(), vec![Some(0.0); values.len()])],
         },
@@ -423,7 +423,7 @@ pub fn read_cross_axis(
     });
     if own_column {
         let up = table.values.for_direction(Direction::Up).to_vec();
-        table = super::table_as_read(column_axis, table.positions_mm, TableValues::Mean(up));
+        table = super::table_as_read(column_axis, table.positions, TableValues::Mean(up));
     } else if table.values.mode() != crate::compensate::TableMode::Mean {
         return Err(ParseError::new(
             2,
@@ -548,10 +548,11 @@ mod tests {
     fn mean_and_bidirectional_round_trip() {
         let mean = CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![-10.0, 12.5, 40.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![-10.0, 12.5, 40.0],
             values: TableValues::Mean(vec![0.0, -0.0023, 0.0101]),
-            reference_mm: -10.0,
-            suggested_backlash_mm: None,
+            reference: -10.0,
+            suggested_backlash: None,
         };
         let text = write(&mean, &options()).unwrap();
         assert!(
@@ -574,10 +575,11 @@ mod tests {
     fn other_machine_columns_stay_empty() {
         let table = CompensationTable {
             axis: "Y".into(),
-            positions_mm: vec![0.0, 5.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 5.0],
             values: TableValues::Mean(vec![0.0, 0.0005]),
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         };
         let mut opts = options();
         opts.axes = vec![MachineProfile::default().axis("Y").unwrap()];
@@ -602,10 +604,11 @@ mod tests {
         let good = write(
             &CompensationTable {
                 axis: "X".into(),
-                positions_mm: vec![0.0, 100.0],
+                kind: crate::measurement::AxisKind::Linear,
+                positions: vec![0.0, 100.0],
                 values: TableValues::Mean(vec![0.0, -0.0023]),
-                reference_mm: 0.0,
-                suggested_backlash_mm: None,
+                reference: 0.0,
+                suggested_backlash: None,
             },
             &options(),
         )

@@ -29,7 +29,7 @@ pub(crate) fn cross_compensated(
         }
         let name = ErrorName::of(ErrorComponent::Translation { axis, direction });
         let own = compensated.function(name).cloned().unwrap_or_default();
-        let positions = merged_positions(grid.axis_mm(axis), &cross.table.positions_mm);
+        let positions = merged_positions(grid.axis_mm(axis), &cross.table.positions);
         let values = positions
             .iter()
             .map(|&x| own.value_at(x) - cross.value_at(x))

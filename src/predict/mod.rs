@@ -529,7 +529,7 @@ fn compensated_errors(
             .map_err(|why| PredictError::Backlash { axis, why })?;
         let name = positioning_error(axis);
         let own = errors.function(name).cloned().unwrap_or_default();
-        let positions = merged_positions(grid.axis_mm(axis), &table.positions_mm);
+        let positions = merged_positions(grid.axis_mm(axis), &table.positions);
         let values = positions
             .iter()
             .map(|&x| {

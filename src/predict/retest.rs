@@ -97,7 +97,7 @@ pub(super) fn predicted_retest(
     let sign = positioning_sign(machine, axis)?;
     let targets: Vec<f64> = match measured {
         Some(m) => m.targets().to_vec(),
-        None => table.positions_mm.clone(),
+        None => table.positions.clone(),
     };
     // The first test's own error, per direction: the reversal it measured.
     let known = measured.and_then(|m| KnownError::from_evaluation(&evaluate(m)));

@@ -212,10 +212,11 @@ fn a_scale_error_compensated_exactly_leaves_its_square() {
         .unwrap();
     let tables = [CompensationTable {
         axis: "X".into(),
-        positions_mm: vec![0.0, 750.0],
+        kind: crate::measurement::AxisKind::Linear,
+        positions: vec![0.0, 750.0],
         values: crate::compensate::TableValues::Mean(vec![0.0, 750.0 * k]),
-        reference_mm: 0.0,
-        suggested_backlash_mm: None,
+        reference: 0.0,
+        suggested_backlash: None,
     }];
     let prediction = predict(&input(&machine, &errors, &[], &tables, [0.0; 3])).unwrap();
     assert!((prediction.volumetric_before.max_mm - 0.0075).abs() < 1e-12);

@@ -435,7 +435,7 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
     let first_target = before.per_target.first().map(|t| t.target);
     let last_target = before.per_target.last().map(|t| t.target);
     if let Some(known) = KnownError::from_evaluation(before) {
-        let at_reference = known.mean_at(table.reference_mm);
+        let at_reference = known.mean_at(table.reference);
         let points = known
             .positions_mm()
             .iter()
@@ -445,7 +445,7 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
         all.push(series(
             Some(format!(
                 "first test's mean, zero at {} mm",
-                crate::report::chart::tick_label(table.reference_mm)
+                crate::report::chart::tick_label(table.reference)
             )),
             GREY,
             Mark::Dashed(2),
@@ -462,7 +462,7 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
     for (direction, color, label) in directions {
         let values = table.values.for_direction(*direction);
         let mut line: Vec<(f64, f64)> = table
-            .positions_mm
+            .positions
             .iter()
             .zip(values)
             .map(|(x, v)| (*x, mm_to_um(*v)))
@@ -480,7 +480,7 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
         }
         all.push(series(Some(label.to_string()), *color, Mark::Line(2), line));
         let points = table
-            .positions_mm
+            .positions
             .iter()
             .zip(values)
             .map(|(x, v)| (*x, mm_to_um(*v)))
@@ -491,7 +491,7 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
         title: format!(
             "Compensation table, axis {}: {} points",
             plain_or_blank(&table.axis),
-            table.positions_mm.len()
+            table.positions.len()
         ),
         x_label: "position [mm]".into(),
         y_label: "axis error the table compensates [µm]".into(),

@@ -123,13 +123,13 @@ macro_rules! table_json {
                 shown: fn($position) -> $value,
             ) -> $name {
                 $name {
-                    $positions: table.positions_mm.iter().map(|&p| unit(p)).collect(),
-                    count: table.positions_mm.len(),
-                    $start: unit(table.positions_mm[0]),
-                    $step: table.regular_step_mm().map(unit),
-                    $reference: unit(table.reference_mm),
+                    $positions: table.positions.iter().map(|&p| unit(p)).collect(),
+                    count: table.positions.len(),
+                    $start: unit(table.positions[0]),
+                    $step: table.regular_step().map(unit),
+                    $reference: unit(table.reference),
                     $values: ValuesJson::of(&table.values, unit, shown),
-                    $backlash: table.suggested_backlash_mm.map(|b| shown(unit(b))),
+                    $backlash: table.suggested_backlash.map(|b| shown(unit(b))),
                 }
             }
 
@@ -174,9 +174,9 @@ pub enum TableJson {
 }
 
 impl TableJson {
-    /// The points and values of `table`, of an axis of `kind`.
-    pub fn of(table: &CompensationTable, kind: AxisKind) -> TableJson {
-        match kind {
+    /// The points and values of `table`, in the units of its axis.
+    pub fn of(table: &CompensationTable) -> TableJson {
+        match table.kind {
             AxisKind::Linear => TableJson::Linear(LinearTableJson::of(table, Mm, Mm::to_um)),
             AxisKind::Rotary => TableJson::Rotary(RotaryTableJson::of(table, Deg, Deg::to_arcsec)),
         }
@@ -276,9 +276,8 @@ pub struct ConvertJson {
 }
 
 impl ConvertJson {
-    /// Builds the wire object of an axis of `kind` (values in ″ on a rotary axis).
+    /// Builds the wire object of `table`, in its axis' units (values in ″ on a rotary axis).
     pub fn new(
-        kind: AxisKind,
         controller: &'static str,
         file: String,
         table: &CompensationTable,
@@ -287,8 +286,8 @@ impl ConvertJson {
         warnings: Vec<String>,
     ) -> ConvertJson {
         ConvertJson {
-            kind,
-            file_unit: match kind {
+            kind: table.kind,
+            file_unit: match table.kind {
                 AxisKind::Linear => LengthUnit::Millimetre.as_str(),
                 AxisKind::Rotary => "deg",
             },
@@ -297,7 +296,7 @@ impl ConvertJson {
             axis: table.axis.clone(),
             also,
             mode: table.values.mode().as_str(),
-            table: TableJson::of(table, kind),
+            table: TableJson::of(table),
             backlash_parameter: None,
             backlash_note: None,
             activation,

@@ -100,10 +100,11 @@ fn effects_act_only_in_their_tests() {
     );
     let zero = CompensationTable {
         axis: "X".into(),
-        positions_mm: vec![0.0, 400.0],
+        kind: crate::measurement::AxisKind::Linear,
+        positions: vec![0.0, 400.0],
         values: TableValues::Mean(vec![0.0, 0.0]),
-        reference_mm: 0.0,
-        suggested_backlash_mm: None,
+        reference: 0.0,
+        suggested_backlash: None,
     };
     let second = after(&t, &zero, 7).unwrap();
     assert_eq!(deviations_um(&second, 0), vec![0.0, 1.0, 2.0, 3.0, 4.0]);
@@ -118,10 +119,11 @@ fn the_table_is_applied_as_the_controller_does() {
     let t = truth("[error]\nscale_um_per_m = 10.0\n");
     let perfect = CompensationTable {
         axis: "X".into(),
-        positions_mm: vec![0.0, 400.0],
+        kind: crate::measurement::AxisKind::Linear,
+        positions: vec![0.0, 400.0],
         values: TableValues::Mean(vec![0.0, 0.004]),
-        reference_mm: 0.0,
-        suggested_backlash_mm: None,
+        reference: 0.0,
+        suggested_backlash: None,
     };
     let retest = after(&t, &perfect, 1).unwrap();
     // e(m) − v with m = x − v: 10e-3·(x − v) − v·1000 leaves −1e-5·v µm ≈ 0 at 0.001 µm.

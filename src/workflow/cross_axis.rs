@@ -183,10 +183,10 @@ pub fn cross_axis(request: &CrossAxisRequest<'_>) -> Result<CrossAxis, WorkflowE
         reference_line: fit.reference.as_str(),
         straightness_um: mm_to_um(fit.deviation_mm()),
         slope_urad: rad_to_um_per_m(fit.slope),
-        reference_mm: table.table.reference_mm,
+        reference_mm: table.table.reference,
         points: table
             .table
-            .positions_mm
+            .positions
             .iter()
             .map(|&p| CrossAxisPoint {
                 position_mm: p,

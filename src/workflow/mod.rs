@@ -314,7 +314,6 @@ pub fn convert(
     let activation = emit::activation(table.controller, &compensation, &table.file_name, options);
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
     let mut report = ConvertJson::new(
-        measurement.kind(),
         table.controller.name(),
         table.output.clone(),
         &compensation,
@@ -337,7 +336,7 @@ pub fn convert(
         report.file_decimals = (-resolution.log10()).round().max(0.0) as usize;
     }
     report.update = update.map(|summary| UpdateJson::new(&summary, report.file_unit));
-    if let Some(backlash_mm) = compensation.suggested_backlash_mm {
+    if let Some(backlash_mm) = compensation.suggested_backlash {
         report.set_backlash(table.controller.backlash_parameter(backlash_mm, options));
     }
     Ok(Converted {

@@ -114,7 +114,7 @@ pub fn active_table(
     let doubts = check_together(
         Pairing::TableOnTest,
         &Input::measurement(test, file.test_label.to_string()),
-        &Input::table(&table.axis, &table.positions_mm, file.file.to_string()),
+        &Input::table(&table.axis, &table.positions, file.file.to_string()),
     )?;
     Ok(ActiveTable {
         controller,

@@ -365,8 +365,8 @@ fn golden_files_per_controller() {
             .iter()
             .map(|v| v.as_f64().unwrap())
             .collect();
-        assert_eq!(table.positions_mm.len(), positions.len(), "{}", case.golden);
-        for (a, b) in table.positions_mm.iter().zip(&positions) {
+        assert_eq!(table.positions.len(), positions.len(), "{}", case.golden);
+        for (a, b) in table.positions.iter().zip(&positions) {
             assert!(
                 (a - b).abs() * per_unit <= resolution_um,
                 "{}: position {a} vs {b}",

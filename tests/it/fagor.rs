@@ -57,13 +57,13 @@ fn every_real_fagor_table_reads() {
         let (found, table) =
             emit::read_any(&text, &options(axis), None).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert_eq!(found, *controller, "{file}");
-        assert!(table.positions_mm.len() >= 3, "{file}");
+        assert!(table.positions.len() >= 3, "{file}");
     }
     // By hand: ALX P002 is 5 in = 127 mm, −0.00127 in = −0.032258 mm;
     // X.mp POSITION 1 = −127.0000 mm, POSERROR 1 = −0.0127 mm.
     let alx = std::fs::read_to_string(data("example__8055__ALX")).unwrap();
     let (_, table) = emit::read_any(&alx, &options("X"), None).unwrap();
-    assert_eq!(table.positions_mm[1], 127.0);
+    assert_eq!(table.positions[1], 127.0);
     assert!(
         (table
             .values
@@ -76,10 +76,7 @@ fn every_real_fagor_table_reads() {
         emit::decode_table(&std::fs::read(data("example__8065__X.mp")).unwrap()).unwrap();
     assert_eq!(encoding, TextEncoding::Utf16Le);
     let (_, table) = emit::read_any(&text, &options("X"), None).unwrap();
-    assert_eq!(
-        (table.positions_mm[0], table.positions_mm.len()),
-        (-127.0, 27)
-    );
+    assert_eq!((table.positions[0], table.positions.len()), (-127.0, 27));
     let (_, encoding) =
         emit::decode_table(&std::fs::read(data("example__8065__Y.mp.out")).unwrap()).unwrap();
     assert_eq!(encoding, TextEncoding::Utf16Be);

@@ -135,10 +135,10 @@ fn every_real_file_reads() {
         assert_eq!(controller, Controller::Fanuc);
         let p = backup.axis(axis).unwrap();
         assert_eq!(
-            table.positions_mm.len() as i64,
+            table.positions.len() as i64,
             p.most_positive - p.most_negative + 2
         );
-        assert_eq!(table.value_at(table.reference_mm, Direction::Up), 0.0);
+        assert_eq!(table.value_at(table.reference, Direction::Up), 0.0);
         let found = table.value_at(position, Direction::Up);
         assert!(
             (found - value).abs() < 1e-12,
@@ -375,7 +375,7 @@ fn golden_files_read_back() {
     assert_eq!(count, 16);
     options.axes[0].fanuc = Some(AxisParameters::default_for("X", count, 50.0, 0, 0.0));
     let (_, table) = emit::read_any(&written, &options, None).unwrap();
-    assert_eq!(table.positions_mm.len(), count);
+    assert_eq!(table.positions.len(), count);
     assert_eq!(table.values.for_direction(Direction::Up)[0], 0.0);
 }
 
@@ -415,7 +415,7 @@ fn the_fuzz_property_holds_on_the_real_files() {
         let updated = emit::fanuc::update(&text, &table, &options).unwrap();
         assert_eq!(updated, text, "{file}: its own table changes nothing");
         let back = emit::fanuc::read(&updated, &parameters).unwrap();
-        assert_eq!(back.positions_mm, table.positions_mm);
+        assert_eq!(back.positions, table.positions);
     }
     assert_eq!(read_tables, 2);
 }

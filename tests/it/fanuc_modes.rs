@@ -232,7 +232,7 @@ fn the_rescaled_alternative_keeps_the_compensation_in_a_finer_unit() {
     let new_text = std::fs::read_to_string(path("NEW.TXT")).unwrap();
     let a = axcomp::emit::fanuc::read(&new_text, &coarse).unwrap();
     let b = axcomp::emit::fanuc::read(&fine_text, &finer).unwrap();
-    assert_eq!(a.positions_mm, b.positions_mm);
+    assert_eq!(a.positions, b.positions);
     for (x, y) in a
         .values
         .for_direction(Direction::Up)
@@ -445,7 +445,7 @@ fn the_new_golden_files_read_back() {
     };
     let a = axcomp::emit::fanuc::read(&std::fs::read_to_string(&coarse).unwrap(), &x).unwrap();
     let b = axcomp::emit::fanuc::read(&written, &x_fine).unwrap();
-    assert_eq!(a.positions_mm, b.positions_mm);
+    assert_eq!(a.positions, b.positions);
     let up =
         |t: &axcomp::compensate::CompensationTable| t.values.for_direction(Direction::Up).to_vec();
     for (x, y) in up(&a).iter().zip(up(&b)) {

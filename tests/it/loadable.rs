@@ -327,7 +327,7 @@ fn tables_record_their_source_where_the_format_has_comments() {
     assert_eq!(
         sinumerik840d::read(&text, "X1", true)
             .unwrap()
-            .positions_mm
+            .positions
             .len(),
         16
     );

@@ -298,10 +298,11 @@ fn rotary_table(
 ) -> axcomp::compensate::CompensationTable {
     axcomp::compensate::CompensationTable {
         axis: "C".to_string(),
-        positions_mm: positions_deg.to_vec(),
+        kind: axcomp::measurement::AxisKind::Rotary,
+        positions: positions_deg.to_vec(),
         values: axcomp::compensate::TableValues::Mean(values_deg.to_vec()),
-        reference_mm: positions_deg[0],
-        suggested_backlash_mm: None,
+        reference: positions_deg[0],
+        suggested_backlash: None,
     }
 }
 
@@ -321,7 +322,14 @@ fn rotary_tables_are_written_in_degrees_and_read_back() {
         let text = emit::write(controller, &full, &options)
             .unwrap_or_else(|e| panic!("{}: {e}", controller.name()));
         let (_, back) = emit::read_any(&text, &options, Some(0)).unwrap();
-        assert_eq!(back.positions_mm, FULL_TURN, "{}", controller.name());
+        assert_eq!(back.positions, FULL_TURN, "{}", controller.name());
+        // The file holds bare numbers; the axis read them as degrees.
+        assert_eq!(
+            back.reference_typed(),
+            axcomp::measurement::ByKind::Rotary(axcomp::units::Deg(FULL_TURN[0])),
+            "{}",
+            controller.name()
+        );
     }
     let sinumerik = emit::write(Controller::Sinumerik840d, &full, &options).unwrap();
     for line in [

@@ -174,8 +174,8 @@ mod tests {
         text.push('%');
         let table = read(&text, &manual_parameters()).unwrap();
         // Point 32 at −400 mm … point 49 at 450 mm.
-        assert_eq!(table.positions_mm[0], -400.0);
-        assert_eq!(table.positions_mm.len(), 18);
+        assert_eq!(table.positions[0], -400.0);
+        assert_eq!(table.positions.len(), 18);
         // By hand: absolute at 0 = 0; at −50: −v40 = +1; at −100: 1 − v39 = 1;
         // at 50: v41 = 2; at 100: 3. The table holds −absolute × 1 µm.
         let at = |x: f64| table.value_at(x, crate::measurement::Direction::Up) * 1000.0;
@@ -194,10 +194,11 @@ mod tests {
     fn table(positions_mm: Vec<f64>, values: Vec<f64>) -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            reference_mm: positions_mm[0],
-            positions_mm,
+            kind: crate::measurement::AxisKind::Linear,
+            reference: positions_mm[0],
+            positions: positions_mm,
             values: TableValues::Mean(values),
-            suggested_backlash_mm: None,
+            suggested_backlash: None,
         }
     }
 
@@ -293,7 +294,7 @@ mod tests {
             vec![(0, 0), (1, -3), (2, -2), (3, 1), (4, 4), (5, -3)]
         );
         let back = read(&text, &p).unwrap();
-        assert_eq!(back.positions_mm.len(), 6);
+        assert_eq!(back.positions.len(), 6);
         // A turn that does not close (0.002° at 360°) is closed, and said.
         let open = table(
             vec![0.0, 90.0, 180.0, 270.0, 360.0],
@@ -323,13 +324,14 @@ mod tests {
         // ↓ −2, −4, −10 (3627 = −2; increments −2, −6).
         let t = CompensationTable {
             axis: "X".into(),
-            positions_mm: vec![0.0, 100.0, 200.0],
+            kind: crate::measurement::AxisKind::Linear,
+            positions: vec![0.0, 100.0, 200.0],
             values: TableValues::Bidirectional {
                 up: vec![-0.001, 0.001, 0.002],
                 down: vec![0.001, 0.003, 0.009],
             },
-            reference_mm: 0.0,
-            suggested_backlash_mm: None,
+            reference: 0.0,
+            suggested_backlash: None,
         };
         let options = EmitOptions::for_axis(&Default::default(), "X", "").unwrap();
         let text = write(&t, &options).unwrap();
@@ -377,7 +379,7 @@ mod tests {
         options.axes[0].fanuc = Some(p.clone());
         if let Ok(updated) = update(pitch, &table, &options) {
             let back = read(&updated, p).expect("an updated file reads back");
-            assert_eq!(back.positions_mm, table.positions_mm);
+            assert_eq!(back.positions, table.positions);
         }
         let _ = rescaled(Some(pitch), &table, &options, None);
     }

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use super::{AxisParameters, DATA_NUMBER_OFFSET, READ_LIMIT};
 use crate::compensate::{CompensationTable, TableValues};
 use crate::error::ParseError;
-use crate::measurement::Direction;
+use crate::measurement::{AxisKind, Direction};
 use crate::read::text::{self, Line};
 
 /// Whether the text is a pitch file: a `%` line, then `N1nnnnQ0P…`.
@@ -158,10 +158,15 @@ pub fn read(input: &str, p: &AxisParameters) -> Result<CompensationTable, ParseE
     };
     Ok(CompensationTable {
         axis: p.axis.clone(),
-        positions_mm,
+        kind: if p.rotary {
+            AxisKind::Rotary
+        } else {
+            AxisKind::Linear
+        },
+        positions: positions_mm,
         values,
-        reference_mm: p.position(p.reference_point),
-        suggested_backlash_mm: None,
+        reference: p.position(p.reference_point),
+        suggested_backlash: None,
     })
 }
 

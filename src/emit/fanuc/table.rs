@@ -65,10 +65,10 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     let finest = finest_for_sections(&[values], p.detection_unit);
     let mut notes = Vec::new();
     let all = (p.most_positive - p.first_point() + 1) as usize;
-    if p.from_backup && table.positions_mm.len() * 2 < all {
+    if p.from_backup && table.positions.len() * 2 < all {
         notes.push(format!(
             "Fanuc: the test covers {} of the {all} compensation points of axis {} ({} … {} {}); the others keep their old values, which this test does not check",
-            table.positions_mm.len(),
+            table.positions.len(),
             p.axis,
             p.position(p.first_point()),
             p.position(p.most_positive),
@@ -138,7 +138,7 @@ pub fn parameters_for(
     if p.bidirectional && table.values.mode() == TableMode::Bidirectional {
         // 3627: the ↓ table's absolute compensation at the reference position.
         let at = table
-            .positions_mm
+            .positions
             .iter()
             .position(|x| (x - p.position(p.reference_point)).abs() < 1e-6);
         if let Some(k) = at {
@@ -155,25 +155,25 @@ fn default_parameters(
     options: &EmitOptions,
     axis: &str,
 ) -> Result<AxisParameters, EmitError> {
-    let step = table.regular_step_mm().ok_or(EmitError::UnevenSpacing {
+    let step = table.regular_step().ok_or(EmitError::UnevenSpacing {
         controller: "fanuc",
     })?;
     let reference = table
-        .positions_mm
+        .positions
         .iter()
-        .position(|x| (x - table.reference_mm).abs() < 1e-9)
+        .position(|x| (x - table.reference).abs() < 1e-9)
         .ok_or_else(|| {
             EmitError::Profile(format!(
                 "a Fanuc table is zero at a compensation point (3620); {} mm is none: give --reference at a point",
-                table.reference_mm
+                table.reference
             ))
         })?;
     let mut p = AxisParameters::default_for(
         axis,
-        table.positions_mm.len(),
+        table.positions.len(),
         step,
         reference,
-        table.reference_mm,
+        table.reference,
     );
     p.rotary = options.kind == AxisKind::Rotary;
     if p.rotary {
@@ -195,8 +195,8 @@ pub(super) fn new_increments(
     p: &AxisParameters,
 ) -> Result<BTreeMap<i64, i64>, EmitError> {
     check_mode(table, p)?;
-    let mut points = Vec::with_capacity(table.positions_mm.len());
-    for position in &table.positions_mm {
+    let mut points = Vec::with_capacity(table.positions.len());
+    for position in &table.positions {
         let point = p
             .point_at(*position)
             .filter(|n| (p.first_point()..=p.most_positive).contains(n))
@@ -211,13 +211,13 @@ pub(super) fn new_increments(
             })?;
         points.push(point);
     }
-    if (table.reference_mm - p.position(p.reference_point)).abs() > 1e-9 {
+    if (table.reference - p.position(p.reference_point)).abs() > 1e-9 {
         return Err(EmitError::Profile(format!(
             "the Fanuc compensation is zero at the reference point 3620 = {} ({} = {} mm); the table is zero at {} mm: give --reference {} (inside the measured range)",
             p.reference_point,
             p.axis,
             p.position(p.reference_point),
-            table.reference_mm,
+            table.reference,
             p.position(p.reference_point)
         )));
     }
@@ -342,9 +342,9 @@ fn closing_point(table: &CompensationTable, p: &AxisParameters) -> Option<usize>
     } else {
         360.0
     };
-    let first = table.positions_mm.first()?;
+    let first = table.positions.first()?;
     table
-        .positions_mm
+        .positions
         .iter()
         .position(|x| (x - first - turn).abs() < 1e-6)
 }

@@ -66,7 +66,7 @@ pub fn check_read_back(
         EmitError::Internal(format!("the written fanuc table does not read back: {e}"))
     })?;
     for direction in p.directions() {
-        for (position, value) in table.positions_mm.iter().zip(wanted(table, &p, *direction)) {
+        for (position, value) in table.positions.iter().zip(wanted(table, &p, *direction)) {
             let read = back.value_at(*position, *direction);
             if (read - value).abs() > p.unit() / 2.0 + 1e-12 {
                 return Err(EmitError::Internal(format!(
