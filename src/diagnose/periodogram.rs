@@ -440,6 +440,38 @@ mod tests {
     use crate::diagnose::covariance::Covariance;
     use std::f64::consts::TAU as TAU_;
 
+    /// The best of `periods` (refined within `refine`) fitting only the
+    /// `marks`ed ones is the best fitting every one, by `exact` χ²; returns it.
+    fn screened_best_is_every_best(
+        periods: &[f64],
+        marks: &[bool],
+        refine: (f64, f64),
+        exact: &(dyn Fn(f64) -> f64 + Sync),
+    ) -> Shape {
+        let set = ShapeSet {
+            shapes: periods
+                .iter()
+                .map(|p| Shape::Period(*p, PeriodicIn::ReTest))
+                .collect(),
+            trials: 1.0,
+            refine: Some(refine),
+        };
+        let score = |shape: Shape| {
+            let Shape::Period(p, _) = shape else {
+                unreachable!()
+            };
+            (exact(p), ())
+        };
+        let screened = crate::diagnose::selection::best_of(&set, Some(marks), score);
+        let every = crate::diagnose::selection::best_of(&set, None, score);
+        let (Some((a, chi2_a, _)), Some((b, chi2_b, _))) = (screened, every) else {
+            panic!("no best")
+        };
+        assert_eq!(a, b);
+        assert_eq!(chi2_a, chi2_b);
+        a
+    }
+
     #[test]
     fn a_scan_counts_its_independent_periods_not_its_frequencies() {
         // 1000 mm from 5 to 500 mm: frequencies 0.002 to 0.2 /mm, peaks 0.001 /mm wide.
@@ -532,27 +564,7 @@ mod tests {
         assert!(!kept.is_empty() && kept.len() <= 2, "{kept:?}");
         assert!((kept[0] - 37.0).abs() < 0.5, "{kept:?}");
         // The best of the scan, refined, is the one every period fitted exactly finds.
-        let set = ShapeSet {
-            shapes: periods
-                .iter()
-                .map(|p| Shape::Period(*p, PeriodicIn::ReTest))
-                .collect(),
-            trials: 1.0,
-            refine: Some((10.0, span / 2.0)),
-        };
-        let score = |shape: Shape| {
-            let Shape::Period(p, _) = shape else {
-                unreachable!()
-            };
-            (exact(p), ())
-        };
-        let screened_best = crate::diagnose::selection::best_of(&set, Some(&marks), score);
-        let every_best = crate::diagnose::selection::best_of(&set, None, score);
-        let (Some((a, chi2_a, _)), Some((b, chi2_b, _))) = (screened_best, every_best) else {
-            panic!("no best")
-        };
-        assert_eq!(a, b);
-        assert_eq!(chi2_a, chi2_b);
+        screened_best_is_every_best(&periods, &marks, (10.0, span / 2.0), &exact);
     }
 
     /// 99 levels between the targets of a first test of 100 (7.5 mm apart, as a
@@ -640,27 +652,7 @@ mod tests {
             // The best of the marked periods is the best of all, refined alike.
             let lowest = lowest_bound(&lower).unwrap();
             let marks = may_be_lowest(&lower, every[lowest]);
-            let set = ShapeSet {
-                shapes: periods
-                    .iter()
-                    .map(|p| Shape::Period(*p, PeriodicIn::ReTest))
-                    .collect(),
-                trials: 1.0,
-                refine: Some((15.0, span / 2.0)),
-            };
-            let score = |shape: Shape| {
-                let Shape::Period(p, _) = shape else {
-                    unreachable!()
-                };
-                (exact(p), ())
-            };
-            let screened = crate::diagnose::selection::best_of(&set, Some(&marks), score);
-            let all = crate::diagnose::selection::best_of(&set, None, score);
-            let (Some((a, chi2_a, _)), Some((b, chi2_b, _))) = (screened, all) else {
-                panic!("no best")
-            };
-            assert_eq!(a, b);
-            assert_eq!(chi2_a, chi2_b);
+            let a = screened_best_is_every_best(&periods, &marks, (15.0, span / 2.0), &exact);
             let kept = marks.iter().filter(|m| **m).count();
             if amplitude > 0.0 {
                 // A clear 47 mm error: only the periods of its peak are fitted.
