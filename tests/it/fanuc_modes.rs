@@ -100,19 +100,9 @@ fn bidirectional_compensation_needs_3605_and_goes_to_3626() {
     let new_text = std::fs::read_to_string(path("NEW.TXT")).unwrap();
     // Sections 16 … 40 of both tables are new (↓ at 50 + n − 1 = 65 … 89);
     // every other line is byte for byte the old one.
-    let changed = |n: i64| (16..=40).contains(&n) || (65..=89).contains(&n);
-    for (a, b) in old_text
-        .split_inclusive('\n')
-        .zip(new_text.split_inclusive('\n'))
-    {
-        let n = a
-            .get(1..6)
-            .and_then(|d| d.parse::<i64>().ok())
-            .map(|d| d - 10_000);
-        if !n.is_some_and(changed) {
-            assert_eq!(a, b);
-        }
-    }
+    only_these_points_changed(&old_text, &new_text, |n| {
+        (16..=40).contains(&n) || (65..=89).contains(&n)
+    });
     assert_eq!(old_text.len() - old_text.trim_end_matches('%').len(), 1);
     let (old, new) = (increments(&old_text), increments(&new_text));
     // The ↓ table's absolute compensation: 3627 at the reference point 40,
@@ -187,18 +177,7 @@ fn the_rescaled_alternative_keeps_the_compensation_in_a_finer_unit() {
     let old_text = std::fs::read_to_string(&pitch).unwrap();
     let fine_text = std::fs::read_to_string(path("FINE.TXT")).unwrap();
     // Only X's points 1 … 41 change; every other line is byte for byte.
-    for (a, b) in old_text
-        .split_inclusive('\n')
-        .zip(fine_text.split_inclusive('\n'))
-    {
-        let n = a
-            .get(1..6)
-            .and_then(|d| d.parse::<i64>().ok())
-            .map(|d| d - 10_000);
-        if !n.is_some_and(|n| (1..=41).contains(&n)) {
-            assert_eq!(a, b);
-        }
-    }
+    only_these_points_changed(&old_text, &fine_text, |n| (1..=41).contains(&n));
     assert_eq!(old_text.lines().count(), fine_text.lines().count());
     let (old, fine) = (increments(&old_text), increments(&fine_text));
     // Outside the test (sections 1 … 15 and 41) the old increments, ten times.
@@ -455,4 +434,18 @@ fn the_new_golden_files_read_back() {
         std::fs::read_to_string(&coarse).unwrap(),
         std::fs::read_to_string(root().join("formats/fanuc/golden/synth-x-HM100TS.TXT")).unwrap()
     );
+}
+
+/// Every line of `new` is byte for byte `old`'s (trailing spaces, line
+/// ends, `%`) except the data numbers 10000 + n whose point n is `changed`.
+fn only_these_points_changed(old: &str, new: &str, changed: impl Fn(i64) -> bool) {
+    for (a, b) in old.split_inclusive('\n').zip(new.split_inclusive('\n')) {
+        let point = a
+            .get(1..6)
+            .and_then(|d| d.parse::<i64>().ok())
+            .map(|d| d - 10_000);
+        if !point.is_some_and(&changed) {
+            assert_eq!(a, b);
+        }
+    }
 }
