@@ -14,8 +14,8 @@
 //!
 //! Pure: no I/O. Lengths in mm (degrees on a rotary axis).
 
-use super::{CompensateError, CompensationTable, TableValues};
-use crate::measurement::Direction;
+use super::{CompensateError, CompensationTable, TableValues, check_kind};
+use crate::measurement::{AxisKind, Direction, Position};
 
 /// Two positions closer than this are one point, mm.
 const SAME_POINT_MM: f64 = 1e-6;
@@ -68,22 +68,35 @@ pub struct UpdateSummary {
 }
 
 impl UpdatePlan {
-    /// The plan of an update, or why it cannot be referred: the reference
+    /// The plan of an update of `existing` by a test of an axis of `kind`
+    /// over `targets_mm` (in its unit), or why it cannot be made: the table
+    /// and the reference must be of an axis of that kind, and the reference
     /// (`given`, else the existing table's zero) must lie inside the measured
     /// range, where the test measured the residual.
     pub fn new(
         existing: &CompensationTable,
+        kind: AxisKind,
         targets_mm: &[f64],
-        given_reference_mm: Option<f64>,
+        given_reference: Option<Position>,
     ) -> Result<UpdatePlan, CompensateError> {
+        if existing.kind != kind {
+            return Err(CompensateError::KindMismatch {
+                what: "existing table",
+                given: existing.kind,
+                measured: kind,
+            });
+        }
+        let given_reference_mm = given_reference
+            .map(|reference| check_kind("reference", reference, kind))
+            .transpose()?;
         let measured_mm = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
         let reference_mm = given_reference_mm.unwrap_or(existing.reference);
         if reference_mm < measured_mm.0 - 1e-9 || reference_mm > measured_mm.1 + 1e-9 {
             return Err(CompensateError::UpdateReference {
-                reference_mm,
+                reference: kind.position(reference_mm),
                 given: given_reference_mm.is_some(),
-                first_mm: measured_mm.0,
-                last_mm: measured_mm.1,
+                first: kind.position(measured_mm.0),
+                last: kind.position(measured_mm.1),
             });
         }
         Ok(UpdatePlan {
@@ -210,7 +223,7 @@ mod tests {
     fn table(positions_mm: Vec<f64>, values: TableValues) -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            kind: crate::measurement::AxisKind::Linear,
+            kind: AxisKind::Linear,
             positions: positions_mm,
             values,
             reference: 0.0,
@@ -225,7 +238,8 @@ mod tests {
             vec![-200.0, -100.0, 0.0, 150.0, 300.0, 400.0],
             TableValues::Mean(vec![0.02, 0.01, 0.0, 0.004, 0.006, 0.008]),
         );
-        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0, 300.0], None).unwrap();
+        let update =
+            UpdatePlan::new(&old, AxisKind::Linear, &[0.0, 100.0, 200.0, 300.0], None).unwrap();
         assert_eq!(update.reference_mm, 0.0);
         // Built (old + residual, zero at 0 mm) on 0, 100, 200, 300.
         let new = table(
@@ -269,7 +283,13 @@ mod tests {
             vec![0.0, 100.0, 200.0],
             TableValues::Mean(vec![0.0, 0.004, 0.006]),
         );
-        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0], Some(100.0)).unwrap();
+        let update = UpdatePlan::new(
+            &old,
+            AxisKind::Linear,
+            &[0.0, 100.0, 200.0],
+            Some(AxisKind::Linear.position(100.0)),
+        )
+        .unwrap();
         let new = table(
             vec![0.0, 100.0, 200.0],
             TableValues::Mean(vec![-0.001, 0.0, 0.003]),
@@ -285,9 +305,68 @@ mod tests {
         assert!((summary.existing_at_reference_mm - 0.004).abs() < 1e-15);
         // A reference the test did not measure is refused.
         assert!(matches!(
-            UpdatePlan::new(&old, &[0.0, 100.0], Some(150.0)),
+            UpdatePlan::new(
+                &old,
+                AxisKind::Linear,
+                &[0.0, 100.0],
+                Some(AxisKind::Linear.position(150.0))
+            ),
             Err(CompensateError::UpdateReference { given: true, .. })
         ));
+    }
+
+    #[test]
+    fn a_rotary_update_is_refused_in_degrees_and_of_one_kind() {
+        // An old rotary table over 0 … 270°, zero at 0°; the test measured
+        // 90 … 270°: its zero is outside, and so is a given 300°.
+        let mut old = table(
+            vec![0.0, 90.0, 180.0, 270.0],
+            TableValues::Mean(vec![0.0, 0.001, 0.002, 0.001]),
+        );
+        old.kind = AxisKind::Rotary;
+        let measured = [90.0, 180.0, 270.0];
+        let error = UpdatePlan::new(&old, AxisKind::Rotary, &measured, None).unwrap_err();
+        assert!(
+            error.to_string().starts_with(
+                "the existing table is zero (its reference) at 0° is outside the measured range 90 … 270°: "
+            ),
+            "{error}"
+        );
+        let given = Some(AxisKind::Rotary.position(300.0));
+        let error = UpdatePlan::new(&old, AxisKind::Rotary, &measured, given).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .starts_with("the reference 300° is outside the measured range 90 … 270°: "),
+            "{error}"
+        );
+        // A reference in mm, or a rotary table under a linear test: refused.
+        let in_mm = Some(AxisKind::Linear.position(180.0));
+        assert_eq!(
+            UpdatePlan::new(&old, AxisKind::Rotary, &measured, in_mm),
+            Err(CompensateError::KindMismatch {
+                what: "reference",
+                given: AxisKind::Linear,
+                measured: AxisKind::Rotary
+            })
+        );
+        assert_eq!(
+            UpdatePlan::new(&old, AxisKind::Linear, &measured, None),
+            Err(CompensateError::KindMismatch {
+                what: "existing table",
+                given: AxisKind::Rotary,
+                measured: AxisKind::Linear
+            })
+        );
+        assert!(
+            UpdatePlan::new(
+                &old,
+                AxisKind::Rotary,
+                &measured,
+                Some(AxisKind::Rotary.position(180.0))
+            )
+            .is_ok()
+        );
     }
 
     #[test]
@@ -299,7 +378,7 @@ mod tests {
                 down: vec![0.003, 0.0, 0.004],
             },
         );
-        let update = UpdatePlan::new(&old, &[0.0, 100.0], None).unwrap();
+        let update = UpdatePlan::new(&old, AxisKind::Linear, &[0.0, 100.0], None).unwrap();
         let new = table(vec![0.0, 100.0], TableValues::Mean(vec![0.0, 0.005]));
         let (merged, _) = update.apply(new);
         assert_eq!(

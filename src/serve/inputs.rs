@@ -198,10 +198,10 @@ pub fn grid(form: &Form) -> Result<TableGrid, ApiError> {
             .map(TableMode::from_name)
             .transpose()
             .map_err(|e| format!("mode: {e}"))?,
-        step_mm: form.number("step", "a number of mm")?,
-        start_mm: form.number("start", "a number of mm")?,
+        step: form.number("step", "a number of mm")?,
+        start: form.number("start", "a number of mm")?,
         count: form.number("count", "a whole number of points")?,
-        reference_mm: form.number("reference", "a number of mm")?,
+        reference: form.number("reference", "a number of mm")?,
         extrapolate: form
             .text("extrapolate")
             .map(Extrapolate::from_name)
