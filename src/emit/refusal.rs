@@ -131,6 +131,18 @@ pub enum EmitError {
         /// The value at 360°, °.
         last_deg: f64,
     },
+    /// A table of one kind of axis with the options of the other: its
+    /// numbers would be written in the other unit (degrees as mm).
+    #[error(
+        "the table is of a {} axis (in {}) and the file is for a {} axis (in {}): they do not belong together",
+        table.as_str(), table.position_unit(), options.as_str(), options.position_unit()
+    )]
+    KindMismatch {
+        /// The table's axis kind.
+        table: AxisKind,
+        /// The kind the options write.
+        options: AxisKind,
+    },
     /// A profile value the format cannot use.
     #[error("{0}")]
     Profile(String),
@@ -177,6 +189,12 @@ pub fn check_table(
     options: &EmitOptions,
 ) -> Result<(), EmitError> {
     let name = controller.name();
+    if table.kind != options.kind {
+        return Err(EmitError::KindMismatch {
+            table: table.kind,
+            options: options.kind,
+        });
+    }
     check_rotary(controller, table, options)?;
     let count = table.positions.len();
     let limit = match (controller.max_points(), options.max_points) {
@@ -309,4 +327,59 @@ fn check_rotary(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensate::TableValues;
+
+    /// A table of the two points 0 and 90 with the values 0 and 0.001, of
+    /// an axis of `kind`.
+    fn table(kind: AxisKind) -> CompensationTable {
+        CompensationTable {
+            axis: "C".into(),
+            kind,
+            positions: vec![0.0, 90.0],
+            values: TableValues::Mean(vec![0.0, 0.001]),
+            reference: 0.0,
+            suggested_backlash: None,
+        }
+    }
+
+    #[test]
+    fn a_table_is_written_only_for_its_own_kind_of_axis() {
+        let linear =
+            EmitOptions::for_axis(&super::super::MachineProfile::default(), "C", "C").unwrap();
+        let rotary = EmitOptions {
+            kind: AxisKind::Rotary,
+            ..linear.clone()
+        };
+        // 0 and 90° would be written as 0 and 90 mm, and 90 mm as 90°.
+        for controller in [Controller::LinuxCnc, Controller::Tnc640] {
+            let error =
+                super::super::write(controller, &table(AxisKind::Rotary), &linear).unwrap_err();
+            assert_eq!(
+                error,
+                EmitError::KindMismatch {
+                    table: AxisKind::Rotary,
+                    options: AxisKind::Linear
+                }
+            );
+            assert_eq!(
+                error.to_string(),
+                "the table is of a rotary axis (in °) and the file is for a linear axis (in mm): they do not belong together"
+            );
+            assert!(matches!(
+                super::super::write(controller, &table(AxisKind::Linear), &rotary),
+                Err(EmitError::KindMismatch {
+                    table: AxisKind::Linear,
+                    options: AxisKind::Rotary
+                })
+            ));
+            // Of one kind, both are written.
+            assert!(super::super::write(controller, &table(AxisKind::Rotary), &rotary).is_ok());
+            assert!(super::super::write(controller, &table(AxisKind::Linear), &linear).is_ok());
+        }
+    }
 }
