@@ -65,6 +65,8 @@ pub struct UpdateSummary {
     pub dropped_mm: Vec<f64>,
     /// New points the old table did not have, mm.
     pub added_mm: Vec<f64>,
+    /// The axis' kind: the unit of every position above (mm, or °).
+    pub kind: AxisKind,
 }
 
 impl UpdatePlan {
@@ -211,6 +213,7 @@ impl UpdatePlan {
             at_existing_zero: self.at_existing_zero,
             dropped_mm,
             added_mm,
+            kind: old.kind,
         };
         (table, summary)
     }

@@ -15,88 +15,159 @@
 use serde::Serialize;
 
 use crate::compensate::update::{KeptRange, UpdateSummary};
+use crate::measurement::AxisKind;
 use crate::report::format::inch_text;
-use crate::units::LengthUnit;
+use crate::units::{Deg, LengthUnit, Mm};
 
-/// Old points kept as they were, one run.
+/// Old points kept as they were, one run, in `P` (mm, or ° on a rotary axis).
 #[derive(Clone, Debug, Serialize)]
-pub struct KeptJson {
-    /// First point, mm.
-    pub first: f64,
-    /// Last point, mm.
-    pub last: f64,
+pub struct KeptJson<P> {
+    /// First point.
+    pub first: P,
+    /// Last point.
+    pub last: P,
     /// How many points.
     pub count: usize,
+}
+
+/// Declares the update's wire struct of one kind of axis: its positions
+/// typed in the unit its keys name.
+macro_rules! update_json {
+    ($(#[$doc:meta])* $name:ident<$position:ty> {
+        $kept:ident, $measured:ident, $reference:ident, $dropped:ident, $added:ident $(,)?
+    }) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, Serialize)]
+        pub struct $name {
+            /// Old points outside the measured range, kept as they were, by runs.
+            pub $kept: Vec<KeptJson<$position>>,
+            /// The measured range.
+            pub $measured: [$position; 2],
+            /// Points inside it that got old + residual.
+            pub updated: usize,
+            /// Where the update adds nothing.
+            pub $reference: $position,
+            /// `existing zero` (the existing table's zero, the default) or `given` (`--reference`).
+            pub reference: &'static str,
+            /// Old points inside the measured range the new grid does not have.
+            pub $dropped: Vec<$position>,
+            /// New points the old table did not have.
+            pub $added: Vec<$position>,
+            /// What the terminal prints.
+            pub lines: Vec<String>,
+        }
+
+        impl $name {
+            /// The summary's positions typed by `unit`, with the sentences.
+            fn of(
+                summary: &UpdateSummary,
+                unit: fn(f64) -> $position,
+                lines: Vec<String>,
+            ) -> $name {
+                let all = |positions: &[f64]| positions.iter().map(|&p| unit(p)).collect();
+                $name {
+                    $kept: summary
+                        .kept
+                        .iter()
+                        .map(|k| KeptJson {
+                            first: unit(k.first_mm),
+                            last: unit(k.last_mm),
+                            count: k.count,
+                        })
+                        .collect(),
+                    $measured: [unit(summary.measured_mm.0), unit(summary.measured_mm.1)],
+                    updated: summary.updated,
+                    $reference: unit(summary.reference_mm),
+                    reference: if summary.at_existing_zero {
+                        "existing zero"
+                    } else {
+                        "given"
+                    },
+                    $dropped: all(&summary.dropped_mm),
+                    $added: all(&summary.added_mm),
+                    lines,
+                }
+            }
+        }
+    };
+}
+
+update_json!(
+    /// A linear axis' update: positions in mm.
+    LinearUpdateJson<Mm> { kept_mm, measured_mm, reference_mm, dropped_mm, added_mm }
+);
+
+update_json!(
+    /// A rotary axis' update: positions in °.
+    RotaryUpdateJson<Deg> { kept_deg, measured_deg, reference_deg, dropped_deg, added_deg }
+);
+
+/// The update's positions in the unit of its axis, the keys naming it: a
+/// rotary axis' in ° under `kept_deg`, `measured_deg`, `reference_deg`,
+/// `dropped_deg`, `added_deg`.
+#[derive(Clone, Debug, Serialize)]
+#[serde(untagged)]
+pub enum UpdateWireJson {
+    /// In mm.
+    Linear(LinearUpdateJson),
+    /// In °.
+    Rotary(RotaryUpdateJson),
 }
 
 /// The update, for `--json` and the terminal.
 #[derive(Clone, Debug, Serialize)]
 pub struct UpdateJson {
-    /// Old points outside the measured range, kept as they were, by runs.
-    pub kept_mm: Vec<KeptJson>,
-    /// The measured range, mm.
-    pub measured_mm: [f64; 2],
-    /// Points inside it that got old + residual.
-    pub updated: usize,
-    /// Where the update adds nothing, mm.
-    pub reference_mm: f64,
-    /// `existing zero` (the existing table's zero, the default) or `given` (`--reference`).
-    pub reference: &'static str,
-    /// Old points inside the measured range the new grid does not have, mm.
-    pub dropped_mm: Vec<f64>,
-    /// New points the old table did not have, mm.
-    pub added_mm: Vec<f64>,
-    /// What the terminal prints.
-    pub lines: Vec<String>,
+    /// What `--json` writes.
+    #[serde(flatten)]
+    pub wire: UpdateWireJson,
     /// Whether the new table is zero at the reference (the existing table is).
     #[serde(skip)]
     pub zero_at_reference: bool,
-    /// Every kept point, mm (for marking the printed table's rows).
+    /// Every kept point, in the axis' unit (for marking the printed table's rows).
     #[serde(skip)]
-    pub kept_points_mm: Vec<f64>,
+    pub kept_points: Vec<f64>,
+    /// Every new point, in the axis' unit (for marking the printed table's rows).
+    #[serde(skip)]
+    pub added_points: Vec<f64>,
 }
 
 impl UpdateJson {
     /// What a row of the printed table is: `kept` (the old value), `new`
     /// (a point the old table did not have) or nothing (old + residual).
-    pub fn row_mark(&self, position_mm: f64) -> &'static str {
-        let among = |list: &[f64]| list.iter().any(|p| (p - position_mm).abs() < 1e-6);
-        if among(&self.kept_points_mm) {
+    pub fn row_mark(&self, position: f64) -> &'static str {
+        let among = |list: &[f64]| list.iter().any(|p| (p - position).abs() < 1e-6);
+        if among(&self.kept_points) {
             "  kept"
-        } else if among(&self.added_mm) {
+        } else if among(&self.added_points) {
             "  new"
         } else {
             ""
         }
     }
+
+    /// What the terminal prints.
+    pub fn lines(&self) -> &[String] {
+        match &self.wire {
+            UpdateWireJson::Linear(update) => &update.lines,
+            UpdateWireJson::Rotary(update) => &update.lines,
+        }
+    }
 }
 
 impl UpdateJson {
-    /// From the summary; positions written in `file_unit` (`mm`, `inch` or `deg`).
+    /// From the summary; positions written in `file_unit` (`mm`, `inch` or
+    /// `deg`) in the sentences, in mm or ° under keys naming them.
     pub fn new(summary: &UpdateSummary, file_unit: &str) -> UpdateJson {
+        let lines = lines(summary, file_unit);
+        let wire = match summary.kind {
+            AxisKind::Linear => UpdateWireJson::Linear(LinearUpdateJson::of(summary, Mm, lines)),
+            AxisKind::Rotary => UpdateWireJson::Rotary(RotaryUpdateJson::of(summary, Deg, lines)),
+        };
         UpdateJson {
-            kept_mm: summary
-                .kept
-                .iter()
-                .map(|k| KeptJson {
-                    first: k.first_mm,
-                    last: k.last_mm,
-                    count: k.count,
-                })
-                .collect(),
-            measured_mm: [summary.measured_mm.0, summary.measured_mm.1],
-            updated: summary.updated,
-            reference_mm: summary.reference_mm,
-            reference: if summary.at_existing_zero {
-                "existing zero"
-            } else {
-                "given"
-            },
-            dropped_mm: summary.dropped_mm.clone(),
-            added_mm: summary.added_mm.clone(),
-            lines: lines(summary, file_unit),
+            wire,
             zero_at_reference: summary.existing_at_reference_mm.abs() < 1e-12,
-            kept_points_mm: summary.kept_points_mm.clone(),
+            kept_points: summary.kept_points_mm.clone(),
+            added_points: summary.added_mm.clone(),
         }
     }
 }
@@ -220,6 +291,7 @@ mod tests {
             dropped_mm: vec![],
             added_mm: vec![3302.0],
             kept_points_mm: vec![],
+            kind: AxisKind::Linear,
         };
         let lines = lines(&summary, "mm");
         assert_eq!(

@@ -63,3 +63,39 @@ fn an_update_reference_outside_the_rotary_test_is_said_in_degrees() {
         "the reference -30° is outside the measured range 0 … 360°",
     );
 }
+
+/// `convert --existing --json` of a rotary axis writes the update's
+/// positions under `_deg` keys: the fixture's 0 … 360° updated on a 30°
+/// grid, the old 15°, 45°, … 345° points dropped, referred to the old
+/// table's zero, 0°.
+#[test]
+fn a_rotary_update_says_its_positions_in_degrees_in_json() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = directory.path().join("c.comp");
+    let run = axcomp([
+        "convert",
+        ROTARY,
+        "--controller",
+        "linuxcnc",
+        "--existing",
+        "formats/linuxcnc/golden/rotary-c-mean-type0.txt",
+        "--start",
+        "0",
+        "--step",
+        "30",
+        "-o",
+        output.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let update = &json["update"];
+    assert_eq!(update["measured_deg"], serde_json::json!([0.0, 360.0]));
+    assert_eq!(update["reference_deg"], 0.0);
+    assert_eq!(update["kept_deg"], serde_json::json!([]));
+    let dropped: Vec<f64> = (0..12).map(|k| 15.0 + 30.0 * f64::from(k)).collect();
+    assert_eq!(update["dropped_deg"], serde_json::json!(dropped));
+    assert_eq!(update["added_deg"], serde_json::json!([]));
+    let keys: Vec<&String> = update.as_object().unwrap().keys().collect();
+    assert!(keys.iter().all(|k| !k.ends_with("_mm")), "{keys:?}");
+}
