@@ -6,16 +6,16 @@ use crate::util::axcomp;
 
 const ROTARY: &str = "fixtures/rotary/c.csv";
 
-/// `convert` of the rotary fixture to LinuxCNC with `extra` flags: it must
-/// be refused (exit 2); its message.
-fn refused(extra: &[&str]) -> String {
+/// `convert` of the rotary fixture to `controller` with `extra` flags: it
+/// must be refused (exit 2); its message.
+fn refused(controller: &str, extra: &[&str]) -> String {
     let directory = tempfile::tempdir().unwrap();
     let output = directory.path().join("c.comp");
     let mut args = vec![
         "convert",
         ROTARY,
         "--controller",
-        "linuxcnc",
+        controller,
         "-o",
         output.to_str().unwrap(),
     ];
@@ -26,9 +26,15 @@ fn refused(extra: &[&str]) -> String {
     run.stderr
 }
 
-/// The refusal of `convert` with `extra` says `expected`, and no "mm".
+/// The refusal of `convert` to LinuxCNC with `extra` says `expected`, and
+/// no "mm".
 fn said_in_degrees(extra: &[&str], expected: &str) {
-    let stderr = refused(extra);
+    said_in_degrees_for("linuxcnc", extra, expected);
+}
+
+/// [`said_in_degrees`] for `controller`.
+fn said_in_degrees_for(controller: &str, extra: &[&str], expected: &str) {
+    let stderr = refused(controller, extra);
     assert!(stderr.contains(expected), "{stderr}");
     assert!(!stderr.contains("mm"), "{stderr}");
 }
@@ -98,4 +104,15 @@ fn a_rotary_update_says_its_positions_in_degrees_in_json() {
     assert_eq!(update["added_deg"], serde_json::json!([]));
     let keys: Vec<&String> = update.as_object().unwrap().keys().collect();
     assert!(keys.iter().all(|k| !k.ends_with("_mm")), "{keys:?}");
+}
+
+#[test]
+fn a_step_the_itnc_cannot_write_is_said_in_degrees() {
+    // The iTNC 530 writes the step to 0.0001°: 7.50005° is no multiple.
+    said_in_degrees_for(
+        "itnc530",
+        &["--start", "0", "--step", "7.50005", "--count", "3"],
+        "writes the step to 0.0001°; a step of 7.50005° would shift the points along the table: \
+         give --step as a multiple of 0.0001°",
+    );
 }
