@@ -23,7 +23,8 @@
 
 use super::AxisFigures;
 use super::targets::{DirectionStats, TargetStats};
-use crate::measurement::Direction;
+use crate::measurement::{AxisKind, ByKind, Direction};
+use crate::units::{Deg, Mm};
 
 /// What derives a test's figures from the statistics of each target.
 pub trait Standard: Sync + std::fmt::Debug {
@@ -53,13 +54,43 @@ pub trait Standard: Sync + std::fmt::Debug {
     fn figures(&self, per_target: &[TargetStats], axis: &AxisFigures) -> Vec<StandardFigure>;
 }
 
-/// One figure as a standard names it.
+/// One figure as a standard names it: its value a bare number in the axis'
+/// unit (`V = f64`: mm, or ° on a rotary axis; no name here says which), or
+/// typed by the axis' kind ([`typed`]: `StandardFigure<Mm>` or
+/// `StandardFigure<Deg>`) for whatever reports it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StandardFigure {
+pub struct StandardFigure<V = f64> {
     /// Its key in `figures_um` and in `--limit` (`A`, `Ps_max`).
     pub key: &'static str,
-    /// The value, in the axis' unit (mm, or °); `None` where not evaluated.
-    pub value: Option<f64>,
+    /// The value; `None` where not evaluated.
+    pub value: Option<V>,
+}
+
+impl<V> StandardFigure<V> {
+    /// The same figure with its value converted by `convert` (`Mm`,
+    /// `Mm::to_um`, `Deg::to_arcsec`): the function's type decides which
+    /// unit it accepts.
+    pub fn map<E>(self, convert: impl FnOnce(V) -> E) -> StandardFigure<E> {
+        StandardFigure {
+            key: self.key,
+            value: self.value.map(convert),
+        }
+    }
+}
+
+/// A standard's figures typed by their axis' kind: in [`Mm`] on a linear
+/// axis, in [`Deg`] on a rotary one.
+pub type FiguresByKind = ByKind<Vec<StandardFigure<Mm>>, Vec<StandardFigure<Deg>>>;
+
+/// `figures` (in the axis' unit) typed by the axis' `kind`: with
+/// [`crate::evaluate::TargetStats::typed`], where a standard's figure gets its
+/// unit ([`crate::evaluate::Evaluation::standard_figures_typed`] asks the
+/// evaluation's own kind).
+pub fn typed(figures: &[StandardFigure], kind: AxisKind) -> FiguresByKind {
+    match kind {
+        AxisKind::Linear => ByKind::Linear(figures.iter().map(|f| f.map(Mm)).collect()),
+        AxisKind::Rotary => ByKind::Rotary(figures.iter().map(|f| f.map(Deg)).collect()),
+    }
 }
 
 /// A `--standard` name that is not one of [`SUPPORTED`].
