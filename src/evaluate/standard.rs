@@ -443,6 +443,40 @@ mod tests {
     }
 
     #[test]
+    fn figures_are_typed_by_the_axis_kind() {
+        use crate::measurement::AxisKind;
+        use approx::assert_abs_diff_eq;
+        // x̄↑ = 1, 5; x̄↓ = −1, 3 (thousandths of the axis' unit): E = 5 − (−1) = 6.
+        let e_of = |figures: &[StandardFigure<f64>]| {
+            figures
+                .iter()
+                .find(|f| f.key == "E")
+                .unwrap()
+                .value
+                .unwrap()
+        };
+        let linear = evaluate_with(&two_by_two(), &ISO_230_2);
+        let ByKind::Linear(in_mm) = linear.standard_figures_typed() else {
+            panic!("a linear axis' figures are mm")
+        };
+        let e_mm = in_mm.iter().find(|f| f.key == "E").unwrap().value.unwrap();
+        assert_abs_diff_eq!(e_mm.0, 0.006, epsilon = 1e-15);
+        let rotary = evaluate_with(&two_by_two().with_kind(AxisKind::Rotary), &ISO_230_2);
+        let ByKind::Rotary(in_deg) = rotary.standard_figures_typed() else {
+            panic!("a rotary axis' figures are degrees")
+        };
+        assert_eq!(in_deg[3].key, "E");
+        assert_eq!(in_deg[3].value, Some(Deg(e_of(&rotary.standard_figures))));
+        assert_abs_diff_eq!(e_of(&rotary.standard_figures), 0.006, epsilon = 1e-15);
+        // 0.006° = 21.6″.
+        let in_arcsec = in_deg[3].map(Deg::to_arcsec);
+        assert_abs_diff_eq!(in_arcsec.value.unwrap().0, 21.6, epsilon = 1e-12);
+        // The ISO 230-2 figures are typed the same way.
+        assert_eq!(rotary.figures_typed().kind(), AxisKind::Rotary);
+        assert_eq!(linear.figures_typed().kind(), AxisKind::Linear);
+    }
+
+    #[test]
     fn an_edition_is_a_value_not_a_fork() {
         // s = √2 µm in every cell (two readings 2 µm apart); B_i = 2 µm.
         let s = 2f64.sqrt();

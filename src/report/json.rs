@@ -979,4 +979,16 @@ mod tests {
         );
         assert!(key(AxisKind::Rotary, AngleUnit::Urad).starts_with(r#"{"figures_urad":{"E":34.9"#));
     }
+
+    #[test]
+    fn what_is_written_in_um_only_leaves_a_rotary_axis_figures_out() {
+        let figures = [StandardFigure {
+            key: "E",
+            value: Some(0.002),
+        }];
+        // 0.002 mm = 2 µm; 0.002° is not written as 2 µm.
+        let um = |kind| FiguresJson::of_linear(&typed(&figures, kind));
+        assert_eq!(um(AxisKind::Linear).get("E"), Some(2.0));
+        assert!(um(AxisKind::Rotary).is_empty());
+    }
 }
