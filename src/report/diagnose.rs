@@ -74,7 +74,7 @@ use crate::evaluate::{StandardFigure, standard};
 use crate::measurement::AxisKind;
 use crate::report::format::{pad_name, um};
 use crate::report::json::{FiguresByUnit, FiguresJson};
-use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, um_to_mm};
+use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, millideg_to_deg};
 
 /// A deviation as a diagnosis reports it: µm ([`Um`]) on a linear axis, ″
 /// ([`Arcsec`]) or µrad ([`Urad`]) on a rotary one. A diagnosis holds its
@@ -109,7 +109,7 @@ macro_rules! reported_angle {
             const UNIT: DeviationUnit = DeviationUnit::Angle($unit);
 
             fn from_held(value_millideg: f64) -> $quantity {
-                $from_deg(Deg(um_to_mm(value_millideg)))
+                $from_deg(Deg(millideg_to_deg(value_millideg)))
             }
 
             fn number(self) -> f64 {
