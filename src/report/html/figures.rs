@@ -51,7 +51,8 @@ pub(super) const FIGURE_ROWS: [(&str, &str, Figure); 6] = [
     ("B̄", "mean reversal value", Figure::BMean),
 ];
 
-/// A figure's value as `figures_um` gives it, µm.
+/// A figure's value in the unit of the key that holds it (`figures_um`: µm;
+/// `figures_arcsec` or `figures_urad` on a rotary axis).
 pub(super) fn figure_value(figures: &FiguresJson, figure: Figure) -> Option<f64> {
     figures.get(figure.name())
 }
