@@ -404,12 +404,13 @@ pub struct RunCountsJson {
     pub down: usize,
 }
 
-/// A standard's axis figures, µm, under its own keys and in its order
+/// A standard's axis figures as reported (µm; ″ or µrad on a rotary axis:
+/// [`FiguresByUnit`] names which), under its own keys and in its order
 /// (ISO 230-2: `A`, `A_up`, …, `B_mean`; VDI 3441: `P`, `Pa`, `Ps_max`,
 /// `Ps_mean`, `U_max`, `U_mean`); serialised as one JSON object.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FiguresJson {
-    /// (key, value µm), in the standard's order.
+    /// (key, value as reported), in the standard's order.
     pub values: Vec<(&'static str, Option<f64>)>,
 }
 
@@ -506,7 +507,7 @@ impl FiguresJson {
         self.values.is_empty()
     }
 
-    /// The value under `key`, µm (`None` when not evaluated or not this standard's).
+    /// The value under `key`, as reported (`None` when not evaluated or not this standard's).
     pub fn get(&self, key: &str) -> Option<f64> {
         self.values
             .iter()
