@@ -26,6 +26,7 @@ mod fagor;
 mod fagor_update;
 mod fanuc;
 mod fanuc_modes;
+mod fanuc_read_note;
 mod fanuc_web;
 mod flags;
 mod generated_docs;
