@@ -61,3 +61,4 @@ mod together;
 mod units_wire;
 mod util;
 mod verdict;
+mod web_existing;
