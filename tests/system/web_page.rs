@@ -181,6 +181,8 @@ fn step_two_updates_the_table_that_was_active() {
             "PITCH-OLD.TXT",
             "--fanuc-parameters",
             "CNC-PARA.TXT",
+            "--o2",
+            "after.rtl",
         ],
     );
     std::fs::create_dir(dir.join("cli")).unwrap();
