@@ -124,21 +124,32 @@ fn convert_says_the_unknown_bit_once() {
 
 /// The web app's re-test and report read the table as `diagnose --table`
 /// and `report --table` do: the same sentence among the re-test's
-/// warnings, the backup named as uploaded.
+/// warnings and in the report, the backup named as uploaded.
 #[test]
-fn the_web_retest_says_the_unknown_bit() {
+fn the_web_retest_and_report_say_the_unknown_bit() {
     let directory = tempfile::tempdir().unwrap();
     let (before, after) = tests_with_the_pitch_file(directory.path());
     let app = App::new();
-    let form = Form::new()
-        .file("file", "before.rtl", &read(Path::new(&before)))
+    let first_test_and_table = || {
+        Form::new()
+            .file("file", "before.rtl", &read(Path::new(&before)))
+            .file("table", "PITCH.TXT", &read(Path::new(&data("PITCH.TXT"))))
+            .file(
+                "fanuc_parameters",
+                "CNC-PARA.TXT",
+                &read(Path::new(&data("CNC-PARA.TXT"))),
+            )
+    };
+    let report = app.post("/api/report", first_test_and_table(), &[]);
+    assert_eq!(report.status, 200, "{}", report.text());
+    assert!(
+        report
+            .text()
+            .contains("CNC-PARA.TXT:1411:12): bit #1 set besides #0"),
+        "the web report does not say it"
+    );
+    let form = first_test_and_table()
         .file("after", "after.rtl", &read(Path::new(&after)))
-        .file("table", "PITCH.TXT", &read(Path::new(&data("PITCH.TXT"))))
-        .file(
-            "fanuc_parameters",
-            "CNC-PARA.TXT",
-            &read(Path::new(&data("CNC-PARA.TXT"))),
-        )
         .text("controller", "fanuc")
         .text("axis", "X");
     let answer = app.post("/api/retest", form, &[]);
