@@ -58,6 +58,7 @@ mod thermal;
 mod thermal_front;
 mod thermal_hal;
 mod together;
+mod units_figures;
 mod units_wire;
 mod util;
 mod verdict;
