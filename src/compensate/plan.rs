@@ -138,7 +138,7 @@ pub fn plan(
             grid,
             reference: update
                 .as_ref()
-                .map_or(request.reference, |u| Some(u.reference_mm))
+                .map_or(request.reference, |u| Some(u.reference))
                 .map(|r| kind.position(r)),
             // An update keeps the old values outside the measured range
             // (`UpdatePlan::apply` replaces whatever is built there).
@@ -164,7 +164,7 @@ fn check_update_grid(
     if controller.free_positions {
         return Ok(());
     }
-    let (first, last) = update.measured_mm;
+    let (first, last) = update.measured;
     let mut positions = super::grid_positions(targets_mm, grid)?;
     positions.extend(
         update
@@ -473,7 +473,7 @@ mod tests {
         };
         let update = linear_plan(&[], &free, &Request::default(), &context).unwrap();
         assert_eq!(update.options.reference, Some(ByKind::Linear(Mm(0.0))));
-        assert_eq!(update.update.unwrap().measured_mm, (0.0, 500.0));
+        assert_eq!(update.update.unwrap().measured, (0.0, 500.0));
         // A zero the test did not measure cannot refer the update.
         let mut shifted = existing();
         shifted.reference = 600.0;

@@ -70,21 +70,21 @@ macro_rules! update_json {
                         .kept
                         .iter()
                         .map(|k| KeptJson {
-                            first: unit(k.first_mm),
-                            last: unit(k.last_mm),
+                            first: unit(k.first),
+                            last: unit(k.last),
                             count: k.count,
                         })
                         .collect(),
-                    $measured: [unit(summary.measured_mm.0), unit(summary.measured_mm.1)],
+                    $measured: [unit(summary.measured.0), unit(summary.measured.1)],
                     updated: summary.updated,
-                    $reference: unit(summary.reference_mm),
+                    $reference: unit(summary.reference),
                     reference: if summary.at_existing_zero {
                         "existing zero"
                     } else {
                         "given"
                     },
-                    $dropped: all(&summary.dropped_mm),
-                    $added: all(&summary.added_mm),
+                    $dropped: all(&summary.dropped),
+                    $added: all(&summary.added),
                     lines,
                 }
             }
@@ -165,9 +165,9 @@ impl UpdateJson {
         };
         UpdateJson {
             wire,
-            zero_at_reference: summary.existing_at_reference_mm.abs() < 1e-12,
-            kept_points: summary.kept_points_mm.clone(),
-            added_points: summary.added_mm.clone(),
+            zero_at_reference: summary.existing_at_reference.abs() < 1e-12,
+            kept_points: summary.kept_points.clone(),
+            added_points: summary.added.clone(),
         }
     }
 }
@@ -207,7 +207,7 @@ fn ranges_text(ranges: &[KeptRange], file_unit: &str) -> String {
             let points = if k.count == 1 { "point" } else { "points" };
             format!(
                 "{} ({} {points})",
-                range_text(k.first_mm, k.last_mm, file_unit),
+                range_text(k.first, k.last, file_unit),
                 k.count
             )
         })
@@ -226,7 +226,7 @@ fn list_text(positions_mm: &[f64], file_unit: &str) -> String {
 /// The sentences: what was kept, what was updated and where it is referred,
 /// how the grid changed.
 fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
-    let (first, last) = summary.measured_mm;
+    let (first, last) = summary.measured;
     let measured = range_text(first, last, file_unit);
     let mut lines = Vec::new();
     if !summary.kept.is_empty() {
@@ -237,8 +237,8 @@ fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
             if kept == 1 { "it was" } else { "they were" }
         ));
     }
-    let reference = range_text(summary.reference_mm, summary.reference_mm, file_unit);
-    let why = if summary.at_existing_zero && summary.existing_at_reference_mm.abs() < 1e-12 {
+    let reference = range_text(summary.reference, summary.reference, file_unit);
+    let why = if summary.at_existing_zero && summary.existing_at_reference.abs() < 1e-12 {
         "the existing table's zero".to_string()
     } else if summary.at_existing_zero {
         "the existing table's first point; it has no zero".to_string()
@@ -249,16 +249,16 @@ fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
         "{measured} ({} points): the existing table plus the measured residual, referred to {reference} ({why}), where the update adds nothing",
         summary.updated
     ));
-    if !summary.dropped_mm.is_empty() {
+    if !summary.dropped.is_empty() {
         lines.push(format!(
             "grid changed: the old points at {} are not on the new grid (the new table follows the old one plus the residual between its points)",
-            list_text(&summary.dropped_mm, file_unit)
+            list_text(&summary.dropped, file_unit)
         ));
     }
-    if !summary.added_mm.is_empty() {
+    if !summary.added.is_empty() {
         lines.push(format!(
             "grid changed: new points at {} (the old table had none there)",
-            list_text(&summary.added_mm, file_unit)
+            list_text(&summary.added, file_unit)
         ));
     }
     lines
@@ -273,24 +273,24 @@ mod tests {
         let summary = UpdateSummary {
             kept: vec![
                 KeptRange {
-                    first_mm: -4953.0,
-                    last_mm: -2286.0,
+                    first: -4953.0,
+                    last: -2286.0,
                     count: 22,
                 },
                 KeptRange {
-                    first_mm: 127.0,
-                    last_mm: 127.0,
+                    first: 127.0,
+                    last: 127.0,
                     count: 1,
                 },
             ],
-            measured_mm: (-2159.0, 0.0),
+            measured: (-2159.0, 0.0),
             updated: 18,
-            reference_mm: 0.0,
-            existing_at_reference_mm: 0.0,
+            reference: 0.0,
+            existing_at_reference: 0.0,
             at_existing_zero: true,
-            dropped_mm: vec![],
-            added_mm: vec![3302.0],
-            kept_points_mm: vec![],
+            dropped: vec![],
+            added: vec![3302.0],
+            kept_points: vec![],
             kind: AxisKind::Linear,
         };
         let lines = lines(&summary, "mm");
