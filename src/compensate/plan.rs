@@ -90,11 +90,11 @@ pub struct Plan {
     pub update: Option<UpdatePlan>,
 }
 
-/// The plan for a table of an axis of `kind` over `targets_mm` (the
+/// The plan for a table of an axis of `kind` over `targets` (the
 /// measured targets, ascending, in the axis' unit).
 pub fn plan(
     kind: AxisKind,
-    targets_mm: &[f64],
+    targets: &[f64],
     effects: &[Effect],
     controller: &Capabilities,
     request: &Request,
@@ -110,12 +110,12 @@ pub fn plan(
         Some(existing) => Some(UpdatePlan::new(
             existing,
             kind,
-            targets_mm,
+            targets,
             request.reference.map(|r| kind.position(r)),
         )?),
         None => None,
     };
-    let step_mm = effects_step(kind, effects, controller, request, &mut notes);
+    let finer_step = effects_step(kind, effects, controller, request, &mut notes);
     for effect in effects {
         if let TableRole::TakenOut { note } | TableRole::NotATable { note } = effect.in_table() {
             notes.push(note);
@@ -123,14 +123,14 @@ pub fn plan(
     }
     let grid = grid(
         kind,
-        targets_mm,
+        targets,
         controller,
         request,
-        step_mm,
+        finer_step,
         &mut table_notes,
     )?;
     if let Some(update) = &update {
-        check_update_grid(update, targets_mm, grid, controller)?;
+        check_update_grid(update, targets, grid, controller)?;
     }
     Ok(Plan {
         options: TableOptions {
@@ -157,7 +157,7 @@ pub fn plan(
 /// points lie on the new grid's step.
 fn check_update_grid(
     update: &UpdatePlan,
-    targets_mm: &[f64],
+    targets: &[f64],
     grid: GridSpec,
     controller: &Capabilities,
 ) -> Result<(), CompensateError> {
@@ -165,7 +165,7 @@ fn check_update_grid(
         return Ok(());
     }
     let (first, last) = update.measured;
-    let mut positions = super::grid_positions(targets_mm, grid)?;
+    let mut positions = super::grid_positions(targets, grid)?;
     positions.extend(
         update
             .existing
@@ -273,52 +273,52 @@ fn effects_step(
 /// else the measured targets when the controller takes them.
 fn grid(
     kind: AxisKind,
-    targets_mm: &[f64],
+    targets: &[f64],
     controller: &Capabilities,
     request: &Request,
     effects_step: Option<f64>,
     notes: &mut Vec<String>,
 ) -> Result<GridSpec, CompensateError> {
-    let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
-    let Some(step_mm) = effects_step.or(request.step) else {
-        if controller.free_positions || regular_step(targets_mm).is_some() {
+    let (first, last) = (targets[0], targets[targets.len() - 1]);
+    let Some(step) = effects_step.or(request.step) else {
+        if controller.free_positions || regular_step(targets).is_some() {
             return Ok(GridSpec::Targets);
         }
         return Err(CompensateError::UnevenTargets {
-            count: targets_mm.len(),
+            count: targets.len(),
             first: kind.position(first),
             last: kind.position(last),
             controller: controller.name,
         });
     };
     let unit = kind.unit_after_number();
-    let start_mm = request.start.unwrap_or(first);
-    if request.count.is_none() && start_mm + step_mm > last + 1e-9 {
+    let start = request.start.unwrap_or(first);
+    if request.count.is_none() && start + step > last + 1e-9 {
         return Err(CompensateError::Grid(format!(
-            "the grid starts at {start_mm}{unit} with a step of {step_mm}{unit}, but the test measured \
+            "the grid starts at {start}{unit} with a step of {step}{unit}, but the test measured \
              {first} … {last}{unit}: no second point lies within it (give a start below {}{unit}, or --count)",
-            last - step_mm
+            last - step
         )));
     }
     // A --count belongs to the --step it was given with, not to a finer step of the effects.
-    let count = match request.count.filter(|_| Some(step_mm) == request.step) {
+    let count = match request.count.filter(|_| Some(step) == request.step) {
         Some(count) => count,
-        None => ((last - start_mm) / step_mm + 1e-9).floor().max(0.0) as usize + 1,
+        None => ((last - start) / step + 1e-9).floor().max(0.0) as usize + 1,
     };
-    let end_mm = start_mm + (count - 1) as f64 * step_mm;
+    let end = start + (count - 1) as f64 * step;
     // The user's step is said where it falls short; the effects' fine step ends within it.
-    if request.count.is_none() && request.step == Some(step_mm) && end_mm < last - 1e-9 {
+    if request.count.is_none() && request.step == Some(step) && end < last - 1e-9 {
         notes.push(format!(
             "the table ends at {end}{unit}, its last compensation point, short of the measured end \
-             {last}{unit} ({start_mm}{unit} + whole steps of {step_mm}{unit}): to include {last}{unit} give a \
+             {last}{unit} ({start}{unit} + whole steps of {step}{unit}): to include {last}{unit} give a \
              step that divides {length}{unit}",
-            end = super::round_nm(end_mm),
-            length = super::round_nm(last - start_mm),
+            end = super::round_nm(end),
+            length = super::round_nm(last - start),
         ));
     }
     Ok(GridSpec::Regular {
-        start: kind.position(start_mm),
-        step: kind.position(step_mm),
+        start: kind.position(start),
+        step: kind.position(step),
         count,
     })
 }
