@@ -95,7 +95,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let options = TableOptions {
         mode: TableMode::Mean,
         grid: GridSpec::Targets,
-        reference_mm: None,
+        reference: None,
         extrapolate: Extrapolate::Refuse,
     };
     let table = compensate::build_table(before, evaluation, &options)?;
