@@ -741,3 +741,149 @@ fn period_notes(
     }
     notes
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::effects::outlier_run::OutlierRun;
+    use crate::evaluate::ISO_230_2;
+    use crate::units::{Arcsec, Urad};
+
+    /// Run 1↓ 10 µm (or m°, 0.01°) off the others, σ 1; its prediction
+    /// error 1000 without it, 500 with it.
+    pub(crate) fn outlier_run() -> AcceptedEffect {
+        AcceptedEffect {
+            effect: Effect::OutlierRun(OutlierRun {
+                run: 1,
+                direction: Direction::Down,
+                offset_um: 10.0,
+            }),
+            uncertainty: vec![("offset_um", 1.0)],
+            evidence: Evidence {
+                delta_bic: -20.0,
+                trials: 5,
+                p_value: 0.001,
+                cv_rmse_without: 1000.0,
+                cv_rmse_with: 500.0,
+            },
+            explanation: String::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// A diagnosis of `kind` holding its deviations bare: 250 and 125 (µm,
+    /// or m°) for the residual before, 62.5 and 31.25 after, noise 500, an
+    /// outlier run's evidence 1000 → 500, unexplained structure at 90 and
+    /// 180 (mm, or °) of rms 62.5, one reading of residual 250 fitted 125.
+    fn held(kind: AxisKind) -> Diagnosis {
+        let none = FigureSet {
+            measured: AxisFigures::default(),
+            predicted: AxisFigures::default(),
+            predicted_with_effects: AxisFigures::default(),
+        };
+        Diagnosis {
+            kind,
+            predicted_from_first_test: true,
+            residual_before: ResidualStats {
+                rms: 250.0,
+                max_abs: 125.0,
+            },
+            accepted: vec![outlier_run()],
+            rejected: Vec::new(),
+            residual_after: ResidualStats {
+                rms: 62.5,
+                max_abs: 31.25,
+            },
+            figures: none,
+            standard_figures: FigureSet {
+                measured: Vec::new(),
+                predicted: Vec::new(),
+                predicted_with_effects: Vec::new(),
+            },
+            standard: StandardUsed::of(&ISO_230_2),
+            unexplained: Unexplained {
+                significant: true,
+                p_value: 1e-4,
+                targets: vec![90.0, 180.0],
+                rms: 62.5,
+            },
+            noise: 500.0,
+            time_assumed: false,
+            run_h: 0.5,
+            readings: vec![ReadingResidual {
+                reading: Reading {
+                    target_index: 0,
+                    target_mm: 90.0,
+                    direction: Direction::Up,
+                    run: 1,
+                    run_index: 0,
+                    time_h: 0.0,
+                },
+                residual: 250.0,
+                fitted: 125.0,
+            }],
+        }
+    }
+
+    #[test]
+    fn a_linear_diagnosis_is_typed_in_mm_and_um_as_held() {
+        let ByKind::Linear(typed) = held(AxisKind::Linear).typed() else {
+            panic!("a linear diagnosis typed as rotary")
+        };
+        assert_eq!(
+            typed.residual_before,
+            ResidualStats {
+                rms: Um(250.0),
+                max_abs: Um(125.0)
+            }
+        );
+        assert_eq!(typed.noise, Um(500.0));
+        assert_eq!(typed.unexplained.targets, [Mm(90.0), Mm(180.0)]);
+        assert_eq!(typed.unexplained.rms, Um(62.5));
+        assert_eq!(
+            (typed.readings[0].residual, typed.readings[0].fitted),
+            (Um(250.0), Um(125.0))
+        );
+    }
+
+    #[test]
+    fn a_rotary_diagnosis_held_in_millidegrees_is_typed_in_degrees() {
+        // 250 m° = 0.25° = 900″; 62.5 m° = 0.0625° = 225″; 1000 m° = 1° =
+        // 3600″ = 10⁶·π/180 µrad; the places stay degrees.
+        let ByKind::Rotary(typed) = held(AxisKind::Rotary).typed() else {
+            panic!("a rotary diagnosis typed as linear")
+        };
+        assert_eq!(typed.residual_before.rms, Deg(0.25));
+        assert_eq!(typed.residual_after.max_abs, Deg(0.03125));
+        assert_eq!(typed.noise, Deg(0.5));
+        assert_eq!(typed.unexplained.targets, [Deg(90.0), Deg(180.0)]);
+        assert_eq!(
+            (typed.readings[0].residual, typed.readings[0].fitted),
+            (Deg(0.25), Deg(0.125))
+        );
+        let arcsec = typed.clone().map_deviations(Deg::to_arcsec);
+        assert_eq!(
+            arcsec.residual_before,
+            ResidualStats {
+                rms: Arcsec(900.0),
+                max_abs: Arcsec(450.0)
+            }
+        );
+        assert_eq!(arcsec.unexplained.rms, Arcsec(225.0));
+        assert_eq!(
+            (
+                arcsec.evidence[0].cv_rmse_without,
+                arcsec.evidence[0].cv_rmse_with,
+                arcsec.evidence[0].trials
+            ),
+            (Arcsec(3600.0), Arcsec(1800.0), 5)
+        );
+        let urad = typed.map_deviations(Deg::to_urad);
+        approx::assert_relative_eq!(
+            urad.evidence[0].cv_rmse_without.0,
+            1e6 * std::f64::consts::PI / 180.0,
+            max_relative = 1e-15
+        );
+        let _: Urad = urad.noise;
+    }
+}

@@ -1030,30 +1030,8 @@ pub fn render(report: &DiagnoseJson) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::Evidence;
-    use crate::effects::outlier_run::OutlierRun;
-    use crate::measurement::Direction;
-
     /// Run 1↓ 10 m° (0.01°) off the others, σ 1 m°.
-    fn outlier_run() -> AcceptedEffect {
-        AcceptedEffect {
-            effect: Effect::OutlierRun(OutlierRun {
-                run: 1,
-                direction: Direction::Down,
-                offset_um: 10.0,
-            }),
-            uncertainty: vec![("offset_um", 1.0)],
-            evidence: Evidence {
-                delta_bic: -20.0,
-                trials: 5,
-                p_value: 0.001,
-                cv_rmse_without: 2.0,
-                cv_rmse_with: 1.0,
-            },
-            explanation: String::new(),
-            warnings: Vec::new(),
-        }
-    }
+    use crate::diagnose::tests::outlier_run;
 
     #[test]
     fn a_rotary_outlier_run_is_in_its_angle_unit_under_its_key() {
