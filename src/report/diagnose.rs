@@ -52,7 +52,11 @@
 //! diagnosed for per-revolution harmonics, its reversal and outlier runs
 //! only; it has no `friction`.
 //!
-//! Each key's unit is the type of the value under it: the object, its
+//! Each key's unit is the type of the value under it, and each value comes
+//! typed from the diagnosis (`Diagnosis::typed`: `Um` and `Mm`, or `Deg`
+//! converted by `Deg::to_arcsec` or `Deg::to_urad`); only an effect's
+//! parameters, bare in the effects file's units, are converted here
+//! (`ReportedDeviation::from_held`). The object, its
 //! evidence and its unexplained structure are one struct per pair of units
 //! (`LinearDiagnoseJson` with `residual_before_um: ResidualJson<Um>` and
 //! `unexplained.where_mm: Vec<Mm>`, `ArcsecDiagnoseJson`,
