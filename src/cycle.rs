@@ -132,7 +132,7 @@ mod tests {
             overrun_mm: 10.0,
         };
         let times = reading_times_for(&[0.0, 100.0], &[Direction::Up, Direction::Down], timing);
-        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        let close = |a: f64, b: f64| approx::abs_diff_eq!(a, b, epsilon = 1e-12);
         assert!(
             close(times[0][0], 2.1) && close(times[0][1], 5.1),
             "{times:?}"

@@ -254,6 +254,13 @@ pub enum Warning {
         /// The instrument as the file names it, if it does.
         instrument: Option<String>,
     },
+    /// A compensation table read as its file and parameters describe it,
+    /// where the control has a setting axcomp does not know: the sentence
+    /// says which and what to check.
+    TableReadAs {
+        /// The sentence.
+        note: String,
+    },
 }
 
 /// Something that makes two inputs doubtful together; the user decides.
@@ -390,6 +397,7 @@ impl fmt::Display for Warning {
                 "line {line}: laser status {status} ({meaning}); the reading is used, but check the beam path and re-measure if in doubt"
             ),
             Warning::InconsistentMetadata { message } => write!(f, "{message}"),
+            Warning::TableReadAs { note } => write!(f, "{note}"),
             Warning::SingleRun { direction } => {
                 write!(f, "n = 1 run {direction}: s, R and A are not evaluated")
             }

@@ -319,6 +319,12 @@ pub fn deg_to_urad(value_deg: f64) -> f64 {
     value_deg * URAD_PER_DEG
 }
 
+/// Millidegrees (m°, how a diagnosis holds a rotary axis' deviations where
+/// a linear axis' are µm) to degrees.
+pub fn millideg_to_deg(value_millideg: f64) -> f64 {
+    value_millideg / 1000.0
+}
+
 /// Arc-seconds to microradians (1″ ≈ 4.848 µrad).
 pub fn arcsec_to_urad(value_arcsec: f64) -> f64 {
     deg_to_urad(arcsec_to_deg(value_arcsec))
@@ -450,6 +456,8 @@ mod tests {
         // 1° = 3600″; 1″ = π/648000 rad = 4.848 136 811 µrad.
         assert_eq!(deg_to_arcsec(0.5), 1800.0);
         assert_eq!(arcsec_to_deg(36.0), 0.01);
+        // 10 m° (a diagnosis holds a rotary axis in m°) is 0.01° = 36″.
+        assert_eq!(millideg_to_deg(10.0), 0.01);
         assert_eq!(opt_deg_to_arcsec(None), None);
         assert!((arcsec_to_urad(1.0) - 4.848_136_811).abs() < 1e-9);
         assert!((deg_to_urad(180.0) - std::f64::consts::PI * 1e6).abs() < 1e-6);

@@ -4,7 +4,9 @@
 "use strict";
 
 const $ = (id) => document.getElementById(id);
-const files = { file: [], after: [], table: [], machine: [], fanuc_parameters: [] };
+// `existing` is step 2's table that was active during the test (`convert --existing`), sent as
+// `table` with the test; step 3's `table` is the one active during the re-test.
+const files = { file: [], after: [], table: [], existing: [], machine: [], fanuc_parameters: [] };
 // The rescaled Fanuc file of the last conversion (`--fanuc-rescaled`), for its download.
 let rescaled = null;
 // The limits typed next to the figures, µm, by figure key (`A`, `R_up`).
@@ -65,6 +67,14 @@ function tableForm(fields) {
     if (value) data.append(id, value);
   }
   if ($("fanuc_rescaled").checked) data.append("fanuc_rescaled", "1");
+  return data;
+}
+
+// Step 2's request: the test, the table that was active during it, the settings
+// (`convert FILE --existing TABLE …`).
+function convertForm() {
+  const data = tableForm(["file"]);
+  for (const file of files.existing) data.append("table", file, file.name);
   return data;
 }
 
@@ -247,7 +257,7 @@ function showTable(answer, prefix) {
 async function convert() {
   showError("table-error", "");
   if (!files.file.length) return;
-  const request = tableForm(["file"]);
+  const request = convertForm();
   lastConvert = request;
   try {
     const answer = await (await post("/api/convert", request)).json();
@@ -348,7 +358,8 @@ async function start() {
   for (const id of ["controller", "mode", "start", "step", "count", "reference", "extrapolate", "linuxcnc_type"]) {
     $(id).addEventListener("change", () => { convert(); retest(); });
   }
-  $("download").addEventListener("click", () => download("/api/table", tableForm(["file"]), "table-error"));
+  $("download").addEventListener("click", () => download("/api/table", convertForm(), "table-error"));
+  $("existing").addEventListener("change", (event) => pick("existing", event.target.files, convert));
   $("fanuc_parameters").addEventListener("change", (event) => pick("fanuc_parameters", event.target.files, () => { convert(); retest(); }));
   $("fanuc_rescaled").addEventListener("change", convert);
   $("download-rescaled").addEventListener("click", () => {

@@ -8,9 +8,9 @@ use anyhow::{Result, bail};
 use axcomp::compensate::cross_axis::CrossAxisTable;
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
-use axcomp::emit::{Controller, sinumerik840d, tnc640};
-use axcomp::error::ParseError;
-use axcomp::measurement::Measurement;
+use axcomp::emit::{Controller, fanuc, sinumerik840d, tnc640};
+use axcomp::error::{ParseError, Warning};
+use axcomp::measurement::{AxisKind, Measurement};
 use axcomp::model::{GeometricErrors, Optics, read_error_description};
 use axcomp::predict::survey::{MeasuredState, Survey, SurveyFile, assemble};
 use axcomp::predict::{MeasuredAxis, PredictInput, Prediction, predict};
@@ -19,6 +19,7 @@ use axcomp::report::predict::{PredictJson, SurveyJson, render};
 use axcomp::together::{Input, Pairing, check_together};
 use axcomp::units::{LengthUnit, mm_to_um};
 use axcomp::workflow::rotary;
+use axcomp::workflow::table::read_options;
 
 use super::common::{
     JsonOutput, LinuxCncType, MachineFile, StandardArg, Verbosity, load, load_effects,
@@ -189,11 +190,13 @@ pub fn run(args: &PredictArgs) -> Result<()> {
         })
         .collect();
     check_one_machine(args, &measurements)?;
-    let tables = args
+    let (tables, read_notes): (Vec<CompensationTable>, Vec<Option<Warning>>) = args
         .table
         .iter()
         .map(|spec| load_table(spec, &measurements, &profile, args.table_type.linuxcnc_type))
-        .collect::<Result<Vec<CompensationTable>>>()?;
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
     let cross_tables = args
         .cross_table
         .iter()
@@ -218,6 +221,7 @@ pub fn run(args: &PredictArgs) -> Result<()> {
             &Input::table(&table.axis, &table.positions, format!("--table {spec}")),
         )?);
     }
+    doubts.extend(read_notes.into_iter().flatten());
     print_warnings(&doubts, args.verbosity.quiet);
     let tool = args
         .tool_offset
@@ -323,13 +327,15 @@ fn load_survey(
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
-/// `[AXIS=]FILE`: the axis defaults to the one measured axis.
+/// `[AXIS=]FILE`: the axis defaults to the one measured axis. With the
+/// table, what its reading rests on when the file does not tell all
+/// (`emit::fanuc::read_note`).
 fn load_table(
     spec: &str,
     measurements: &[(Measurement, [f64; 3])],
     profile: &axcomp::emit::MachineProfile,
     linuxcnc_type: Option<u8>,
-) -> Result<CompensationTable> {
+) -> Result<(CompensationTable, Option<Warning>)> {
     let (axis, path) = match spec.split_once('=') {
         Some((axis, path)) if axis.len() == 1 => (axis.to_ascii_uppercase(), path),
         _ => match measurements {
@@ -347,7 +353,10 @@ fn load_table(
         .find(|m| m.axis() == axis)
         .or(measurements.first().map(|(m, _)| m))
         .map_or(LengthUnit::Millimetre, |m| m.metadata.length_unit);
-    Ok(read_table(Path::new(path), &axis, profile, linuxcnc_type, test_unit)?.1)
+    let (controller, table) =
+        read_table(Path::new(path), &axis, profile, linuxcnc_type, test_unit)?;
+    let options = read_options(profile, &axis, AxisKind::Linear, linuxcnc_type)?;
+    Ok((table, fanuc::read_note(controller, &options)))
 }
 
 /// Refuses table files of one machine that would overwrite each other in

@@ -359,9 +359,14 @@ impl TestConformance {
                 required: MIN_TARGETS.max(for_length as usize),
             });
         }
-        if self.is_long_axis() && self.runs_up.max(self.runs_down) > 1 {
+        // A long axis is a linear one: its travel is taken as mm from the
+        // `Mm` it is, not from the axis' bare number.
+        if let ByKind::Linear(Mm(length_mm)) = self.length
+            && self.is_long_axis()
+            && self.runs_up.max(self.runs_down) > 1
+        {
             warnings.push(Warning::LongAxis {
-                length_mm: self.length_in_axis_unit(),
+                length_mm,
                 runs: self.runs_up.max(self.runs_down),
             });
         }

@@ -22,7 +22,8 @@
 //! statistics are bare numbers in the axis' unit, under names that say no
 //! unit (`target`, `mean`, `a`, …: the unit is the axis'), and leave typed
 //! by the axis' kind ([`TargetStats::typed`],
-//! [`SuspectedOutlier::typed`], [`crate::measurement::AxisKind::position`]).
+//! [`SuspectedOutlier::typed`], [`Evaluation::standard_figures_typed`],
+//! [`crate::measurement::AxisKind::position`]).
 
 pub mod conformance;
 pub mod environment;
@@ -39,7 +40,9 @@ use crate::measurement::{AxisKind, Direction, Measurement};
 pub use conformance::TestConformance;
 use environment::{RefractiveIndexCheck, check_refractive_index};
 pub use outliers::{OutlierIn, SuspectedOutlier};
-pub use standard::{ISO_230_2, SUPPORTED, Standard, StandardFigure, UnknownStandard, by_name};
+pub use standard::{
+    FiguresByKind, ISO_230_2, SUPPORTED, Standard, StandardFigure, UnknownStandard, by_name,
+};
 use targets::per_target_stats;
 pub use targets::{DirectionStats, TargetIn, TargetStats};
 
@@ -90,6 +93,18 @@ impl AxisFigures {
             ("B", self.b),
             ("B_mean", self.b_mean),
         ]
+    }
+
+    /// The figures under their keys, typed by the axis' kind: in
+    /// [`crate::units::Mm`] on a linear axis, in [`crate::units::Deg`] on a
+    /// rotary one ([`Evaluation::figures_typed`] asks the evaluation's kind).
+    pub fn typed(&self, kind: AxisKind) -> FiguresByKind {
+        standard::typed(
+            &self
+                .keyed()
+                .map(|(key, value)| StandardFigure { key, value }),
+            kind,
+        )
     }
 }
 
@@ -149,6 +164,19 @@ impl Evaluation {
     /// Linear or rotary: the unit of every value here (mm, or °).
     pub fn kind(&self) -> AxisKind {
         self.conformance.kind()
+    }
+
+    /// The ISO 230-2 figures typed by the axis' kind ([`AxisFigures::typed`]).
+    pub fn figures_typed(&self) -> FiguresByKind {
+        self.figures.typed(self.kind())
+    }
+
+    /// The standard's figures typed by the axis' kind: `StandardFigure<Mm>`
+    /// on a linear axis, `StandardFigure<Deg>` on a rotary one. A rotary
+    /// axis' figures are degrees, which nothing that takes millimetres accepts
+    /// (`report::json::FiguresJson::from_standard`).
+    pub fn standard_figures_typed(&self) -> FiguresByKind {
+        standard::typed(&self.standard_figures, self.kind())
     }
 
     /// The variance of one reading about its target's mean, pooled over

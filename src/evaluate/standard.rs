@@ -23,7 +23,8 @@
 
 use super::AxisFigures;
 use super::targets::{DirectionStats, TargetStats};
-use crate::measurement::Direction;
+use crate::measurement::{AxisKind, ByKind, Direction};
+use crate::units::{Deg, Mm};
 
 /// What derives a test's figures from the statistics of each target.
 pub trait Standard: Sync + std::fmt::Debug {
@@ -53,13 +54,43 @@ pub trait Standard: Sync + std::fmt::Debug {
     fn figures(&self, per_target: &[TargetStats], axis: &AxisFigures) -> Vec<StandardFigure>;
 }
 
-/// One figure as a standard names it.
+/// One figure as a standard names it: its value a bare number in the axis'
+/// unit (`V = f64`: mm, or ° on a rotary axis; no name here says which), or
+/// typed by the axis' kind ([`typed`]: `StandardFigure<Mm>` or
+/// `StandardFigure<Deg>`) for whatever reports it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StandardFigure {
+pub struct StandardFigure<V = f64> {
     /// Its key in `figures_um` and in `--limit` (`A`, `Ps_max`).
     pub key: &'static str,
-    /// The value, in the axis' unit (mm, or °); `None` where not evaluated.
-    pub value: Option<f64>,
+    /// The value; `None` where not evaluated.
+    pub value: Option<V>,
+}
+
+impl<V> StandardFigure<V> {
+    /// The same figure with its value converted by `convert` (`Mm`,
+    /// `Mm::to_um`, `Deg::to_arcsec`): the function's type decides which
+    /// unit it accepts.
+    pub fn map<E>(self, convert: impl FnOnce(V) -> E) -> StandardFigure<E> {
+        StandardFigure {
+            key: self.key,
+            value: self.value.map(convert),
+        }
+    }
+}
+
+/// A standard's figures typed by their axis' kind: in [`Mm`] on a linear
+/// axis, in [`Deg`] on a rotary one.
+pub type FiguresByKind = ByKind<Vec<StandardFigure<Mm>>, Vec<StandardFigure<Deg>>>;
+
+/// `figures` (in the axis' unit) typed by the axis' `kind`: with
+/// [`crate::evaluate::TargetStats::typed`], where a standard's figure gets its
+/// unit ([`crate::evaluate::Evaluation::standard_figures_typed`] asks the
+/// evaluation's own kind).
+pub fn typed(figures: &[StandardFigure], kind: AxisKind) -> FiguresByKind {
+    match kind {
+        AxisKind::Linear => ByKind::Linear(figures.iter().map(|f| f.map(Mm)).collect()),
+        AxisKind::Rotary => ByKind::Rotary(figures.iter().map(|f| f.map(Deg)).collect()),
+    }
 }
 
 /// A `--standard` name that is not one of [`SUPPORTED`].
@@ -409,6 +440,40 @@ mod tests {
             Default::default(),
         )
         .unwrap()
+    }
+
+    #[test]
+    fn figures_are_typed_by_the_axis_kind() {
+        use crate::measurement::AxisKind;
+        use approx::assert_abs_diff_eq;
+        // x̄↑ = 1, 5; x̄↓ = −1, 3 (thousandths of the axis' unit): E = 5 − (−1) = 6.
+        let e_of = |figures: &[StandardFigure<f64>]| {
+            figures
+                .iter()
+                .find(|f| f.key == "E")
+                .unwrap()
+                .value
+                .unwrap()
+        };
+        let linear = evaluate_with(&two_by_two(), &ISO_230_2);
+        let ByKind::Linear(in_mm) = linear.standard_figures_typed() else {
+            panic!("a linear axis' figures are mm")
+        };
+        let e_mm = in_mm.iter().find(|f| f.key == "E").unwrap().value.unwrap();
+        assert_abs_diff_eq!(e_mm.0, 0.006, epsilon = 1e-15);
+        let rotary = evaluate_with(&two_by_two().with_kind(AxisKind::Rotary), &ISO_230_2);
+        let ByKind::Rotary(in_deg) = rotary.standard_figures_typed() else {
+            panic!("a rotary axis' figures are degrees")
+        };
+        assert_eq!(in_deg[3].key, "E");
+        assert_eq!(in_deg[3].value, Some(Deg(e_of(&rotary.standard_figures))));
+        assert_abs_diff_eq!(e_of(&rotary.standard_figures), 0.006, epsilon = 1e-15);
+        // 0.006° = 21.6″.
+        let in_arcsec = in_deg[3].map(Deg::to_arcsec);
+        assert_abs_diff_eq!(in_arcsec.value.unwrap().0, 21.6, epsilon = 1e-12);
+        // The ISO 230-2 figures are typed the same way.
+        assert_eq!(rotary.figures_typed().kind(), AxisKind::Rotary);
+        assert_eq!(linear.figures_typed().kind(), AxisKind::Linear);
     }
 
     #[test]

@@ -70,11 +70,11 @@ use serde_json::{Map, Value};
 use crate::diagnose::friction::ReversalFriction;
 use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
 use crate::effects::{Effect, ParameterValue};
-use crate::evaluate::StandardFigure;
+use crate::evaluate::{StandardFigure, standard};
 use crate::measurement::AxisKind;
 use crate::report::format::{pad_name, um};
-use crate::report::json::FiguresJson;
-use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, um_to_mm};
+use crate::report::json::{FiguresByUnit, FiguresJson};
+use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, millideg_to_deg};
 
 /// A deviation as a diagnosis reports it: µm ([`Um`]) on a linear axis, ″
 /// ([`Arcsec`]) or µrad ([`Urad`]) on a rotary one. A diagnosis holds its
@@ -88,9 +88,6 @@ pub trait ReportedDeviation: Serialize + Copy {
 
     /// The number, in this unit.
     fn number(self) -> f64;
-
-    /// A standard's figures (held in mm, or °) in this unit.
-    fn figures(figures: &[StandardFigure]) -> FiguresJson;
 }
 
 impl ReportedDeviation for Um {
@@ -103,10 +100,6 @@ impl ReportedDeviation for Um {
     fn number(self) -> f64 {
         self.0
     }
-
-    fn figures(figures: &[StandardFigure]) -> FiguresJson {
-        FiguresJson::from_standard(figures)
-    }
 }
 
 /// [`ReportedDeviation`] for an angle unit: held in m°, reported in `$unit`.
@@ -116,15 +109,11 @@ macro_rules! reported_angle {
             const UNIT: DeviationUnit = DeviationUnit::Angle($unit);
 
             fn from_held(value_millideg: f64) -> $quantity {
-                $from_deg(Deg(um_to_mm(value_millideg)))
+                $from_deg(Deg(millideg_to_deg(value_millideg)))
             }
 
             fn number(self) -> f64 {
                 self.0
-            }
-
-            fn figures(figures: &[StandardFigure]) -> FiguresJson {
-                FiguresJson::from_standard_deg(figures, $unit)
             }
         }
     };
@@ -479,12 +468,17 @@ pub struct FigureSetJson {
 }
 
 impl FigureSetJson {
-    fn new<D: ReportedDeviation>(diagnosis: &Diagnosis) -> FigureSetJson {
+    /// The diagnosis' figures typed by its axis' kind: µm on a linear axis,
+    /// `angle` on a rotary one.
+    fn new(diagnosis: &Diagnosis, angle: AngleUnit) -> FigureSetJson {
         let figures = &diagnosis.standard_figures;
+        let shown = |figures: &[StandardFigure]| {
+            FiguresByUnit::of(&standard::typed(figures, diagnosis.kind), angle).into_values()
+        };
         FigureSetJson {
-            measured: D::figures(&figures.measured),
-            predicted: D::figures(&figures.predicted),
-            predicted_with_effects: D::figures(&figures.predicted_with_effects),
+            measured: shown(&figures.measured),
+            predicted: shown(&figures.predicted),
+            predicted_with_effects: shown(&figures.predicted_with_effects),
         }
     }
 }
@@ -604,7 +598,7 @@ macro_rules! diagnose_json {
         }
 
         impl $name {
-            fn new(diagnosis: &Diagnosis, files: Files) -> $name {
+            fn new(diagnosis: &Diagnosis, files: Files, angle: AngleUnit) -> $name {
                 let deviation = <$deviation>::from_held;
                 $name {
                     after: files.after,
@@ -640,7 +634,7 @@ macro_rules! diagnose_json {
                         .collect(),
                     rejected: rejected(diagnosis),
                     $residual_after: ResidualJson::new(diagnosis.residual_after),
-                    $figures: FigureSetJson::new::<$deviation>(diagnosis),
+                    $figures: FigureSetJson::new(diagnosis, angle),
                     unexplained: $unexplained {
                         significant: diagnosis.unexplained.significant,
                         $where_: diagnosis
@@ -808,13 +802,13 @@ impl DiagnoseJson {
         };
         match (diagnosis.kind, angle) {
             (AxisKind::Linear, _) => {
-                DiagnoseJson::Linear(LinearDiagnoseJson::new(diagnosis, files))
+                DiagnoseJson::Linear(LinearDiagnoseJson::new(diagnosis, files, angle))
             }
             (AxisKind::Rotary, AngleUnit::Arcsec) => {
-                DiagnoseJson::Arcsec(ArcsecDiagnoseJson::new(diagnosis, files))
+                DiagnoseJson::Arcsec(ArcsecDiagnoseJson::new(diagnosis, files, angle))
             }
             (AxisKind::Rotary, AngleUnit::Urad) => {
-                DiagnoseJson::Urad(UradDiagnoseJson::new(diagnosis, files))
+                DiagnoseJson::Urad(UradDiagnoseJson::new(diagnosis, files, angle))
             }
         }
     }

@@ -91,12 +91,12 @@ pub use per_target::{ArcsecTargetJson, LinearTargetJson, PerTargetJson, UradTarg
 
 use crate::error::Warning;
 use crate::evaluate::environment::{AGREEMENT_PPM, IndexComparison, RefractiveIndexCheck};
-use crate::evaluate::{AxisFigures, Evaluation, StandardFigure, TestConformance};
+use crate::evaluate::{Evaluation, FiguresByKind, StandardFigure, TestConformance};
 use crate::measurement::{
     AxisKind, AxisSource, ByKind, Environment, Measurement, RunSelector, SourceFormat, StartEnd,
     TestSetup,
 };
-use crate::units::{AngleUnit, Deg, DeviationUnit, Mm, opt_mm_to_um};
+use crate::units::{AngleUnit, Deg, DeviationUnit, Mm};
 
 /// The whole `evaluate --json` object.
 #[derive(Clone, Debug, Serialize)]
@@ -270,14 +270,15 @@ pub enum FiguresByUnit {
 }
 
 impl FiguresByUnit {
-    /// A standard's figures of an axis of `kind`, an angle's in `angle`.
-    pub fn of(figures: &[StandardFigure], kind: AxisKind, angle: AngleUnit) -> FiguresByUnit {
-        match (kind, angle) {
-            (AxisKind::Linear, _) => FiguresByUnit::Um(FiguresJson::from_standard(figures)),
-            (AxisKind::Rotary, AngleUnit::Arcsec) => {
+    /// A standard's figures typed by their axis' kind
+    /// ([`Evaluation::standard_figures_typed`]), a rotary axis' in `angle`.
+    pub fn of(figures: &FiguresByKind, angle: AngleUnit) -> FiguresByUnit {
+        match (figures, angle) {
+            (ByKind::Linear(figures), _) => FiguresByUnit::Um(FiguresJson::from_standard(figures)),
+            (ByKind::Rotary(figures), AngleUnit::Arcsec) => {
                 FiguresByUnit::Arcsec(FiguresJson::from_standard_deg(figures, angle))
             }
-            (AxisKind::Rotary, AngleUnit::Urad) => {
+            (ByKind::Rotary(figures), AngleUnit::Urad) => {
                 FiguresByUnit::Urad(FiguresJson::from_standard_deg(figures, angle))
             }
         }
@@ -285,6 +286,15 @@ impl FiguresByUnit {
 
     /// The figures, in their unit.
     pub fn values(&self) -> &FiguresJson {
+        match self {
+            FiguresByUnit::Um(figures)
+            | FiguresByUnit::Arcsec(figures)
+            | FiguresByUnit::Urad(figures) => figures,
+        }
+    }
+
+    /// The figures, in their unit, without the key that names it.
+    pub fn into_values(self) -> FiguresJson {
         match self {
             FiguresByUnit::Um(figures)
             | FiguresByUnit::Arcsec(figures)
@@ -394,33 +404,78 @@ pub struct RunCountsJson {
     pub down: usize,
 }
 
-/// A standard's axis figures, µm, under its own keys and in its order
+/// A standard's axis figures as reported (µm; ″ or µrad on a rotary axis:
+/// [`FiguresByUnit`] names which), under its own keys and in its order
 /// (ISO 230-2: `A`, `A_up`, …, `B_mean`; VDI 3441: `P`, `Pa`, `Ps_max`,
 /// `Ps_mean`, `U_max`, `U_mean`); serialised as one JSON object.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FiguresJson {
-    /// (key, value µm), in the standard's order.
+    /// (key, value as reported), in the standard's order.
     pub values: Vec<(&'static str, Option<f64>)>,
 }
 
 impl FiguresJson {
-    /// Converts ISO 230-2 axis figures (mm) to µm.
-    pub fn from_figures(f: &AxisFigures) -> FiguresJson {
-        FiguresJson {
-            values: f
-                .keyed()
-                .into_iter()
-                .map(|(key, value_mm)| (key, opt_mm_to_um(value_mm)))
-                .collect(),
+    /// A linear axis' figures (mm), in µm.
+    ///
+    /// A rotary axis' figures are degrees ([`Evaluation::standard_figures_typed`]
+    /// gives them as `StandardFigure<Deg>`), which this does not take: they
+    /// cannot come out as µm.
+    /// ```compile_fail
+    /// use axcomp::evaluate::Evaluation;
+    /// use axcomp::measurement::ByKind;
+    /// use axcomp::report::json::FiguresJson;
+    /// fn wire(evaluation: &Evaluation) -> Option<FiguresJson> {
+    ///     let rotary = evaluation.standard_figures_typed().rotary()?;
+    ///     Some(FiguresJson::from_standard(&rotary))
+    /// }
+    /// ```
+    /// They go through [`FiguresJson::from_standard_deg`] (or [`FiguresByUnit::of`]):
+    /// ```
+    /// use axcomp::evaluate::Evaluation;
+    /// use axcomp::report::json::FiguresJson;
+    /// use axcomp::units::AngleUnit;
+    /// fn wire(evaluation: &Evaluation) -> Option<FiguresJson> {
+    ///     let rotary = evaluation.standard_figures_typed().rotary()?;
+    ///     Some(FiguresJson::from_standard_deg(&rotary, AngleUnit::Arcsec))
+    /// }
+    /// ```
+    pub fn from_standard(figures: &[StandardFigure<Mm>]) -> FiguresJson {
+        FiguresJson::converted(figures, Mm::to_um, |um| um.0)
+    }
+
+    /// A linear axis' figures in µm, for what is written in µm only (a
+    /// diagnosis in the report, a predicted re-test, a servo cycle: linear
+    /// axes only, `workflow::rotary`); none for a rotary axis, whose
+    /// figures are degrees, rather than degrees written as µm.
+    pub fn of_linear(figures: &FiguresByKind) -> FiguresJson {
+        match figures {
+            ByKind::Linear(figures) => FiguresJson::from_standard(figures),
+            ByKind::Rotary(_) => FiguresJson::default(),
         }
     }
 
-    /// Converts a standard's figures (mm) to µm.
-    pub fn from_standard(figures: &[StandardFigure]) -> FiguresJson {
+    /// A rotary axis' figures (°), in `angle` (″ or µrad).
+    pub fn from_standard_deg(figures: &[StandardFigure<Deg>], angle: AngleUnit) -> FiguresJson {
+        match angle {
+            AngleUnit::Arcsec => FiguresJson::converted(figures, Deg::to_arcsec, |arcsec| arcsec.0),
+            AngleUnit::Urad => FiguresJson::converted(figures, Deg::to_urad, |urad| urad.0),
+        }
+    }
+
+    /// Each figure converted by `convert` (whose type says which unit it
+    /// takes), written as the bare number `number` gives.
+    fn converted<U, R>(
+        figures: &[StandardFigure<U>],
+        convert: fn(U) -> R,
+        number: fn(R) -> f64,
+    ) -> FiguresJson
+    where
+        U: Copy,
+    {
         FiguresJson {
             values: figures
                 .iter()
-                .map(|f| (f.key, opt_mm_to_um(f.value)))
+                .map(|f| (f.key, f.value.map(|value| number(convert(value)))))
                 .collect(),
         }
     }
@@ -447,22 +502,12 @@ impl FiguresJson {
         }
     }
 
-    /// Converts a standard's figures (°) to `angle` (″ or µrad), for a rotary axis.
-    pub fn from_standard_deg(figures: &[StandardFigure], angle: AngleUnit) -> FiguresJson {
-        FiguresJson {
-            values: figures
-                .iter()
-                .map(|f| (f.key, f.value.map(|value_deg| angle.from_deg(value_deg))))
-                .collect(),
-        }
-    }
-
     /// No figures: the other unit's field of a rotary or linear axis.
     pub fn is_empty(&self) -> bool {
         self.values.is_empty()
     }
 
-    /// The value under `key`, µm (`None` when not evaluated or not this standard's).
+    /// The value under `key`, as reported (`None` when not evaluated or not this standard's).
     pub fn get(&self, key: &str) -> Option<f64> {
         self.values
             .iter()
@@ -739,9 +784,12 @@ impl EvaluationJson {
             standard: evaluation.standard.key,
             standard_name: evaluation.standard.name,
             definitions_reconstructed: evaluation.standard.reconstructed,
-            figures_iso230_2_um: (!rotary && !iso_keys(&evaluation.standard_figures))
-                .then(|| FiguresJson::from_figures(&evaluation.figures)),
-            figures: FiguresByUnit::of(&evaluation.standard_figures, kind, angle),
+            figures_iso230_2_um: evaluation
+                .figures_typed()
+                .linear()
+                .filter(|_| !iso_keys(&evaluation.standard_figures))
+                .map(|figures| FiguresJson::from_standard(&figures)),
+            figures: FiguresByUnit::of(&evaluation.standard_figures_typed(), angle),
             deviation,
             per_target,
             outliers: evaluation
@@ -777,6 +825,7 @@ impl EvaluationJson {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::evaluate::standard::typed;
     use crate::evaluate::{DirectionStats, SuspectedOutlier, TargetStats};
     use crate::measurement::Direction;
 
@@ -917,7 +966,7 @@ mod tests {
         }];
         // 0.002 mm = 2 µm; 0.002° = 7.2″.
         let key = |kind, angle| {
-            serde_json::to_value(FiguresByUnit::of(&figures, kind, angle))
+            serde_json::to_value(FiguresByUnit::of(&typed(&figures, kind), angle))
                 .unwrap()
                 .to_string()
         };
@@ -930,5 +979,17 @@ mod tests {
             r#"{"figures_arcsec":{"E":7.2}}"#
         );
         assert!(key(AxisKind::Rotary, AngleUnit::Urad).starts_with(r#"{"figures_urad":{"E":34.9"#));
+    }
+
+    #[test]
+    fn what_is_written_in_um_only_leaves_a_rotary_axis_figures_out() {
+        let figures = [StandardFigure {
+            key: "E",
+            value: Some(0.002),
+        }];
+        // 0.002 mm = 2 µm; 0.002° is not written as 2 µm.
+        let um = |kind| FiguresJson::of_linear(&typed(&figures, kind));
+        assert_eq!(um(AxisKind::Linear).get("E"), Some(2.0));
+        assert!(um(AxisKind::Rotary).is_empty());
     }
 }

@@ -51,6 +51,7 @@ use std::fmt::Write;
 
 use serde::Serialize;
 
+use crate::evaluate::{StandardFigure, standard};
 use crate::predict::survey::{MeasuredState, Source, pair_name, squareness_name};
 use crate::predict::{PredictedRetest, Prediction};
 use crate::report::format::{pad_name, um};
@@ -128,8 +129,8 @@ impl RetestJson {
             table_mode: retest.table_mode.as_str(),
             measured_b_mean_um: retest.measured_mean_reversal_mm.map(mm_to_um),
             backlash_set: retest.backlash_reversal_mm != 0.0,
-            predicted_figures_um: FiguresJson::from_standard(&retest.standard_figures),
-            figures_before_um: FiguresJson::from_standard(&retest.standard_figures_before),
+            predicted_figures_um: in_um(&retest.standard_figures, retest),
+            figures_before_um: in_um(&retest.standard_figures_before, retest),
             per_target: retest
                 .per_target
                 .iter()
@@ -143,6 +144,11 @@ impl RetestJson {
                 .collect(),
         }
     }
+}
+
+/// A re-test's figures in µm (the volumetric model predicts linear axes only).
+fn in_um(figures: &[StandardFigure], retest: &PredictedRetest) -> FiguresJson {
+    FiguresJson::of_linear(&standard::typed(figures, retest.retest.kind()))
 }
 
 /// One error's share of the largest residual volumetric error.

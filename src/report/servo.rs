@@ -298,7 +298,7 @@ impl IsoJson {
             feed_m_min: cycle.limits.feed_m_per_s * 60.0,
             stiffness_n_per_um,
             compliance_n_per_um: stiffness_n_per_um,
-            figures_um: FiguresJson::from_figures(&result.evaluation.figures),
+            figures_um: FiguresJson::of_linear(&result.evaluation.figures_typed()),
             residual_friction_n: ResidualJson {
                 up: residual.up_n,
                 down: residual.down_n,

@@ -519,8 +519,8 @@ mod tests {
 
     #[test]
     fn figure_names_are_the_keys_of_figures_um() {
-        let json =
-            serde_json::to_value(FiguresJson::from_figures(&AxisFigures::default())).unwrap();
+        let figures = AxisFigures::default().typed(crate::measurement::AxisKind::Linear);
+        let json = serde_json::to_value(FiguresJson::of_linear(&figures)).unwrap();
         let mut keys: Vec<&str> = json
             .as_object()
             .unwrap()

@@ -312,6 +312,11 @@ pub fn convert(
         false => None,
     };
     let activation = emit::activation(table.controller, &compensation, &table.file_name, options);
+    // A Fanuc file written says what an unknown 3605 bit means for it
+    // (`emit::fanuc::notes`): the table read beside it does not say it again.
+    if table.controller == Controller::Fanuc {
+        warnings.retain(|w| !matches!(w, Warning::TableReadAs { .. }));
+    }
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
     let mut report = ConvertJson::new(
         table.controller.name(),

@@ -102,7 +102,7 @@ pub fn active_table(
     let options = read_options(profile, axis, test.kind(), file.linuxcnc_type)?;
     let (controller, table) = read_table(
         file.bytes,
-        options,
+        options.clone(),
         profile,
         test.metadata.length_unit,
         file.linuxcnc_type,
@@ -111,11 +111,12 @@ pub fn active_table(
         file: file.file.to_string(),
         error,
     })?;
-    let doubts = check_together(
+    let mut doubts = check_together(
         Pairing::TableOnTest,
         &Input::measurement(test, file.test_label.to_string()),
         &Input::table(&table.axis, &table.positions, file.file.to_string()),
     )?;
+    doubts.extend(emit::fanuc::read_note(controller, &options));
     Ok(ActiveTable {
         controller,
         table,

@@ -10,6 +10,7 @@
 
 use std::path::{Path, PathBuf};
 
+use approx::abs_diff_eq;
 use serde_json::Value;
 
 use crate::util::{Run, axcomp, evaluate_json, root, shared_data};
@@ -392,7 +393,7 @@ fn ecmc_reports_differ_as_the_readme_says() {
     let theirs = std::fs::read_to_string(shared_data(ECMC_B02_X_REPORT)).unwrap();
     let ours = |key: &str| json["figures_um"][key].as_f64().unwrap();
     // The report prints 5 decimals of mm: agreement within half of 0.01 µm.
-    let same = |a: f64, b: f64| (a - b).abs() <= 0.0051;
+    let same = |a: f64, b: f64| abs_diff_eq!(a, b, epsilon = 0.0051);
     // What agrees: A, M, B; what is swapped: B̄ and the ↑/↓ figures.
     assert!(same(ours("A"), printed_um(&theirs, "A")));
     assert!(same(ours("M"), printed_um(&theirs, "M")));
@@ -443,7 +444,7 @@ fn every_ecmc_report_follows_the_same_two_rules() {
             let json = evaluate_json(&[dat.as_path()]);
             let ours = |key: &str| json["figures_um"][key].as_f64().unwrap();
             // Within the report's rounding (5 decimals of mm; 0.01 µm), or 0.1 % for 1.22e-05-style prints.
-            let same = |a: f64, b: f64| (a - b).abs() <= 0.0051 + 1e-3 * b.abs();
+            let same = |a: f64, b: f64| abs_diff_eq!(a, b, epsilon = 0.0051 + 1e-3 * b.abs());
             let name = md.display();
             assert!(
                 same(ecmc_e_um(&json), printed_um(&theirs, "E")),

@@ -11,6 +11,7 @@
 //! "Realistic noise (repeatability 0.5–2 µm)" is read as the ISO 230-2
 //! repeatability R = 4σ: σ cycles through 0.125, 0.25 and 0.5 µm.
 
+use approx::abs_diff_eq;
 use axcomp::cycle::CycleTiming;
 use axcomp::diagnose::{AngularProfile, DiagnoseInput, Diagnosis, diagnose};
 use axcomp::effects::{Abbe, Drift, Effect, OutlierRun, Periodic, Reversal, Scale};
@@ -126,8 +127,9 @@ fn periodic_truth(sigma_um: f64, effects: &str) -> String {
     )
 }
 
+/// Within 10 % of `expected`, and never closer than 0.2 asked.
 fn within(actual: f64, expected: f64) -> bool {
-    (actual - expected).abs() <= (0.1 * expected.abs()).max(0.2)
+    abs_diff_eq!(actual, expected, epsilon = (0.1 * expected.abs()).max(0.2))
 }
 
 /// Finds the effect of a kind among the accepted ones.

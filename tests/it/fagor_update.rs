@@ -8,6 +8,8 @@
 
 use std::path::Path;
 
+use approx::abs_diff_eq;
+
 use crate::fagor::{al_rows, data, laser_data, mp_rows};
 use crate::util::axcomp;
 
@@ -97,7 +99,7 @@ fn an_update_is_old_plus_residual_at_the_old_zero_and_keeps_every_old_point() {
         let within = |got: f64, expected: f64, what: &str| {
             // The file's rounding: half its last digit (and 1 nm of arithmetic).
             assert!(
-                (got - expected).abs() <= last_digit_mm / 2.0 + 1e-6,
+                abs_diff_eq!(got, expected, epsilon = last_digit_mm / 2.0 + 1e-6),
                 "{table} {what}: {got} mm vs {expected} mm"
             );
         };

@@ -467,14 +467,11 @@ fn the_profile_names_the_fanuc_control() {
     assert!(run.stderr.contains("CNC-PARA.TXT"), "{}", run.stderr);
 }
 
-/// `diagnose --table` and `predict --table` take the machine's pitch file
-/// with its parameter backup: the loop closes on a Fanuc machine.
-#[test]
-fn diagnose_and_predict_take_the_real_pitch_file() {
-    let directory = tempfile::tempdir().unwrap();
-    let path = |name: &str| directory.path().join(name).display().to_string();
-    let (pitch, parameters) = (data("PITCH.TXT"), data("CNC-PARA.TXT"));
-    let (before, after) = (path("before.rtl"), path("after.rtl"));
+/// The first test and the re-test of X with the real pitch file active
+/// (`synth --table` with the real backup), in `directory`: (before.rtl, after.rtl).
+pub(crate) fn tests_with_the_pitch_file(directory: &Path) -> (String, String) {
+    let [before, after] =
+        ["before.rtl", "after.rtl"].map(|n| directory.join(n).display().to_string());
     ok(&[
         "synth",
         "--truth",
@@ -482,12 +479,49 @@ fn diagnose_and_predict_take_the_real_pitch_file() {
         "-o",
         &before,
         "--table",
-        &pitch,
+        &data("PITCH.TXT"),
         "--fanuc-parameters",
-        &parameters,
+        &data("CNC-PARA.TXT"),
         "--o2",
         &after,
     ]);
+    (before, after)
+}
+
+/// The bundled machine with X's stroke of the real one, written to
+/// `directory`: the machine's X travels −1000 … +1 mm (1320/1321), and the
+/// bundled model's 0 … 750 mm does not cover the test, so predict needs it.
+pub(crate) fn machine_of_the_backup(directory: &Path) -> String {
+    let description = std::fs::read_to_string("fixtures/machines/mcv754-quick.toml")
+        .unwrap()
+        .replace(
+            "[kinematics.axes.X]\nstroke_mm = [0.0, 750.0]",
+            "[kinematics.axes.X]\nstroke_mm = [-1000.0, 1.0]",
+        );
+    assert!(description.contains("[-1000.0, 1.0]"));
+    let machine = directory.join("machine.toml");
+    std::fs::write(&machine, description).unwrap();
+    machine.display().to_string()
+}
+
+/// The real backup with X's 3605 cleared to 00000000 (bit 1 no longer
+/// set), written to `directory`.
+pub(crate) fn cleared_3605_backup(directory: &Path) -> String {
+    let text = std::fs::read_to_string(data("CNC-PARA.TXT")).unwrap();
+    let cleared = text.replace("N03605Q1A1P00000010A2", "N03605Q1A1P00000000A2");
+    assert_ne!(cleared, text);
+    let path = directory.join("CNC-PARA.TXT");
+    std::fs::write(&path, cleared).unwrap();
+    path.display().to_string()
+}
+
+/// `diagnose --table` and `predict --table` take the machine's pitch file
+/// with its parameter backup: the loop closes on a Fanuc machine.
+#[test]
+fn diagnose_and_predict_take_the_real_pitch_file() {
+    let directory = tempfile::tempdir().unwrap();
+    let (pitch, parameters) = (data("PITCH.TXT"), data("CNC-PARA.TXT"));
+    let (before, after) = tests_with_the_pitch_file(directory.path());
     let run = ok(&[
         "diagnose",
         "--after",
@@ -508,17 +542,7 @@ fn diagnose_and_predict_take_the_real_pitch_file() {
         "{}",
         run.stdout
     );
-    // The machine's X travels −1000 … +1 mm (1320/1321): the bundled model's
-    // 0 … 750 mm does not cover the test, so predict needs this machine's stroke.
-    let machine = path("machine.toml");
-    let description = std::fs::read_to_string("fixtures/machines/mcv754-quick.toml")
-        .unwrap()
-        .replace(
-            "[kinematics.axes.X]\nstroke_mm = [0.0, 750.0]",
-            "[kinematics.axes.X]\nstroke_mm = [-1000.0, 1.0]",
-        );
-    assert!(description.contains("[-1000.0, 1.0]"));
-    std::fs::write(&machine, description).unwrap();
+    let machine = machine_of_the_backup(directory.path());
     let table = format!("X={pitch}");
     let run = ok(&[
         "predict",
@@ -571,13 +595,6 @@ fn the_unknown_bit_of_3605_is_said() {
         ),
         "{activation}"
     );
-    let json = convert_with(&|directory| {
-        let text = std::fs::read_to_string(data("CNC-PARA.TXT")).unwrap();
-        let cleared = text.replace("N03605Q1A1P00000010A2", "N03605Q1A1P00000000A2");
-        assert_ne!(cleared, text);
-        let path = directory.join("CNC-PARA.TXT");
-        std::fs::write(&path, cleared).unwrap();
-        path.display().to_string()
-    });
+    let json = convert_with(&cleared_3605_backup);
     assert!(!json["notes"].to_string().contains("3605"), "{json:#}");
 }

@@ -94,7 +94,7 @@ fn the_sample_report_shows_the_figures_of_evaluate_json() {
 /// The diagnosis values the report keys, from the library.
 fn diagnosis_json(d: &Diagnosis) -> serde_json::Value {
     let figures = |f: &axcomp::evaluate::AxisFigures| {
-        let json = axcomp::report::json::FiguresJson::from_figures(f);
+        let json = axcomp::report::json::FiguresJson::of_linear(&f.typed(d.kind));
         serde_json::to_value(json).unwrap()
     };
     let accepted: Vec<serde_json::Value> = d

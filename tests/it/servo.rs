@@ -251,7 +251,8 @@ mod identify {
                 k.simulations,
                 k.rms_residual_m * 1e6
             );
-            let within = |found: f64, truth: f64| (found - truth).abs() <= 0.1 * truth;
+            let within =
+                |found: f64, truth: f64| approx::abs_diff_eq!(found, truth, epsilon = 0.1 * truth);
             assert!(within(found.coulomb_n, 110.0), "F_C {}", found.coulomb_n);
             assert!(
                 within(found.viscous_n_s_per_m, 430.0),

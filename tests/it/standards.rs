@@ -4,6 +4,7 @@
 //! data (5 targets × 5 cycles each way). The readings come from the reader;
 //! everything after that is computed in this file.
 
+use approx::abs_diff_eq;
 use serde_json::Value;
 
 use axcomp::measurement::Direction;
@@ -54,7 +55,7 @@ fn figures(standard: &str) -> Value {
 fn close(json: &Value, key: &str, expected: f64) {
     let found = json["figures_um"][key].as_f64().unwrap_or(f64::NAN);
     assert!(
-        (found - expected).abs() <= TOLERANCE_UM,
+        abs_diff_eq!(found, expected, epsilon = TOLERANCE_UM),
         "{key}: axcomp {found} µm, independent {expected} µm"
     );
 }
@@ -214,7 +215,7 @@ fn predict_diagnose_and_report_give_the_standards_figures_of_one_prediction() {
         let check = |key: &str, expected: f64| {
             let found = figures[key].as_f64().unwrap_or(f64::NAN);
             assert!(
-                (found - expected).abs() <= TOLERANCE_UM,
+                abs_diff_eq!(found, expected, epsilon = TOLERANCE_UM),
                 "{standard} {key}: axcomp {found} µm, independent {expected} µm"
             );
         };
@@ -256,7 +257,7 @@ fn predict_diagnose_and_report_give_the_standards_figures_of_one_prediction() {
         for (key, value) in evaluated["figures_um"].as_object().unwrap() {
             let before = predict["figures_before_um"][key].as_f64().unwrap();
             assert!(
-                (before - value.as_f64().unwrap()).abs() < 1e-6,
+                abs_diff_eq!(before, value.as_f64().unwrap(), epsilon = 1e-6),
                 "{standard} {key}"
             );
         }
@@ -287,7 +288,7 @@ fn predict_diagnose_and_report_give_the_standards_figures_of_one_prediction() {
             let value = value.as_f64().unwrap();
             let diagnosed = diagnose["figures_um"]["predicted"][key].as_f64().unwrap();
             assert!(
-                (diagnosed - value).abs() < 1e-6,
+                abs_diff_eq!(diagnosed, value, epsilon = 1e-6),
                 "{standard} {key}: diagnose {diagnosed}, predict {value}"
             );
             // The report names A, E and B of ISO 230-2, every figure of another standard.
@@ -297,7 +298,7 @@ fn predict_diagnose_and_report_give_the_standards_figures_of_one_prediction() {
                         panic!("{standard}: no prediction.figures_um.{key} in the report")
                     });
                 assert!(
-                    (shown - value).abs() < 1e-6,
+                    abs_diff_eq!(shown, value, epsilon = 1e-6),
                     "{standard} {key}: report {shown}, predict {value}"
                 );
             }

@@ -4,6 +4,8 @@
 //! until the machine is on and homed (what LinuxCNC's motion controller
 //! needs to apply the whole offset: `formats/linuxcnc/thermal.md`).
 
+use approx::abs_diff_eq;
+
 use crate::util::{assert_golden, axcomp, root, test_data};
 
 const MODEL: &str = "thermal/two-terms.toml";
@@ -132,7 +134,7 @@ fn on_an_inch_machine_the_offset_is_in_inches() {
     let close = |name: &str, expected: f64| {
         let value = setp(&hal, name);
         assert!(
-            (value / expected - 1.0).abs() < 1e-12,
+            abs_diff_eq!(value / expected, 1.0, epsilon = 1e-12),
             "{name}: {value:e}, expected {expected:e}"
         );
     };

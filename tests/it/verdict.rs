@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use serde_json::{Value, json};
 
 use crate::report::{check_against_json, embedded_data};
@@ -44,7 +45,9 @@ fn write(directory: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 fn close(value: &Value, expected: f64) -> bool {
-    value.as_f64().is_some_and(|v| (v - expected).abs() < 1e-9)
+    value
+        .as_f64()
+        .is_some_and(|v| abs_diff_eq!(v, expected, epsilon = 1e-9))
 }
 
 #[test]
@@ -389,16 +392,16 @@ fn iso_14253_1_pass_fail_and_not_proven_with_the_json_keys() {
             .as_f64()
             .unwrap()
     };
-    assert!((named("u_M,MACHINE") - 0.8775).abs() < 1e-9);
-    assert!((named("u_DEVICE") - 0.1875).abs() < 1e-9);
+    assert_abs_diff_eq!(named("u_M,MACHINE"), 0.8775, epsilon = 1e-9);
+    assert_abs_diff_eq!(named("u_DEVICE"), 0.1875, epsilon = 1e-9);
     // Largest first, and U = 2 √Σu² from the rows themselves.
     let sizes: Vec<f64> = budget.iter().map(|c| c["u_um"].as_f64().unwrap()).collect();
     assert!(sizes.windows(2).all(|w| w[0] >= w[1]), "{sizes:?}");
     let expanded = 2.0 * sizes.iter().map(|s| s * s).sum::<f64>().sqrt();
     for figure in ["E", "M", "A"] {
-        assert!((u[figure].as_f64().unwrap() - expanded).abs() < 1e-9);
+        assert_abs_diff_eq!(u[figure].as_f64().unwrap(), expanded, epsilon = 1e-9);
     }
-    assert!((expanded - 1.82).abs() < 0.01, "{expanded}");
+    assert!(abs_diff_eq!(expanded, 1.82, epsilon = 0.01), "{expanded}");
     assert_eq!(u["R"], Value::Null);
     assert_eq!(u["B"], Value::Null);
     for contributor in budget {
@@ -424,7 +427,7 @@ fn iso_14253_1_pass_fail_and_not_proven_with_the_json_keys() {
     let check = &straddles["checks"][0];
     assert_eq!(check["conformance"], "not-proven");
     assert_eq!(check["outcome"], "pass");
-    assert!((check["U_um"].as_f64().unwrap() - expanded).abs() < 1e-9);
+    assert_abs_diff_eq!(check["U_um"].as_f64().unwrap(), expanded, epsilon = 1e-9);
     assert!(
         check["reason"].as_str().unwrap().contains("not proven")
             || check["reason"].as_str().unwrap().contains("neither")
@@ -476,7 +479,11 @@ fn an_equipment_file_and_its_errors() {
     let json = evaluate_json_with(&[SAMPLE, "--equipment", given.to_str().unwrap()]);
     let budget = json["uncertainty_um"]["budget"].as_array().unwrap();
     assert_eq!(budget[0]["name"], "u_EVE");
-    assert!((budget[0]["u_um"].as_f64().unwrap() - 1.732_051).abs() < 1e-6);
+    assert_abs_diff_eq!(
+        budget[0]["u_um"].as_f64().unwrap(),
+        1.732_051,
+        epsilon = 1e-6
+    );
     // A drift test: BEFORE's deviations span 0–12 µm, E_VE = 12, u_EVE = 3.4641 µm.
     write(directory.path(), "drift.csv", BEFORE);
     let drift = write(
@@ -486,7 +493,7 @@ fn an_equipment_file_and_its_errors() {
     );
     let json = evaluate_json_with(&[SAMPLE, "--equipment", drift.to_str().unwrap()]);
     let first = &json["uncertainty_um"]["budget"][0];
-    assert!((first["u_um"].as_f64().unwrap() - 3.464_102).abs() < 1e-6);
+    assert_abs_diff_eq!(first["u_um"].as_f64().unwrap(), 3.464_102, epsilon = 1e-6);
     assert!(first["source"].as_str().unwrap().contains("drift.csv"));
     // A negative value: PATH:LINE:COL, exit 2.
     let bad = write(

@@ -114,7 +114,7 @@ pub fn chromedriver() -> PathBuf {
 }
 
 /// Headless Chromium driven over WebDriver (W3C, JSON over HTTP through
-/// `http::request`): a page that runs scripts, takes uploads and saves
+/// `http::request`, ureq): a page that runs scripts, takes uploads and saves
 /// downloads, as the engineer's browser does. The `--screenshot` runs of
 /// [`open_in_browser`] cannot click; this can.
 pub struct WebDriver {

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use crate::browser::WebDriver;
 use crate::pixels::{Pixels, artefacts};
 use crate::server::{Server, cli_in, read, sample};
-use crate::util::root;
+use crate::util::{root, shared_data};
 
 /// A screenshot of the page with something on it: at least `inked` of it
 /// not white (the start page is about 0.015), and in `expect_blue` steps
@@ -39,18 +39,24 @@ fn check_screenshot(browser: &WebDriver, name: &str, inked: f64, expect_blue: bo
     path
 }
 
-/// The engineer's steps in a real browser: open the page, pick the sample,
-/// change the controller, download the table (equal to the CLI's), then
-/// pick a malformed file and read the error.
-#[test]
-fn the_page_works_in_a_real_browser() {
-    let server = Server::start();
+/// The page of `server` in a new browser, once its script is ready.
+fn open_page(server: &Server) -> WebDriver {
     let browser = WebDriver::start((1200, 1400));
     browser.goto(&server.url());
     browser.wait_for(
         "return document.body.dataset.ready === 'yes'",
         "the page to load",
     );
+    browser
+}
+
+/// The engineer's steps in a real browser: open the page, pick the sample,
+/// change the controller, download the table (equal to the CLI's), then
+/// pick a malformed file and read the error.
+#[test]
+fn the_page_works_in_a_real_browser() {
+    let server = Server::start();
+    let browser = open_page(&server);
     // The start page is mostly white: a heading, the drop zone, the settings.
     check_screenshot(&browser, "1-start", 0.01, false);
 
@@ -145,4 +151,83 @@ fn the_page_works_in_a_real_browser() {
     // The error box's red is on the page.
     let red = Pixels::read(&shot).fraction(|r, g, b| r > 150 && g < 60 && b < 60);
     assert!(red > 0.0005, "{red:.4} red");
+}
+
+/// Step 2 with the table that was active during the test, in a real
+/// browser: the test of X measured with the real Fanuc pitch file active,
+/// the machine's parameter backup and that pitch file picked in step 2; the
+/// preview is the whole pitch file updated (B's points 301 … 312 still in
+/// it) and the download is byte for byte `convert --existing`'s.
+#[test]
+fn step_two_updates_the_table_that_was_active() {
+    let work = tempfile::tempdir().unwrap();
+    let dir = work.path();
+    let pitch = shared_data("fanuc/HM100TS__PITCH.TXT");
+    let backup = shared_data("fanuc/HM100TS__CNC-PARA.TXT");
+    for (from, name) in [(&pitch, "PITCH-OLD.TXT"), (&backup, "CNC-PARA.TXT")] {
+        std::fs::copy(from, dir.join(name)).unwrap();
+    }
+    let truth = root().join("tests/data/fanuc/x-truth.toml");
+    let truth = truth.display().to_string();
+    cli_in(
+        dir,
+        &[
+            "synth",
+            "--truth",
+            &truth,
+            "-o",
+            "x.rtl",
+            "--table",
+            "PITCH-OLD.TXT",
+            "--fanuc-parameters",
+            "CNC-PARA.TXT",
+            "--o2",
+            "after.rtl",
+        ],
+    );
+    std::fs::create_dir(dir.join("cli")).unwrap();
+    cli_in(
+        dir,
+        &[
+            "convert",
+            "x.rtl",
+            "--controller",
+            "fanuc",
+            "--existing",
+            "PITCH-OLD.TXT",
+            "--fanuc-parameters",
+            "CNC-PARA.TXT",
+            "-o",
+            "cli/PITCH.TXT",
+            "-q",
+        ],
+    );
+    let expected = read(&dir.join("cli/PITCH.TXT"));
+
+    let server = Server::start();
+    let browser = open_page(&server);
+    browser.send_keys(
+        &browser.find("#file"),
+        &dir.join("x.rtl").display().to_string(),
+    );
+    browser.wait_for(
+        "return document.body.dataset.evaluated === 'x.rtl' && document.body.dataset.busy === '0'",
+        "the test's figures",
+    );
+    browser.click(&browser.find("#controller option[value='fanuc']"));
+    let path = |name: &str| dir.join(name).display().to_string();
+    browser.send_keys(&browser.find("#fanuc_parameters"), &path("CNC-PARA.TXT"));
+    browser.send_keys(&browser.find("#existing"), &path("PITCH-OLD.TXT"));
+    browser.wait_for(
+        "return document.body.dataset.converted === 'fanuc:PITCH.TXT' && document.body.dataset.busy === '0' \
+         && document.getElementById('preview').textContent.includes('N10312Q0P')",
+        "the updated pitch file",
+    );
+    browser.execute("document.getElementById('step-table').scrollIntoView(); return true");
+    check_screenshot(&browser, "5-fanuc-update", 0.03, false);
+    browser.click(&browser.find("#download"));
+    assert!(
+        browser.downloaded("PITCH.TXT") == expected,
+        "the page's PITCH.TXT differs from convert --existing's"
+    );
 }

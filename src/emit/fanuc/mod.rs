@@ -34,13 +34,14 @@ pub use parameters::{AxisParameters, ParameterBackup, looks_like_parameters};
 use pitch::{absolute_units, data_line, increments, parse_pitch};
 pub use pitch::{looks_like, read};
 pub use rescale::{Rescaled, rescaled};
+pub use table::{BitsUse, notes, parameters_for, points_in, unknown_bits_note, write};
 use table::{check_turn, finest_for_sections, new_increments, wanted};
-pub use table::{notes, parameters_for, points_in, write};
 use update::replace_lines;
 pub use update::{check_read_back, update};
 
 use crate::compensate::CompensationTable;
-use crate::emit::{BacklashAdvice, EmitOptions};
+use crate::emit::{BacklashAdvice, Controller, EmitOptions};
+use crate::error::Warning;
 use crate::measurement::AxisKind;
 
 /// \[file\] Data number of compensation point 0 (`N10000` … in the real `PITCH.TXT`).
@@ -105,6 +106,18 @@ pub fn backlash_parameter(backlash_mm: f64, options: &EmitOptions) -> BacklashAd
         crate::emit::minimal(new as f64 * unit, 7),
         p.backlash.1
     ))
+}
+
+/// What a table read as `controller`'s for `options`' axis rests on, when
+/// it is Fanuc pitch data under a 3605 with bits axcomp does not know
+/// ([`unknown_bits_note`]): said wherever the control's table is computed
+/// with (`predict --table`, `diagnose --table`, `report --table`).
+pub fn read_note(controller: Controller, options: &EmitOptions) -> Option<Warning> {
+    let p = options.axes.first()?.fanuc.as_ref()?;
+    (controller == Controller::Fanuc)
+        .then(|| unknown_bits_note(p, BitsUse::Read))
+        .flatten()
+        .map(|note| Warning::TableReadAs { note })
 }
 
 /// What to do after loading the file.

@@ -75,7 +75,7 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
             p.length_unit()
         ));
     }
-    if let Some(note) = unknown_bits_note(&p) {
+    if let Some(note) = unknown_bits_note(&p, BitsUse::Written) {
         notes.push(note);
     }
     if let Some(k) = closing_point(table, &p) {
@@ -100,17 +100,40 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     notes
 }
 
+/// What axcomp did with pitch data under a 3605 it does not fully know.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BitsUse {
+    /// Wrote a file (`convert`): the user checks before loading it.
+    Written,
+    /// Read the control's file and computed with it (`predict`,
+    /// `diagnose`, `report`): the user checks before relying on the numbers.
+    Read,
+}
+
 /// The bits of 3605 besides #0 the backup sets, said: their meaning on the
 /// control was not found (`formats/fanuc/README.md`), so the user checks
-/// them before loading a table axcomp computed without them.
-fn unknown_bits_note(p: &AxisParameters) -> Option<String> {
+/// them before loading a table axcomp computed without them, or before
+/// relying on numbers computed from the control's table read without them.
+pub fn unknown_bits_note(p: &AxisParameters, used: BitsUse) -> Option<String> {
     let bits = p.unknown_3605_bits();
     if bits.is_empty() {
         return None;
     }
     let list: Vec<String> = bits.iter().map(|b| format!("#{b}")).collect();
+    // Between the points, the prediction and the diagnosis interpolate the
+    // absolute compensation linearly (`CompensationTable::value_at`).
+    let (done, before) = match used {
+        BitsUse::Written => (
+            "wrote the data as 3620–3627 alone describe them",
+            "before loading the file",
+        ),
+        BitsUse::Read => (
+            "read the data as 3620–3627 alone describe them (the compensation at each point, linear between the points)",
+            "before relying on what is computed with this table",
+        ),
+    };
     Some(format!(
-        "Fanuc: 3605 of axis {} is {} in the parameter backup ({}): {} {} set besides #0 (bidirectional pitch error compensation); axcomp does not know what {} changes (no public Fanuc manual page giving it was found) and wrote the data as 3620–3627 alone describe them: check {} in the control's parameter manual before loading the file",
+        "Fanuc: 3605 of axis {} is {} in the parameter backup ({}): {} {} set besides #0 (bidirectional pitch error compensation); axcomp does not know what {} changes (no public Fanuc manual page giving it was found) and {done}: check {} in the control's parameter manual {before}",
         p.axis,
         p.bits_3605,
         p.at_3605,

@@ -56,8 +56,8 @@ use std::fmt;
 use crate::evaluate::uncertainty::Budget;
 use crate::evaluate::{Evaluation, StandardFigure};
 use crate::measurement::Direction;
-use crate::units::per_m_over_mm;
 use crate::units::um_to_mm;
+use crate::units::{Mm, per_m_over_mm};
 
 mod acceptance;
 
@@ -180,9 +180,10 @@ impl Figure {
     /// ([`Evaluation::standard_figures`]): the figure, except |B̄| for
     /// B_mean (the signed mean reversal is a direction, its size is the
     /// error). `None` when the figure is not evaluated or not the standard's
-    /// ([`check_standard`] refuses such a limit first).
-    pub fn value_mm(self, figures: &[StandardFigure]) -> Option<f64> {
-        let value = figures.iter().find(|f| f.key == self.name())?.value?;
+    /// ([`check_standard`] refuses such a limit first). A linear axis'
+    /// figures only ([`Evaluation::standard_figures_typed`]): limits are µm.
+    pub fn value_mm(self, figures: &[StandardFigure<Mm>]) -> Option<f64> {
+        let Mm(value) = figures.iter().find(|f| f.key == self.name())?.value?;
         Some(match self {
             Figure::BMean => value.abs(),
             _ => value,
@@ -612,12 +613,18 @@ pub fn verdict_with(
         (Some(first), Some(last)) => last.target - first.target,
         _ => 0.0,
     };
+    // Limits are µm: a rotary axis' figures (degrees; refused before, in
+    // `workflow::rotary`) would not be compared, not taken for millimetres.
+    let linear_figures = evaluation
+        .standard_figures_typed()
+        .linear()
+        .unwrap_or_default();
     let mut ordered: Vec<&Limit> = limits.iter().collect();
     ordered.sort_by_key(|l| l.figure);
     let checks = ordered
         .into_iter()
         .map(|limit| {
-            let value_mm = limit.figure.value_mm(&evaluation.standard_figures);
+            let value_mm = limit.figure.value_mm(&linear_figures);
             let limit_mm = limit.permissible.limit_mm(travel_mm);
             let outcome = match value_mm {
                 None => Outcome::NotEvaluated,
@@ -720,6 +727,29 @@ mod tests {
         // A fixed limit ignores the travel.
         let fixed = Permissible::Fixed { limit_mm: 0.012 };
         assert_eq!(fixed.limit_mm(10_000.0), 0.012);
+    }
+
+    #[test]
+    fn a_rotary_axis_figures_are_not_taken_for_millimetres() {
+        // E = 0.003 on a rotary axis is 0.003° = 10.8″, not 3 µm: against a
+        // 5 µm limit it is not compared (limits are µm), so the check fails
+        // as not evaluated rather than passing.
+        let figures = AxisFigures {
+            e: Some(0.003),
+            ..Default::default()
+        };
+        let mut rotary = evaluation(0.0, 90.0, figures);
+        rotary.conformance.length = crate::measurement::ByKind::Rotary(crate::units::Deg(90.0));
+        let limit = [Limit {
+            figure: Figure::E,
+            permissible: Permissible::Fixed { limit_mm: 0.005 },
+            source: LimitSource::CommandLine,
+        }];
+        let v = verdict(&rotary, &limit).unwrap();
+        assert_eq!(v.checks[0].outcome, Outcome::NotEvaluated);
+        // The same figure of a linear axis, 3 µm, passes.
+        let v = verdict(&evaluation(0.0, 90.0, figures), &limit).unwrap();
+        assert_eq!(v.checks[0].outcome, Outcome::Pass);
     }
 
     #[test]

@@ -4,7 +4,7 @@ use super::figures::{FIGURE_ROWS, FigureRow};
 use super::{Plot, signed};
 use crate::diagnose::{Diagnosis, ResidualStats};
 use crate::effects::{Parameter, ParameterValue};
-use crate::evaluate::standard::vdi_figure_name;
+use crate::evaluate::standard::{self, vdi_figure_name};
 use crate::report::format::{SourcedUm, um};
 use crate::report::json::FiguresJson;
 
@@ -118,7 +118,13 @@ pub(super) fn diagnosis_figures(diagnosis: &Diagnosis) -> Vec<FigureRow> {
         ("predicted", &figures.predicted),
         ("predicted_with_effects", &figures.predicted_with_effects),
     ]
-    .map(|(set, figures)| (set, FiguresJson::from_standard(figures)));
+    // This page's figures are µm: a rotary axis' (degrees) are left out.
+    .map(|(set, figures)| {
+        (
+            set,
+            FiguresJson::of_linear(&standard::typed(figures, diagnosis.kind)),
+        )
+    });
     // The ISO 230-2 family's bidirectional figures, or every figure of another standard.
     let rows: Vec<(&'static str, &'static str, &'static str)> = if sets[0].1.is_iso230_2() {
         FIGURE_ROWS

@@ -5,11 +5,11 @@ use super::tests_of;
 use crate::evaluate::Standard;
 use crate::evaluate::standard::{Vdi3441, vdi_figure_name};
 use crate::evaluate::verdict::Figure;
-use crate::measurement::{AxisKind, Direction};
+use crate::measurement::{AxisKind, ByKind, Direction};
 use crate::report::acceptance::{ReportInput, TestRecord};
 use crate::report::format::{SourcedUm, inch_text, um};
 use crate::report::json::source_notes;
-use crate::report::json::{FiguresJson, iso_keys};
+use crate::report::json::{FiguresByUnit, FiguresJson, iso_keys};
 use crate::units::{LengthUnit, mm_to_um, um_to_mm};
 
 /// `figures.html`.
@@ -51,7 +51,8 @@ pub(super) const FIGURE_ROWS: [(&str, &str, Figure); 6] = [
     ("B̄", "mean reversal value", Figure::BMean),
 ];
 
-/// A figure's value as `figures_um` gives it, µm.
+/// A figure's value in the unit of the key that holds it (`figures_um`: µm;
+/// `figures_arcsec` or `figures_urad` on a rotary axis).
 pub(super) fn figure_value(figures: &FiguresJson, figure: Figure) -> Option<f64> {
     figures.get(figure.name())
 }
@@ -60,11 +61,14 @@ pub(super) fn figures(input: &ReportInput<'_>) -> Figures {
     let tests = tests_of(input);
     let figures: Vec<FiguresJson> = tests
         .iter()
-        .map(|(_, test)| match test.measurement.kind() {
-            AxisKind::Linear => FiguresJson::from_figures(&test.evaluation.figures),
-            AxisKind::Rotary => {
-                FiguresJson::from_standard_deg(&test.evaluation.standard_figures, input.angle)
-            }
+        .map(|(_, test)| {
+            // A linear axis' ISO 230-2 figures (beside another standard's),
+            // a rotary axis' standard's (ISO 230-2 only), each in its unit.
+            let shown = match test.evaluation.figures_typed() {
+                ByKind::Linear(iso) => ByKind::Linear(iso),
+                ByKind::Rotary(_) => test.evaluation.standard_figures_typed(),
+            };
+            FiguresByUnit::of(&shown, input.angle).into_values()
         })
         .collect();
     let rows = FIGURE_ROWS
@@ -117,25 +121,25 @@ pub(super) fn figures(input: &ReportInput<'_>) -> Figures {
         .collect();
     let standard = input.before.evaluation.standard;
     let standard_rows = if standard.key == Vdi3441.key() {
+        // µm: another standard than ISO 230-2 is for linear axes only
+        // (`workflow::rotary`); a rotary axis' would be left out, not shown as µm.
+        let in_um: Vec<FiguresJson> = tests
+            .iter()
+            .map(|(_, test)| FiguresJson::of_linear(&test.evaluation.standard_figures_typed()))
+            .collect();
         input
             .before
             .evaluation
             .standard_figures
             .iter()
             .map(|figure| {
-                let cells = tests
+                let cells = in_um
                     .iter()
                     .zip(["before", "after"])
-                    .map(|((_, test), prefix)| {
-                        let value = test
-                            .evaluation
-                            .standard_figures
-                            .iter()
-                            .find(|f| f.key == figure.key)
-                            .and_then(|f| f.value);
+                    .map(|(figures, prefix)| {
                         Some(SourcedUm::new(
                             format!("{prefix}.figures_um.{}", figure.key),
-                            value.map(mm_to_um),
+                            figures.get(figure.key),
                         ))
                     })
                     .collect();
@@ -168,10 +172,11 @@ pub(super) fn inch_figures(
 ) -> Vec<(&'static str, String)> {
     let mut notes = Vec::new();
     for (name, test) in tests {
-        if test.measurement.metadata.length_unit != LengthUnit::Inch {
+        let iso = test.evaluation.figures_typed().linear();
+        let (Some(iso), LengthUnit::Inch) = (iso, test.measurement.metadata.length_unit) else {
             continue;
-        }
-        let f = &FiguresJson::from_figures(&test.evaluation.figures);
+        };
+        let f = &FiguresJson::from_standard(&iso);
         let parts: Vec<String> = FIGURE_ROWS
             .iter()
             .flat_map(|&(symbol, _, figure)| {

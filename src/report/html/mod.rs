@@ -193,7 +193,7 @@ struct Page<'a> {
 }
 
 /// The units a report is written in: a linear axis in mm and µm, a rotary
-/// one in ° and ″ or µrad (its `Measurement` holds ° in the `_mm` fields).
+/// one in ° and ″ or µrad (its `Measurement` holds ° where a linear one holds mm).
 struct Units {
     /// `linear` or `rotary`, as the subtitle names the axis.
     kind: &'static str,

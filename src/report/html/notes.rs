@@ -1,9 +1,9 @@
 //! `notes.html`: the warnings and suspected outliers, naming their test.
 
 use super::{signed_plus, tests_of};
-use crate::measurement::{Direction, Measurement};
+use crate::measurement::Direction;
 use crate::report::acceptance::ReportInput;
-use crate::units::{AngleUnit, DeviationUnit};
+use crate::report::json::OutlierJson;
 
 /// `notes.html`: a line of the warnings, naming its test.
 pub(super) struct Note {
@@ -17,8 +17,10 @@ pub(super) enum NoteText {
         run: u32,
         direction: Direction,
         score: String,
-        offset_um: String,
-        worst_target_mm: f64,
+        /// In the report's deviation unit (µm, or ″ or µrad on a rotary axis).
+        offset: String,
+        /// In the axis' unit (mm, or °).
+        worst_target: f64,
     },
 }
 
@@ -32,27 +34,20 @@ pub(super) fn notes(input: &ReportInput<'_>) -> Vec<Note> {
             });
         }
         for outlier in &record.evaluation.outliers {
+            // Typed by the axis' kind, as `evaluate --json` writes it.
+            let shown =
+                OutlierJson::from_outlier(outlier, record.measurement.kind(), input.angle).shown();
             notes.push(Note {
                 test,
                 what: NoteText::Outlier {
                     run: outlier.run,
                     direction: outlier.direction,
                     score: format!("{:.1}", outlier.score),
-                    offset_um: signed_plus(
-                        deviation_shown(record.measurement, input.angle)
-                            .from_internal(outlier.offset),
-                        2,
-                    ),
-                    worst_target_mm: outlier.worst_target,
+                    offset: signed_plus(shown.offset, 2),
+                    worst_target: shown.worst_target,
                 },
             });
         }
     }
     notes
-}
-
-/// The unit the report shows a test's deviations in (held in the `_mm`
-/// fields as mm, or ° on a rotary axis): µm, or ″ or µrad.
-pub(super) fn deviation_shown(measurement: &Measurement, angle: AngleUnit) -> DeviationUnit {
-    measurement.kind().deviation_unit(angle)
 }

@@ -2,9 +2,10 @@
 
 use super::{Plot, signed};
 use crate::compensate::TableMode;
+use crate::evaluate::standard;
 use crate::report::acceptance::{ReportInput, TableRecord};
 use crate::report::format::{SourcedUm, um};
-use crate::report::json::iso_keys;
+use crate::report::json::{FiguresJson, iso_keys};
 use crate::units::mm_to_um;
 
 /// `table.html`.
@@ -40,16 +41,19 @@ pub(super) fn table_view(
     let table = record.table;
     let prediction = input.prediction.map(|predicted| {
         let iso_family = iso_keys(&predicted.figures);
+        // µm: the prediction is of a linear axis (`workflow::rotary`).
+        let kind = input.before.measurement.kind();
+        let in_um = FiguresJson::of_linear(&standard::typed(&predicted.figures, kind));
         PredictionView {
             range_um: um(Some(predicted.range_um())),
             uncompensated_range_um: um(Some(predicted.uncompensated_range_um())),
-            figures: predicted
-                .figures
+            figures: in_um
+                .values
                 .iter()
-                .filter(|f| !iso_family || ["A", "E", "B"].contains(&f.key))
-                .map(|f| {
-                    let key = format!("prediction.figures_um.{}", f.key);
-                    (f.key, SourcedUm::new(key, f.value.map(mm_to_um)))
+                .filter(|(key, _)| !iso_family || ["A", "E", "B"].contains(key))
+                .map(|&(key, value)| {
+                    let data_key = format!("prediction.figures_um.{key}");
+                    (key, SourcedUm::new(data_key, value))
                 })
                 .collect(),
             plot: plot("predicted"),
