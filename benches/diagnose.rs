@@ -58,7 +58,7 @@ fn bench_group(c: &mut Criterion, name: &str, between: bool) {
         let options = TableOptions {
             mode: TableMode::Mean,
             grid: GridSpec::Targets,
-            reference_mm: None,
+            reference: None,
             extrapolate: Extrapolate::Hold,
         };
         let table = build_table(&before, &evaluate(&before), &options).unwrap();

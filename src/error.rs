@@ -12,7 +12,7 @@ use std::fmt;
 
 use crate::measurement::{AxisKind, Direction};
 use crate::units::LengthUnit;
-use crate::units::{AngleUnit, DeviationUnit, mm_to_um, um_to_mm};
+use crate::units::{AngleUnit, DeviationUnit};
 
 /// A position in a text file. Both fields start at 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -188,12 +188,10 @@ pub enum Warning {
     },
     /// Fewer targets than ISO 230-2 asks: 5 in all and 5 per metre of travel.
     TooFewTargets {
-        /// Linear or rotary.
-        kind: AxisKind,
         /// Targets measured.
         targets: usize,
-        /// Travel, in the axis' unit (mm, or ° on a rotary axis).
-        length: f64,
+        /// Travel, typed by the axis' kind (mm, or ° on a rotary axis).
+        length: crate::measurement::Position,
         /// Targets the standard asks for this travel.
         required: usize,
     },
@@ -360,11 +358,11 @@ impl Warning {
         };
         let unit = DeviationUnit::Angle(angle).suffix();
         format!(
-            "{}° and {}° are one physical position, but their mean deviations differ by {:.2}{unit} \
+            "{} and {} are one physical position, but their mean deviations differ by {:.2}{unit} \
              ({:+.2}{unit} and {:+.2}{unit}), more than the repeatability there ({:.2}{unit}): \
              check for drift or a reference that moved during the turn",
-            mm_text(*first_deg),
-            mm_text(*last_deg),
+            degree_text(*first_deg),
+            degree_text(*last_deg),
             angle.from_deg((mean_last_deg - mean_first_deg).abs()),
             angle.from_deg(*mean_first_deg),
             angle.from_deg(*mean_last_deg),
@@ -428,27 +426,24 @@ impl fmt::Display for Warning {
                 )
             }
             Warning::TooFewTargets {
-                kind: AxisKind::Rotary,
                 targets,
-                length: range_deg,
+                length,
                 required,
-            } => write!(
-                f,
-                "{targets} target(s) over {}°: ISO 230-2 asks for at least {required}; measure at least {required}, \
-                 with 0°, 90°, 180° and 270° among them where in range",
-                mm_text(*range_deg)
-            ),
-            Warning::TooFewTargets {
-                kind: AxisKind::Linear,
-                targets,
-                length: length_mm,
-                required,
-            } => write!(
-                f,
-                "{targets} target(s) over {} mm: ISO 230-2 asks for at least 5 targets and at least 5 per metre of travel, \
-                 {required} here; measure at least {required}, with a random part in the spacing",
-                mm_text(*length_mm)
-            ),
+            } => {
+                let over = position_text(*length);
+                match length.kind() {
+                    AxisKind::Rotary => write!(
+                        f,
+                        "{targets} target(s) over {over}: ISO 230-2 asks for at least {required}; measure at least {required}, \
+                         with 0°, 90°, 180° and 270° among them where in range"
+                    ),
+                    AxisKind::Linear => write!(
+                        f,
+                        "{targets} target(s) over {over}: ISO 230-2 asks for at least 5 targets and at least 5 per metre of travel, \
+                         {required} here; measure at least {required}, with a random part in the spacing"
+                    ),
+                }
+            }
             Warning::LongAxis { length_mm, runs } => write!(
                 f,
                 "note: travel {} mm is over 2000 mm, where ISO 230-2 needs only one run per direction \
@@ -484,14 +479,14 @@ impl fmt::Display for Warning {
             ),
             Warning::RotaryOverFullTurn { range_deg } => write!(
                 f,
-                "rotary axis over 360° ({}°): ISO 230-2 takes one approach per direction and target there (n = 1), \
+                "rotary axis over 360° ({}): ISO 230-2 takes one approach per direction and target there (n = 1), \
                  so the repeatabilities and A are not evaluated",
-                mm_text(*range_deg)
+                degree_text(*range_deg)
             ),
             Warning::PrincipalAnglesMissing { missing_deg } => {
                 let angles: Vec<String> = missing_deg
                     .iter()
-                    .map(|angle| format!("{}°", mm_text(*angle)))
+                    .map(|angle| degree_text(*angle))
                     .collect();
                 write!(
                     f,
@@ -510,8 +505,30 @@ impl fmt::Display for Warning {
 
 /// A length in mm for a sentence: at most three decimals, no trailing zeros.
 pub(crate) fn mm_text(value_mm: f64) -> String {
-    let rounded = um_to_mm(mm_to_um(value_mm).round());
-    format!("{}", rounded + 0.0)
+    three_decimals(value_mm)
+}
+
+/// A number for a sentence: at most three decimals, no trailing zeros
+/// (µm for a length in mm, thousandths of a degree for an angle).
+fn three_decimals(value: f64) -> String {
+    format!("{}", (value * 1000.0).round() / 1000.0 + 0.0)
+}
+
+/// An angle in degrees for a sentence, as [`position_text`] writes it.
+fn degree_text(value_deg: f64) -> String {
+    position_text(crate::measurement::ByKind::Rotary(crate::units::Deg(
+        value_deg,
+    )))
+}
+
+/// A position or length in its axis' unit for a sentence: at most three
+/// decimals of that unit, no trailing zeros, then ` mm` or `°`.
+pub(crate) fn position_text(position: crate::measurement::Position) -> String {
+    format!(
+        "{}{}",
+        three_decimals(position.in_axis_unit()),
+        position.unit_after_number()
+    )
 }
 
 #[cfg(test)]
@@ -529,6 +546,34 @@ mod tests {
         assert_eq!(
             error.to_string(),
             "X.rtl:31:9: expected a deviation value, found end of line"
+        );
+    }
+
+    #[test]
+    fn too_few_targets_are_said_in_the_axis_unit() {
+        use crate::measurement::ByKind;
+        use crate::units::{Deg, Mm};
+        // 3 targets over 90.0004°: at most three decimals of a degree, 90°.
+        let rotary = Warning::TooFewTargets {
+            targets: 3,
+            length: ByKind::Rotary(Deg(90.0004)),
+            required: 5,
+        };
+        assert_eq!(
+            rotary.to_string(),
+            "3 target(s) over 90°: ISO 230-2 asks for at least 5; measure at least 5, \
+             with 0°, 90°, 180° and 270° among them where in range"
+        );
+        // 6 targets over 1500.0625 mm: 1500.063 mm; ⌈5 × 1.5⌉ = 8 needed.
+        let linear = Warning::TooFewTargets {
+            targets: 6,
+            length: ByKind::Linear(Mm(1500.0625)),
+            required: 8,
+        };
+        assert_eq!(
+            linear.to_string(),
+            "6 target(s) over 1500.063 mm: ISO 230-2 asks for at least 5 targets and at least 5 per metre of travel, \
+             8 here; measure at least 8, with a random part in the spacing"
         );
     }
 

@@ -114,6 +114,11 @@ impl AxisKind {
         }
     }
 
+    /// What follows a position in a sentence: ` mm`, or `°` set close.
+    pub fn unit_after_number(self) -> &'static str {
+        unit_after_number(self)
+    }
+
     /// A bare number in this axis' unit (a target, a deviation, a figure),
     /// typed: [`Mm`] on a linear axis, [`Deg`] on a rotary one. With
     /// [`crate::evaluate::TargetStats::typed`], the one place where such a
@@ -166,6 +171,22 @@ impl<L, R> ByKind<L, R> {
 /// A position, or a length along the axis (a range, a deviation), in its
 /// axis' unit: mm on a linear axis, ° on a rotary one.
 pub type Position = ByKind<Mm, Deg>;
+
+impl Position {
+    /// The bare number in its axis' unit (mm, or ° on a rotary axis): for
+    /// arithmetic that is the same in both, once the kinds are known to agree.
+    pub fn in_axis_unit(self) -> f64 {
+        match self {
+            ByKind::Linear(Mm(value)) => value,
+            ByKind::Rotary(Deg(value)) => value,
+        }
+    }
+
+    /// What follows the number in a sentence: ` mm`, or `°` set close.
+    pub fn unit_after_number(self) -> &'static str {
+        self.kind().unit_after_number()
+    }
+}
 
 /// One pass over the targets in one direction.
 #[derive(Clone, Debug, PartialEq)]

@@ -295,10 +295,10 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     );
     let request = Request {
         mode: args.mode,
-        step_mm: args.step,
-        start_mm: args.start,
+        step: args.step,
+        start: args.start,
         count: args.count,
-        reference_mm: args.reference,
+        reference: args.reference,
         extrapolate: args.extrapolate,
     };
     let Converted {

@@ -95,7 +95,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let options = TableOptions {
         mode: TableMode::Mean,
         grid: GridSpec::Targets,
-        reference_mm: None,
+        reference: None,
         extrapolate: Extrapolate::Refuse,
     };
     let table = compensate::build_table(before, evaluation, &options)?;
@@ -400,7 +400,7 @@ fn summary(s: &Summary<'_>) -> String {
     let _ = writeln!(
         out,
         " 6 residual      rms {:.2} µm → {:.2} µm with the effects; {unexplained}",
-        s.diagnosis.residual_before.rms_um, s.diagnosis.residual_after.rms_um
+        s.diagnosis.residual_before.rms, s.diagnosis.residual_after.rms
     );
     let next_reason = match s.next.values.mode() {
         TableMode::Bidirectional => format!(

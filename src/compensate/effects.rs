@@ -88,7 +88,8 @@ mod tests {
     use super::*;
     use crate::compensate::{Extrapolate, GridSpec, TableMode};
     use crate::effects::{Periodic, Scale};
-    use crate::measurement::{Direction, Run};
+    use crate::measurement::{ByKind, Direction, Run};
+    use crate::units::Mm;
 
     /// Two runs each way of e(x) = 2 µm · sin(2πx/5) + 10 µm/m · x at 0, 1, … 20 mm.
     fn screw() -> Measurement {
@@ -123,11 +124,11 @@ mod tests {
         let options = TableOptions {
             mode: TableMode::Mean,
             grid: GridSpec::Regular {
-                start_mm: 0.0,
-                step_mm: 0.5,
+                start: ByKind::Linear(Mm(0.0)),
+                step: ByKind::Linear(Mm(0.5)),
                 count: 41,
             },
-            reference_mm: None,
+            reference: None,
             extrapolate: Extrapolate::Refuse,
         };
         let table =
@@ -147,7 +148,7 @@ mod tests {
         let options = TableOptions {
             mode: TableMode::Mean,
             grid: GridSpec::Targets,
-            reference_mm: None,
+            reference: None,
             extrapolate: Extrapolate::Refuse,
         };
         let effects = [Effect::Scale(Scale {

@@ -128,12 +128,13 @@ impl Extrapolate {
 pub enum GridSpec {
     /// At the measured targets.
     Targets,
-    /// At `start_mm + k·step_mm`, k = 0 … count − 1.
+    /// At `start + k·step`, k = 0 … count − 1, in the axis' unit (mm, or °
+    /// on a rotary axis: [`build_table`] refuses a grid of the other kind).
     Regular {
-        /// First point, mm.
-        start_mm: f64,
-        /// Spacing, mm (> 0).
-        step_mm: f64,
+        /// First point.
+        start: Position,
+        /// Spacing (> 0).
+        step: Position,
         /// Number of points (≥ 2).
         count: usize,
     },
@@ -147,9 +148,41 @@ pub struct TableOptions {
     /// Where the points go.
     pub grid: GridSpec,
     /// Position where the table is zero; `None` for the first point.
-    pub reference_mm: Option<f64>,
+    pub reference: Option<Position>,
     /// Points outside the measured range.
     pub extrapolate: Extrapolate,
+}
+
+impl TableOptions {
+    /// Refuses options whose positions (the grid's start and step, the
+    /// reference) are of an axis of another kind than `kind`.
+    fn check_kind(&self, kind: AxisKind) -> Result<(), CompensateError> {
+        if let GridSpec::Regular { start, step, .. } = self.grid {
+            check_kind("grid's start", start, kind)?;
+            check_kind("grid's step", step, kind)?;
+        }
+        if let Some(reference) = self.reference {
+            check_kind("reference", reference, kind)?;
+        }
+        Ok(())
+    }
+}
+
+/// `position`'s bare number when it is of an axis of `kind`, else the
+/// refusal naming `what` it is.
+pub(crate) fn check_kind(
+    what: &'static str,
+    position: Position,
+    kind: AxisKind,
+) -> Result<f64, CompensateError> {
+    if position.kind() != kind {
+        return Err(CompensateError::KindMismatch {
+            what,
+            given: position.kind(),
+            measured: kind,
+        });
+    }
+    Ok(position.in_axis_unit())
 }
 
 /// The values of a table: one column, or one per direction. Axis error in mm
@@ -299,54 +332,77 @@ pub enum CompensateError {
     Backlash(retest::BacklashRefusal),
     /// The controller needs one step and the targets have none.
     #[error(
-        "the targets are unevenly spaced ({count} targets from {first_mm} to {last_mm} mm) and {controller} needs one step: give --step (and optionally --start, --count)"
+        "the targets are unevenly spaced ({count} targets from {} to {}{}) and {controller} needs one step: give --step (and optionally --start, --count)",
+        first.in_axis_unit(), last.in_axis_unit(), last.unit_after_number()
     )]
     UnevenTargets {
         /// How many targets.
         count: usize,
-        /// The first, mm.
-        first_mm: f64,
-        /// The last, mm.
-        last_mm: f64,
+        /// The first.
+        first: Position,
+        /// The last.
+        last: Position,
         /// The controller's name.
         controller: &'static str,
     },
     /// A compensation point lies outside the measured range.
     #[error(
-        "compensation point {position_mm} mm is outside the measured range {first_mm} … {last_mm} mm; use --extrapolate hold or --extrapolate zero, or a grid inside the range"
+        "compensation point {}{} is outside the measured range {} … {}{}; use --extrapolate hold or --extrapolate zero, or a grid inside the range",
+        position.in_axis_unit(), position.unit_after_number(),
+        first.in_axis_unit(), last.in_axis_unit(), last.unit_after_number()
     )]
     OutsideMeasuredRange {
         /// The point.
-        position_mm: f64,
+        position: Position,
         /// First measured target.
-        first_mm: f64,
+        first: Position,
         /// Last measured target.
-        last_mm: f64,
+        last: Position,
     },
     /// The reference position lies outside the table.
-    #[error("reference position {reference_mm} mm is outside the table {first_mm} … {last_mm} mm")]
+    #[error(
+        "reference position {}{} is outside the table {} … {}{}",
+        reference.in_axis_unit(), reference.unit_after_number(),
+        first.in_axis_unit(), last.in_axis_unit(), last.unit_after_number()
+    )]
     ReferenceOutside {
         /// The reference.
-        reference_mm: f64,
+        reference: Position,
         /// First point.
-        first_mm: f64,
+        first: Position,
         /// Last point.
-        last_mm: f64,
+        last: Position,
     },
     /// An update cannot be referred where the test did not measure.
     #[error(
-        "{} {reference_mm} mm is outside the measured range {first_mm} … {last_mm} mm: the test did not measure the residual there, so the update cannot be referred to it; give --reference with the position inside the measured range where the update should add nothing (the machine's reference point)",
-        if *given { "the reference" } else { "the existing table is zero (its reference) at" }
+        "{} {}{} is outside the measured range {} … {}{}: the test did not measure the residual there, so the update cannot be referred to it; give --reference with the position inside the measured range where the update should add nothing (the machine's reference point)",
+        if *given { "the reference" } else { "the existing table is zero (its reference) at" },
+        reference.in_axis_unit(), reference.unit_after_number(),
+        first.in_axis_unit(), last.in_axis_unit(), last.unit_after_number()
     )]
     UpdateReference {
         /// The reference.
-        reference_mm: f64,
+        reference: Position,
         /// Whether `--reference` gave it (else it is the existing table's zero).
         given: bool,
         /// First measured target.
-        first_mm: f64,
+        first: Position,
         /// Last measured target.
-        last_mm: f64,
+        last: Position,
+    },
+    /// A position given for an axis of one kind (a reference, a grid, an
+    /// existing table) with a measurement of the other.
+    #[error(
+        "the {what} is in {} (a {} axis' unit), but the test measured a {} axis, in {}: they do not belong together",
+        given.position_unit(), given.as_str(), measured.as_str(), measured.position_unit()
+    )]
+    KindMismatch {
+        /// What was given: `reference`, `grid's step`, `existing table`.
+        what: &'static str,
+        /// The kind it is of.
+        given: AxisKind,
+        /// The kind of the measured axis.
+        measured: AxisKind,
     },
     /// A one-direction test cannot update a table with a column per direction.
     #[error(
@@ -438,7 +494,7 @@ fn join_full_turn(curve: (Vec<f64>, Vec<f64>), kind: AxisKind) -> (Vec<f64>, Vec
 /// let csv = "target_mm,run,direction,deviation_um\n0,1,up,1\n100,1,up,-2\n0,1,down,3\n100,1,down,0\n";
 /// let (m, _) = parse_str(csv, SourceFormat::Csv).unwrap();
 /// let options = TableOptions { mode: TableMode::Mean, grid: GridSpec::Targets,
-///                              reference_mm: None, extrapolate: Extrapolate::Refuse };
+///                              reference: None, extrapolate: Extrapolate::Refuse };
 /// let table = build_table(&m, &evaluate(&m), &options).unwrap();
 /// // x̄ = 2, −1 µm; shifted to zero at 0 mm: 0, −3 µm.
 /// assert_eq!(table.values, TableValues::Mean(vec![0.0, -0.003]));
@@ -454,9 +510,10 @@ pub fn build_table(
     evaluation: &Evaluation,
     options: &TableOptions,
 ) -> Result<CompensationTable, CompensateError> {
+    let kind = measurement.kind();
+    options.check_kind(kind)?;
     let positions_mm = grid_positions(measurement.targets(), options.grid)?;
     let has = |d: Direction| measurement.run_count(d) > 0;
-    let kind = measurement.kind();
     let source_curve = |pick: fn(&crate::evaluate::TargetStats) -> Option<f64>| {
         join_full_turn(source_curve(evaluation, pick), kind)
     };
@@ -467,7 +524,7 @@ pub fn build_table(
                 (true, false) => source_curve(|t| t.up.mean),
                 _ => source_curve(|t| t.down.mean),
             };
-            let column = resample(&curve, &positions_mm, options.extrapolate)?;
+            let column = resample(&curve, &positions_mm, kind, options.extrapolate)?;
             let backlash = evaluation.figures.b_mean.map(|b| -b);
             (TableValues::Mean(column), backlash)
         }
@@ -480,23 +537,27 @@ pub fn build_table(
             let up = resample(
                 &source_curve(|t| t.up.mean),
                 &positions_mm,
+                kind,
                 options.extrapolate,
             )?;
             let down = resample(
                 &source_curve(|t| t.down.mean),
                 &positions_mm,
+                kind,
                 options.extrapolate,
             )?;
             (TableValues::Bidirectional { up, down }, None)
         }
     };
-    let reference_mm = options.reference_mm.unwrap_or(positions_mm[0]);
+    let reference_mm = options
+        .reference
+        .map_or(positions_mm[0], Position::in_axis_unit);
     let (first_mm, last_mm) = (positions_mm[0], positions_mm[positions_mm.len() - 1]);
     if reference_mm < first_mm - 1e-9 || reference_mm > last_mm + 1e-9 {
         return Err(CompensateError::ReferenceOutside {
-            reference_mm,
-            first_mm,
-            last_mm,
+            reference: kind.position(reference_mm),
+            first: kind.position(first_mm),
+            last: kind.position(last_mm),
         });
     }
     let values = shift_to_reference(
@@ -549,7 +610,8 @@ fn shift_to_reference(
     })
 }
 
-/// The compensation points of a grid spec.
+/// The compensation points of a grid spec, in the unit of the grid (and of
+/// the targets: [`build_table`] checks that they agree).
 pub fn grid_positions(targets_mm: &[f64], grid: GridSpec) -> Result<Vec<f64>, CompensateError> {
     match grid {
         GridSpec::Targets => {
@@ -560,14 +622,12 @@ pub fn grid_positions(targets_mm: &[f64], grid: GridSpec) -> Result<Vec<f64>, Co
             }
             Ok(targets_mm.to_vec())
         }
-        GridSpec::Regular {
-            start_mm,
-            step_mm,
-            count,
-        } => {
+        GridSpec::Regular { start, step, count } => {
+            let (start_mm, step_mm) = (start.in_axis_unit(), step.in_axis_unit());
             if !(step_mm.is_finite() && step_mm > 0.0) {
                 return Err(CompensateError::Grid(format!(
-                    "step must be positive, found {step_mm} mm"
+                    "step must be positive, found {step_mm}{}",
+                    step.unit_after_number()
                 )));
             }
             if count < 2 {
@@ -596,6 +656,7 @@ fn round_nm(mm: f64) -> f64 {
 fn resample(
     curve: &(Vec<f64>, Vec<f64>),
     positions_mm: &[f64],
+    kind: AxisKind,
     extrapolate: Extrapolate,
 ) -> Result<Vec<f64>, CompensateError> {
     let (xs, ys) = curve;
@@ -609,9 +670,9 @@ fn resample(
             let outside = p < first_mm - 1e-9 || p > last_mm + 1e-9;
             match (outside, extrapolate) {
                 (true, Extrapolate::Refuse) => Err(CompensateError::OutsideMeasuredRange {
-                    position_mm: p,
-                    first_mm,
-                    last_mm,
+                    position: kind.position(p),
+                    first: kind.position(first_mm),
+                    last: kind.position(last_mm),
                 }),
                 _ => Ok(interpolate_hold(xs, ys, p)),
             }

@@ -29,7 +29,7 @@ use super::{
     regular_step,
 };
 use crate::effects::{Effect, TableRole};
-use crate::measurement::Direction;
+use crate::measurement::{AxisKind, Direction};
 
 /// What the controller can take, as far as a table's plan is concerned
 /// (filled by the caller from `emit::Controller`).
@@ -57,19 +57,21 @@ pub struct PlanContext<'a> {
     pub existing: Option<&'a CompensationTable>,
 }
 
-/// What the user asked for (`None`: let the plan decide).
+/// What the user asked for (`None`: let the plan decide). Positions as
+/// typed, in the measured axis' unit (mm, or ° on a rotary axis): [`plan`]
+/// gives them the axis' kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Request {
     /// `--mode`.
     pub mode: Option<TableMode>,
-    /// `--step`, mm.
-    pub step_mm: Option<f64>,
-    /// `--start`, mm.
-    pub start_mm: Option<f64>,
+    /// `--step`, in the axis' unit.
+    pub step: Option<f64>,
+    /// `--start`, in the axis' unit.
+    pub start: Option<f64>,
     /// `--count`.
     pub count: Option<usize>,
-    /// `--reference`, mm.
-    pub reference_mm: Option<f64>,
+    /// `--reference`, in the axis' unit.
+    pub reference: Option<f64>,
     /// `--extrapolate`.
     pub extrapolate: Option<Extrapolate>,
 }
@@ -88,9 +90,11 @@ pub struct Plan {
     pub update: Option<UpdatePlan>,
 }
 
-/// The plan for a table over `targets_mm` (the measured targets, ascending).
+/// The plan for a table of an axis of `kind` over `targets` (the
+/// measured targets, ascending, in the axis' unit).
 pub fn plan(
-    targets_mm: &[f64],
+    kind: AxisKind,
+    targets: &[f64],
     effects: &[Effect],
     controller: &Capabilities,
     request: &Request,
@@ -103,26 +107,39 @@ pub fn plan(
         Some(_) if request.extrapolate.is_some() => {
             return Err(CompensateError::ExtrapolateUpdate);
         }
-        Some(existing) => Some(UpdatePlan::new(existing, targets_mm, request.reference_mm)?),
+        Some(existing) => Some(UpdatePlan::new(
+            existing,
+            kind,
+            targets,
+            request.reference.map(|r| kind.position(r)),
+        )?),
         None => None,
     };
-    let step_mm = effects_step(effects, controller, request, &mut notes);
+    let finer_step = effects_step(kind, effects, controller, request, &mut notes);
     for effect in effects {
         if let TableRole::TakenOut { note } | TableRole::NotATable { note } = effect.in_table() {
             notes.push(note);
         }
     }
-    let grid = grid(targets_mm, controller, request, step_mm, &mut table_notes)?;
+    let grid = grid(
+        kind,
+        targets,
+        controller,
+        request,
+        finer_step,
+        &mut table_notes,
+    )?;
     if let Some(update) = &update {
-        check_update_grid(update, targets_mm, grid, controller)?;
+        check_update_grid(update, targets, grid, controller)?;
     }
     Ok(Plan {
         options: TableOptions {
             mode,
             grid,
-            reference_mm: update
+            reference: update
                 .as_ref()
-                .map_or(request.reference_mm, |u| Some(u.reference_mm)),
+                .map_or(request.reference, |u| Some(u.reference))
+                .map(|r| kind.position(r)),
             // An update keeps the old values outside the measured range
             // (`UpdatePlan::apply` replaces whatever is built there).
             extrapolate: match update {
@@ -140,15 +157,15 @@ pub fn plan(
 /// points lie on the new grid's step.
 fn check_update_grid(
     update: &UpdatePlan,
-    targets_mm: &[f64],
+    targets: &[f64],
     grid: GridSpec,
     controller: &Capabilities,
 ) -> Result<(), CompensateError> {
     if controller.free_positions {
         return Ok(());
     }
-    let (first, last) = update.measured_mm;
-    let mut positions = super::grid_positions(targets_mm, grid)?;
+    let (first, last) = update.measured;
+    let mut positions = super::grid_positions(targets, grid)?;
     positions.extend(
         update
             .existing
@@ -162,8 +179,9 @@ fn check_update_grid(
         return Ok(());
     }
     let old = &update.existing.positions;
+    let unit = update.existing.kind.unit_after_number();
     Err(CompensateError::Grid(format!(
-        "the update keeps the existing table's points outside the measured range {first} … {last} mm, and with them the points are unevenly spaced, which {} cannot take: put the new points on the existing table's grid ({} points from {} to {} mm; --start, --step, --count)",
+        "the update keeps the existing table's points outside the measured range {first} … {last}{unit}, and with them the points are unevenly spaced, which {} cannot take: put the new points on the existing table's grid ({} points from {} to {}{unit}; --start, --step, --count)",
         controller.name,
         old.len(),
         old[0],
@@ -228,6 +246,7 @@ fn mode(
 /// The step the periodic effects ask for: a step the format writes exactly,
 /// at most the finest they allow (and at most the user's).
 fn effects_step(
+    kind: AxisKind,
     effects: &[Effect],
     controller: &Capabilities,
     request: &Request,
@@ -242,9 +261,10 @@ fn effects_step(
         .min_by(f64::total_cmp)?;
     let resolution = controller.resolution_mm;
     let step = ((finest / resolution).floor() * resolution).max(resolution);
-    let chosen = request.step_mm.map_or(step, |given| given.min(step));
+    let chosen = request.step.map_or(step, |given| given.min(step));
     notes.push(format!(
-        "periodic: points every {chosen} mm (at most a tenth of the period), the periodic error at each point"
+        "periodic: points every {chosen}{} (at most a tenth of the period), the periodic error at each point",
+        kind.unit_after_number()
     ));
     Some(chosen)
 }
@@ -252,51 +272,53 @@ fn effects_step(
 /// The grid: the effects' finer step or `--step` (with `--start`, `--count`),
 /// else the measured targets when the controller takes them.
 fn grid(
-    targets_mm: &[f64],
+    kind: AxisKind,
+    targets: &[f64],
     controller: &Capabilities,
     request: &Request,
     effects_step: Option<f64>,
     notes: &mut Vec<String>,
 ) -> Result<GridSpec, CompensateError> {
-    let (first, last) = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
-    let Some(step_mm) = effects_step.or(request.step_mm) else {
-        if controller.free_positions || regular_step(targets_mm).is_some() {
+    let (first, last) = (targets[0], targets[targets.len() - 1]);
+    let Some(step) = effects_step.or(request.step) else {
+        if controller.free_positions || regular_step(targets).is_some() {
             return Ok(GridSpec::Targets);
         }
         return Err(CompensateError::UnevenTargets {
-            count: targets_mm.len(),
-            first_mm: first,
-            last_mm: last,
+            count: targets.len(),
+            first: kind.position(first),
+            last: kind.position(last),
             controller: controller.name,
         });
     };
-    let start_mm = request.start_mm.unwrap_or(first);
-    if request.count.is_none() && start_mm + step_mm > last + 1e-9 {
+    let unit = kind.unit_after_number();
+    let start = request.start.unwrap_or(first);
+    if request.count.is_none() && start + step > last + 1e-9 {
         return Err(CompensateError::Grid(format!(
-            "the grid starts at {start_mm} mm with a step of {step_mm} mm, but the test measured \
-             {first} … {last} mm: no second point lies within it (give a start below {} mm, or --count)",
-            last - step_mm
+            "the grid starts at {start}{unit} with a step of {step}{unit}, but the test measured \
+             {first} … {last}{unit}: no second point lies within it (give a start below {}{unit}, or --count)",
+            last - step
         )));
     }
     // A --count belongs to the --step it was given with, not to a finer step of the effects.
-    let count = match request.count.filter(|_| Some(step_mm) == request.step_mm) {
+    let count = match request.count.filter(|_| Some(step) == request.step) {
         Some(count) => count,
-        None => ((last - start_mm) / step_mm + 1e-9).floor().max(0.0) as usize + 1,
+        None => ((last - start) / step + 1e-9).floor().max(0.0) as usize + 1,
     };
-    let end_mm = start_mm + (count - 1) as f64 * step_mm;
+    let end = start + (count - 1) as f64 * step;
     // The user's step is said where it falls short; the effects' fine step ends within it.
-    if request.count.is_none() && request.step_mm == Some(step_mm) && end_mm < last - 1e-9 {
+    if request.count.is_none() && request.step == Some(step) && end < last - 1e-9 {
         notes.push(format!(
-            "the table ends at {end} mm, its last compensation point, short of the measured end \
-             {last} mm ({start_mm} mm + whole steps of {step_mm} mm): to include {last} mm give a \
-             step that divides {length} mm",
-            end = super::round_nm(end_mm),
-            length = super::round_nm(last - start_mm),
+            "the table ends at {end}{unit}, its last compensation point, short of the measured end \
+             {last}{unit} ({start}{unit} + whole steps of {step}{unit}): to include {last}{unit} give a \
+             step that divides {length}{unit}",
+            end = super::round_nm(end),
+            length = super::round_nm(last - start),
         ));
     }
     Ok(GridSpec::Regular {
-        start_mm,
-        step_mm,
+        start: kind.position(start),
+        step: kind.position(step),
         count,
     })
 }
@@ -305,6 +327,8 @@ fn grid(
 mod tests {
     use super::*;
     use crate::effects::{Drift, Periodic, Reversal};
+    use crate::measurement::ByKind;
+    use crate::units::Mm;
 
     const ITNC: Capabilities = Capabilities {
         name: "iTNC 530",
@@ -318,16 +342,26 @@ mod tests {
         (0..=10).map(|i| f64::from(i) * 50.0).collect()
     }
 
+    /// The plan of a linear axis measured at [`targets`].
+    fn linear_plan(
+        effects: &[Effect],
+        controller: &Capabilities,
+        request: &Request,
+        context: &PlanContext<'_>,
+    ) -> Result<Plan, CompensateError> {
+        plan(
+            AxisKind::Linear,
+            &targets(),
+            effects,
+            controller,
+            request,
+            context,
+        )
+    }
+
     #[test]
     fn without_effects_a_mean_table_at_the_targets() {
-        let plan = plan(
-            &targets(),
-            &[],
-            &ITNC,
-            &Request::default(),
-            &PlanContext::default(),
-        )
-        .unwrap();
+        let plan = linear_plan(&[], &ITNC, &Request::default(), &PlanContext::default()).unwrap();
         assert_eq!(plan.options.mode, TableMode::Mean);
         assert_eq!(plan.options.grid, GridSpec::Targets);
         assert!(plan.notes.is_empty());
@@ -336,8 +370,7 @@ mod tests {
     #[test]
     fn a_reversal_makes_it_bidirectional_where_the_controller_takes_it() {
         let effects = [Effect::Reversal(Reversal { b_um: -3.0 })];
-        let bidirectional = plan(
-            &targets(),
+        let bidirectional = linear_plan(
             &effects,
             &ITNC,
             &Request::default(),
@@ -350,8 +383,7 @@ mod tests {
             name: "LinuxCNC",
             ..ITNC
         };
-        let mean = plan(
-            &targets(),
+        let mean = linear_plan(
             &effects,
             &mean_only,
             &Request::default(),
@@ -370,7 +402,7 @@ mod tests {
             ..Request::default()
         };
         assert_eq!(
-            plan(&targets(), &effects, &ITNC, &asked, &PlanContext::default())
+            linear_plan(&effects, &ITNC, &asked, &PlanContext::default())
                 .unwrap()
                 .options
                 .mode,
@@ -389,8 +421,7 @@ mod tests {
             }),
             Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),
         ];
-        let plan = plan(
-            &targets(),
+        let plan = linear_plan(
             &effects,
             &ITNC,
             &Request::default(),
@@ -398,8 +429,8 @@ mod tests {
         )
         .unwrap();
         let GridSpec::Regular {
-            start_mm,
-            step_mm,
+            start: ByKind::Linear(Mm(start_mm)),
+            step: ByKind::Linear(Mm(step_mm)),
             count,
         } = plan.options.grid
         else {
@@ -421,7 +452,7 @@ mod tests {
     fn existing() -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            kind: crate::measurement::AxisKind::Linear,
+            kind: AxisKind::Linear,
             positions: vec![-100.0, 0.0, 250.0, 600.0],
             values: crate::compensate::TableValues::Mean(vec![0.01, 0.0, 0.002, 0.003]),
             reference: 0.0,
@@ -440,9 +471,9 @@ mod tests {
             only_direction: None,
             existing: Some(&old),
         };
-        let update = plan(&targets(), &[], &free, &Request::default(), &context).unwrap();
-        assert_eq!(update.options.reference_mm, Some(0.0));
-        assert_eq!(update.update.unwrap().measured_mm, (0.0, 500.0));
+        let update = linear_plan(&[], &free, &Request::default(), &context).unwrap();
+        assert_eq!(update.options.reference, Some(ByKind::Linear(Mm(0.0))));
+        assert_eq!(update.update.unwrap().measured, (0.0, 500.0));
         // A zero the test did not measure cannot refer the update.
         let mut shifted = existing();
         shifted.reference = 600.0;
@@ -450,7 +481,7 @@ mod tests {
             only_direction: None,
             existing: Some(&shifted),
         };
-        let error = plan(&targets(), &[], &free, &Request::default(), &context).unwrap_err();
+        let error = linear_plan(&[], &free, &Request::default(), &context).unwrap_err();
         assert!(
             error
                 .to_string()
@@ -458,22 +489,22 @@ mod tests {
             "{error}"
         );
         let given = Request {
-            reference_mm: Some(250.0),
+            reference: Some(250.0),
             ..Request::default()
         };
         assert_eq!(
-            plan(&targets(), &[], &free, &given, &context)
+            linear_plan(&[], &free, &given, &context)
                 .unwrap()
                 .options
-                .reference_mm,
-            Some(250.0)
+                .reference,
+            Some(ByKind::Linear(Mm(250.0)))
         );
         let extrapolate = Request {
             extrapolate: Some(Extrapolate::Hold),
             ..given
         };
         assert_eq!(
-            plan(&targets(), &[], &free, &extrapolate, &context).unwrap_err(),
+            linear_plan(&[], &free, &extrapolate, &context).unwrap_err(),
             CompensateError::ExtrapolateUpdate
         );
         // One step: the kept −100 and 600 mm leave the 50 mm grid 0 … 500 mm
@@ -482,7 +513,7 @@ mod tests {
             only_direction: None,
             existing: Some(&old),
         };
-        let error = plan(&targets(), &[], &ITNC, &Request::default(), &context).unwrap_err();
+        let error = linear_plan(&[], &ITNC, &Request::default(), &context).unwrap_err();
         assert!(
             error.to_string().contains("4 points from -100 to 600 mm"),
             "{error}"
@@ -495,7 +526,7 @@ mod tests {
             only_direction: Some(Direction::Down),
             existing: None,
         };
-        let plan_down = plan(&targets(), &[], &ITNC, &Request::default(), &down).unwrap();
+        let plan_down = linear_plan(&[], &ITNC, &Request::default(), &down).unwrap();
         assert_eq!(
             plan_down.table_notes,
             vec!["the test ran ↓ only: the table is the ↓ curve, in its one column; the reversal (backlash) was not measured, so leave the backlash parameter as it is (measure both directions to check it)".to_string()]
@@ -510,41 +541,40 @@ mod tests {
             ..down
         };
         assert_eq!(
-            plan(&targets(), &[], &ITNC, &Request::default(), &update).unwrap_err(),
+            linear_plan(&[], &ITNC, &Request::default(), &update).unwrap_err(),
             CompensateError::OneDirectionUpdate(Direction::Down)
         );
     }
 
     #[test]
     fn uneven_targets_need_a_step_where_the_controller_takes_only_one() {
-        let uneven = [0.0, 10.0, 25.0, 40.0];
-        let error = plan(
-            &uneven,
-            &[],
-            &ITNC,
-            &Request::default(),
-            &PlanContext::default(),
-        )
-        .unwrap_err();
-        assert!(
-            error.to_string().contains("iTNC 530 needs one step"),
-            "{error}"
+        let uneven = |kind, controller: &Capabilities| {
+            plan(
+                kind,
+                &[0.0, 10.0, 25.0, 40.0],
+                &[],
+                controller,
+                &Request::default(),
+                &PlanContext::default(),
+            )
+        };
+        let error = uneven(AxisKind::Linear, &ITNC).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "the targets are unevenly spaced (4 targets from 0 to 40 mm) and iTNC 530 needs one step: give --step (and optionally --start, --count)"
+        );
+        // On a rotary axis the same targets are degrees.
+        let rotary = uneven(AxisKind::Rotary, &ITNC).unwrap_err();
+        assert_eq!(
+            rotary.to_string(),
+            "the targets are unevenly spaced (4 targets from 0 to 40°) and iTNC 530 needs one step: give --step (and optionally --start, --count)"
         );
         let free = Capabilities {
             free_positions: true,
             ..ITNC
         };
         assert_eq!(
-            plan(
-                &uneven,
-                &[],
-                &free,
-                &Request::default(),
-                &PlanContext::default()
-            )
-            .unwrap()
-            .options
-            .grid,
+            uneven(AxisKind::Linear, &free).unwrap().options.grid,
             GridSpec::Targets
         );
     }

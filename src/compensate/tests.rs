@@ -4,7 +4,8 @@ use proptest::prelude::*;
 
 use super::*;
 use crate::evaluate::evaluate;
-use crate::measurement::{Environment, Metadata, Run};
+use crate::measurement::{ByKind, Environment, Metadata, Run};
+use crate::units::{Deg, Mm};
 
 /// Targets 0, 40, 100 mm; one run each way. Deviations in µm.
 fn measurement(up_um: [f64; 3], down_um: Option<[f64; 3]>) -> Measurement {
@@ -38,15 +39,15 @@ fn build(
     let options = TableOptions {
         mode,
         grid,
-        reference_mm,
+        reference: reference_mm.map(|r| AxisKind::Linear.position(r)),
         extrapolate,
     };
     build_table(m, &evaluate(m), &options)
 }
 
 const GRID_0_TO_100: GridSpec = GridSpec::Regular {
-    start_mm: 0.0,
-    step_mm: 25.0,
+    start: ByKind::Linear(Mm(0.0)),
+    step: ByKind::Linear(Mm(25.0)),
     count: 5,
 };
 
@@ -118,8 +119,8 @@ fn reference_shift_makes_the_reference_zero() {
 fn points_outside_the_measured_range() {
     let m = measurement([1.0, 8.0, 4.0], Some([-1.0, 4.0, 2.0]));
     let beyond = GridSpec::Regular {
-        start_mm: 0.0,
-        step_mm: 25.0,
+        start: ByKind::Linear(Mm(0.0)),
+        step: ByKind::Linear(Mm(25.0)),
         count: 6,
     };
     let refused = build(&m, TableMode::Mean, beyond, None, Extrapolate::Refuse).unwrap_err();
@@ -140,6 +141,96 @@ fn points_outside_the_measured_range() {
         zero.values.for_direction(Direction::Up),
         &[-3.75, 0.0, 1.75, 0.5, -0.75, 0.0],
     );
+}
+
+#[test]
+fn a_rotary_table_says_its_positions_in_degrees() {
+    // The targets 0, 40, 100 read as degrees: the point 125° of the grid
+    // 0 … 125° lies past the last target, 100°; a reference at 120° past
+    // the table 0 … 100°.
+    let m = measurement([1.0, 8.0, 4.0], Some([-1.0, 4.0, 2.0])).with_kind(AxisKind::Rotary);
+    let beyond = GridSpec::Regular {
+        start: ByKind::Rotary(Deg(0.0)),
+        step: ByKind::Rotary(Deg(25.0)),
+        count: 6,
+    };
+    let refused = build_rotary(&m, beyond, None).unwrap_err();
+    assert_eq!(
+        refused.to_string(),
+        "compensation point 125° is outside the measured range 0 … 100°; \
+         use --extrapolate hold or --extrapolate zero, or a grid inside the range"
+    );
+    let outside = build_rotary(&m, GridSpec::Targets, Some(120.0)).unwrap_err();
+    assert_eq!(
+        outside.to_string(),
+        "reference position 120° is outside the table 0 … 100°"
+    );
+    let step = GridSpec::Regular {
+        start: ByKind::Rotary(Deg(0.0)),
+        step: ByKind::Rotary(Deg(-5.0)),
+        count: 3,
+    };
+    assert_eq!(
+        build_rotary(&m, step, None).unwrap_err().to_string(),
+        "invalid grid: step must be positive, found -5°"
+    );
+}
+
+fn build_rotary(
+    m: &Measurement,
+    grid: GridSpec,
+    reference_deg: Option<f64>,
+) -> Result<CompensationTable, CompensateError> {
+    let options = TableOptions {
+        mode: TableMode::Mean,
+        grid,
+        reference: reference_deg.map(|r| ByKind::Rotary(Deg(r))),
+        extrapolate: Extrapolate::Refuse,
+    };
+    build_table(m, &evaluate(m), &options)
+}
+
+#[test]
+fn options_of_an_axis_of_the_other_kind_are_refused() {
+    let linear = measurement([1.0, 8.0, 4.0], Some([-1.0, 4.0, 2.0]));
+    let rotary = linear.clone().with_kind(AxisKind::Rotary);
+    // A reference in degrees for a linear axis, inside 0 … 100 as a number.
+    assert_eq!(
+        build_rotary(&linear, GridSpec::Targets, Some(40.0)),
+        Err(CompensateError::KindMismatch {
+            what: "reference",
+            given: AxisKind::Rotary,
+            measured: AxisKind::Linear
+        })
+    );
+    // A grid in mm for a rotary axis.
+    let refused = build(
+        &rotary,
+        TableMode::Mean,
+        GRID_0_TO_100,
+        None,
+        Extrapolate::Refuse,
+    )
+    .unwrap_err();
+    assert_eq!(
+        refused.to_string(),
+        "the grid's start is in mm (a linear axis' unit), but the test measured a rotary axis, in °: they do not belong together"
+    );
+    // A step of the other kind behind a start of the right one.
+    let mixed = GridSpec::Regular {
+        start: ByKind::Rotary(Deg(0.0)),
+        step: ByKind::Linear(Mm(25.0)),
+        count: 5,
+    };
+    assert!(matches!(
+        build_rotary(&rotary, mixed, None),
+        Err(CompensateError::KindMismatch {
+            what: "grid's step",
+            ..
+        })
+    ));
+    // Of the right kind, the same numbers build.
+    assert!(build_rotary(&rotary, GridSpec::Targets, Some(40.0)).is_ok());
 }
 
 #[test]
@@ -210,18 +301,18 @@ fn invalid_grids() {
     let m = measurement([1.0, 8.0, 4.0], None);
     for grid in [
         GridSpec::Regular {
-            start_mm: 0.0,
-            step_mm: 0.0,
+            start: ByKind::Linear(Mm(0.0)),
+            step: ByKind::Linear(Mm(0.0)),
             count: 5,
         },
         GridSpec::Regular {
-            start_mm: 0.0,
-            step_mm: 10.0,
+            start: ByKind::Linear(Mm(0.0)),
+            step: ByKind::Linear(Mm(10.0)),
             count: 1,
         },
         GridSpec::Regular {
-            start_mm: f64::NAN,
-            step_mm: 10.0,
+            start: ByKind::Linear(Mm(f64::NAN)),
+            step: ByKind::Linear(Mm(10.0)),
             count: 3,
         },
     ] {

@@ -14,88 +14,106 @@
 //!
 //! Pure: no I/O. Lengths in mm (degrees on a rotary axis).
 
-use super::{CompensateError, CompensationTable, TableValues};
-use crate::measurement::Direction;
+use super::{CompensateError, CompensationTable, TableValues, check_kind};
+use crate::measurement::{AxisKind, Direction, Position};
 
-/// Two positions closer than this are one point, mm.
-const SAME_POINT_MM: f64 = 1e-6;
+/// Two positions closer than this are one point, in the axis' unit.
+const SAME_POINT: f64 = 1e-6;
 
-/// An update of `existing` by a test over `measured_mm`, referred to `reference_mm`.
+/// An update of `existing` by a test over `measured`, referred to
+/// `reference`; positions in the axis' unit (`existing.kind`: mm, or °).
 #[derive(Clone, Debug, PartialEq)]
 pub struct UpdatePlan {
     /// The table the control had during the test.
     pub existing: CompensationTable,
-    /// The first and last measured target, mm.
-    pub measured_mm: (f64, f64),
-    /// Where the update adds nothing, mm.
-    pub reference_mm: f64,
+    /// The first and last measured target.
+    pub measured: (f64, f64),
+    /// Where the update adds nothing.
+    pub reference: f64,
     /// Whether the reference is the existing table's own zero (not `--reference`).
     pub at_existing_zero: bool,
 }
 
-/// Consecutive old points kept as they were: first, last, how many.
+/// Consecutive old points kept as they were: first, last (in the axis'
+/// unit), how many.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KeptRange {
-    /// First point, mm.
-    pub first_mm: f64,
-    /// Last point, mm.
-    pub last_mm: f64,
+    /// First point.
+    pub first: f64,
+    /// Last point.
+    pub last: f64,
     /// Number of points.
     pub count: usize,
 }
 
-/// What an update did, for the engineer to read.
+/// What an update did, for the engineer to read; positions and values in
+/// the axis' unit (`kind`: mm, or °).
 #[derive(Clone, Debug, PartialEq)]
 pub struct UpdateSummary {
     /// Old points outside the measured range, kept with their old values, by runs.
     pub kept: Vec<KeptRange>,
-    /// The same points one by one, mm.
-    pub kept_points_mm: Vec<f64>,
-    /// The measured range, mm.
-    pub measured_mm: (f64, f64),
+    /// The same points one by one.
+    pub kept_points: Vec<f64>,
+    /// The measured range.
+    pub measured: (f64, f64),
     /// How many points inside it got old + residual.
     pub updated: usize,
-    /// Where the update adds nothing, mm.
-    pub reference_mm: f64,
-    /// The existing table's value there, mm (0 at its own zero).
-    pub existing_at_reference_mm: f64,
+    /// Where the update adds nothing.
+    pub reference: f64,
+    /// The existing table's value there (0 at its own zero).
+    pub existing_at_reference: f64,
     /// Whether the reference is the existing table's own zero.
     pub at_existing_zero: bool,
-    /// Old points inside the measured range that the new grid does not have, mm.
-    pub dropped_mm: Vec<f64>,
-    /// New points the old table did not have, mm.
-    pub added_mm: Vec<f64>,
+    /// Old points inside the measured range that the new grid does not have.
+    pub dropped: Vec<f64>,
+    /// New points the old table did not have.
+    pub added: Vec<f64>,
+    /// The axis' kind: the unit of every position above (mm, or °).
+    pub kind: AxisKind,
 }
 
 impl UpdatePlan {
-    /// The plan of an update, or why it cannot be referred: the reference
+    /// The plan of an update of `existing` by a test of an axis of `kind`
+    /// over `targets_mm` (in its unit), or why it cannot be made: the table
+    /// and the reference must be of an axis of that kind, and the reference
     /// (`given`, else the existing table's zero) must lie inside the measured
     /// range, where the test measured the residual.
     pub fn new(
         existing: &CompensationTable,
+        kind: AxisKind,
         targets_mm: &[f64],
-        given_reference_mm: Option<f64>,
+        given_reference: Option<Position>,
     ) -> Result<UpdatePlan, CompensateError> {
-        let measured_mm = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
-        let reference_mm = given_reference_mm.unwrap_or(existing.reference);
-        if reference_mm < measured_mm.0 - 1e-9 || reference_mm > measured_mm.1 + 1e-9 {
+        if existing.kind != kind {
+            return Err(CompensateError::KindMismatch {
+                what: "existing table",
+                given: existing.kind,
+                measured: kind,
+            });
+        }
+        let given_reference = given_reference
+            .map(|given| check_kind("reference", given, kind))
+            .transpose()?;
+        let measured = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
+        let reference = given_reference.unwrap_or(existing.reference);
+        if reference < measured.0 - 1e-9 || reference > measured.1 + 1e-9 {
             return Err(CompensateError::UpdateReference {
-                reference_mm,
-                given: given_reference_mm.is_some(),
-                first_mm: measured_mm.0,
-                last_mm: measured_mm.1,
+                reference: kind.position(reference),
+                given: given_reference.is_some(),
+                first: kind.position(measured.0),
+                last: kind.position(measured.1),
             });
         }
         Ok(UpdatePlan {
             existing: existing.clone(),
-            measured_mm,
-            reference_mm,
-            at_existing_zero: given_reference_mm.is_none(),
+            measured,
+            reference,
+            at_existing_zero: given_reference.is_none(),
         })
     }
 
     fn inside(&self, position_mm: f64) -> bool {
-        position_mm >= self.measured_mm.0 - 1e-9 && position_mm <= self.measured_mm.1 + 1e-9
+        position_mm >= self.measured.0 - 1e-9 && position_mm <= self.measured.1 + 1e-9
     }
 
     /// The existing table's value at `position_mm`, the mean of its two
@@ -113,7 +131,7 @@ impl UpdatePlan {
     /// measured range added.
     pub fn apply(&self, new: CompensationTable) -> (CompensationTable, UpdateSummary) {
         let old = &self.existing;
-        let at_reference = self.existing_at(self.reference_mm);
+        let at_reference = self.existing_at(self.reference);
         let bidirectional = new.values.mode() == super::TableMode::Bidirectional
             || old.values.mode() == super::TableMode::Bidirectional;
         // (position, ↑, ↓) of every point of the updated table.
@@ -131,41 +149,38 @@ impl UpdatePlan {
             rows.push((p, value(Direction::Up), value(Direction::Down)));
         }
         let mut kept = Vec::new();
-        let mut dropped_mm = Vec::new();
+        let mut dropped = Vec::new();
         for (index, &p) in old.positions.iter().enumerate() {
-            let on_new_grid = new.positions.iter().any(|q| (q - p).abs() < SAME_POINT_MM);
+            let on_new_grid = new.positions.iter().any(|q| (q - p).abs() < SAME_POINT);
             if self.inside(p) {
                 if !on_new_grid {
-                    dropped_mm.push(p);
+                    dropped.push(p);
                 }
                 continue;
             }
             let value = |d: Direction| old.values.for_direction(d)[index];
-            match rows
-                .iter_mut()
-                .find(|row| (row.0 - p).abs() < SAME_POINT_MM)
-            {
+            match rows.iter_mut().find(|row| (row.0 - p).abs() < SAME_POINT) {
                 Some(row) => *row = (p, value(Direction::Up), value(Direction::Down)),
                 None => rows.push((p, value(Direction::Up), value(Direction::Down))),
             }
             match kept.last_mut() {
-                Some(KeptRange { last_mm, count, .. }) if old.positions[index - 1] == *last_mm => {
-                    *last_mm = p;
+                Some(KeptRange { last, count, .. }) if old.positions[index - 1] == *last => {
+                    *last = p;
                     *count += 1;
                 }
                 _ => kept.push(KeptRange {
-                    first_mm: p,
-                    last_mm: p,
+                    first: p,
+                    last: p,
                     count: 1,
                 }),
             }
         }
         rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let added_mm = new
+        let added = new
             .positions
             .iter()
             .copied()
-            .filter(|p| !old.positions.iter().any(|q| (q - p).abs() < SAME_POINT_MM))
+            .filter(|p| !old.positions.iter().any(|q| (q - p).abs() < SAME_POINT))
             .collect();
         let positions_mm: Vec<f64> = rows.iter().map(|r| r.0).collect();
         let up: Vec<f64> = rows.iter().map(|r| r.1).collect();
@@ -180,24 +195,25 @@ impl UpdatePlan {
         let table = CompensationTable {
             positions: positions_mm,
             values,
-            reference: self.reference_mm,
+            reference: self.reference,
             ..new
         };
         let summary = UpdateSummary {
-            kept_points_mm: old
+            kept_points: old
                 .positions
                 .iter()
                 .copied()
                 .filter(|&p| !self.inside(p))
                 .collect(),
             kept,
-            measured_mm: self.measured_mm,
+            measured: self.measured,
             updated,
-            reference_mm: self.reference_mm,
-            existing_at_reference_mm: at_reference,
+            reference: self.reference,
+            existing_at_reference: at_reference,
             at_existing_zero: self.at_existing_zero,
-            dropped_mm,
-            added_mm,
+            dropped,
+            added,
+            kind: old.kind,
         };
         (table, summary)
     }
@@ -210,7 +226,7 @@ mod tests {
     fn table(positions_mm: Vec<f64>, values: TableValues) -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
-            kind: crate::measurement::AxisKind::Linear,
+            kind: AxisKind::Linear,
             positions: positions_mm,
             values,
             reference: 0.0,
@@ -225,8 +241,9 @@ mod tests {
             vec![-200.0, -100.0, 0.0, 150.0, 300.0, 400.0],
             TableValues::Mean(vec![0.02, 0.01, 0.0, 0.004, 0.006, 0.008]),
         );
-        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0, 300.0], None).unwrap();
-        assert_eq!(update.reference_mm, 0.0);
+        let update =
+            UpdatePlan::new(&old, AxisKind::Linear, &[0.0, 100.0, 200.0, 300.0], None).unwrap();
+        assert_eq!(update.reference, 0.0);
         // Built (old + residual, zero at 0 mm) on 0, 100, 200, 300.
         let new = table(
             vec![0.0, 100.0, 200.0, 300.0],
@@ -245,20 +262,20 @@ mod tests {
             summary.kept,
             vec![
                 KeptRange {
-                    first_mm: -200.0,
-                    last_mm: -100.0,
+                    first: -200.0,
+                    last: -100.0,
                     count: 2
                 },
                 KeptRange {
-                    first_mm: 400.0,
-                    last_mm: 400.0,
+                    first: 400.0,
+                    last: 400.0,
                     count: 1
                 }
             ]
         );
         assert_eq!(summary.updated, 4);
-        assert_eq!(summary.dropped_mm, vec![150.0]);
-        assert_eq!(summary.added_mm, vec![100.0, 200.0]);
+        assert_eq!(summary.dropped, vec![150.0]);
+        assert_eq!(summary.added, vec![100.0, 200.0]);
     }
 
     #[test]
@@ -269,7 +286,13 @@ mod tests {
             vec![0.0, 100.0, 200.0],
             TableValues::Mean(vec![0.0, 0.004, 0.006]),
         );
-        let update = UpdatePlan::new(&old, &[0.0, 100.0, 200.0], Some(100.0)).unwrap();
+        let update = UpdatePlan::new(
+            &old,
+            AxisKind::Linear,
+            &[0.0, 100.0, 200.0],
+            Some(AxisKind::Linear.position(100.0)),
+        )
+        .unwrap();
         let new = table(
             vec![0.0, 100.0, 200.0],
             TableValues::Mean(vec![-0.001, 0.0, 0.003]),
@@ -282,12 +305,71 @@ mod tests {
             assert!((got - expected).abs() < 1e-15, "{values:?}");
         }
         assert!(!summary.at_existing_zero);
-        assert!((summary.existing_at_reference_mm - 0.004).abs() < 1e-15);
+        assert!((summary.existing_at_reference - 0.004).abs() < 1e-15);
         // A reference the test did not measure is refused.
         assert!(matches!(
-            UpdatePlan::new(&old, &[0.0, 100.0], Some(150.0)),
+            UpdatePlan::new(
+                &old,
+                AxisKind::Linear,
+                &[0.0, 100.0],
+                Some(AxisKind::Linear.position(150.0))
+            ),
             Err(CompensateError::UpdateReference { given: true, .. })
         ));
+    }
+
+    #[test]
+    fn a_rotary_update_is_refused_in_degrees_and_of_one_kind() {
+        // An old rotary table over 0 … 270°, zero at 0°; the test measured
+        // 90 … 270°: its zero is outside, and so is a given 300°.
+        let mut old = table(
+            vec![0.0, 90.0, 180.0, 270.0],
+            TableValues::Mean(vec![0.0, 0.001, 0.002, 0.001]),
+        );
+        old.kind = AxisKind::Rotary;
+        let measured = [90.0, 180.0, 270.0];
+        let error = UpdatePlan::new(&old, AxisKind::Rotary, &measured, None).unwrap_err();
+        assert!(
+            error.to_string().starts_with(
+                "the existing table is zero (its reference) at 0° is outside the measured range 90 … 270°: "
+            ),
+            "{error}"
+        );
+        let given = Some(AxisKind::Rotary.position(300.0));
+        let error = UpdatePlan::new(&old, AxisKind::Rotary, &measured, given).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .starts_with("the reference 300° is outside the measured range 90 … 270°: "),
+            "{error}"
+        );
+        // A reference in mm, or a rotary table under a linear test: refused.
+        let in_mm = Some(AxisKind::Linear.position(180.0));
+        assert_eq!(
+            UpdatePlan::new(&old, AxisKind::Rotary, &measured, in_mm),
+            Err(CompensateError::KindMismatch {
+                what: "reference",
+                given: AxisKind::Linear,
+                measured: AxisKind::Rotary
+            })
+        );
+        assert_eq!(
+            UpdatePlan::new(&old, AxisKind::Linear, &measured, None),
+            Err(CompensateError::KindMismatch {
+                what: "existing table",
+                given: AxisKind::Rotary,
+                measured: AxisKind::Linear
+            })
+        );
+        assert!(
+            UpdatePlan::new(
+                &old,
+                AxisKind::Rotary,
+                &measured,
+                Some(AxisKind::Rotary.position(180.0))
+            )
+            .is_ok()
+        );
     }
 
     #[test]
@@ -299,7 +381,7 @@ mod tests {
                 down: vec![0.003, 0.0, 0.004],
             },
         );
-        let update = UpdatePlan::new(&old, &[0.0, 100.0], None).unwrap();
+        let update = UpdatePlan::new(&old, AxisKind::Linear, &[0.0, 100.0], None).unwrap();
         let new = table(vec![0.0, 100.0], TableValues::Mean(vec![0.0, 0.005]));
         let (merged, _) = update.apply(new);
         assert_eq!(

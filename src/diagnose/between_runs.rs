@@ -260,8 +260,8 @@ pub(super) fn select_reversal(
         delta_bic: delta,
         trials: 1,
         p_value: chi2_p(about_zero - about_mean, 1),
-        cv_rmse_without_um: cv_without,
-        cv_rmse_with_um: cv_with,
+        cv_rmse_without: cv_without,
+        cv_rmse_with: cv_with,
     };
     (
         Some(ReversalFit {

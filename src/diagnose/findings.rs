@@ -79,8 +79,8 @@ pub(super) fn accepted_effect(
 pub(super) fn stats(values: &[f64]) -> ResidualStats {
     let n = values.len().max(1) as f64;
     ResidualStats {
-        rms_um: (values.iter().map(|v| v * v).sum::<f64>() / n).sqrt(),
-        max_abs_um: values.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+        rms: (values.iter().map(|v| v * v).sum::<f64>() / n).sqrt(),
+        max_abs: values.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
     }
 }
 

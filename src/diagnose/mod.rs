@@ -55,9 +55,9 @@ use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
 use crate::effects::{Context, Effect, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape};
 use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
-use crate::measurement::{AxisKind, Direction, Measurement};
+use crate::measurement::{AxisKind, ByKind, Direction, Measurement};
 use crate::together::NotTogether;
-use crate::units::mm_to_um;
+use crate::units::{Deg, Mm, Um, millideg_to_deg, mm_to_um};
 use along_axis::{AlongAxisSelection, Background, select_along_axis};
 use between_runs::{select_between_runs, select_reversal};
 use findings::{accepted_effect, context, figures, stats};
@@ -154,18 +154,31 @@ impl KnownPeriod {
     }
 }
 
-/// RMS and largest |value| of a residual, µm.
+/// RMS and largest |value| of a residual, in `D`: in a [`Diagnosis`] a bare
+/// number in the diagnosis' deviation unit (µm, or m° on a rotary axis),
+/// typed by [`Diagnosis::typed`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ResidualStats {
-    /// Root mean square, µm.
-    pub rms_um: f64,
-    /// Largest absolute value, µm.
-    pub max_abs_um: f64,
+pub struct ResidualStats<D = f64> {
+    /// Root mean square.
+    pub rms: D,
+    /// Largest absolute value.
+    pub max_abs: D,
 }
 
-/// Why an accepted effect was accepted.
+impl<D> ResidualStats<D> {
+    /// The same converted by `convert` (`Deg::to_arcsec`, …).
+    pub fn map<E>(self, convert: fn(D) -> E) -> ResidualStats<E> {
+        ResidualStats {
+            rms: convert(self.rms),
+            max_abs: convert(self.max_abs),
+        }
+    }
+}
+
+/// Why an accepted effect was accepted; its prediction errors in `D` (as
+/// [`ResidualStats`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Evidence {
+pub struct Evidence<D = f64> {
     /// Change of the BIC when it was added (negative is better).
     pub delta_bic: f64,
     /// How many independent shapes were tried (runs, periods searched), 1 otherwise.
@@ -173,10 +186,23 @@ pub struct Evidence {
     /// p-value of adding it (partial F-test, or χ² with known variances), as
     /// the chance that the best of `trials` shapes of noise fits as well.
     pub p_value: f64,
-    /// Leave-one-run-out prediction error without it, µm.
-    pub cv_rmse_without_um: f64,
-    /// The same with it, µm.
-    pub cv_rmse_with_um: f64,
+    /// Leave-one-run-out prediction error without it.
+    pub cv_rmse_without: D,
+    /// The same with it.
+    pub cv_rmse_with: D,
+}
+
+impl<D> Evidence<D> {
+    /// The same with its prediction errors converted by `convert`.
+    pub fn map<E>(self, convert: fn(D) -> E) -> Evidence<E> {
+        Evidence {
+            delta_bic: self.delta_bic,
+            trials: self.trials,
+            p_value: self.p_value,
+            cv_rmse_without: convert(self.cv_rmse_without),
+            cv_rmse_with: convert(self.cv_rmse_with),
+        }
+    }
 }
 
 /// An effect found in the residual.
@@ -203,17 +229,32 @@ pub struct RejectedEffect {
     pub why: String,
 }
 
-/// Structure left after the accepted effects.
+/// Structure left after the accepted effects: targets in `P` (in a
+/// [`Diagnosis`] bare, in the axis' unit: mm or °), its size in `D` (as
+/// [`ResidualStats`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Unexplained {
+pub struct Unexplained<P = f64, D = f64> {
     /// Whether it is significant (lack-of-fit p < [`LACK_OF_FIT_P`]).
     pub significant: bool,
     /// p-value of the lack-of-fit test.
     pub p_value: f64,
-    /// Targets where it is largest (|mean residual| > 3 standard errors), mm.
-    pub where_mm: Vec<f64>,
-    /// RMS of the per-target mean residual, µm.
-    pub rms_um: f64,
+    /// Targets where it is largest (|mean residual| > 3 standard errors).
+    pub targets: Vec<P>,
+    /// RMS of the per-target mean residual.
+    pub rms: D,
+}
+
+impl<P, D> Unexplained<P, D> {
+    /// The same with its targets converted by `position` and its size by
+    /// `deviation`.
+    pub fn map<Q, E>(self, position: fn(P) -> Q, deviation: fn(D) -> E) -> Unexplained<Q, E> {
+        Unexplained {
+            significant: self.significant,
+            p_value: self.p_value,
+            targets: self.targets.into_iter().map(position).collect(),
+            rms: deviation(self.rms),
+        }
+    }
 }
 
 /// The figures of the re-test as measured and as the model predicts it:
@@ -236,8 +277,10 @@ pub struct FigureSet<F = AxisFigures> {
 /// The diagnosis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Diagnosis {
-    /// Linear or rotary: on a rotary axis every `_um` value is m° (1/1000 °)
-    /// and every `_mm` value °, which the report shows in ″ and °.
+    /// Linear or rotary. The numbers below are bare, in the diagnosis'
+    /// units: deviations (residuals, noise, prediction errors) in µm, or m°
+    /// (1/1000 °) on a rotary axis; positions in mm, or °. They leave typed
+    /// by this kind through [`Diagnosis::typed`].
     pub kind: AxisKind,
     /// Whether a prediction from a first test was used.
     pub predicted_from_first_test: bool,
@@ -257,8 +300,8 @@ pub struct Diagnosis {
     pub standard: StandardUsed,
     /// What none of the effects explains.
     pub unexplained: Unexplained,
-    /// Scatter of one reading left at the end, µm.
-    pub noise_um: f64,
+    /// Scatter of one reading left at the end (µm, or m°).
+    pub noise: f64,
     /// Whether reading times were assumed from a typical cycle (a drift is
     /// then per run).
     pub time_assumed: bool,
@@ -284,16 +327,108 @@ impl Diagnosis {
     }
 }
 
-/// One reading of the re-test and what the diagnosis made of it.
+/// One reading of the re-test and what the diagnosis made of it, its
+/// deviations in `D` (as [`ResidualStats`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ReadingResidual {
+pub struct ReadingResidual<D = f64> {
     /// Where, in which direction and run, and when it was taken.
     pub reading: Reading,
-    /// Measured − predicted, µm.
-    pub residual_um: f64,
+    /// Measured − predicted.
+    pub residual: D,
     /// The fitted model of the residual there: the level along the axis, the
-    /// reversal and the between-runs effects, µm.
-    pub fitted_um: f64,
+    /// reversal and the between-runs effects.
+    pub fitted: D,
+}
+
+impl<D> ReadingResidual<D> {
+    /// The same with its deviations converted by `convert`.
+    pub fn map<E>(self, convert: fn(D) -> E) -> ReadingResidual<E> {
+        ReadingResidual {
+            reading: self.reading,
+            residual: convert(self.residual),
+            fitted: convert(self.fitted),
+        }
+    }
+}
+
+/// What of a [`Diagnosis`] has a unit, with the unit as a type: positions in
+/// `P`, deviations in `D` ([`Diagnosis::typed`]: `Mm` and `Um` on a linear
+/// axis, `Deg` and `Deg` on a rotary one).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiagnosisIn<P, D> {
+    /// The model's error before adding effects.
+    pub residual_before: ResidualStats<D>,
+    /// The model's error with the effects.
+    pub residual_after: ResidualStats<D>,
+    /// Scatter of one reading left at the end.
+    pub noise: D,
+    /// Why each accepted effect was accepted, in the order of
+    /// [`Diagnosis::accepted`].
+    pub evidence: Vec<Evidence<D>>,
+    /// What none of the effects explains.
+    pub unexplained: Unexplained<P, D>,
+    /// Every reading of the re-test, as [`Diagnosis::readings`].
+    pub readings: Vec<ReadingResidual<D>>,
+}
+
+impl<P, D> DiagnosisIn<P, D> {
+    /// The same with every deviation converted by `convert` (`Deg::to_arcsec`,
+    /// `Deg::to_urad`): the function's type decides which unit it accepts.
+    pub fn map_deviations<E>(self, convert: fn(D) -> E) -> DiagnosisIn<P, E> {
+        DiagnosisIn {
+            residual_before: self.residual_before.map(convert),
+            residual_after: self.residual_after.map(convert),
+            noise: convert(self.noise),
+            evidence: self.evidence.into_iter().map(|e| e.map(convert)).collect(),
+            unexplained: self.unexplained.map(|place| place, convert),
+            readings: self.readings.into_iter().map(|r| r.map(convert)).collect(),
+        }
+    }
+}
+
+impl Diagnosis {
+    /// Its numbers with their units as types: on a linear axis positions in
+    /// [`Mm`] and deviations in [`Um`], on a rotary one both in [`Deg`] (the
+    /// deviations held in m°). A rotary axis' residual is no `Um`:
+    /// ```
+    /// # fn f(diagnosis: &axcomp::diagnose::Diagnosis) {
+    /// use axcomp::units::Deg;
+    /// if let Some(rotary) = diagnosis.typed().rotary() {
+    ///     let rms: Deg = rotary.residual_after.rms;
+    /// }
+    /// # }
+    /// ```
+    /// ```compile_fail
+    /// # fn f(diagnosis: &axcomp::diagnose::Diagnosis) {
+    /// use axcomp::units::Um;
+    /// if let Some(rotary) = diagnosis.typed().rotary() {
+    ///     let rms: Um = rotary.residual_after.rms;
+    /// }
+    /// # }
+    /// ```
+    pub fn typed(&self) -> ByKind<DiagnosisIn<Mm, Um>, DiagnosisIn<Deg, Deg>> {
+        match self.kind {
+            AxisKind::Linear => ByKind::Linear(self.in_units(Mm, Um)),
+            AxisKind::Rotary => {
+                ByKind::Rotary(self.in_units(Deg, |millideg| Deg(millideg_to_deg(millideg))))
+            }
+        }
+    }
+
+    fn in_units<P, D>(&self, position: fn(f64) -> P, deviation: fn(f64) -> D) -> DiagnosisIn<P, D> {
+        DiagnosisIn {
+            residual_before: self.residual_before.map(deviation),
+            residual_after: self.residual_after.map(deviation),
+            noise: deviation(self.noise),
+            evidence: self
+                .accepted
+                .iter()
+                .map(|accepted| accepted.evidence.map(deviation))
+                .collect(),
+            unexplained: self.unexplained.clone().map(position, deviation),
+            readings: self.readings.iter().map(|r| r.map(deviation)).collect(),
+        }
+    }
 }
 
 /// Why a diagnosis cannot be made.
@@ -536,7 +671,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         standard_figures,
         standard: StandardUsed::of(input.standard),
         unexplained,
-        noise_um,
+        noise: noise_um,
         time_assumed,
         run_h: problem.run_h,
         readings: problem
@@ -545,8 +680,8 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             .zip(y.iter().zip(&model_um))
             .map(|(reading, (residual_um, fitted_um))| ReadingResidual {
                 reading: *reading,
-                residual_um: *residual_um,
-                fitted_um: *fitted_um,
+                residual: *residual_um,
+                fitted: *fitted_um,
             })
             .collect(),
     })
@@ -605,4 +740,150 @@ fn period_notes(
         ));
     }
     notes
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::effects::outlier_run::OutlierRun;
+    use crate::evaluate::ISO_230_2;
+    use crate::units::{Arcsec, Urad};
+
+    /// Run 1↓ 10 µm (or m°, 0.01°) off the others, σ 1; its prediction
+    /// error 1000 without it, 500 with it.
+    pub(crate) fn outlier_run() -> AcceptedEffect {
+        AcceptedEffect {
+            effect: Effect::OutlierRun(OutlierRun {
+                run: 1,
+                direction: Direction::Down,
+                offset_um: 10.0,
+            }),
+            uncertainty: vec![("offset_um", 1.0)],
+            evidence: Evidence {
+                delta_bic: -20.0,
+                trials: 5,
+                p_value: 0.001,
+                cv_rmse_without: 1000.0,
+                cv_rmse_with: 500.0,
+            },
+            explanation: String::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// A diagnosis of `kind` holding its deviations bare: 250 and 125 (µm,
+    /// or m°) for the residual before, 62.5 and 31.25 after, noise 500, an
+    /// outlier run's evidence 1000 → 500, unexplained structure at 90 and
+    /// 180 (mm, or °) of rms 62.5, one reading of residual 250 fitted 125.
+    fn held(kind: AxisKind) -> Diagnosis {
+        let none = FigureSet {
+            measured: AxisFigures::default(),
+            predicted: AxisFigures::default(),
+            predicted_with_effects: AxisFigures::default(),
+        };
+        Diagnosis {
+            kind,
+            predicted_from_first_test: true,
+            residual_before: ResidualStats {
+                rms: 250.0,
+                max_abs: 125.0,
+            },
+            accepted: vec![outlier_run()],
+            rejected: Vec::new(),
+            residual_after: ResidualStats {
+                rms: 62.5,
+                max_abs: 31.25,
+            },
+            figures: none,
+            standard_figures: FigureSet {
+                measured: Vec::new(),
+                predicted: Vec::new(),
+                predicted_with_effects: Vec::new(),
+            },
+            standard: StandardUsed::of(&ISO_230_2),
+            unexplained: Unexplained {
+                significant: true,
+                p_value: 1e-4,
+                targets: vec![90.0, 180.0],
+                rms: 62.5,
+            },
+            noise: 500.0,
+            time_assumed: false,
+            run_h: 0.5,
+            readings: vec![ReadingResidual {
+                reading: Reading {
+                    target_index: 0,
+                    target_mm: 90.0,
+                    direction: Direction::Up,
+                    run: 1,
+                    run_index: 0,
+                    time_h: 0.0,
+                },
+                residual: 250.0,
+                fitted: 125.0,
+            }],
+        }
+    }
+
+    #[test]
+    fn a_linear_diagnosis_is_typed_in_mm_and_um_as_held() {
+        let ByKind::Linear(typed) = held(AxisKind::Linear).typed() else {
+            panic!("a linear diagnosis typed as rotary")
+        };
+        assert_eq!(
+            typed.residual_before,
+            ResidualStats {
+                rms: Um(250.0),
+                max_abs: Um(125.0)
+            }
+        );
+        assert_eq!(typed.noise, Um(500.0));
+        assert_eq!(typed.unexplained.targets, [Mm(90.0), Mm(180.0)]);
+        assert_eq!(typed.unexplained.rms, Um(62.5));
+        assert_eq!(
+            (typed.readings[0].residual, typed.readings[0].fitted),
+            (Um(250.0), Um(125.0))
+        );
+    }
+
+    #[test]
+    fn a_rotary_diagnosis_held_in_millidegrees_is_typed_in_degrees() {
+        // 250 m° = 0.25° = 900″; 62.5 m° = 0.0625° = 225″; 1000 m° = 1° =
+        // 3600″ = 10⁶·π/180 µrad; the places stay degrees.
+        let ByKind::Rotary(typed) = held(AxisKind::Rotary).typed() else {
+            panic!("a rotary diagnosis typed as linear")
+        };
+        assert_eq!(typed.residual_before.rms, Deg(0.25));
+        assert_eq!(typed.residual_after.max_abs, Deg(0.03125));
+        assert_eq!(typed.noise, Deg(0.5));
+        assert_eq!(typed.unexplained.targets, [Deg(90.0), Deg(180.0)]);
+        assert_eq!(
+            (typed.readings[0].residual, typed.readings[0].fitted),
+            (Deg(0.25), Deg(0.125))
+        );
+        let arcsec = typed.clone().map_deviations(Deg::to_arcsec);
+        assert_eq!(
+            arcsec.residual_before,
+            ResidualStats {
+                rms: Arcsec(900.0),
+                max_abs: Arcsec(450.0)
+            }
+        );
+        assert_eq!(arcsec.unexplained.rms, Arcsec(225.0));
+        assert_eq!(
+            (
+                arcsec.evidence[0].cv_rmse_without,
+                arcsec.evidence[0].cv_rmse_with,
+                arcsec.evidence[0].trials
+            ),
+            (Arcsec(3600.0), Arcsec(1800.0), 5)
+        );
+        let urad = typed.map_deviations(Deg::to_urad);
+        approx::assert_relative_eq!(
+            urad.evidence[0].cv_rmse_without.0,
+            1e6 * std::f64::consts::PI / 180.0,
+            max_relative = 1e-15
+        );
+        let _: Urad = urad.noise;
+    }
 }

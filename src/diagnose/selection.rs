@@ -246,8 +246,8 @@ pub(super) fn forward_selection<S: Search>(
                 // The chance that the best of `trials` independent shapes of noise fits
                 // as well: 1 − (1 − p)^trials (Šidák 1967), without the cancellation.
                 p_value: -(trials.max(1.0) * (-p_one).ln_1p()).exp_m1(),
-                cv_rmse_without_um: cv_without,
-                cv_rmse_with_um: cv_with,
+                cv_rmse_without: cv_without,
+                cv_rmse_with: cv_with,
             };
             accepted = Some((
                 Chosen {

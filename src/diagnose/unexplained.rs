@@ -66,7 +66,7 @@ pub(super) fn unexplained(
         } else {
             reversal_p
         },
-        where_mm,
-        rms_um,
+        targets: where_mm,
+        rms: rms_um,
     }
 }

@@ -3,7 +3,7 @@
 
 use super::{Controller, EmitOptions, fagor, resolution_mm};
 use crate::compensate::{CompensationTable, TableMode};
-use crate::measurement::{AxisKind, Direction};
+use crate::measurement::{AxisKind, Direction, Position};
 use crate::units::LengthUnit;
 
 /// Why a table is refused for a controller.
@@ -33,13 +33,15 @@ pub enum EmitError {
     },
     /// Points not strictly increasing.
     #[error(
-        "compensation positions must be strictly increasing: {position_mm} mm follows {previous_mm} mm"
+        "compensation positions must be strictly increasing: {}{} follows {}{}",
+        position.in_axis_unit(), position.unit_after_number(),
+        previous.in_axis_unit(), previous.unit_after_number()
     )]
     NotIncreasing {
         /// The offending point.
-        position_mm: f64,
+        position: Position,
         /// The one before.
-        previous_mm: f64,
+        previous: Position,
     },
     /// Uneven spacing where the format has one step.
     #[error(
@@ -51,39 +53,47 @@ pub enum EmitError {
     },
     /// A step the format cannot write exactly.
     #[error(
-        "{controller} writes the step to {resolution_mm} mm; a step of {step_mm} mm would shift the points along the table: give --step as a multiple of {resolution_mm} mm"
+        "{controller} writes the step to {}{unit}; a step of {}{unit} would shift the points along the table: give --step as a multiple of {}{unit}",
+        resolution.in_axis_unit(), step.in_axis_unit(), resolution.in_axis_unit(),
+        unit = step.unit_after_number()
     )]
     StepNotRepresentable {
         /// The controller.
         controller: &'static str,
         /// The step.
-        step_mm: f64,
+        step: Position,
         /// The format's resolution.
-        resolution_mm: f64,
+        resolution: Position,
     },
     /// A compensation point beyond the positions the format can hold.
     #[error(
-        "compensation point {position_mm} mm is beyond the {controller} position range of ±{limit_mm} mm"
+        "compensation point {}{unit} is beyond the {controller} position range of ±{}{unit}",
+        position.in_axis_unit(), limit.in_axis_unit(),
+        unit = position.unit_after_number()
     )]
     PositionOutOfRange {
         /// The controller.
         controller: &'static str,
         /// The point.
-        position_mm: f64,
+        position: Position,
         /// The limit.
-        limit_mm: f64,
+        limit: Position,
     },
     /// A value beyond the format's or the machine's range.
-    #[error("value {value_mm} mm at {position_mm} mm is beyond the {what} range of ±{limit_mm} mm")]
+    #[error(
+        "value {}{unit} at {}{unit} is beyond the {what} range of ±{}{unit}",
+        value.in_axis_unit(), position.in_axis_unit(), limit.in_axis_unit(),
+        unit = position.unit_after_number()
+    )]
     ValueOutOfRange {
         /// The value.
-        value_mm: f64,
+        value: Position,
         /// Where.
-        position_mm: f64,
+        position: Position,
         /// Whose range.
         what: &'static str,
         /// The limit.
-        limit_mm: f64,
+        limit: Position,
     },
     /// The format has one column only.
     #[error(
@@ -95,13 +105,14 @@ pub enum EmitError {
     },
     /// The format needs zero at its first point.
     #[error(
-        "{controller} needs the value 0 at the first point (the datum); the table is {value_mm} mm there: use --reference at the first point"
+        "{controller} needs the value 0 at the first point (the datum); the table is {}{} there: use --reference at the first point",
+        value.in_axis_unit(), value.unit_after_number()
     )]
     NotZeroAtDatum {
         /// The controller.
         controller: &'static str,
         /// The value at the first point.
-        value_mm: f64,
+        value: Position,
     },
     /// A rotary axis for a format that shows no rotary form.
     #[error(
@@ -130,6 +141,18 @@ pub enum EmitError {
         first_deg: f64,
         /// The value at 360°, °.
         last_deg: f64,
+    },
+    /// A table of one kind of axis with the options of the other: its
+    /// numbers would be written in the other unit (degrees as mm).
+    #[error(
+        "the table is of a {} axis (in {}) and the file is for a {} axis (in {}): they do not belong together",
+        table.as_str(), table.position_unit(), options.as_str(), options.position_unit()
+    )]
+    KindMismatch {
+        /// The table's axis kind.
+        table: AxisKind,
+        /// The kind the options write.
+        options: AxisKind,
     },
     /// A profile value the format cannot use.
     #[error("{0}")]
@@ -177,6 +200,13 @@ pub fn check_table(
     options: &EmitOptions,
 ) -> Result<(), EmitError> {
     let name = controller.name();
+    let typed = |value: f64| table.kind.position(value);
+    if table.kind != options.kind {
+        return Err(EmitError::KindMismatch {
+            table: table.kind,
+            options: options.kind,
+        });
+    }
     check_rotary(controller, table, options)?;
     let count = table.positions.len();
     let limit = match (controller.max_points(), options.max_points) {
@@ -195,8 +225,8 @@ pub fn check_table(
     for pair in table.positions.windows(2) {
         if pair[1] <= pair[0] {
             return Err(EmitError::NotIncreasing {
-                position_mm: pair[1],
-                previous_mm: pair[0],
+                position: typed(pair[1]),
+                previous: typed(pair[0]),
             });
         }
     }
@@ -210,8 +240,8 @@ pub fn check_table(
         if ((step / resolution).round() * resolution - step).abs() > 1e-9 {
             return Err(EmitError::StepNotRepresentable {
                 controller: name,
-                step_mm: step,
-                resolution_mm: resolution,
+                step: typed(step),
+                resolution: typed(resolution),
             });
         }
     }
@@ -228,7 +258,7 @@ pub fn check_table(
     if controller == Controller::Itnc530 && first_value.abs() >= 0.5e-4 {
         return Err(EmitError::NotZeroAtDatum {
             controller: name,
-            value_mm: first_value,
+            value: typed(first_value),
         });
     }
     let (position_limit_mm, value_limit) = format_limits_mm(controller, options.file_unit());
@@ -239,8 +269,8 @@ pub fn check_table(
     {
         return Err(EmitError::PositionOutOfRange {
             controller: name,
-            position_mm: *position_mm,
-            limit_mm: position_limit_mm,
+            position: typed(*position_mm),
+            limit: typed(position_limit_mm),
         });
     }
     let machine_limit = options.max_value_mm.map(|limit| ("machine profile", limit));
@@ -253,10 +283,10 @@ pub fn check_table(
                 .find(|(value, _)| value.abs() > limit_mm)
             {
                 return Err(EmitError::ValueOutOfRange {
-                    value_mm: *value,
-                    position_mm: *position,
+                    value: typed(*value),
+                    position: typed(*position),
                     what,
-                    limit_mm,
+                    limit: typed(limit_mm),
                 });
             }
         }
@@ -309,4 +339,89 @@ fn check_rotary(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensate::TableValues;
+
+    /// A table of the two points 0 and 90 with the values 0 and 0.001, of
+    /// an axis of `kind`.
+    fn table(kind: AxisKind) -> CompensationTable {
+        CompensationTable {
+            axis: "C".into(),
+            kind,
+            positions: vec![0.0, 90.0],
+            values: TableValues::Mean(vec![0.0, 0.001]),
+            reference: 0.0,
+            suggested_backlash: None,
+        }
+    }
+
+    #[test]
+    fn a_table_is_written_only_for_its_own_kind_of_axis() {
+        let linear =
+            EmitOptions::for_axis(&super::super::MachineProfile::default(), "C", "C").unwrap();
+        let rotary = EmitOptions {
+            kind: AxisKind::Rotary,
+            ..linear.clone()
+        };
+        // 0 and 90° would be written as 0 and 90 mm, and 90 mm as 90°.
+        for controller in [Controller::LinuxCnc, Controller::Tnc640] {
+            let error =
+                super::super::write(controller, &table(AxisKind::Rotary), &linear).unwrap_err();
+            assert_eq!(
+                error,
+                EmitError::KindMismatch {
+                    table: AxisKind::Rotary,
+                    options: AxisKind::Linear
+                }
+            );
+            assert_eq!(
+                error.to_string(),
+                "the table is of a rotary axis (in °) and the file is for a linear axis (in mm): they do not belong together"
+            );
+            assert!(matches!(
+                super::super::write(controller, &table(AxisKind::Linear), &rotary),
+                Err(EmitError::KindMismatch {
+                    table: AxisKind::Linear,
+                    options: AxisKind::Rotary
+                })
+            ));
+            // Of one kind, both are written.
+            assert!(super::super::write(controller, &table(AxisKind::Rotary), &rotary).is_ok());
+            assert!(super::super::write(controller, &table(AxisKind::Linear), &linear).is_ok());
+        }
+    }
+
+    #[test]
+    fn a_rotary_table_is_refused_in_degrees() {
+        let linear =
+            EmitOptions::for_axis(&super::super::MachineProfile::default(), "C", "C").unwrap();
+        let rotary = EmitOptions {
+            kind: AxisKind::Rotary,
+            ..linear
+        };
+        // The iTNC 530 (named itnc530) writes the step to 0.0001 (its resolution, ° on a
+        // rotary axis): 0.00015° is no multiple of it.
+        let mut fine = table(AxisKind::Rotary);
+        fine.positions = vec![0.0, 0.00015, 0.0003];
+        fine.values = TableValues::Mean(vec![0.0; 3]);
+        assert_eq!(
+            check_table(Controller::Itnc530, &fine, &rotary)
+                .unwrap_err()
+                .to_string(),
+            "itnc530 writes the step to 0.0001°; a step of 0.00015° would shift the points along the table: give --step as a multiple of 0.0001°"
+        );
+        // 0.001° at its first point, 0°: the iTNC 530 needs 0 there.
+        let mut shifted = table(AxisKind::Rotary);
+        shifted.values = TableValues::Mean(vec![0.001, 0.0]);
+        assert_eq!(
+            check_table(Controller::Itnc530, &shifted, &rotary)
+                .unwrap_err()
+                .to_string(),
+            "itnc530 needs the value 0 at the first point (the datum); the table is 0.001° there: use --reference at the first point"
+        );
+    }
 }

@@ -353,9 +353,8 @@ impl TestConformance {
                 ByKind::Rotary(_) => 0.0,
             };
             warnings.push(Warning::TooFewTargets {
-                kind: self.kind(),
                 targets: self.targets,
-                length: self.length_in_axis_unit(),
+                length: self.length,
                 required: MIN_TARGETS.max(for_length as usize),
             });
         }
@@ -445,9 +444,8 @@ mod tests {
         assert_eq!(
             c.warnings(),
             vec![Warning::TooFewTargets {
-                kind: AxisKind::Linear,
                 targets: 6,
-                length: 1500.0,
+                length: ByKind::Linear(Mm(1500.0)),
                 required: 8
             }]
         );

@@ -23,7 +23,7 @@ fn table(measurement: &Measurement, mode: TableMode) -> CompensationTable {
     let options = TableOptions {
         mode,
         grid: GridSpec::Targets,
-        reference_mm: None,
+        reference: None,
         extrapolate: Extrapolate::Hold,
     };
     build_table(measurement, &evaluate(measurement), &options).unwrap()

@@ -590,7 +590,7 @@ fn residual_chart(diagnosis: &Diagnosis) -> Chart {
         numbered
             .clone()
             .filter(|(_, r)| r.reading.direction == direction)
-            .map(|(x, r)| (x, r.residual_um))
+            .map(|(x, r)| (x, r.residual))
             .collect()
     };
     let count = diagnosis.readings.len() as f64;
@@ -604,7 +604,7 @@ fn residual_chart(diagnosis: &Diagnosis) -> Chart {
                 Some("fitted model".into()),
                 MODEL,
                 Mark::Line(2),
-                numbered.clone().map(|(x, r)| (x, r.fitted_um)).collect(),
+                numbered.clone().map(|(x, r)| (x, r.fitted)).collect(),
             ),
             series(
                 Some("residual ↑".into()),
@@ -648,7 +648,7 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
             .readings
             .iter()
             .filter(|r| r.reading.direction == direction)
-            .map(|r| (r.reading.target_mm, r.residual_um))
+            .map(|r| (r.reading.target_mm, r.residual))
             .collect();
         all.push(series(
             Some(format!("residual {direction}")),
@@ -658,7 +658,7 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
         ));
     }
     for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
-        let fitted = mean_per_target(diagnosis, direction, |r| r.fitted_um);
+        let fitted = mean_per_target(diagnosis, direction, |r| r.fitted);
         if !fitted.is_empty() {
             all.push(series(
                 Some(format!("fitted model {direction} (mean per target)")),
@@ -668,11 +668,11 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
             ));
         }
     }
-    if diagnosis.unexplained.significant && !diagnosis.unexplained.where_mm.is_empty() {
-        let (low, _) = extent(diagnosis.readings.iter().map(|r| r.residual_um));
+    if diagnosis.unexplained.significant && !diagnosis.unexplained.targets.is_empty() {
+        let (low, _) = extent(diagnosis.readings.iter().map(|r| r.residual));
         let marks = diagnosis
             .unexplained
-            .where_mm
+            .targets
             .iter()
             .map(|x| (*x, low))
             .collect();

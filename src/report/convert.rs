@@ -378,7 +378,7 @@ impl ConvertJson {
         for effect in &self.effects {
             let _ = writeln!(out, "Effect: {effect}");
         }
-        for line in self.update.iter().flat_map(|u| &u.lines) {
+        for line in self.update.iter().flat_map(|u| u.lines()) {
             let _ = writeln!(out, "Update: {line}");
         }
         for note in &self.notes {

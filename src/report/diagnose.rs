@@ -52,7 +52,11 @@
 //! diagnosed for per-revolution harmonics, its reversal and outlier runs
 //! only; it has no `friction`.
 //!
-//! Each key's unit is the type of the value under it: the object, its
+//! Each key's unit is the type of the value under it, and each value comes
+//! typed from the diagnosis (`Diagnosis::typed`: `Um` and `Mm`, or `Deg`
+//! converted by `Deg::to_arcsec` or `Deg::to_urad`); only an effect's
+//! parameters, bare in the effects file's units, are converted here
+//! (`ReportedDeviation::from_held`). The object, its
 //! evidence and its unexplained structure are one struct per pair of units
 //! (`LinearDiagnoseJson` with `residual_before_um: ResidualJson<Um>` and
 //! `unexplained.where_mm: Vec<Mm>`, `ArcsecDiagnoseJson`,
@@ -68,22 +72,24 @@ use serde::Serialize;
 use serde_json::{Map, Value};
 
 use crate::diagnose::friction::ReversalFriction;
-use crate::diagnose::{AcceptedEffect, Diagnosis, ResidualStats};
+use crate::diagnose::{AcceptedEffect, Diagnosis, DiagnosisIn, ResidualStats};
 use crate::effects::{Effect, ParameterValue};
 use crate::evaluate::{StandardFigure, standard};
-use crate::measurement::AxisKind;
+use crate::measurement::{AxisKind, ByKind};
 use crate::report::format::{pad_name, um};
 use crate::report::json::{FiguresByUnit, FiguresJson};
 use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, millideg_to_deg};
 
 /// A deviation as a diagnosis reports it: µm ([`Um`]) on a linear axis, ″
-/// ([`Arcsec`]) or µrad ([`Urad`]) on a rotary one. A diagnosis holds its
-/// deviations in µm, a rotary axis' in m° (1/1000 °).
+/// ([`Arcsec`]) or µrad ([`Urad`]) on a rotary one. The diagnosis' own
+/// numbers come typed ([`Diagnosis::typed`]); an effect's parameters are
+/// bare, in µm, a rotary axis' in m° (1/1000 °), as the effects file keeps
+/// them.
 pub trait ReportedDeviation: Serialize + Copy {
     /// The unit, for the terminal.
     const UNIT: DeviationUnit;
 
-    /// A deviation as the diagnosis holds it (µm, or m°), in this unit.
+    /// An effect's parameter (µm, or m°), in this unit.
     fn from_held(value: f64) -> Self;
 
     /// The number, in this unit.
@@ -123,13 +129,10 @@ reported_angle!(Arcsec, AngleUnit::Arcsec, Deg::to_arcsec);
 reported_angle!(Urad, AngleUnit::Urad, Deg::to_urad);
 
 /// A position as a diagnosis reports it: mm ([`Mm`]) on a linear axis, °
-/// ([`Deg`]) on a rotary one, as it is held.
+/// ([`Deg`]) on a rotary one.
 pub trait ReportedPosition: Serialize + Copy {
     /// What follows the number in the terminal: ` mm` or `°`.
     const SUFFIX: &'static str;
-
-    /// A position as the diagnosis holds it (mm, or °).
-    fn from_held(value: f64) -> Self;
 
     /// The number, in this unit.
     fn number(self) -> f64;
@@ -138,10 +141,6 @@ pub trait ReportedPosition: Serialize + Copy {
 impl ReportedPosition for Mm {
     const SUFFIX: &'static str = " mm";
 
-    fn from_held(value_mm: f64) -> Mm {
-        Mm(value_mm)
-    }
-
     fn number(self) -> f64 {
         self.0
     }
@@ -149,10 +148,6 @@ impl ReportedPosition for Mm {
 
 impl ReportedPosition for Deg {
     const SUFFIX: &'static str = "°";
-
-    fn from_held(value_deg: f64) -> Deg {
-        Deg(value_deg)
-    }
 
     fn number(self) -> f64 {
         self.0
@@ -169,10 +164,10 @@ pub struct ResidualJson<D> {
 }
 
 impl<D: ReportedDeviation> ResidualJson<D> {
-    fn new(s: ResidualStats) -> ResidualJson<D> {
+    fn new(s: ResidualStats<D>) -> ResidualJson<D> {
         ResidualJson {
-            rms: D::from_held(s.rms_um),
-            max_abs: D::from_held(s.max_abs_um),
+            rms: s.rms,
+            max_abs: s.max_abs,
         }
     }
 
@@ -598,8 +593,12 @@ macro_rules! diagnose_json {
         }
 
         impl $name {
-            fn new(diagnosis: &Diagnosis, files: Files, angle: AngleUnit) -> $name {
-                let deviation = <$deviation>::from_held;
+            fn new(
+                diagnosis: &Diagnosis,
+                typed: DiagnosisIn<$position, $deviation>,
+                files: Files,
+                angle: AngleUnit,
+            ) -> $name {
                 $name {
                     after: files.after,
                     before: files.before,
@@ -609,13 +608,13 @@ macro_rules! diagnose_json {
                     standard_name: diagnosis.standard.name,
                     definitions_reconstructed: diagnosis.standard.reconstructed,
                     predicted_from_first_test: diagnosis.predicted_from_first_test,
-                    $residual_before: ResidualJson::new(diagnosis.residual_before),
+                    $residual_before: ResidualJson::new(typed.residual_before),
                     effects: diagnosis
                         .accepted
                         .iter()
-                        .map(|accepted| {
+                        .zip(&typed.evidence)
+                        .map(|(accepted, evidence)| {
                             let (params, uncertainty) = <$params>::of(accepted);
-                            let evidence = &accepted.evidence;
                             EffectJson {
                                 kind: accepted.effect.kind().name(),
                                 params,
@@ -624,8 +623,8 @@ macro_rules! diagnose_json {
                                     delta_bic: evidence.delta_bic,
                                     trials: evidence.trials,
                                     p_value: evidence.p_value,
-                                    $cv_without: deviation(evidence.cv_rmse_without_um),
-                                    $cv_with: deviation(evidence.cv_rmse_with_um),
+                                    $cv_without: evidence.cv_rmse_without,
+                                    $cv_with: evidence.cv_rmse_with,
                                 },
                                 explanation: accepted.explanation.clone(),
                                 warnings: accepted.warnings.clone(),
@@ -633,20 +632,15 @@ macro_rules! diagnose_json {
                         })
                         .collect(),
                     rejected: rejected(diagnosis),
-                    $residual_after: ResidualJson::new(diagnosis.residual_after),
+                    $residual_after: ResidualJson::new(typed.residual_after),
                     $figures: FigureSetJson::new(diagnosis, angle),
                     unexplained: $unexplained {
-                        significant: diagnosis.unexplained.significant,
-                        $where_: diagnosis
-                            .unexplained
-                            .where_mm
-                            .iter()
-                            .map(|place| <$position>::from_held(*place))
-                            .collect(),
-                        $rms: deviation(diagnosis.unexplained.rms_um),
-                        p_value: diagnosis.unexplained.p_value,
+                        significant: typed.unexplained.significant,
+                        $where_: typed.unexplained.targets,
+                        $rms: typed.unexplained.rms,
+                        p_value: typed.unexplained.p_value,
                     },
-                    $noise: deviation(diagnosis.noise_um),
+                    $noise: typed.noise,
                     time_assumed: diagnosis.time_assumed,
                     $($tail: $tail_value,)*
                 }
@@ -800,16 +794,24 @@ impl DiagnoseJson {
             before,
             table,
         };
-        match (diagnosis.kind, angle) {
-            (AxisKind::Linear, _) => {
-                DiagnoseJson::Linear(LinearDiagnoseJson::new(diagnosis, files, angle))
+        match (diagnosis.typed(), angle) {
+            (ByKind::Linear(typed), _) => {
+                DiagnoseJson::Linear(LinearDiagnoseJson::new(diagnosis, typed, files, angle))
             }
-            (AxisKind::Rotary, AngleUnit::Arcsec) => {
-                DiagnoseJson::Arcsec(ArcsecDiagnoseJson::new(diagnosis, files, angle))
+            (ByKind::Rotary(typed), AngleUnit::Arcsec) => {
+                DiagnoseJson::Arcsec(ArcsecDiagnoseJson::new(
+                    diagnosis,
+                    typed.map_deviations(Deg::to_arcsec),
+                    files,
+                    angle,
+                ))
             }
-            (AxisKind::Rotary, AngleUnit::Urad) => {
-                DiagnoseJson::Urad(UradDiagnoseJson::new(diagnosis, files, angle))
-            }
+            (ByKind::Rotary(typed), AngleUnit::Urad) => DiagnoseJson::Urad(UradDiagnoseJson::new(
+                diagnosis,
+                typed.map_deviations(Deg::to_urad),
+                files,
+                angle,
+            )),
         }
     }
 
@@ -1032,30 +1034,8 @@ pub fn render(report: &DiagnoseJson) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::Evidence;
-    use crate::effects::outlier_run::OutlierRun;
-    use crate::measurement::Direction;
-
     /// Run 1↓ 10 m° (0.01°) off the others, σ 1 m°.
-    fn outlier_run() -> AcceptedEffect {
-        AcceptedEffect {
-            effect: Effect::OutlierRun(OutlierRun {
-                run: 1,
-                direction: Direction::Down,
-                offset_um: 10.0,
-            }),
-            uncertainty: vec![("offset_um", 1.0)],
-            evidence: Evidence {
-                delta_bic: -20.0,
-                trials: 5,
-                p_value: 0.001,
-                cv_rmse_without_um: 2.0,
-                cv_rmse_with_um: 1.0,
-            },
-            explanation: String::new(),
-            warnings: Vec::new(),
-        }
-    }
+    use crate::diagnose::tests::outlier_run;
 
     #[test]
     fn a_rotary_outlier_run_is_in_its_angle_unit_under_its_key() {

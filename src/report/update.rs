@@ -15,88 +15,159 @@
 use serde::Serialize;
 
 use crate::compensate::update::{KeptRange, UpdateSummary};
+use crate::measurement::AxisKind;
 use crate::report::format::inch_text;
-use crate::units::LengthUnit;
+use crate::units::{Deg, LengthUnit, Mm};
 
-/// Old points kept as they were, one run.
+/// Old points kept as they were, one run, in `P` (mm, or ° on a rotary axis).
 #[derive(Clone, Debug, Serialize)]
-pub struct KeptJson {
-    /// First point, mm.
-    pub first: f64,
-    /// Last point, mm.
-    pub last: f64,
+pub struct KeptJson<P> {
+    /// First point.
+    pub first: P,
+    /// Last point.
+    pub last: P,
     /// How many points.
     pub count: usize,
+}
+
+/// Declares the update's wire struct of one kind of axis: its positions
+/// typed in the unit its keys name.
+macro_rules! update_json {
+    ($(#[$doc:meta])* $name:ident<$position:ty> {
+        $kept:ident, $measured:ident, $reference:ident, $dropped:ident, $added:ident $(,)?
+    }) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, Serialize)]
+        pub struct $name {
+            /// Old points outside the measured range, kept as they were, by runs.
+            pub $kept: Vec<KeptJson<$position>>,
+            /// The measured range.
+            pub $measured: [$position; 2],
+            /// Points inside it that got old + residual.
+            pub updated: usize,
+            /// Where the update adds nothing.
+            pub $reference: $position,
+            /// `existing zero` (the existing table's zero, the default) or `given` (`--reference`).
+            pub reference: &'static str,
+            /// Old points inside the measured range the new grid does not have.
+            pub $dropped: Vec<$position>,
+            /// New points the old table did not have.
+            pub $added: Vec<$position>,
+            /// What the terminal prints.
+            pub lines: Vec<String>,
+        }
+
+        impl $name {
+            /// The summary's positions typed by `unit`, with the sentences.
+            fn of(
+                summary: &UpdateSummary,
+                unit: fn(f64) -> $position,
+                lines: Vec<String>,
+            ) -> $name {
+                let all = |positions: &[f64]| positions.iter().map(|&p| unit(p)).collect();
+                $name {
+                    $kept: summary
+                        .kept
+                        .iter()
+                        .map(|k| KeptJson {
+                            first: unit(k.first),
+                            last: unit(k.last),
+                            count: k.count,
+                        })
+                        .collect(),
+                    $measured: [unit(summary.measured.0), unit(summary.measured.1)],
+                    updated: summary.updated,
+                    $reference: unit(summary.reference),
+                    reference: if summary.at_existing_zero {
+                        "existing zero"
+                    } else {
+                        "given"
+                    },
+                    $dropped: all(&summary.dropped),
+                    $added: all(&summary.added),
+                    lines,
+                }
+            }
+        }
+    };
+}
+
+update_json!(
+    /// A linear axis' update: positions in mm.
+    LinearUpdateJson<Mm> { kept_mm, measured_mm, reference_mm, dropped_mm, added_mm }
+);
+
+update_json!(
+    /// A rotary axis' update: positions in °.
+    RotaryUpdateJson<Deg> { kept_deg, measured_deg, reference_deg, dropped_deg, added_deg }
+);
+
+/// The update's positions in the unit of its axis, the keys naming it: a
+/// rotary axis' in ° under `kept_deg`, `measured_deg`, `reference_deg`,
+/// `dropped_deg`, `added_deg`.
+#[derive(Clone, Debug, Serialize)]
+#[serde(untagged)]
+pub enum UpdateWireJson {
+    /// In mm.
+    Linear(LinearUpdateJson),
+    /// In °.
+    Rotary(RotaryUpdateJson),
 }
 
 /// The update, for `--json` and the terminal.
 #[derive(Clone, Debug, Serialize)]
 pub struct UpdateJson {
-    /// Old points outside the measured range, kept as they were, by runs.
-    pub kept_mm: Vec<KeptJson>,
-    /// The measured range, mm.
-    pub measured_mm: [f64; 2],
-    /// Points inside it that got old + residual.
-    pub updated: usize,
-    /// Where the update adds nothing, mm.
-    pub reference_mm: f64,
-    /// `existing zero` (the existing table's zero, the default) or `given` (`--reference`).
-    pub reference: &'static str,
-    /// Old points inside the measured range the new grid does not have, mm.
-    pub dropped_mm: Vec<f64>,
-    /// New points the old table did not have, mm.
-    pub added_mm: Vec<f64>,
-    /// What the terminal prints.
-    pub lines: Vec<String>,
+    /// What `--json` writes.
+    #[serde(flatten)]
+    pub wire: UpdateWireJson,
     /// Whether the new table is zero at the reference (the existing table is).
     #[serde(skip)]
     pub zero_at_reference: bool,
-    /// Every kept point, mm (for marking the printed table's rows).
+    /// Every kept point, in the axis' unit (for marking the printed table's rows).
     #[serde(skip)]
-    pub kept_points_mm: Vec<f64>,
+    pub kept_points: Vec<f64>,
+    /// Every new point, in the axis' unit (for marking the printed table's rows).
+    #[serde(skip)]
+    pub added_points: Vec<f64>,
 }
 
 impl UpdateJson {
     /// What a row of the printed table is: `kept` (the old value), `new`
     /// (a point the old table did not have) or nothing (old + residual).
-    pub fn row_mark(&self, position_mm: f64) -> &'static str {
-        let among = |list: &[f64]| list.iter().any(|p| (p - position_mm).abs() < 1e-6);
-        if among(&self.kept_points_mm) {
+    pub fn row_mark(&self, position: f64) -> &'static str {
+        let among = |list: &[f64]| list.iter().any(|p| (p - position).abs() < 1e-6);
+        if among(&self.kept_points) {
             "  kept"
-        } else if among(&self.added_mm) {
+        } else if among(&self.added_points) {
             "  new"
         } else {
             ""
         }
     }
+
+    /// What the terminal prints.
+    pub fn lines(&self) -> &[String] {
+        match &self.wire {
+            UpdateWireJson::Linear(update) => &update.lines,
+            UpdateWireJson::Rotary(update) => &update.lines,
+        }
+    }
 }
 
 impl UpdateJson {
-    /// From the summary; positions written in `file_unit` (`mm`, `inch` or `deg`).
+    /// From the summary; positions written in `file_unit` (`mm`, `inch` or
+    /// `deg`) in the sentences, in mm or ° under keys naming them.
     pub fn new(summary: &UpdateSummary, file_unit: &str) -> UpdateJson {
+        let lines = lines(summary, file_unit);
+        let wire = match summary.kind {
+            AxisKind::Linear => UpdateWireJson::Linear(LinearUpdateJson::of(summary, Mm, lines)),
+            AxisKind::Rotary => UpdateWireJson::Rotary(RotaryUpdateJson::of(summary, Deg, lines)),
+        };
         UpdateJson {
-            kept_mm: summary
-                .kept
-                .iter()
-                .map(|k| KeptJson {
-                    first: k.first_mm,
-                    last: k.last_mm,
-                    count: k.count,
-                })
-                .collect(),
-            measured_mm: [summary.measured_mm.0, summary.measured_mm.1],
-            updated: summary.updated,
-            reference_mm: summary.reference_mm,
-            reference: if summary.at_existing_zero {
-                "existing zero"
-            } else {
-                "given"
-            },
-            dropped_mm: summary.dropped_mm.clone(),
-            added_mm: summary.added_mm.clone(),
-            lines: lines(summary, file_unit),
-            zero_at_reference: summary.existing_at_reference_mm.abs() < 1e-12,
-            kept_points_mm: summary.kept_points_mm.clone(),
+            wire,
+            zero_at_reference: summary.existing_at_reference.abs() < 1e-12,
+            kept_points: summary.kept_points.clone(),
+            added_points: summary.added.clone(),
         }
     }
 }
@@ -136,7 +207,7 @@ fn ranges_text(ranges: &[KeptRange], file_unit: &str) -> String {
             let points = if k.count == 1 { "point" } else { "points" };
             format!(
                 "{} ({} {points})",
-                range_text(k.first_mm, k.last_mm, file_unit),
+                range_text(k.first, k.last, file_unit),
                 k.count
             )
         })
@@ -155,7 +226,7 @@ fn list_text(positions_mm: &[f64], file_unit: &str) -> String {
 /// The sentences: what was kept, what was updated and where it is referred,
 /// how the grid changed.
 fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
-    let (first, last) = summary.measured_mm;
+    let (first, last) = summary.measured;
     let measured = range_text(first, last, file_unit);
     let mut lines = Vec::new();
     if !summary.kept.is_empty() {
@@ -166,8 +237,8 @@ fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
             if kept == 1 { "it was" } else { "they were" }
         ));
     }
-    let reference = range_text(summary.reference_mm, summary.reference_mm, file_unit);
-    let why = if summary.at_existing_zero && summary.existing_at_reference_mm.abs() < 1e-12 {
+    let reference = range_text(summary.reference, summary.reference, file_unit);
+    let why = if summary.at_existing_zero && summary.existing_at_reference.abs() < 1e-12 {
         "the existing table's zero".to_string()
     } else if summary.at_existing_zero {
         "the existing table's first point; it has no zero".to_string()
@@ -178,16 +249,16 @@ fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
         "{measured} ({} points): the existing table plus the measured residual, referred to {reference} ({why}), where the update adds nothing",
         summary.updated
     ));
-    if !summary.dropped_mm.is_empty() {
+    if !summary.dropped.is_empty() {
         lines.push(format!(
             "grid changed: the old points at {} are not on the new grid (the new table follows the old one plus the residual between its points)",
-            list_text(&summary.dropped_mm, file_unit)
+            list_text(&summary.dropped, file_unit)
         ));
     }
-    if !summary.added_mm.is_empty() {
+    if !summary.added.is_empty() {
         lines.push(format!(
             "grid changed: new points at {} (the old table had none there)",
-            list_text(&summary.added_mm, file_unit)
+            list_text(&summary.added, file_unit)
         ));
     }
     lines
@@ -202,24 +273,25 @@ mod tests {
         let summary = UpdateSummary {
             kept: vec![
                 KeptRange {
-                    first_mm: -4953.0,
-                    last_mm: -2286.0,
+                    first: -4953.0,
+                    last: -2286.0,
                     count: 22,
                 },
                 KeptRange {
-                    first_mm: 127.0,
-                    last_mm: 127.0,
+                    first: 127.0,
+                    last: 127.0,
                     count: 1,
                 },
             ],
-            measured_mm: (-2159.0, 0.0),
+            measured: (-2159.0, 0.0),
             updated: 18,
-            reference_mm: 0.0,
-            existing_at_reference_mm: 0.0,
+            reference: 0.0,
+            existing_at_reference: 0.0,
             at_existing_zero: true,
-            dropped_mm: vec![],
-            added_mm: vec![3302.0],
-            kept_points_mm: vec![],
+            dropped: vec![],
+            added: vec![3302.0],
+            kept_points: vec![],
+            kind: AxisKind::Linear,
         };
         let lines = lines(&summary, "mm");
         assert_eq!(

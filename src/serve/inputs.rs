@@ -190,6 +190,9 @@ pub fn controller(form: &Form) -> Result<Controller, ApiError> {
     Ok(Controller::from_name(name).ok_or_else(|| format!("unknown controller {name:?}"))?)
 }
 
+/// What a grid position is typed in: the measured axis' unit.
+const AXIS_NUMBER: &str = "a number in the axis' unit (mm, or ° on a rotary axis)";
+
 /// The form's grid, mode, reference and extrapolation (`convert`'s flags).
 pub fn grid(form: &Form) -> Result<TableGrid, ApiError> {
     Ok(TableGrid {
@@ -198,10 +201,10 @@ pub fn grid(form: &Form) -> Result<TableGrid, ApiError> {
             .map(TableMode::from_name)
             .transpose()
             .map_err(|e| format!("mode: {e}"))?,
-        step_mm: form.number("step", "a number of mm")?,
-        start_mm: form.number("start", "a number of mm")?,
+        step: form.number("step", AXIS_NUMBER)?,
+        start: form.number("start", AXIS_NUMBER)?,
         count: form.number("count", "a whole number of points")?,
-        reference_mm: form.number("reference", "a number of mm")?,
+        reference: form.number("reference", AXIS_NUMBER)?,
         extrapolate: form
             .text("extrapolate")
             .map(Extrapolate::from_name)
@@ -219,5 +222,25 @@ pub fn fanuc_rescaled(form: &Form) -> Result<bool, ApiError> {
         Some(other) => Err(ApiError::bad(format!(
             "fanuc_rescaled: expected 1 or 0, found {other:?}"
         ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_positions_are_asked_for_in_the_axis_unit() {
+        let mut form = Form::default();
+        form.text.insert("step", "15°".to_string());
+        let error = format!("{:?}", grid(&form).unwrap_err());
+        assert!(
+            error.contains(
+                "step: expected a number in the axis' unit (mm, or ° on a rotary axis), found \\\"15°\\\""
+            ),
+            "{error}"
+        );
+        form.text.insert("step", "15".to_string());
+        assert_eq!(grid(&form).unwrap().step, Some(15.0));
     }
 }

@@ -272,7 +272,7 @@ fn build(
     };
     let positions = match existing_points {
         Some(points) => {
-            if grid.step_mm.is_some() {
+            if grid.step.is_some() {
                 return Err(refused(
                     "--step: the table goes into the existing table, on its points (the TNC 640 has one table per axis)".to_string(),
                 ));
@@ -281,9 +281,16 @@ fn build(
         }
         None => grid_positions(
             targets,
-            plan(targets, &[], &capabilities, &grid, &PlanContext::default())?
-                .options
-                .grid,
+            plan(
+                AxisKind::Linear,
+                targets,
+                &[],
+                &capabilities,
+                &grid,
+                &PlanContext::default(),
+            )?
+            .options
+            .grid,
         )?,
     };
     let (first_mm, last_mm) = (targets[0], targets[targets.len() - 1]);
@@ -292,9 +299,9 @@ fn build(
         .find(|&&p| p < first_mm - 1e-9 || p > last_mm + 1e-9)
     {
         return Err(CompensateError::OutsideMeasuredRange {
-            position_mm,
-            first_mm,
-            last_mm,
+            position: AxisKind::Linear.position(position_mm),
+            first: AxisKind::Linear.position(first_mm),
+            last: AxisKind::Linear.position(last_mm),
         }
         .into());
     }
@@ -302,7 +309,7 @@ fn build(
         return Err(refused(format!("{name} is no straightness")));
     };
     let reference = grid
-        .reference_mm
+        .reference
         .unwrap_or(request.machine.reference_mm()[axis.index()]);
     Ok(cross_axis_table_at(errors, name, positions, reference)?)
 }

@@ -279,6 +279,7 @@ pub fn convert(
         measurement.targets(),
     )?;
     let plan = plan(
+        measurement.kind(),
         measurement.targets(),
         table.effects,
         &table.controller.capabilities(options.machine_unit),

@@ -156,7 +156,7 @@ pub fn fanuc_grid(
         (Controller::Fanuc, Some(parameters)) => parameters,
         _ => return Ok(*request),
     };
-    if request.step_mm.is_some() || request.start_mm.is_some() || request.reference_mm.is_some() {
+    if request.step.is_some() || request.start.is_some() || request.reference.is_some() {
         return Err(EmitError::Profile(format!(
             "the Fanuc parameter backup fixes the compensation points and the reference ({}): leave out --step, --start, --count and --reference",
             parameters.settings()
@@ -168,10 +168,10 @@ pub fn fanuc_grid(
     let (start_mm, count) =
         emit::fanuc::points_in(parameters, *first, *last).map_err(EmitError::Profile)?;
     Ok(Request {
-        step_mm: Some(parameters.interval),
-        start_mm: Some(start_mm),
+        step: Some(parameters.interval),
+        start: Some(start_mm),
         count: Some(count),
-        reference_mm: Some(parameters.position(parameters.reference_point)),
+        reference: Some(parameters.position(parameters.reference_point)),
         ..*request
     })
 }

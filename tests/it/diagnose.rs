@@ -217,7 +217,7 @@ fn reversal_is_found_and_measured() {
             seed,
             sigma,
         );
-        assert!(d.residual_after.rms_um < d.residual_before.rms_um);
+        assert!(d.residual_after.rms < d.residual_before.rms);
     });
     extras.finish();
 }
@@ -475,9 +475,9 @@ fn clean_retests_rarely_accept_an_effect() {
         let d = run(&truth(sigma, "", ""), seed, false);
         // What is left is the noise put in: σ estimated from 310 readings within 25 %.
         assert!(
-            (d.noise_um / sigma - 1.0).abs() < 0.25,
+            (d.noise / sigma - 1.0).abs() < 0.25,
             "seed {seed}: noise {} µm for σ {sigma}",
-            d.noise_um
+            d.noise
         );
         if !d.accepted.is_empty() {
             false_alarms.push((
@@ -518,7 +518,7 @@ fn a_step_or_a_sag_is_unexplained_not_a_wrong_kind() {
                 d.unexplained.significant,
                 "seed {seed}, σ {sigma}, {effect}: structure not reported"
             );
-            assert!(!d.unexplained.where_mm.is_empty());
+            assert!(!d.unexplained.targets.is_empty());
         }
     });
 }

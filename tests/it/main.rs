@@ -47,6 +47,7 @@ mod read_api_pos;
 mod report;
 mod retest_case;
 mod rotary;
+mod rotary_units;
 mod serve;
 mod server;
 mod servo;

@@ -117,9 +117,9 @@ fn diagnosis_json(d: &Diagnosis) -> serde_json::Value {
         })
         .collect();
     serde_json::json!({
-        "residual_before": {"rms_um": d.residual_before.rms_um, "max_abs_um": d.residual_before.max_abs_um},
-        "residual_after": {"rms_um": d.residual_after.rms_um, "max_abs_um": d.residual_after.max_abs_um},
-        "noise_um": d.noise_um,
+        "residual_before": {"rms_um": d.residual_before.rms, "max_abs_um": d.residual_before.max_abs},
+        "residual_after": {"rms_um": d.residual_after.rms, "max_abs_um": d.residual_after.max_abs},
+        "noise_um": d.noise,
         "figures": {
             "measured": figures(&d.figures.measured),
             "predicted": figures(&d.figures.predicted),
@@ -174,14 +174,11 @@ fn the_retest_report_shows_evaluate_and_diagnose_numbers_and_writes_pngs() {
     let rms = (diagnosis
         .readings
         .iter()
-        .map(|r| (r.residual_um - r.fitted_um).powi(2))
+        .map(|r| (r.residual - r.fitted).powi(2))
         .sum::<f64>()
         / readings as f64)
         .sqrt();
-    assert!(
-        (rms - diagnosis.residual_after.rms_um).abs() < 1e-9,
-        "{rms}"
-    );
+    assert!((rms - diagnosis.residual_after.rms).abs() < 1e-9, "{rms}");
     // Text from the file is escaped: the machine name has <, & and ".
     assert!(html.contains("MCV 754 Quick &lt;test &amp; &quot;escape&quot;&gt;"));
     assert!(!html.contains("<test &"));

@@ -71,7 +71,7 @@ impl RetestCase {
         let options = TableOptions {
             mode: TableMode::Mean,
             grid: GridSpec::Targets,
-            reference_mm: None,
+            reference: None,
             extrapolate: Extrapolate::Hold,
         };
         let table = build_table(&first, &evaluate(&first), &options).unwrap();

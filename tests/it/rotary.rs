@@ -401,7 +401,7 @@ fn a_full_turn_table_joins_its_ends() {
     let options = TableOptions {
         mode: TableMode::Mean,
         grid: GridSpec::Targets,
-        reference_mm: None,
+        reference: None,
         extrapolate: Extrapolate::Refuse,
     };
     let table = build_table(&c, &axcomp::evaluate::evaluate(&c), &options).unwrap();

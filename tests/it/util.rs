@@ -147,7 +147,7 @@ pub fn synth_loop(
     let options = TableOptions {
         mode: TableMode::Mean,
         grid: GridSpec::Targets,
-        reference_mm: None,
+        reference: None,
         extrapolate: Extrapolate::Hold,
     };
     let table = build_table(&before, &axcomp::evaluate::evaluate(&before), &options).unwrap();

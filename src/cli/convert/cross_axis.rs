@@ -53,10 +53,10 @@ pub fn run(args: &ConvertArgs, file: &Path) -> Result<()> {
             .unwrap_or([None; 3])
             .map(|v| v.unwrap_or(0.0)),
         grid: axcomp::compensate::plan::Request {
-            step_mm: args.step,
-            start_mm: args.start,
+            step: args.step,
+            start: args.start,
             count: args.count,
-            reference_mm: args.reference,
+            reference: args.reference,
             ..Default::default()
         },
         existing: existing

@@ -2,11 +2,12 @@
 
 use super::figures::{FIGURE_ROWS, FigureRow};
 use super::{Plot, signed};
-use crate::diagnose::{Diagnosis, ResidualStats};
+use crate::diagnose::{Diagnosis, Evidence, ResidualStats};
 use crate::effects::{Parameter, ParameterValue};
 use crate::evaluate::standard::{self, vdi_figure_name};
 use crate::report::format::{SourcedUm, um};
 use crate::report::json::FiguresJson;
+use crate::units::Um;
 
 /// `diagnosis.html`.
 pub(super) struct DiagnosisView {
@@ -67,19 +68,22 @@ pub(super) struct UnexplainedView {
     pub(super) where_mm: String,
 }
 
+/// The page's diagnosis, in mm and µm: `None` for a rotary axis' (the
+/// report diagnoses linear axes only, `workflow::rotary`).
 pub(super) fn diagnosis_view(
     diagnosis: &Diagnosis,
     plot: &dyn Fn(&str) -> Option<Plot>,
-) -> DiagnosisView {
-    let u = &diagnosis.unexplained;
-    DiagnosisView {
+) -> Option<DiagnosisView> {
+    let typed = diagnosis.typed().linear()?;
+    let u = &typed.unexplained;
+    Some(DiagnosisView {
         predicted_from_first_test: diagnosis.predicted_from_first_test,
-        residual_before: residual_cells("residual_before", &diagnosis.residual_before),
-        residual_after: residual_cells("residual_after", &diagnosis.residual_after),
-        noise: SourcedUm::new("diagnosis.noise_um".to_string(), Some(diagnosis.noise_um)),
+        residual_before: residual_cells("residual_before", typed.residual_before),
+        residual_after: residual_cells("residual_after", typed.residual_after),
+        noise: SourcedUm::new("diagnosis.noise_um".to_string(), Some(typed.noise.0)),
         time_assumed: diagnosis.time_assumed,
         figures: diagnosis_figures(diagnosis),
-        accepted: accepted_effects(diagnosis),
+        accepted: accepted_effects(diagnosis, &typed.evidence),
         rejected: diagnosis
             .rejected
             .iter()
@@ -88,26 +92,26 @@ pub(super) fn diagnosis_view(
         unexplained: UnexplainedView {
             significant: u.significant,
             p_value: p_value(u.p_value),
-            rms_um: um(Some(u.rms_um)),
+            rms_um: um(Some(u.rms.0)),
             where_mm: u
-                .where_mm
+                .targets
                 .iter()
-                .map(|x| x.to_string())
+                .map(|x| x.0.to_string())
                 .collect::<Vec<_>>()
                 .join(", "),
         },
         residual_plot: plot("residual"),
         along_axis_plot: plot("residual-along-axis"),
         effects_plot: plot("effects"),
-    }
+    })
 }
 
 /// The RMS and largest |value| cells of a residual.
-pub(super) fn residual_cells(name: &str, stats: &ResidualStats) -> ResidualCells {
+pub(super) fn residual_cells(name: &str, stats: ResidualStats<Um>) -> ResidualCells {
     let key = |what: &str| format!("diagnosis.{name}.{what}");
     ResidualCells {
-        rms: SourcedUm::new(key("rms_um"), Some(stats.rms_um)),
-        max_abs: SourcedUm::new(key("max_abs_um"), Some(stats.max_abs_um)),
+        rms: SourcedUm::new(key("rms_um"), Some(stats.rms.0)),
+        max_abs: SourcedUm::new(key("max_abs_um"), Some(stats.max_abs.0)),
     }
 }
 
@@ -157,29 +161,29 @@ pub(super) fn diagnosis_figures(diagnosis: &Diagnosis) -> Vec<FigureRow> {
         .collect()
 }
 
-pub(super) fn accepted_effects(diagnosis: &Diagnosis) -> Vec<EffectRow> {
+/// The accepted effects, each with its evidence in µm (`evidence`, in the
+/// same order).
+pub(super) fn accepted_effects(diagnosis: &Diagnosis, evidence: &[Evidence<Um>]) -> Vec<EffectRow> {
     diagnosis
         .accepted
         .iter()
+        .zip(evidence)
         .enumerate()
-        .map(|(index, accepted)| {
-            let evidence = &accepted.evidence;
-            EffectRow {
-                kind: accepted.effect.kind().name(),
-                parameters: accepted
-                    .effect
-                    .parameters()
-                    .into_iter()
-                    .map(|parameter| parameter_text(index, &parameter, &accepted.uncertainty))
-                    .collect(),
-                delta_bic: signed(evidence.delta_bic, 1),
-                trials: (evidence.trials > 1).then_some(evidence.trials),
-                p_value: p_value(evidence.p_value),
-                cv_rmse_without_um: um(Some(evidence.cv_rmse_without_um)),
-                cv_rmse_with_um: um(Some(evidence.cv_rmse_with_um)),
-                explanation: accepted.explanation.clone(),
-                warnings: accepted.warnings.clone(),
-            }
+        .map(|(index, (accepted, evidence))| EffectRow {
+            kind: accepted.effect.kind().name(),
+            parameters: accepted
+                .effect
+                .parameters()
+                .into_iter()
+                .map(|parameter| parameter_text(index, &parameter, &accepted.uncertainty))
+                .collect(),
+            delta_bic: signed(evidence.delta_bic, 1),
+            trials: (evidence.trials > 1).then_some(evidence.trials),
+            p_value: p_value(evidence.p_value),
+            cv_rmse_without_um: um(Some(evidence.cv_rmse_without.0)),
+            cv_rmse_with_um: um(Some(evidence.cv_rmse_with.0)),
+            explanation: accepted.explanation.clone(),
+            warnings: accepted.warnings.clone(),
         })
         .collect()
 }

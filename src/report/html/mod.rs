@@ -157,7 +157,7 @@ pub fn render(input: &ReportInput<'_>) -> Result<String, PlotError> {
             .as_ref()
             .map(|table| table_view(input, table, &plot)),
         diagnosis: match (input.diagnosis, &input.after) {
-            (Some(diagnosis), Some(_)) => Some(diagnosis_view(diagnosis, &plot)),
+            (Some(diagnosis), Some(_)) => diagnosis_view(diagnosis, &plot),
             _ => None,
         },
         notes: notes(input),
