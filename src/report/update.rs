@@ -15,7 +15,7 @@
 //! file keeps the increments of the points outside (`"kept_as":
 //! "increments"`): each kept run has `"moved": {"with": -1000.0, "by": [↑,
 //! ↓]}` (the new table's point it continues from, and the change of its
-//! values, in mm), and `"data_lines": {"sections": 25, "changed": 24}` says
+//! values, in mm), and `"data_lines": {"sections": 25, "changed": 23}` says
 //! how many of the file's lines the update wrote and how many differ.
 
 use serde::Serialize;
