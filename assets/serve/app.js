@@ -26,6 +26,25 @@ function text(value, digits = 2) {
   return String(value);
 }
 
+// A position of an answer with its unit, as the JSON keys name it: `KEY_mm`
+// on a linear axis, `KEY_deg` on a rotary one; the number as sent unless
+// `digits` is given.
+function position(answer, key, digits) {
+  const [value, unit] = answer[key + "_deg"] !== undefined
+    ? [answer[key + "_deg"], "°"]
+    : [answer[key + "_mm"], " mm"];
+  if (value === null || value === undefined) return "not evaluated";
+  return (digits === undefined ? String(value) : text(value, digits)) + unit;
+}
+
+// A deviation field of an answer and its unit: `KEY_um` on a linear axis,
+// `KEY_arcsec` on a rotary one (the web app reports angles in ″).
+function deviation(answer, key) {
+  return answer[key + "_um"] !== undefined
+    ? [answer[key + "_um"], " µm"]
+    : [answer[key + "_arcsec"], "″"];
+}
+
 function element(tag, content, className) {
   const node = document.createElement(tag);
   if (content !== undefined) node.textContent = content;
@@ -178,7 +197,7 @@ function showEvaluation(answer) {
     const list = element("ul");
     for (const o of e.outliers) {
       list.appendChild(element("li", "run " + o.run + " " + o.direction + ": score " + text(o.score) +
-        ", worst at " + o.worst_target_mm + " mm"));
+        ", worst at " + position(o, "worst_target")));
     }
     outliers.appendChild(list);
   }
@@ -263,10 +282,10 @@ async function convert() {
     const answer = await (await post("/api/convert", request)).json();
     if (lastConvert !== request) return;
     const c = showTable(answer, "");
-    const values = c.values_um || c.values_arcsec || {};
+    const step = c.step_mm ?? c.step_deg;
     $("table-summary").textContent = answer.file_name + ": " + c.count + " points, " + c.mode +
-      (c.step_mm ? ", step " + c.step_mm + " mm" : "") + ", zero at " + text(c.reference_mm, 3) + " mm, file in " + c.file_unit +
-      (Object.keys(values).length ? "" : "");
+      (step ? ", step " + position(c, "step") : "") + ", zero at " + position(c, "reference", 3) +
+      ", file in " + c.file_unit;
     $("backlash").textContent = c.backlash_parameter
       ? "Backlash: " + c.backlash_parameter.name + " = " + c.backlash_parameter.value + " " + c.backlash_parameter.unit +
         " (" + c.backlash_parameter.sign + ")"
@@ -301,8 +320,10 @@ async function retest() {
   try {
     const answer = await (await post("/api/retest", tableForm(["file", "after", "table"]))).json();
     const d = answer.diagnosis;
-    $("residual").textContent = "Residual rms " + text(d.residual_before_um.rms) + " µm → " +
-      text(d.residual_after_um.rms) + " µm with the effects found" +
+    const [before, unit] = deviation(d, "residual_before");
+    const [after] = deviation(d, "residual_after");
+    $("residual").textContent = "Residual rms " + text(before.rms) + unit + " → " +
+      text(after.rms) + unit + " with the effects found" +
       (d.unexplained.significant ? "; structure no effect explains remains" : "; nothing left unexplained");
     $("effects").replaceChildren(...(d.effects.length
       ? d.effects.map((e) => element("li", e.kind + ": " + e.explanation))

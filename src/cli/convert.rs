@@ -67,36 +67,39 @@ pub struct ConvertArgs {
     #[arg(long, value_name = "MODE", value_parser = TableMode::from_name, help_heading = "Table")]
     pub mode: Option<TableMode>,
 
-    /// First compensation point, mm (default: the first target).
+    /// First compensation point, in the axis' unit: mm, or ° on a rotary
+    /// axis (default: the first target).
     #[arg(
         long,
-        value_name = "MM",
+        value_name = "POS",
         requires = "step",
         allow_negative_numbers = true,
         help_heading = "Grid"
     )]
     pub start: Option<f64>,
 
-    /// Spacing of the compensation points, mm.
+    /// Spacing of the compensation points, in the axis' unit: mm, or ° on a
+    /// rotary axis.
     ///
     /// Without it the points are the measured targets, which iTNC 530 and
     /// Sinumerik accept only when they are evenly spaced.
-    #[arg(long, value_name = "MM", help_heading = "Grid")]
+    #[arg(long, value_name = "STEP", help_heading = "Grid")]
     pub step: Option<f64>,
 
     /// Number of compensation points (default: as many as fit in the measured range).
     #[arg(long, value_name = "N", requires = "step", help_heading = "Grid")]
     pub count: Option<usize>,
 
-    /// Position where the table is zero, mm (default: the first point; with
-    /// --existing, the existing table's zero).
+    /// Position where the table is zero, in the axis' unit: mm, or ° on a
+    /// rotary axis (default: the first point; with --existing, the existing
+    /// table's zero).
     ///
     /// Controllers reference the axis there. With --existing it is where the
     /// update adds nothing (inside the measured range); the old table's zero
     /// is its machine reference point, so the default keeps it.
     #[arg(
         long,
-        value_name = "MM",
+        value_name = "POS",
         allow_negative_numbers = true,
         help_heading = "Table"
     )]

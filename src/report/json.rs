@@ -725,9 +725,9 @@ impl EvaluationJson {
         )
     }
 
-    /// [`EvaluationJson::new`], taking the evaluation: each target's
-    /// statistics are converted where they are (the two types have one
-    /// size), so a large test's table is not held twice.
+    /// [`EvaluationJson::new`], taking the evaluation: its per-target
+    /// table is freed once converted (the wire form is another size, so
+    /// the conversion allocates anew).
     pub fn from_evaluation(
         measurement: &Measurement,
         mut evaluation: Evaluation,

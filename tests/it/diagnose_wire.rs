@@ -89,7 +89,7 @@ fn linear_periodic_keeps_its_keys() {
 #[test]
 fn rotary_retest_keeps_its_keys() {
     let work = tempfile::tempdir().unwrap();
-    crate::rotary::rotary_retest_files(work.path(), (2, 3.0, 0.3), 21);
+    crate::retest_case::rotary_retest_files(work.path(), (2, 3.0, 0.3), 21);
     let args = [
         "diagnose",
         "--after",

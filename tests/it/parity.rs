@@ -106,7 +106,8 @@ fn a_rotary_axis_is_evaluated_and_converted_alike() {
 fn a_rotary_retest_is_diagnosed_alike() {
     let app = App::new();
     let work = tempfile::tempdir().unwrap();
-    let (before, table, after) = crate::rotary::rotary_retest_files(work.path(), (2, 3.0, 0.3), 21);
+    let (before, table, after) =
+        crate::retest_case::rotary_retest_files(work.path(), (2, 3.0, 0.3), 21);
     let name = |p: &Path| p.file_name().unwrap().to_str().unwrap().to_string();
     let (before, table, after) = (name(&before), name(&table), name(&after));
     let form = || {
@@ -176,7 +177,8 @@ fn a_rotary_retest_is_diagnosed_alike() {
 fn the_report_of_a_rotary_axis_refuses_alike() {
     let app = App::new();
     let work = tempfile::tempdir().unwrap();
-    let (before, table, after) = crate::rotary::rotary_retest_files(work.path(), (2, 3.0, 0.3), 22);
+    let (before, table, after) =
+        crate::retest_case::rotary_retest_files(work.path(), (2, 3.0, 0.3), 22);
     let name = |p: &Path| p.file_name().unwrap().to_str().unwrap().to_string();
     let (before, table, after) = (name(&before), name(&table), name(&after));
     std::fs::write(work.path().join("p.toml"), "[acceptance.axes.C]\nE = 5\n").unwrap();

@@ -2,7 +2,7 @@
 //! for a TNC 640, and a re-test with the table applied, as files. Shared by
 //! the report tests here and the browser tests (the `system` target).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use axcomp::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use axcomp::cycle::CycleTiming;
@@ -126,4 +126,58 @@ impl RetestCase {
         })
         .unwrap()
     }
+}
+
+/// A rotary truth over a full turn every 15°, 5 runs each way, with the
+/// harmonics `(order, amplitude ″, phase rad)`.
+fn rotary_truth(harmonics: &[(u32, f64, f64)]) -> axcomp::synth::RotaryTruth {
+    let harmonics: Vec<String> = harmonics
+        .iter()
+        .map(|(order, amplitude, phase)| {
+            format!("{{ per_revolution = {order}, amplitude_arcsec = {amplitude}, phase_rad = {phase} }}")
+        })
+        .collect();
+    let text = format!(
+        "[axis]\nname = \"C\"\n[rotary]\nstart_deg = 0.0\nend_deg = 360.0\ncount = 25\nruns = 5\n\
+         reversal_arcsec = 2.4\nsigma_arcsec = 0.3\nharmonics = [{}]\n",
+        harmonics.join(", ")
+    );
+    axcomp::synth::RotaryTruth::from_toml_str(&text).unwrap()
+}
+
+/// The first test of the fixture's truth (once per revolution 4″), a mean
+/// LinuxCNC table from it written by `convert`, and the re-test with that
+/// table of a truth with one more harmonic (`extra`: order, ″, phase), as
+/// files in `directory`; returns (before, table, after).
+pub(crate) fn rotary_retest_files(
+    directory: &Path,
+    extra: (u32, f64, f64),
+    seed: u64,
+) -> (PathBuf, PathBuf, PathBuf) {
+    use axcomp::emit::{EmitOptions, MachineProfile, read_any};
+    let first = (1, 4.0, 0.5);
+    let before_truth = rotary_truth(&[first]);
+    let after_truth = rotary_truth(&[first, extra]);
+    let before = axcomp::synth::rotary_test(&before_truth, seed).unwrap();
+    let before_path = directory.join(format!("before-{seed}.csv"));
+    std::fs::write(&before_path, axcomp::read::csv::write(&before)).unwrap();
+    let table_path = directory.join(format!("C-{seed}.comp"));
+    let run = axcomp([
+        "convert".as_ref(),
+        before_path.as_os_str(),
+        "--controller".as_ref(),
+        "linuxcnc".as_ref(),
+        "-o".as_ref(),
+        table_path.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let mut options = EmitOptions::for_axis(&MachineProfile::default(), "C", "").unwrap();
+    options.kind = axcomp::measurement::AxisKind::Rotary;
+    let text = std::fs::read_to_string(&table_path).unwrap();
+    let (_, table) = read_any(&text, &options, Some(0)).unwrap();
+    let after = axcomp::synth::rotary_retest(&after_truth, &table, seed + 1000).unwrap();
+    let after_path = directory.join(format!("after-{seed}.csv"));
+    std::fs::write(&after_path, axcomp::read::csv::write(&after)).unwrap();
+    (before_path, table_path, after_path)
 }

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use crate::browser::WebDriver;
 use crate::pixels::{Pixels, artefacts};
+use crate::retest_case::rotary_retest_files;
 use crate::server::{Server, cli_in, read, sample};
 use crate::util::{root, shared_data};
 
@@ -229,5 +230,58 @@ fn step_two_updates_the_table_that_was_active() {
     assert!(
         browser.downloaded("PITCH.TXT") == expected,
         "the page's PITCH.TXT differs from convert --existing's"
+    );
+}
+
+/// A rotary axis on the page is said as the commands say it: the table's
+/// step and zero in degrees, an outlier run's worst target in degrees, the
+/// re-test's residual in ″ (the page used to print them as mm and µm, or
+/// stop at the re-test).
+#[test]
+fn a_rotary_axis_is_said_in_degrees_and_arcseconds() {
+    let work = tempfile::tempdir().unwrap();
+    let (before, table, after) = rotary_retest_files(work.path(), (2, 3.0, 0.3), 23);
+    let server = Server::start();
+    let browser = open_page(&server);
+    browser.send_keys(&browser.find("#file"), &before.display().to_string());
+    browser.wait_for(
+        "return document.body.dataset.converted === 'tnc640:C.COM' && document.body.dataset.busy === '0'",
+        "the rotary test's table",
+    );
+    let summary = browser.execute("return document.getElementById('table-summary').innerText");
+    assert_eq!(
+        summary.as_str().unwrap(),
+        "C.COM: 25 points, mean, step 15°, zero at 0.000°, file in deg"
+    );
+
+    browser.send_keys(&browser.find("#after"), &after.display().to_string());
+    browser.send_keys(&browser.find("#table"), &table.display().to_string());
+    browser.wait_for(
+        "return !document.getElementById('retest-result').hidden && document.body.dataset.busy === '0'",
+        "the rotary re-test's diagnosis",
+    );
+    let residual = browser.execute("return document.getElementById('residual').innerText");
+    let residual = residual.as_str().unwrap();
+    assert!(
+        residual.starts_with("Residual rms ")
+            && residual.contains("″ → ")
+            && !residual.contains("µm"),
+        "{residual}"
+    );
+
+    let outlier_run = root().join("tests/data/rotary/c-outlier-run.csv");
+    browser.execute("document.getElementById('file').value = ''; return true");
+    browser.send_keys(&browser.find("#file"), &outlier_run.display().to_string());
+    browser.wait_for(
+        "return document.body.dataset.evaluated === 'c-outlier-run.csv' && document.body.dataset.busy === '0'",
+        "the outlier run's test",
+    );
+    let outliers = browser.execute("return document.getElementById('outliers').innerText");
+    assert!(
+        outliers
+            .as_str()
+            .unwrap()
+            .contains("run 1 down: score 66.12, worst at 90°"),
+        "{outliers}"
     );
 }
