@@ -116,7 +116,9 @@ pub struct ConvertArgs {
     /// plus that residual, referred to the old table's zero, on the new grid
     /// inside the measured range; every old point outside it is kept as it
     /// was. A Fagor 8065 .mp file is updated in place: only its leadscrew
-    /// lines change.
+    /// lines change. A Fanuc PITCH.TXT is updated in place too, but its data
+    /// are increments: the points outside keep their increments, so their
+    /// values move with the new value at the range's end (said by how much).
     #[arg(long, value_name = "TABLE", help_heading = "Table")]
     pub existing: Option<PathBuf>,
 

@@ -8,7 +8,9 @@
 //! another point. At r the update adds nothing, so the control's zero stays
 //! where it was (a laser zeroed at the first target would otherwise shift the
 //! whole table by e(first)). Outside the measured range the test says
-//! nothing: every old point there stays with its old value. The grid inside
+//! nothing: every old point there stays with its old value (a Fanuc pitch
+//! file, whose data are increments, keeps its old increments there:
+//! [`KeptAs::Increments`], summed up by `emit::fanuc::update_summary`). The grid inside
 //! the measured range is the new one; old points it drops and new points it
 //! adds are listed, so the engineer sees a changed grid.
 //!
@@ -34,8 +36,8 @@ pub struct UpdatePlan {
     pub at_existing_zero: bool,
 }
 
-/// Consecutive old points kept as they were: first, last (in the axis'
-/// unit), how many.
+/// Consecutive old points kept: first, last (in the axis' unit), how many,
+/// and how much their values moved.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KeptRange {
     /// First point.
@@ -44,6 +46,40 @@ pub struct KeptRange {
     pub last: f64,
     /// Number of points.
     pub count: usize,
+    /// How their values moved: not at all where the values are kept, with
+    /// the point at the end of the table next to them where the increments
+    /// are ([`KeptAs::Increments`]).
+    pub moved: Option<Moved>,
+}
+
+/// Old points kept with their increments moved with the new table's end.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Moved {
+    /// The point of the new table they continue from (the table's end next to them).
+    pub with: f64,
+    /// The change of their values there, ↑ and ↓ (mm, or °): new − old.
+    pub by: [f64; 2],
+}
+
+/// What the old points outside the measured range keep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KeptAs {
+    /// Their values: a table of values per point.
+    Values,
+    /// Their increments: the pitch data of a Fanuc control are increments
+    /// per section, updated line by line in the file (`emit::fanuc::update`),
+    /// so beyond the measured range the old curve continues from the new
+    /// value at the range's end.
+    Increments,
+}
+
+/// The data lines of a file updated in place line by line (Fanuc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DataLines {
+    /// The lines of the sections inside the measured range, which the update writes.
+    pub sections: usize,
+    /// Those whose value differs from the existing file's (the others are as they were).
+    pub changed: usize,
 }
 
 /// What an update did, for the engineer to read; positions and values in
@@ -54,6 +90,10 @@ pub struct UpdateSummary {
     pub kept: Vec<KeptRange>,
     /// The same points one by one.
     pub kept_points: Vec<f64>,
+    /// What they keep: their values, or (Fanuc) their increments.
+    pub kept_as: KeptAs,
+    /// A file updated line by line: its lines written and changed.
+    pub data_lines: Option<DataLines>,
     /// The measured range.
     pub measured: (f64, f64),
     /// How many points inside it got old + residual.
@@ -172,6 +212,7 @@ impl UpdatePlan {
                     first: p,
                     last: p,
                     count: 1,
+                    moved: None,
                 }),
             }
         }
@@ -206,6 +247,8 @@ impl UpdatePlan {
                 .filter(|&p| !self.inside(p))
                 .collect(),
             kept,
+            kept_as: KeptAs::Values,
+            data_lines: None,
             measured: self.measured,
             updated,
             reference: self.reference,
@@ -264,12 +307,14 @@ mod tests {
                 KeptRange {
                     first: -200.0,
                     last: -100.0,
-                    count: 2
+                    count: 2,
+                    moved: None
                 },
                 KeptRange {
                     first: 400.0,
                     last: 400.0,
-                    count: 1
+                    count: 1,
+                    moved: None
                 }
             ]
         );

@@ -417,11 +417,7 @@ impl ConvertJson {
         let _ = writeln!(
             out,
             "\nCompensation table [{value_unit}] (axis error actual − target, zero at the reference{})",
-            if self.update.is_some() {
-                "; kept: the old value, outside the measured range; new: a point the old table did not have"
-            } else {
-                ""
-            }
+            self.update.as_ref().map_or("", |u| u.legend)
         );
         let position_header = format!("position {}", position_unit.trim_start());
         if self.file_unit == LengthUnit::Inch.as_str() {

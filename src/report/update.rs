@@ -7,14 +7,20 @@
 //! { "kept_mm": [{"first": -4953.0, "last": -2286.0, "count": 22}, …],
 //!   "measured_mm": [-2159.0, 0.0], "updated": 18, "reference_mm": 0.0,
 //!   "reference": "existing zero" | "given",
-//!   "dropped_mm": [...], "added_mm": [...], "lines": ["…", …] }
+//!   "dropped_mm": [...], "added_mm": [...], "lines": ["…", …],
+//!   "kept_as": "values" | "increments" }
 //! ```
 //! Positions in mm; `lines` are the sentences the terminal prints, with
-//! positions in the file's unit (inch files: inch and mm).
+//! positions in the file's unit (inch files: inch and mm). A Fanuc pitch
+//! file keeps the increments of the points outside (`"kept_as":
+//! "increments"`): each kept run has `"moved": {"with": -1000.0, "by": [↑,
+//! ↓]}` (the new table's point it continues from, and the change of its
+//! values, in mm), and `"data_lines": {"sections": 25, "changed": 23}` says
+//! how many of the file's lines the update wrote and how many differ.
 
 use serde::Serialize;
 
-use crate::compensate::update::{KeptRange, UpdateSummary};
+use crate::compensate::update::{DataLines, KeptAs, KeptRange, Moved, UpdateSummary};
 use crate::measurement::AxisKind;
 use crate::report::format::inch_text;
 use crate::units::{Deg, LengthUnit, Mm};
@@ -28,6 +34,28 @@ pub struct KeptJson<P> {
     pub last: P,
     /// How many points.
     pub count: usize,
+    /// Kept with their increments: how their values moved (Fanuc).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub moved: Option<MovedJson<P>>,
+}
+
+/// A kept run's values moved with the new table's point `with`, by `by`
+/// (↑, ↓), in `P`.
+#[derive(Clone, Debug, Serialize)]
+pub struct MovedJson<P> {
+    /// The new table's point the run continues from.
+    pub with: P,
+    /// new − old there, ↑ and ↓.
+    pub by: [P; 2],
+}
+
+/// The lines of a file updated in place (Fanuc).
+#[derive(Clone, Debug, Serialize)]
+pub struct DataLinesJson {
+    /// The data lines of the updated sections.
+    pub sections: usize,
+    /// Those that differ from the existing file's.
+    pub changed: usize,
 }
 
 /// Declares the update's wire struct of one kind of axis: its positions
@@ -55,6 +83,11 @@ macro_rules! update_json {
             pub $added: Vec<$position>,
             /// What the terminal prints.
             pub lines: Vec<String>,
+            /// What the kept points keep: `values`, or `increments` (Fanuc).
+            pub kept_as: &'static str,
+            /// A file updated line by line (Fanuc): its lines written and changed.
+            #[serde(skip_serializing_if = "Option::is_none")]
+            pub data_lines: Option<DataLinesJson>,
         }
 
         impl $name {
@@ -73,6 +106,10 @@ macro_rules! update_json {
                             first: unit(k.first),
                             last: unit(k.last),
                             count: k.count,
+                            moved: k.moved.map(|m: Moved| MovedJson {
+                                with: unit(m.with),
+                                by: m.by.map(unit),
+                            }),
                         })
                         .collect(),
                     $measured: [unit(summary.measured.0), unit(summary.measured.1)],
@@ -86,6 +123,14 @@ macro_rules! update_json {
                     $dropped: all(&summary.dropped),
                     $added: all(&summary.added),
                     lines,
+                    kept_as: match summary.kept_as {
+                        KeptAs::Values => "values",
+                        KeptAs::Increments => "increments",
+                    },
+                    data_lines: summary.data_lines.map(|d: DataLines| DataLinesJson {
+                        sections: d.sections,
+                        changed: d.changed,
+                    }),
                 }
             }
         }
@@ -129,6 +174,9 @@ pub struct UpdateJson {
     /// Every new point, in the axis' unit (for marking the printed table's rows).
     #[serde(skip)]
     pub added_points: Vec<f64>,
+    /// What the printed table's marks mean (none where the kept points are not printed).
+    #[serde(skip)]
+    pub legend: &'static str,
 }
 
 impl UpdateJson {
@@ -168,6 +216,13 @@ impl UpdateJson {
             zero_at_reference: summary.existing_at_reference.abs() < 1e-12,
             kept_points: summary.kept_points.clone(),
             added_points: summary.added.clone(),
+            // A Fanuc update prints the table's points only: none is kept.
+            legend: match summary.kept_as {
+                KeptAs::Values => {
+                    "; kept: the old value, outside the measured range; new: a point the old table did not have"
+                }
+                KeptAs::Increments => "",
+            },
         }
     }
 }
@@ -229,7 +284,14 @@ fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
     let (first, last) = summary.measured;
     let measured = range_text(first, last, file_unit);
     let mut lines = Vec::new();
-    if !summary.kept.is_empty() {
+    if summary.kept_as == KeptAs::Increments {
+        lines.extend(
+            summary
+                .kept
+                .iter()
+                .map(|run| kept_increments(run, summary.kind, &measured, file_unit)),
+        );
+    } else if !summary.kept.is_empty() {
         let kept: usize = summary.kept.iter().map(|k| k.count).sum();
         lines.push(format!(
             "{}: kept as {} (outside the measured {measured})",
@@ -249,6 +311,11 @@ fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
         "{measured} ({} points): the existing table plus the measured residual, referred to {reference} ({why}), where the update adds nothing",
         summary.updated
     ));
+    if let Some(DataLines { sections, changed }) = summary.data_lines {
+        lines.push(format!(
+            "pitch file: {changed} of the {sections} data lines of those points' sections changed (the others already held their new value); every other line of the file as it was"
+        ));
+    }
     if !summary.dropped.is_empty() {
         lines.push(format!(
             "grid changed: the old points at {} are not on the new grid (the new table follows the old one plus the residual between its points)",
@@ -264,6 +331,54 @@ fn lines(summary: &UpdateSummary, file_unit: &str) -> Vec<String> {
     lines
 }
 
+/// A run kept with its increments (Fanuc): where its values went.
+fn kept_increments(run: &KeptRange, kind: AxisKind, measured: &str, file_unit: &str) -> String {
+    let points = if run.count == 1 { "point" } else { "points" };
+    let (its, they) = if run.count == 1 {
+        ("its increment", "its value")
+    } else {
+        ("their increments", "their values")
+    };
+    let head = format!(
+        "{} ({} {points}): kept {its}, not {they} (outside the measured {measured}; the file's data are increments per section)",
+        range_text(run.first, run.last, file_unit),
+        run.count
+    );
+    let Some(moved) = run.moved else {
+        return head;
+    };
+    let (scale, unit) = match kind {
+        AxisKind::Linear => (1000.0, "µm"),
+        AxisKind::Rotary => (3600.0, "″"),
+    };
+    let value = |v: f64| {
+        let v = (v * scale * 100.0).round() / 100.0 + 0.0;
+        if v == 0.0 {
+            format!("0 {unit}")
+        } else {
+            format!("{v:+} {unit}")
+        }
+    };
+    let [up, down] = moved.by;
+    let by = if (up - down).abs() * scale < 0.005 {
+        value(up)
+    } else {
+        format!("{} ↑, {} ↓", value(up), value(down))
+    };
+    let at = range_text(moved.with, moved.with, file_unit);
+    if up.abs() * scale < 0.005 && down.abs() * scale < 0.005 {
+        let were = if run.count == 1 {
+            "its value is as it was"
+        } else {
+            "their values are as they were"
+        };
+        return format!(
+            "{head}: the old curve continues from the new value at {at}, which is the old one: {were}"
+        );
+    }
+    format!("{head}: the old curve continues from the new value at {at}: {they} moved by {by}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -276,11 +391,13 @@ mod tests {
                     first: -4953.0,
                     last: -2286.0,
                     count: 22,
+                    moved: None,
                 },
                 KeptRange {
                     first: 127.0,
                     last: 127.0,
                     count: 1,
+                    moved: None,
                 },
             ],
             measured: (-2159.0, 0.0),
@@ -291,6 +408,8 @@ mod tests {
             dropped: vec![],
             added: vec![3302.0],
             kept_points: vec![],
+            kept_as: KeptAs::Values,
+            data_lines: None,
             kind: AxisKind::Linear,
         };
         let lines = lines(&summary, "mm");

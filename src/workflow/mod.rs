@@ -21,6 +21,7 @@ pub mod thermal;
 
 use crate::compensate::effects::build_table_with_effects;
 use crate::compensate::plan::{PlanContext, Request, plan};
+use crate::compensate::update::{UpdatePlan, UpdateSummary};
 use crate::compensate::{CompensateError, CompensationTable};
 use crate::diagnose::KnownPeriod;
 use crate::effects::Effect;
@@ -292,8 +293,8 @@ pub fn convert(
     let mut compensation =
         build_table_with_effects(measurement, &evaluation, &plan.options, table.effects)?;
     // A Fanuc pitch file is updated in place point by point (its data are
-    // increments, emit::fanuc::update): the points outside the table stay as
-    // they were there.
+    // increments, emit::fanuc::update): the points outside the table keep
+    // their increments, which its own summary says (`fanuc_update`).
     let update = plan
         .update
         .as_ref()
@@ -304,6 +305,12 @@ pub fn convert(
             summary
         });
     let bytes = emit::write_bytes(table.controller, &compensation, options, table.existing)?;
+    let update = update.or(fanuc_update(
+        table,
+        plan.update.as_ref(),
+        &compensation,
+        options,
+    )?);
     let rescaled = match table.fanuc_rescaled {
         true => Some(table::fanuc_rescaled(
             table.existing,
@@ -351,6 +358,30 @@ pub fn convert(
         table: compensation,
         rescaled,
     })
+}
+
+/// What a Fanuc update changed in the pitch file that was active
+/// (`emit::fanuc::update_summary`), when one was given.
+fn fanuc_update(
+    table: &TableRequest<'_>,
+    plan: Option<&UpdatePlan>,
+    compensation: &CompensationTable,
+    options: &EmitOptions,
+) -> Result<Option<UpdateSummary>, WorkflowError> {
+    let existing = table
+        .existing
+        .and_then(|bytes| emit::decode_table(bytes).ok());
+    match (table.controller, plan, existing) {
+        (Controller::Fanuc, Some(plan), Some((text, _))) if emit::fanuc::looks_like(&text) => {
+            Ok(Some(emit::fanuc::update_summary(
+                &text,
+                compensation,
+                options,
+                plan,
+            )?))
+        }
+        _ => Ok(None),
+    }
 }
 
 /// A test of the acceptance report: read, named, evaluated, with every

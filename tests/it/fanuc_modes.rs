@@ -142,6 +142,50 @@ fn bidirectional_compensation_needs_3605_and_goes_to_3626() {
         (-4..=-2).contains(&reference_negative),
         "{reference_negative}"
     );
+    // The update says it: 2 × 25 sections written, the differing lines
+    // counted; −1600 … −1040 mm and 40 mm kept with their increments, each
+    // direction's values moved by its change at −1000 mm (point 15) and at
+    // 0 mm (point 40), where ↓ moves by −(3627 − 0) units of 1 µm.
+    let update = &json["update"];
+    let differing = old_text
+        .lines()
+        .zip(new_text.lines())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(update["data_lines"]["sections"], 50, "{update:#}");
+    assert_eq!(update["data_lines"]["changed"], differing);
+    assert_eq!(update["updated"], 26);
+    let change_um = |n: i64| {
+        [
+            -(absolute(&new, n) - absolute(&old, n)),
+            -(absolute_down(&new, reference_negative, n) - absolute_down(&old, 0, n)),
+        ]
+    };
+    assert_eq!(change_um(40), [0, -reference_negative]);
+    for (k, (first, last, end)) in [(-1600.0, -1040.0, 15), (40.0, 40.0, 40)]
+        .into_iter()
+        .enumerate()
+    {
+        let run = &update["kept_mm"][k];
+        assert_eq!((&run["first"], &run["last"]), (&first.into(), &last.into()));
+        assert_eq!(run["moved"]["with"], (end - 40) as f64 * 40.0);
+        for d in 0..2 {
+            let said = run["moved"]["by"][d].as_f64().unwrap() * 1000.0;
+            assert!(
+                (said - change_um(end)[d] as f64).abs() < 1e-9,
+                "{run}: {:?}",
+                change_um(end)
+            );
+        }
+    }
+    let lines = update["lines"].to_string();
+    assert!(
+        lines.contains(&format!(
+            "new value at 0 mm: its value moved by 0 µm ↑, {:+} µm ↓",
+            -reference_negative
+        )),
+        "{lines}"
+    );
     // It reads back as a table per direction (what predict and diagnose take).
     let backup = std::fs::read_to_string(&parameters).unwrap();
     let backup = axcomp::emit::fanuc::ParameterBackup::parse(&backup, "CNC-PARA.TXT").unwrap();

@@ -27,6 +27,7 @@ mod fagor_update;
 mod fanuc;
 mod fanuc_modes;
 mod fanuc_read_note;
+mod fanuc_update;
 mod fanuc_web;
 mod flags;
 mod generated_docs;

@@ -37,7 +37,7 @@ pub use rescale::{Rescaled, rescaled};
 pub use table::{BitsUse, notes, parameters_for, points_in, unknown_bits_note, write};
 use table::{check_turn, finest_for_sections, new_increments, wanted};
 use update::replace_lines;
-pub use update::{check_read_back, update};
+pub use update::{check_read_back, update, update_summary};
 
 use crate::compensate::CompensationTable;
 use crate::emit::{BacklashAdvice, Controller, EmitOptions};

@@ -67,7 +67,7 @@ pub fn notes(table: &CompensationTable, options: &EmitOptions) -> Vec<String> {
     let all = (p.most_positive - p.first_point() + 1) as usize;
     if p.from_backup && table.positions.len() * 2 < all {
         notes.push(format!(
-            "Fanuc: the test covers {} of the {all} compensation points of axis {} ({} … {} {}); the others keep their old values, which this test does not check",
+            "Fanuc: the test covers {} of the {all} compensation points of axis {} ({} … {} {}); this test does not check the others (an updated file keeps their increments, a new one holds none there: the values at the table's ends continue)",
             table.positions.len(),
             p.axis,
             p.position(p.first_point()),
