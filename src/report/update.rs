@@ -16,7 +16,9 @@
 //! "increments"`): each kept run has `"moved": {"with": -1000.0, "by": [↑,
 //! ↓]}` (the new table's point it continues from, and the change of its
 //! values, in mm), and `"data_lines": {"sections": 25, "changed": 23}` says
-//! how many of the file's lines the update wrote and how many differ.
+//! how many of the file's lines the update wrote and how many differ. A
+//! rotary axis' update has its positions in ° under `kept_deg`,
+//! `measured_deg`, `reference_deg`, `dropped_deg` and `added_deg`.
 
 use serde::Serialize;
 
