@@ -38,7 +38,7 @@ const SECTIONS: &[(&str, &str, &str)] = &[
     (
         "diagnose",
         "`axcomp diagnose --json`",
-        "src/report/diagnose.rs",
+        "src/report/diagnose/mod.rs",
     ),
     (
         "tolerance",
