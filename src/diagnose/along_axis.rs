@@ -100,7 +100,7 @@ fn level_columns(problem: &Problem, levels: &[Level], shape: Shape) -> Vec<Vec<f
         positions
             .map(|(target_index, target_mm)| Reading {
                 target_index,
-                target_mm,
+                target: target_mm,
                 direction: Direction::Up,
                 run: 0,
                 run_index: 0,

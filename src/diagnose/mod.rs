@@ -813,7 +813,7 @@ pub(crate) mod tests {
             readings: vec![ReadingResidual {
                 reading: Reading {
                     target_index: 0,
-                    target_mm: 90.0,
+                    target: 90.0,
                     direction: Direction::Up,
                     run: 1,
                     run_index: 0,

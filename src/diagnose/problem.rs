@@ -160,7 +160,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
             let Some(value) = value else { continue };
             readings.push(Reading {
                 target_index,
-                target_mm,
+                target: target_mm,
                 direction: run.direction,
                 run: run.number,
                 run_index,

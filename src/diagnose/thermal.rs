@@ -178,7 +178,7 @@ mod tests {
     fn reading(target_index: usize, direction: Direction, time_h: f64) -> Reading {
         Reading {
             target_index,
-            target_mm: 100.0 * target_index as f64,
+            target: 100.0 * target_index as f64,
             direction,
             run: 1,
             run_index: 0,

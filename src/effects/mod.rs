@@ -49,8 +49,8 @@ pub use scale::Scale;
 pub struct Reading {
     /// Index of its target.
     pub target_index: usize,
-    /// Target, mm.
-    pub target_mm: f64,
+    /// Target, in the axis' unit: mm, or ° on a rotary axis.
+    pub target: f64,
     /// ↑ or ↓.
     pub direction: Direction,
     /// Run number within its direction.
@@ -483,7 +483,7 @@ impl Effect {
                 .unwrap_or(0);
             let reading = Reading {
                 target_index,
-                target_mm: targets_mm[target_index],
+                target: targets_mm[target_index],
                 direction: run.direction,
                 run: run.number,
                 run_index,

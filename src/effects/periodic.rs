@@ -42,7 +42,7 @@ impl Periodic {
 
 impl Model for Periodic {
     fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
-        self.at_um(reading.target_mm)
+        self.at_um(reading.target)
     }
 
     fn systematic_um(&self, x_mm: f64, _: Direction, _: f64) -> Option<f64> {
@@ -136,11 +136,11 @@ impl Fit for Periodic {
         vec![
             readings
                 .iter()
-                .map(|r| (TAU * r.target_mm / period).sin())
+                .map(|r| (TAU * r.target / period).sin())
                 .collect(),
             readings
                 .iter()
-                .map(|r| (TAU * r.target_mm / period).cos())
+                .map(|r| (TAU * r.target / period).cos())
                 .collect(),
         ]
     }

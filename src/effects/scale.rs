@@ -23,10 +23,7 @@ const SCALE: OneNumber = OneNumber {
 
 impl Model for Scale {
     fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
-        per_m_over_mm(
-            self.scale_um_per_m,
-            reading.target_mm - line.first_target_mm,
-        )
+        per_m_over_mm(self.scale_um_per_m, reading.target - line.first_target_mm)
     }
 
     fn systematic_um(&self, x_mm: f64, _: Direction, first_target_mm: f64) -> Option<f64> {
@@ -75,7 +72,7 @@ impl Fit for Scale {
     const POSITIONAL: bool = true;
 
     fn columns(_: Shape, readings: &[Reading], line: &Line<'_>) -> Vec<Vec<f64>> {
-        column(readings, |r| mm_to_m(r.target_mm - line.first_target_mm))
+        column(readings, |r| mm_to_m(r.target - line.first_target_mm))
     }
 
     fn from_fit(_: Shape, coefficients: &[f64], _: &Line<'_>) -> Scale {

@@ -3,7 +3,7 @@ use super::*;
 fn reading(target_mm: f64, direction: Direction, run: u32, time_h: f64) -> Reading {
     Reading {
         target_index: 0,
-        target_mm,
+        target: target_mm,
         direction,
         run,
         run_index: 0,

@@ -648,7 +648,7 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
             .readings
             .iter()
             .filter(|r| r.reading.direction == direction)
-            .map(|r| (r.reading.target_mm, r.residual))
+            .map(|r| (r.reading.target, r.residual))
             .collect();
         all.push(series(
             Some(format!("residual {direction}")),
@@ -705,12 +705,12 @@ fn mean_per_target(
         .iter()
         .filter(|r| r.reading.direction == direction)
     {
-        match sums.iter_mut().find(|(x, _, _)| *x == r.reading.target_mm) {
+        match sums.iter_mut().find(|(x, _, _)| *x == r.reading.target) {
             Some(entry) => {
                 entry.1 += value(r);
                 entry.2 += 1;
             }
-            None => sums.push((r.reading.target_mm, value(r), 1)),
+            None => sums.push((r.reading.target, value(r), 1)),
         }
     }
     sums.sort_by(|a, b| a.0.total_cmp(&b.0));
