@@ -53,13 +53,14 @@ pub fn update_summary(
         with: x,
         by: Direction::BOTH.map(|d| new.value_at(x, d) - old.value_at(x, d)),
     };
-    let mut kept: Vec<KeptRange> = Vec::new();
+    let (mut kept, mut kept_points): (Vec<KeptRange>, Vec<f64>) = (Vec::new(), Vec::new());
     for &x in &old.positions {
         let end = match x {
             x if x < first - 1e-6 => first,
             x if x > last + 1e-6 => last,
             _ => continue,
         };
+        kept_points.push(x);
         match kept.last_mut() {
             // One run a side: every point of it moved as its end did.
             Some(run) if (run.first < first) == (x < first) => {
@@ -75,15 +76,7 @@ pub fn update_summary(
         }
     }
     Ok(UpdateSummary {
-        kept_points: kept
-            .iter()
-            .flat_map(|run| {
-                old.positions
-                    .iter()
-                    .copied()
-                    .filter(move |x| *x >= run.first - 1e-6 && *x <= run.last + 1e-6)
-            })
-            .collect(),
+        kept_points,
         kept,
         kept_as: KeptAs::Increments,
         data_lines: Some(DataLines {
