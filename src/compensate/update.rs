@@ -86,7 +86,7 @@ pub struct DataLines {
 /// the axis' unit (`kind`: mm, or °).
 #[derive(Clone, Debug, PartialEq)]
 pub struct UpdateSummary {
-    /// Old points outside the measured range, kept with their old values, by runs.
+    /// Old points outside the measured range, kept (their values, or their increments: `kept_as`), by runs.
     pub kept: Vec<KeptRange>,
     /// The same points one by one.
     pub kept_points: Vec<f64>,
@@ -114,14 +114,14 @@ pub struct UpdateSummary {
 
 impl UpdatePlan {
     /// The plan of an update of `existing` by a test of an axis of `kind`
-    /// over `targets_mm` (in its unit), or why it cannot be made: the table
+    /// over `targets` (in its unit), or why it cannot be made: the table
     /// and the reference must be of an axis of that kind, and the reference
     /// (`given`, else the existing table's zero) must lie inside the measured
     /// range, where the test measured the residual.
     pub fn new(
         existing: &CompensationTable,
         kind: AxisKind,
-        targets_mm: &[f64],
+        targets: &[f64],
         given_reference: Option<Position>,
     ) -> Result<UpdatePlan, CompensateError> {
         if existing.kind != kind {
@@ -134,7 +134,7 @@ impl UpdatePlan {
         let given_reference = given_reference
             .map(|given| check_kind("reference", given, kind))
             .transpose()?;
-        let measured = (targets_mm[0], targets_mm[targets_mm.len() - 1]);
+        let measured = (targets[0], targets[targets.len() - 1]);
         let reference = given_reference.unwrap_or(existing.reference);
         if reference < measured.0 - 1e-9 || reference > measured.1 + 1e-9 {
             return Err(CompensateError::UpdateReference {
