@@ -120,7 +120,10 @@ impl AxisKind {
 
     /// What follows a position in a sentence: ` mm`, or `°` set close.
     pub fn unit_after_number(self) -> &'static str {
-        unit_after_number(self)
+        match self {
+            AxisKind::Linear => " mm",
+            AxisKind::Rotary => "°",
+        }
     }
 
     /// A bare number in this axis' unit (a target, a deviation, a figure),
@@ -219,20 +222,12 @@ impl Run {
 /// What differs where two files have as many targets and the same ends:
 /// the first target that is elsewhere.
 fn differing_target_text(difference: Option<(usize, f64, f64)>, kind: AxisKind) -> String {
-    let unit = unit_after_number(kind);
+    let unit = kind.unit_after_number();
     difference.map_or_else(String::new, |(number, first, other)| {
         format!(
             ": target {number} is at {first:?}{unit} in the first and {other:?}{unit} in the second"
         )
     })
-}
-
-/// What follows a position in a sentence: ` mm`, or `°` set close.
-fn unit_after_number(kind: AxisKind) -> &'static str {
-    match kind {
-        AxisKind::Linear => " mm",
-        AxisKind::Rotary => "°",
-    }
 }
 
 /// Why a set of targets and runs is not a valid measurement.
@@ -242,7 +237,7 @@ pub enum MeasurementError {
     #[error(
         "cannot join the files: targets differ ({count} targets {first:?}…{last:?}{unit} against {other_count} targets {other_first:?}…{other_last:?}{unit}){}",
         differing_target_text(*first_difference, *kind),
-        unit = unit_after_number(*kind)
+        unit = kind.unit_after_number()
     )]
     TargetsDiffer {
         /// Linear or rotary (both files): the unit of the positions.
