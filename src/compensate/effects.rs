@@ -116,8 +116,8 @@ mod tests {
     #[test]
     fn the_periodic_error_is_put_back_at_the_finer_points_by_hand() {
         let effects = [Effect::Periodic(Periodic {
-            period_mm: 5.0,
-            amplitude_um: 2.0,
+            period: 5.0,
+            amplitude: 2.0,
             phase_rad: 0.0,
         })];
         assert_eq!(finest_step_mm(&effects), Some(0.5));

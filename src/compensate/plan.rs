@@ -369,7 +369,7 @@ mod tests {
 
     #[test]
     fn a_reversal_makes_it_bidirectional_where_the_controller_takes_it() {
-        let effects = [Effect::Reversal(Reversal { b_um: -3.0 })];
+        let effects = [Effect::Reversal(Reversal { b: -3.0 })];
         let bidirectional = linear_plan(
             &effects,
             &ITNC,
@@ -415,8 +415,8 @@ mod tests {
         // Period 5.3 mm: a tenth is 0.53 mm, a step the iTNC writes exactly.
         let effects = [
             Effect::Periodic(Periodic {
-                period_mm: 5.3,
-                amplitude_um: 1.0,
+                period: 5.3,
+                amplitude: 1.0,
                 phase_rad: 0.0,
             }),
             Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),

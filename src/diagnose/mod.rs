@@ -53,11 +53,14 @@ pub use angular_profile::AngularProfile;
 use crate::compensate::CompensateError;
 use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
-use crate::effects::{Context, Effect, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape};
+use crate::effects::{
+    Context, Effect, EffectIn, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape, held_angle,
+    reversal,
+};
 use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
 use crate::measurement::{AxisKind, ByKind, Direction, Measurement};
 use crate::together::NotTogether;
-use crate::units::{Deg, Mm, Um, millideg_to_deg, mm_to_um};
+use crate::units::{Deg, Mm, Um, mm_to_um};
 use along_axis::{AlongAxisSelection, Background, select_along_axis};
 use between_runs::{select_between_runs, select_reversal};
 use findings::{accepted_effect, context, figures, stats};
@@ -365,6 +368,10 @@ pub struct DiagnosisIn<P, D> {
     /// Why each accepted effect was accepted, in the order of
     /// [`Diagnosis::accepted`].
     pub evidence: Vec<Evidence<D>>,
+    /// Each accepted effect's parameters that are positions or deviations,
+    /// with their uncertainties ([`Effect::typed`]), in the same order;
+    /// `None` for a kind that has none (scale, drift, Abbe).
+    pub effects: Vec<Option<EffectIn<P, D>>>,
     /// What none of the effects explains.
     pub unexplained: Unexplained<P, D>,
     /// Every reading of the re-test, as [`Diagnosis::readings`].
@@ -380,6 +387,11 @@ impl<P, D> DiagnosisIn<P, D> {
             residual_after: self.residual_after.map(convert),
             noise: convert(self.noise),
             evidence: self.evidence.into_iter().map(|e| e.map(convert)).collect(),
+            effects: self
+                .effects
+                .into_iter()
+                .map(|effect| effect.map(|effect| effect.map_deviations(convert)))
+                .collect(),
             unexplained: self.unexplained.map(|place| place, convert),
             readings: self.readings.into_iter().map(|r| r.map(convert)).collect(),
         }
@@ -389,7 +401,8 @@ impl<P, D> DiagnosisIn<P, D> {
 impl Diagnosis {
     /// Its numbers with their units as types: on a linear axis positions in
     /// [`Mm`] and deviations in [`Um`], on a rotary one both in [`Deg`] (the
-    /// deviations held in m°). A rotary axis' residual is no `Um`:
+    /// deviations held in m°), and so are the accepted effects' parameters
+    /// ([`DiagnosisIn::effects`]). A rotary axis' residual is no `Um`:
     /// ```
     /// # fn f(diagnosis: &axcomp::diagnose::Diagnosis) {
     /// use axcomp::units::Deg;
@@ -408,14 +421,20 @@ impl Diagnosis {
     /// ```
     pub fn typed(&self) -> ByKind<DiagnosisIn<Mm, Um>, DiagnosisIn<Deg, Deg>> {
         match self.kind {
-            AxisKind::Linear => ByKind::Linear(self.in_units(Mm, Um)),
-            AxisKind::Rotary => {
-                ByKind::Rotary(self.in_units(Deg, |millideg| Deg(millideg_to_deg(millideg))))
-            }
+            AxisKind::Linear => ByKind::Linear(self.in_units(Mm, Um, ByKind::linear)),
+            AxisKind::Rotary => ByKind::Rotary(self.in_units(Deg, held_angle, ByKind::rotary)),
         }
     }
 
-    fn in_units<P, D>(&self, position: fn(f64) -> P, deviation: fn(f64) -> D) -> DiagnosisIn<P, D> {
+    /// Its numbers with positions by `position`, deviations by `deviation`,
+    /// and the effects' parameters in the branch `branch` takes of
+    /// [`Effect::typed`] (the same units).
+    fn in_units<P, D>(
+        &self,
+        position: fn(f64) -> P,
+        deviation: fn(f64) -> D,
+        branch: fn(TypedEffect) -> Option<EffectIn<P, D>>,
+    ) -> DiagnosisIn<P, D> {
         DiagnosisIn {
             residual_before: self.residual_before.map(deviation),
             residual_after: self.residual_after.map(deviation),
@@ -425,11 +444,24 @@ impl Diagnosis {
                 .iter()
                 .map(|accepted| accepted.evidence.map(deviation))
                 .collect(),
+            effects: self
+                .accepted
+                .iter()
+                .map(|accepted| {
+                    accepted
+                        .effect
+                        .typed(self.kind, &accepted.uncertainty)
+                        .and_then(branch)
+                })
+                .collect(),
             unexplained: self.unexplained.clone().map(position, deviation),
             readings: self.readings.iter().map(|r| r.map(deviation)).collect(),
         }
     }
 }
+
+/// An effect's parameters typed by the axis' kind ([`Effect::typed`]).
+type TypedEffect = ByKind<EffectIn<Mm, Um>, EffectIn<Deg, Deg>>;
 
 /// Why a diagnosis cannot be made.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -507,11 +539,11 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
 
     let mut accepted: Vec<AcceptedEffect> = Vec::new();
     if let Some(r) = reversal {
-        let effect = Effect::Reversal(Reversal { b_um: r.b_um });
+        let effect = Effect::Reversal(Reversal { b: r.b_um });
         accepted.push(AcceptedEffect {
             explanation: effect.explanation(&context),
             effect,
-            uncertainty: vec![("B_um", r.standard_error_um)],
+            uncertainty: vec![(reversal::B_KEY, r.standard_error_um)],
             evidence: r.evidence,
             warnings: Vec::new(),
         });
@@ -631,7 +663,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
                 mm_to_um(measured_mm)
             };
             found.explanation = found.effect.explanation(&context);
-            if context.deviation(reversal.b_um) != context.deviation(shown_um) {
+            if context.deviation(reversal.b) != context.deviation(shown_um) {
                 let why = if others.is_empty() {
                     "it weighs each target by its readings, where B̄ is the plain mean of the targets' reversals".to_string()
                 } else {
@@ -642,7 +674,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
                 };
                 found.explanation.push_str(&format!(
                     " The fit's B = {} differs from that {}: {why}.",
-                    context.deviation(reversal.b_um),
+                    context.deviation(reversal.b),
                     if with_prediction { "change" } else { "B̄" },
                 ));
             }
@@ -756,7 +788,7 @@ pub(crate) mod tests {
             effect: Effect::OutlierRun(OutlierRun {
                 run: 1,
                 direction: Direction::Down,
-                offset_um: 10.0,
+                offset: 10.0,
             }),
             uncertainty: vec![("offset_um", 1.0)],
             evidence: Evidence {

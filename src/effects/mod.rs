@@ -30,6 +30,7 @@ pub mod outlier_run;
 pub mod periodic;
 pub mod reversal;
 pub mod scale;
+pub mod typed;
 
 use serde::Deserialize;
 
@@ -43,6 +44,7 @@ pub use outlier_run::OutlierRun;
 pub use periodic::Periodic;
 pub use reversal::Reversal;
 pub use scale::Scale;
+pub use typed::{EffectIn, held_angle};
 
 /// One reading, as the effects see it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -197,11 +199,16 @@ pub struct FitSummary<'a> {
 /// One parameter as it is shown and saved.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parameter {
-    /// Its key in JSON and TOML, with the unit (`B_um`, `period_mm`, `run`).
+    /// Its key in the effects file and in a linear axis' JSON, with the
+    /// linear unit (`B_um`, `period_mm`, `run`): both are written for a
+    /// linear axis only. On a rotary axis the key only names the parameter
+    /// (among a fit's [`Uncertainty`]); its value and the keys a report
+    /// writes come from [`Effect::typed`].
     pub key: &'static str,
     /// Its name in a sentence or a table (`B`, `period`, `run`).
     pub name: &'static str,
-    /// The unit of a number as a reader writes it (`µm`, `µm/m`), empty for a run.
+    /// The unit of a number on a linear axis, as a reader writes it (`µm`,
+    /// `µm/m`), empty for a run.
     pub unit: &'static str,
     /// Its value.
     pub value: ParameterValue,
@@ -255,7 +262,9 @@ impl OneNumber {
     }
 }
 
-/// The standard uncertainty of one parameter, by its key.
+/// The standard uncertainty of one parameter, by its key
+/// ([`Parameter::key`]: a linear axis' key, the parameter's name on a rotary
+/// one), in the parameter's unit.
 pub type Uncertainty = (&'static str, f64);
 
 /// What an effect does to a compensation table (`compensate::plan`).

@@ -6,26 +6,33 @@ use super::{Context, Fit, Line, Model, Parameter, Reading, Shape, TableRole, col
 use crate::measurement::Direction;
 use crate::units::um_to_mm;
 
-/// Reversal B = ↑ − ↓, µm.
+/// B's key in the effects file and in a linear axis' JSON, and among a
+/// fit's uncertainties ([`super::Uncertainty`]); it names µm, the unit of B
+/// on a linear axis, the only one these files and keys are written for.
+pub const B_KEY: &str = "B_um";
+
+/// Reversal B = ↑ − ↓, in the axis' deviation unit: µm, or m° (1/1000 °)
+/// on a rotary axis ([`Reversal::typed`]).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Reversal {
-    /// B = ↑ − ↓, µm.
+    /// B = ↑ − ↓: µm, or m° on a rotary axis. The effects file (a linear
+    /// axis' only) keys it `B_um`.
     #[serde(rename = "B_um")]
-    pub b_um: f64,
+    pub b: f64,
 }
 
 impl Model for Reversal {
     fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
-        reading.direction.reversal_share(self.b_um)
+        reading.direction.reversal_share(self.b)
     }
 
     fn systematic_um(&self, _: f64, direction: Direction, _: f64) -> Option<f64> {
-        Some(direction.reversal_share(self.b_um))
+        Some(direction.reversal_share(self.b))
     }
 
     fn in_table(&self) -> TableRole {
-        TableRole::Bidirectional { b_um: self.b_um }
+        TableRole::Bidirectional { b_um: self.b }
     }
 
     fn explanation(&self, context: &Context) -> String {
@@ -33,7 +40,7 @@ impl Model for Reversal {
         // B̄), else the fitted B: the sentence's numbers are the output's own.
         let (predicted_um, measured_um) = context.retest_mean_reversal_um.unwrap_or_else(|| {
             let before_um = context.first_test_reversal_um.unwrap_or(0.0);
-            (before_um, before_um + self.b_um)
+            (before_um, before_um + self.b)
         });
         let change_um = match context.first_test_reversal_um {
             Some(_) => measured_um - predicted_um,
@@ -67,11 +74,11 @@ impl Model for Reversal {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        vec![Parameter::number("B_um", "B", "µm", self.b_um)]
+        vec![Parameter::number(B_KEY, "B", "µm", self.b)]
     }
 
     fn label(&self, number: &dyn Fn(f64) -> String) -> String {
-        format!("reversal B = {} µm", number(self.b_um))
+        format!("reversal B = {} µm", number(self.b))
     }
 }
 
@@ -84,8 +91,6 @@ impl Fit for Reversal {
     }
 
     fn from_fit(_: Shape, coefficients: &[f64], _: &Line<'_>) -> Reversal {
-        Reversal {
-            b_um: coefficients[0],
-        }
+        Reversal { b: coefficients[0] }
     }
 }

@@ -21,20 +21,20 @@ const ORIGIN: Line<'static> = Line {
 /// One effect of every kind (the registry's order).
 fn one_of_each() -> Vec<Effect> {
     vec![
-        Effect::Reversal(Reversal { b_um: -3.0 }),
+        Effect::Reversal(Reversal { b: -3.0 }),
         Effect::Scale(Scale {
             scale_um_per_m: 11.5,
         }),
         Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),
         Effect::Periodic(Periodic {
-            period_mm: 5.0,
-            amplitude_um: 1.25,
+            period: 5.0,
+            amplitude: 1.25,
             phase_rad: 0.5,
         }),
         Effect::OutlierRun(OutlierRun {
             run: 2,
             direction: Direction::Down,
-            offset_um: 4.5,
+            offset: 4.5,
         }),
         Effect::Abbe(Abbe {
             offset_mm: 100.0,
@@ -91,7 +91,7 @@ fn columns_and_values_agree() {
 fn values_by_hand() {
     let up = reading(250.0, Direction::Up, 1, 0.25);
     assert_eq!(
-        Effect::Reversal(Reversal { b_um: -3.0 }).value_um(&up, &ORIGIN),
+        Effect::Reversal(Reversal { b: -3.0 }).value_um(&up, &ORIGIN),
         -1.5
     );
     let from_50 = Line {
@@ -110,8 +110,8 @@ fn values_by_hand() {
         1.0
     );
     let periodic = Effect::Periodic(Periodic {
-        period_mm: 1000.0,
-        amplitude_um: 2.0,
+        period: 1000.0,
+        amplitude: 2.0,
         phase_rad: 0.0,
     });
     assert!(
