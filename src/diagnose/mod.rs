@@ -651,7 +651,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             .filter(|a| {
                 !matches!(a.effect, Effect::Reversal(_)) && !a.effect.kind().is_positional()
             })
-            .map(|a| a.effect.model().label(&|v| format!("{v:.2}")))
+            .map(|a| a.effect.model().label(&context, &|v| format!("{v:.2}")))
             .collect();
         for found in accepted.iter_mut() {
             let Effect::Reversal(reversal) = found.effect else {

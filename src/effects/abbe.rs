@@ -55,7 +55,7 @@ impl Model for Abbe {
         ]
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, _: &Context, number: &dyn Fn(f64) -> String) -> String {
         format!("Abbe, offset {} mm", number(self.offset_mm))
     }
 }

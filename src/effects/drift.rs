@@ -120,7 +120,7 @@ impl Model for Drift {
         parameter.parameters(rate)
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, _: &Context, number: &dyn Fn(f64) -> String) -> String {
         let (rate, parameter) = self.rate();
         parameter.label(Self::NAME, rate, number)
     }

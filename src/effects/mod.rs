@@ -155,12 +155,14 @@ pub struct Context {
 /// writes it in `unit` with `decimals`: `2.40 µm`, or in arc-seconds `8.64″`
 /// (`41.89 µrad`).
 pub fn deviation_text(unit: DeviationUnit, value_um: f64, decimals: usize) -> String {
-    let suffix = unit.suffix();
+    format!("{:.decimals$}{}", in_unit(unit, value_um), unit.suffix())
+}
+
+/// A deviation held in µm (m° on a rotary axis) in `unit`.
+fn in_unit(unit: DeviationUnit, value_um: f64) -> f64 {
     match unit {
-        DeviationUnit::Micrometre => format!("{value_um:.decimals$}{suffix}"),
-        DeviationUnit::Angle(angle) => {
-            format!("{:.decimals$}{suffix}", angle.from_deg(um_to_mm(value_um)))
-        }
+        DeviationUnit::Micrometre => value_um,
+        DeviationUnit::Angle(angle) => angle.from_deg(um_to_mm(value_um)),
     }
 }
 
@@ -168,6 +170,20 @@ impl Context {
     /// A deviation as a sentence writes it ([`deviation_text`], 2 decimals).
     pub fn deviation(&self, value_um: f64) -> String {
         deviation_text(self.kind.deviation_unit(self.angle), value_um, 2)
+    }
+
+    /// A deviation held in µm (m° on a rotary axis) for a legend label,
+    /// written by `number` in the unit the sentences say it in: `2.5 µm`,
+    /// `9″`.
+    pub fn deviation_label(&self, value_um: f64, number: &dyn Fn(f64) -> String) -> String {
+        let unit = self.kind.deviation_unit(self.angle);
+        format!("{}{}", number(in_unit(unit, value_um)), unit.suffix())
+    }
+
+    /// A position or a length held in mm (° on a rotary axis) for a legend
+    /// label, written by `number`: `5 mm`, `180°`.
+    pub fn position_label(&self, value_mm: f64, number: &dyn Fn(f64) -> String) -> String {
+        format!("{}{}", number(value_mm), self.kind.unit_after_number())
     }
 
     /// A position or a length held in mm (° on a rotary axis): `18 mm`, `18°`.
@@ -315,8 +331,10 @@ pub trait Model {
     fn parameters(&self) -> Vec<Parameter>;
 
     /// A short legend label with the fitted parameters, each number written
-    /// by `number` (the plot's own tick format).
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String;
+    /// by `number` (the plot's own tick format) in the unit `context` says
+    /// it in (a rotary axis' deviations in ″ or µrad, its positions in °;
+    /// the kinds looked for on a linear axis only say mm and µm).
+    fn label(&self, context: &Context, number: &dyn Fn(f64) -> String) -> String;
 
     /// A check beyond the types, for an effect read from a file.
     fn check(&self) -> Result<(), String> {

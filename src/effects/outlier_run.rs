@@ -94,12 +94,12 @@ impl Model for OutlierRun {
         ]
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, context: &Context, number: &dyn Fn(f64) -> String) -> String {
         format!(
-            "run {}{} offset {} µm",
+            "run {}{} offset {}",
             self.run,
             self.direction,
-            number(self.offset)
+            context.deviation_label(self.offset, number)
         )
     }
 }

@@ -100,11 +100,11 @@ impl Model for Periodic {
         ]
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, context: &Context, number: &dyn Fn(f64) -> String) -> String {
         format!(
-            "periodic {} µm, period {} mm",
-            number(self.amplitude),
-            number(self.period)
+            "periodic {}, period {}",
+            context.deviation_label(self.amplitude, number),
+            context.position_label(self.period, number)
         )
     }
 

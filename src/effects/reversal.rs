@@ -77,8 +77,8 @@ impl Model for Reversal {
         vec![Parameter::number(B_KEY, "B", "µm", self.b)]
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
-        format!("reversal B = {} µm", number(self.b))
+    fn label(&self, context: &Context, number: &dyn Fn(f64) -> String) -> String {
+        format!("reversal B = {}", context.deviation_label(self.b, number))
     }
 }
 

@@ -62,7 +62,7 @@ impl Model for Scale {
         SCALE.parameters(self.scale_um_per_m)
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, _: &Context, number: &dyn Fn(f64) -> String) -> String {
         SCALE.label(Self::NAME, self.scale_um_per_m, number)
     }
 }

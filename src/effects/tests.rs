@@ -219,7 +219,7 @@ fn every_kind_labels_itself_with_the_numbers_it_is_given() {
     let two_decimals = |v: f64| format!("{v:.2}");
     let labels: Vec<String> = one_of_each()
         .iter()
-        .map(|e| e.model().label(&two_decimals))
+        .map(|e| e.model().label(&Context::default(), &two_decimals))
         .collect();
     assert_eq!(labels[0], "reversal B = -3.00 µm");
     assert_eq!(labels[3], "periodic 1.25 µm, period 5.00 mm");
@@ -249,8 +249,52 @@ fn one_number_kinds_show_their_parameter_and_label() {
         drift.parameters(),
         vec![Parameter::number("rate_um_per_h", "rate", "µm/h", 2.0)]
     );
-    assert_eq!(scale.model().label(&two_decimals), "scale 11.50 µm/m");
-    assert_eq!(drift.model().label(&two_decimals), "drift 2.00 µm/h");
+    let linear = Context::default();
+    assert_eq!(
+        scale.model().label(&linear, &two_decimals),
+        "scale 11.50 µm/m"
+    );
+    assert_eq!(
+        drift.model().label(&linear, &two_decimals),
+        "drift 2.00 µm/h"
+    );
+}
+
+/// A rotary axis' effects label themselves in its units: held in m° and °,
+/// said in ″ (or µrad) and °, never in µm or mm.
+#[test]
+fn a_rotary_axis_effects_label_themselves_in_its_units() {
+    let two_decimals = |v: f64| format!("{v:.2}");
+    let rotary = |angle| Context {
+        kind: AxisKind::Rotary,
+        angle,
+        ..Context::default()
+    };
+    let label = |effect: Effect, angle| effect.model().label(&rotary(angle), &two_decimals);
+    // 10 m° = 0.01° = 36″ = 0.01·π/180·10⁶ µrad = 174.53 µrad.
+    let reversal = Effect::Reversal(Reversal { b: 10.0 });
+    assert_eq!(
+        label(reversal.clone(), AngleUnit::Arcsec),
+        "reversal B = 36.00″"
+    );
+    assert_eq!(label(reversal, AngleUnit::Urad), "reversal B = 174.53 µrad");
+    // 1.25 m° = 4.5″, twice per revolution.
+    let periodic = Effect::Periodic(Periodic {
+        period: 180.0,
+        amplitude: 1.25,
+        phase_rad: 0.0,
+    });
+    assert_eq!(
+        label(periodic, AngleUnit::Arcsec),
+        "periodic 4.50″, period 180.00°"
+    );
+    // 4.5 m° = 16.2″.
+    let run = Effect::OutlierRun(OutlierRun {
+        run: 2,
+        direction: Direction::Down,
+        offset: 4.5,
+    });
+    assert_eq!(label(run, AngleUnit::Arcsec), "run 2↓ offset 16.20″");
 }
 
 /// A drift per run (a test that records no times) grows by its rate each

@@ -11,7 +11,7 @@
 use crate::compensate::CompensationTable;
 use crate::compensate::retest::KnownError;
 use crate::diagnose::{Diagnosis, ReadingResidual};
-use crate::effects::{Effect, Line};
+use crate::effects::{Context, Effect, Line};
 use crate::emit::Controller;
 use crate::error::Warning;
 use crate::evaluate::{DirectionStats, Evaluation, Standard, StandardFigure, TargetStats};
@@ -765,8 +765,13 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
     }
 }
 
-/// A short legend label with the fitted parameters, in the plot font's characters.
+/// A short legend label with the fitted parameters of a linear axis' effect
+/// (mm and µm), in the plot font's characters.
 pub fn effect_label(effect: &Effect) -> String {
     let signed = |v: f64| crate::report::chart::tick_label((v * 100.0).round() / 100.0);
-    effect.model().label(&signed)
+    let linear = Context {
+        kind: AxisKind::Linear,
+        ..Context::default()
+    };
+    effect.model().label(&linear, &signed)
 }

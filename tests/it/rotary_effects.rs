@@ -1,0 +1,70 @@
+//! A rotary axis' effects say their values in the axis' units: every
+//! sentence of a rotary diagnosis in ″ and °, never in µm or mm, including
+//! where one effect names another.
+
+use axcomp::cycle::{CycleTiming, reading_times_h};
+use axcomp::diagnose::{DiagnoseInput, diagnose};
+use axcomp::effects::{Effect, OutlierRun, Reversal};
+use axcomp::evaluate::ISO_230_2;
+use axcomp::measurement::Direction;
+use axcomp::read::read_path;
+
+use crate::util::test_data;
+
+/// The synthetic rotary test with a reversal of 10 m° (36″) and run 1↑ put
+/// 5 m° (18″) off the others added: the reversal fitted with that run
+/// taken out differs from the B̄ of the figures, which include it, and the
+/// reversal's sentence says so, naming the run with the offset its own
+/// sentence gives, in ″.
+#[test]
+fn a_rotary_reversal_names_an_outlier_run_in_arc_seconds() {
+    let read = read_path(&test_data("rotary/c-outlier-run.csv"), None).unwrap();
+    let (times, _) = reading_times_h(&read.measurement, CycleTiming::ASSUMED);
+    let mut after = read.measurement;
+    for effect in [
+        Effect::Reversal(Reversal { b: 10.0 }),
+        Effect::OutlierRun(OutlierRun {
+            run: 1,
+            direction: Direction::Up,
+            offset: 5.0,
+        }),
+    ] {
+        after = effect.added_to(&after, &times).unwrap();
+    }
+    let diagnosis = diagnose(&DiagnoseInput {
+        angle: Default::default(),
+        after: &after,
+        before: None,
+        table: None,
+        backlash_set: false,
+        angular: None,
+        timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
+        known_periods: &[],
+    })
+    .unwrap();
+    let sentence = |kind: &str| {
+        diagnosis
+            .accepted
+            .iter()
+            .find(|a| a.effect.kind().name() == kind)
+            .map(|a| a.explanation.as_str())
+            .unwrap_or_else(|| panic!("no {kind}: {:?}", diagnosis.accepted))
+    };
+    let (reversal, outlier) = (sentence("reversal"), sentence("outlier-run"));
+    // "Run 1↑ sits +17.88″ off the others …": the offset as said there.
+    let offset = outlier
+        .strip_prefix("Run 1↑ sits +")
+        .and_then(|rest| rest.split_once('″'))
+        .map(|(number, _)| number)
+        .unwrap_or_else(|| panic!("{outlier}"));
+    assert!(
+        reversal.contains(&format!(
+            "fitted with the run 1↑ offset {offset}″ taken out"
+        )),
+        "{reversal}"
+    );
+    for text in [reversal, outlier] {
+        assert!(!text.contains("µm") && !text.contains(" mm"), "{text}");
+    }
+}
