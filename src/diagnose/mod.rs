@@ -643,7 +643,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         (figures.predicted.b_mean, figures.measured.b_mean)
     {
         let context = Context {
-            retest_mean_reversal_um: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),
+            retest_mean_reversal: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),
             ..context
         };
         let others: Vec<String> = accepted
@@ -683,7 +683,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // With a first test the prediction carries its reversal (what the table
     // leaves of it): a reversal found is a change, and none found is none.
     if reversal.is_none()
-        && let Some(first_um) = context.first_test_reversal_um
+        && let Some(first_um) = context.first_test_reversal
         && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
     {
         let predicted_um = figures.predicted.b_mean.map(mm_to_um);

@@ -160,13 +160,13 @@ mod tests {
         Context {
             kind: AxisKind::Linear,
             angle: Default::default(),
-            table_step_mm: None,
-            target_spacing_mm: None,
+            table_step: None,
+            target_spacing: None,
             expansion_coefficient_ppm_per_k: None,
             material_change_k: None,
             time_assumed: false,
-            first_test_reversal_um: None,
-            retest_mean_reversal_um: None,
+            first_test_reversal: None,
+            retest_mean_reversal: None,
         }
     }
 

@@ -124,74 +124,83 @@ impl Shape {
     }
 }
 
-/// Context for the sentence a user reads.
+/// Context for the sentence a user reads. Its positions are in the axis'
+/// unit (mm, or ° on a rotary axis) and its deviations in the effects'
+/// deviation unit (µm, or m°, 1/1000 °, on a rotary axis); the sentences say
+/// them in mm and µm, or ° and ″ (µrad) ([`Context::position`],
+/// [`Context::deviation`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Context {
-    /// Linear or rotary: on a rotary axis the values held as mm and µm are °
-    /// and m° (1/1000 °), and the sentences say ° and ″ ([`Context::deviation`]).
+    /// Linear or rotary: the units of the values below.
     pub kind: AxisKind,
     /// The unit a rotary axis' deviations are said in (″ or µrad).
     pub angle: AngleUnit,
-    /// The table's step, mm, if a regular table was applied.
-    pub table_step_mm: Option<f64>,
-    /// Spacing of the targets, when regular, mm.
-    pub target_spacing_mm: Option<f64>,
+    /// The table's step (mm, or °), if a regular table was applied.
+    pub table_step: Option<f64>,
+    /// Spacing of the targets (mm, or °), when regular.
+    pub target_spacing: Option<f64>,
     /// Expansion coefficient the laser used, ppm/K.
     pub expansion_coefficient_ppm_per_k: Option<f64>,
     /// Material temperature change between the tests, K, if both recorded.
     pub material_change_k: Option<f64>,
     /// Whether the times of the readings are assumed (no recorded duration).
     pub time_assumed: bool,
-    /// The first test's mean reversal B̄, µm, which the prediction carries (a
-    /// reversal found is then the change since that test).
-    pub first_test_reversal_um: Option<f64>,
-    /// The re-test's mean reversal B̄ as predicted and as measured, µm (the
-    /// diagnosis' figures): the sentence says these, and the backlash
-    /// parameter follows the measured one.
-    pub retest_mean_reversal_um: Option<(f64, f64)>,
+    /// The first test's mean reversal B̄ (µm, or m°), which the prediction
+    /// carries (a reversal found is then the change since that test).
+    pub first_test_reversal: Option<f64>,
+    /// The re-test's mean reversal B̄ as predicted and as measured (µm, or
+    /// m°; the diagnosis' figures): the sentence says these, and the
+    /// backlash parameter follows the measured one.
+    pub retest_mean_reversal: Option<(f64, f64)>,
 }
 
-/// A deviation held in µm (m°, 1/1000 °, on a rotary axis) as a sentence
-/// writes it in `unit` with `decimals`: `2.40 µm`, or in arc-seconds `8.64″`
-/// (`41.89 µrad`).
-pub fn deviation_text(unit: DeviationUnit, value_um: f64, decimals: usize) -> String {
-    format!("{:.decimals$}{}", in_unit(unit, value_um), unit.suffix())
+/// A deviation held in the effects' unit (µm, or m°, 1/1000 °, with an
+/// angle `unit`) as a sentence writes it in `unit` with `decimals`:
+/// `2.40 µm`, or in arc-seconds `8.64″` (`41.89 µrad`).
+pub fn deviation_text(unit: DeviationUnit, value: f64, decimals: usize) -> String {
+    format!("{:.decimals$}{}", in_unit(unit, value), unit.suffix())
 }
 
-/// A deviation held in µm (m° on a rotary axis) in `unit`.
-fn in_unit(unit: DeviationUnit, value_um: f64) -> f64 {
+/// A deviation held in µm (with an angle `unit`, m°) in `unit`.
+fn in_unit(unit: DeviationUnit, value: f64) -> f64 {
     match unit {
-        DeviationUnit::Micrometre => value_um,
-        DeviationUnit::Angle(angle) => angle.from_deg(um_to_mm(value_um)),
+        DeviationUnit::Micrometre => value,
+        DeviationUnit::Angle(angle) => angle.from_deg(held_angle(value).0),
     }
 }
 
 impl Context {
-    /// A deviation as a sentence writes it ([`deviation_text`], 2 decimals).
-    pub fn deviation(&self, value_um: f64) -> String {
-        deviation_text(self.kind.deviation_unit(self.angle), value_um, 2)
+    /// A deviation (µm, or m°) as a sentence writes it ([`deviation_text`],
+    /// 2 decimals).
+    pub fn deviation(&self, value: f64) -> String {
+        deviation_text(self.kind.deviation_unit(self.angle), value, 2)
     }
 
-    /// A deviation held in µm (m° on a rotary axis) for a legend label,
-    /// written by `number` in the unit the sentences say it in: `2.5 µm`,
-    /// `9″`.
-    pub fn deviation_label(&self, value_um: f64, number: &dyn Fn(f64) -> String) -> String {
+    /// A deviation (µm, or m°) for a legend label, written by `number` in
+    /// the unit the sentences say it in: `2.5 µm`, `9″`.
+    pub fn deviation_label(&self, value: f64, number: &dyn Fn(f64) -> String) -> String {
         let unit = self.kind.deviation_unit(self.angle);
-        format!("{}{}", number(in_unit(unit, value_um)), unit.suffix())
+        format!("{}{}", number(in_unit(unit, value)), unit.suffix())
     }
 
-    /// A position or a length held in mm (° on a rotary axis) for a legend
-    /// label, written by `number`: `5 mm`, `180°`.
-    pub fn position_label(&self, value_mm: f64, number: &dyn Fn(f64) -> String) -> String {
-        format!("{}{}", number(value_mm), self.kind.unit_after_number())
+    /// A position or a length (mm, or °) for a legend label, written by
+    /// `number`: `5 mm`, `180°`.
+    pub fn position_label(&self, value: f64, number: &dyn Fn(f64) -> String) -> String {
+        format!("{}{}", number(value), self.kind.unit_after_number())
     }
 
-    /// A position or a length held in mm (° on a rotary axis): `18 mm`, `18°`.
-    pub fn position(&self, value_mm: f64, decimals: usize) -> String {
+    /// A deviation (µm, or m°) in the axis' position unit (mm, or °): a
+    /// thousandth of it either way.
+    pub fn deviation_as_position(&self, value: f64) -> f64 {
         match self.kind {
-            AxisKind::Linear => format!("{value_mm:.decimals$} mm"),
-            AxisKind::Rotary => format!("{value_mm:.decimals$}°"),
+            AxisKind::Linear => um_to_mm(value),
+            AxisKind::Rotary => held_angle(value).0,
         }
+    }
+
+    /// A position or a length (mm, or °): `18 mm`, `18°`.
+    pub fn position(&self, value: f64, decimals: usize) -> String {
+        format!("{value:.decimals$}{}", self.kind.unit_after_number())
     }
 }
 
@@ -202,13 +211,13 @@ pub struct FitSummary<'a> {
     pub coefficients: &'a [f64],
     /// Their standard errors.
     pub errors: &'a [f64],
-    /// The stroke, last − first target, mm.
-    pub span_mm: f64,
+    /// The stroke, last − first target (mm, or °).
+    pub span: f64,
     /// Number of readings.
     pub n: usize,
-    /// Spacing of the targets, when regular, mm.
-    pub target_spacing_mm: Option<f64>,
-    /// Linear or rotary (the spacing then in °).
+    /// Spacing of the targets (mm, or °), when regular.
+    pub target_spacing: Option<f64>,
+    /// Linear or rotary: the unit of the span and the spacing.
     pub kind: AxisKind,
 }
 
@@ -286,17 +295,17 @@ pub type Uncertainty = (&'static str, f64);
 /// What an effect does to a compensation table (`compensate::plan`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum TableRole {
-    /// A direction-dependent offset B, µm: a bidirectional table, or the
+    /// A direction-dependent offset B: a bidirectional table, or the
     /// backlash parameter where the controller takes no such table.
     Bidirectional {
-        /// B = ↑ − ↓, µm.
-        b_um: f64,
+        /// B = ↑ − ↓ (µm, or m° on a rotary axis, as [`Reversal::b`]).
+        b: f64,
     },
     /// An error the table's points must follow: put back at each point, the
-    /// points at most `finest_step_mm` apart.
+    /// points at most `finest_step` apart.
     AtPoints {
-        /// The largest step that still follows it, mm.
-        finest_step_mm: f64,
+        /// The largest step that still follows it (mm, or °).
+        finest_step: f64,
     },
     /// Taken out of the table; the note says why.
     TakenOut {

@@ -72,7 +72,7 @@ impl Model for Periodic {
     /// A·(1 − cos(πh/p)) of a sine: under 5 % of A for h ≤ p/10.
     fn in_table(&self) -> TableRole {
         TableRole::AtPoints {
-            finest_step_mm: self.period / 10.0,
+            finest_step: self.period / 10.0,
         }
     }
 
@@ -81,7 +81,7 @@ impl Model for Periodic {
             return self.rotary_explanation(context);
         }
         let table = context
-            .table_step_mm
+            .table_step
             .map(|s| format!("; the table's step of {s} mm cannot follow it"))
             .unwrap_or_default();
         format!(
@@ -131,7 +131,7 @@ impl Periodic {
         // Linear interpolation follows the order within 5 % at a step of
         // period/10 (`in_table`); a coarser table cannot.
         let table = context
-            .table_step_mm
+            .table_step
             .filter(|s| *s > self.period / 10.0)
             .map(|s| format!("; the table's step of {s}° cannot follow it"))
             .unwrap_or_default();
@@ -187,10 +187,10 @@ impl Fit for Periodic {
         let sigma_amplitude =
             ((a * errors[0]).powi(2) + (b * errors[1]).powi(2)).sqrt() / self.amplitude.max(1e-12);
         let noise = sigma_amplitude * (n as f64 / 2.0).sqrt();
-        let sigma_frequency = 6f64.sqrt() * noise
-            / (PI * self.amplitude.max(1e-12) * fit.span_mm * (n as f64).sqrt());
+        let sigma_frequency =
+            6f64.sqrt() * noise / (PI * self.amplitude.max(1e-12) * fit.span * (n as f64).sqrt());
         let mut warnings = Vec::new();
-        match (fit.target_spacing_mm, fit.kind, self.per_revolution()) {
+        match (fit.target_spacing, fit.kind, self.per_revolution()) {
             // Samples N = 360°/spacing per revolution: orders N − k and N + k
             // give the same readings as k.
             (Some(spacing), AxisKind::Rotary, Some(k)) => {

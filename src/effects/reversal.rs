@@ -4,7 +4,6 @@ use serde::Deserialize;
 
 use super::{Context, Fit, Line, Model, Parameter, Reading, Shape, TableRole, column};
 use crate::measurement::Direction;
-use crate::units::um_to_mm;
 
 /// B's key in the effects file and in a linear axis' JSON, and among a
 /// fit's uncertainties ([`super::Uncertainty`]); it names µm, the unit of B
@@ -32,22 +31,23 @@ impl Model for Reversal {
     }
 
     fn in_table(&self) -> TableRole {
-        TableRole::Bidirectional { b_um: self.b }
+        TableRole::Bidirectional { b: self.b }
     }
 
     fn explanation(&self, context: &Context) -> String {
         // What the re-test measures when the diagnosis gives it (its figures'
-        // B̄), else the fitted B: the sentence's numbers are the output's own.
-        let (predicted_um, measured_um) = context.retest_mean_reversal_um.unwrap_or_else(|| {
-            let before_um = context.first_test_reversal_um.unwrap_or(0.0);
-            (before_um, before_um + self.b)
+        // B̄), else the fitted B: the sentence's numbers are the output's own,
+        // µm (m° on a rotary axis).
+        let (predicted, measured) = context.retest_mean_reversal.unwrap_or_else(|| {
+            let before = context.first_test_reversal.unwrap_or(0.0);
+            (before, before + self.b)
         });
-        let change_um = match context.first_test_reversal_um {
-            Some(_) => measured_um - predicted_um,
-            None => measured_um,
+        let change = match context.first_test_reversal {
+            Some(_) => measured - predicted,
+            None => measured,
         };
         // What the axis does now, by the sign of the B̄ measured now.
-        let how = if measured_um < 0.0 {
+        let how = if measured < 0.0 {
             "the axis falls short in the direction it moves: lost motion from backlash, or friction force × drive compliance"
         } else {
             "the axis overshoots in the direction it moves (a leading encoder, or an elastic preload released at reversal)"
@@ -57,18 +57,18 @@ impl Model for Reversal {
         // On a rotary axis the parameter is in degrees (`emit`'s rotary tables).
         // Whatever the parameter was during the re-test, −B̄ measured now
         // takes out what is left.
-        let parameter = context.position(um_to_mm(-measured_um), 4);
+        let parameter = context.position(context.deviation_as_position(-measured), 4);
         let d = |v: f64| context.deviation(v);
-        match context.first_test_reversal_um {
+        match context.first_test_reversal {
             Some(_) => format!(
                 "The reversal changed since the first test: B̄ {} predicted, {} measured now, a change of {} ({how}); a bidirectional table from the re-test (convert --existing --effects) takes it out, or change the backlash parameter by {parameter} (−B̄ now; convert prints it in the controller's own terms).",
-                d(predicted_um),
-                d(measured_um),
-                d(change_um),
+                d(predicted),
+                d(measured),
+                d(change),
             ),
             None => format!(
                 "Direction-dependent offset: B̄ {} measured ({how}); write a bidirectional table (convert --effects or --mode bidirectional) or change the backlash parameter by {parameter} (−B̄; convert prints it in the controller's own terms).",
-                d(measured_um)
+                d(measured)
             ),
         }
     }

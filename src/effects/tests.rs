@@ -124,7 +124,7 @@ fn values_by_hand() {
 fn every_explanation_is_one_sentence_with_an_action() {
     let context = Context {
         expansion_coefficient_ppm_per_k: Some(11.5),
-        table_step_mm: Some(50.0),
+        table_step: Some(50.0),
         ..Context::default()
     };
     for effect in one_of_each() {
@@ -143,16 +143,11 @@ fn every_explanation_is_one_sentence_with_an_action() {
 #[test]
 fn every_kind_says_what_it_does_to_a_table() {
     let roles: Vec<TableRole> = one_of_each().iter().map(Effect::in_table).collect();
-    assert_eq!(roles[0], TableRole::Bidirectional { b_um: -3.0 });
+    assert_eq!(roles[0], TableRole::Bidirectional { b: -3.0 });
     assert!(matches!(roles[1], TableRole::TakenOut { .. }));
     assert!(matches!(roles[2], TableRole::NotATable { .. }));
     // A tenth of the period: linear interpolation leaves < 5 % of a sine.
-    assert_eq!(
-        roles[3],
-        TableRole::AtPoints {
-            finest_step_mm: 0.5
-        }
-    );
+    assert_eq!(roles[3], TableRole::AtPoints { finest_step: 0.5 });
     assert!(
         matches!(roles[4], TableRole::NotATable { ref note } if note.contains("--exclude-run 2:down"))
     );
