@@ -49,7 +49,7 @@ pub fn build_table_with_effects(
         effects
             .iter()
             .filter(|e| matches!(e.in_table(), TableRole::AtPoints { .. }))
-            .filter_map(|e| e.systematic_um(x, crate::measurement::Direction::Up, 0.0))
+            .filter_map(|e| e.systematic(x, crate::measurement::Direction::Up, 0.0))
             .sum()
     };
     let scale_um_per_m: f64 = effects

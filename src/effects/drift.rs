@@ -75,7 +75,7 @@ impl Drift {
 }
 
 impl Model for Drift {
-    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+    fn value(&self, reading: &Reading, line: &Line<'_>) -> f64 {
         match *self {
             Drift::PerHour { rate_um_per_h } => rate_um_per_h * reading.time_h,
             Drift::PerRun { rate_um_per_run } => rate_um_per_run * line.runs_at(reading.time_h),
@@ -83,7 +83,7 @@ impl Model for Drift {
     }
 
     /// Not systematic in position: a table cannot take it.
-    fn systematic_um(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
+    fn systematic(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
         None
     }
 

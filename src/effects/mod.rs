@@ -67,7 +67,8 @@ pub struct Reading {
 /// stroke starts (scale is zero there) and the angular profile (Abbe).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Line<'a> {
-    /// The first target, mm.
+    /// The first target, mm: only a scale error reads it, and a scale error
+    /// is looked for on a linear axis only (`diagnose::gates`).
     pub first_target_mm: f64,
     /// The angular error at each target, µrad (Abbe), if given.
     pub angle_urad: Option<&'a [f64]>,
@@ -107,7 +108,7 @@ pub enum PeriodicIn {
 pub enum Shape {
     /// No free shape.
     Fixed(Kind),
-    /// A periodic error of this period, mm, in these tests.
+    /// A periodic error of this period (mm, or °), in these tests.
     Period(f64, PeriodicIn),
     /// One run: (direction, number).
     Run(Direction, u32),
@@ -161,6 +162,16 @@ pub fn deviation_text(unit: DeviationUnit, value: f64, decimals: usize) -> Strin
     format!("{:.decimals$}{}", in_unit(unit, value), unit.suffix())
 }
 
+/// A deviation held in the effects' unit (µm, or m° on a rotary axis) in
+/// the unit of the axis' positions and readings (mm, or °): a thousandth of
+/// it either way.
+pub fn deviation_as_position(kind: AxisKind, value: f64) -> f64 {
+    match kind {
+        AxisKind::Linear => um_to_mm(value),
+        AxisKind::Rotary => held_angle(value).0,
+    }
+}
+
 /// A deviation held in µm (with an angle `unit`, m°) in `unit`.
 fn in_unit(unit: DeviationUnit, value: f64) -> f64 {
     match unit {
@@ -189,13 +200,9 @@ impl Context {
         format!("{}{}", number(value), self.kind.unit_after_number())
     }
 
-    /// A deviation (µm, or m°) in the axis' position unit (mm, or °): a
-    /// thousandth of it either way.
+    /// A deviation (µm, or m°) in the axis' position unit ([`deviation_as_position`]).
     pub fn deviation_as_position(&self, value: f64) -> f64 {
-        match self.kind {
-            AxisKind::Linear => um_to_mm(value),
-            AxisKind::Rotary => held_angle(value).0,
-        }
+        deviation_as_position(self.kind, value)
     }
 
     /// A position or a length (mm, or °): `18 mm`, `18°`.
@@ -322,13 +329,14 @@ pub enum TableRole {
 /// What an effect with its parameters is: the part every user of an effect
 /// asks of it.
 pub trait Model {
-    /// The effect's contribution to one reading, µm.
-    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64;
+    /// The effect's contribution to one reading: µm, or m° on a rotary axis.
+    fn value(&self, reading: &Reading, line: &Line<'_>) -> f64;
 
-    /// The effect's systematic part at `x_mm` moving in `direction`, µm: what
-    /// a table or a prediction can account for (`predict --effects`). `None`
-    /// for what is not systematic in position.
-    fn systematic_um(&self, x_mm: f64, direction: Direction, first_target_mm: f64) -> Option<f64>;
+    /// The effect's systematic part at `x` (mm, or °) moving in
+    /// `direction` (µm, or m°): what a table or a prediction can account for
+    /// (`predict --effects`). `None` for what is not systematic in position.
+    /// `first_target_mm` is [`Line::first_target_mm`].
+    fn systematic(&self, x: f64, direction: Direction, first_target_mm: f64) -> Option<f64>;
 
     /// What it does to a compensation table.
     fn in_table(&self) -> TableRole;
@@ -478,40 +486,36 @@ registry! {
 }
 
 impl Effect {
-    /// The effect's contribution to one reading, µm.
-    pub fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
-        self.model().value_um(reading, line)
+    /// The effect's contribution to one reading ([`Model::value`]).
+    pub fn value(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+        self.model().value(reading, line)
     }
 
-    /// The effect's systematic part at `x_mm` moving in `direction`, µm
-    /// ([`Model::systematic_um`]).
-    pub fn systematic_um(
-        &self,
-        x_mm: f64,
-        direction: Direction,
-        first_target_mm: f64,
-    ) -> Option<f64> {
-        self.model().systematic_um(x_mm, direction, first_target_mm)
+    /// The effect's systematic part at `x` moving in `direction`
+    /// ([`Model::systematic`]).
+    pub fn systematic(&self, x: f64, direction: Direction, first_target_mm: f64) -> Option<f64> {
+        self.model().systematic(x, direction, first_target_mm)
     }
 
     /// The measurement with this effect added to every reading, at the
     /// times `times_h` (`[run][target]`, hours, as `cycle::reading_times_h`
     /// gives them): a known effect put into a measured test, defined by the
-    /// same [`Model::value_um`] the diagnosis fits (tests on real files).
+    /// same [`Model::value`] the diagnosis fits (tests on real files).
     pub fn added_to(
         &self,
         measurement: &Measurement,
         times_h: &[Vec<f64>],
     ) -> Result<Measurement, MeasurementError> {
-        let targets_mm = measurement.targets();
+        let targets = measurement.targets();
         let line = Line {
-            first_target_mm: targets_mm.first().copied().unwrap_or(0.0),
+            first_target_mm: targets.first().copied().unwrap_or(0.0),
             angle_urad: None,
             times_recorded: measurement.metadata.duration_s().is_some(),
             run_h: crate::cycle::run_h(times_h),
         };
         let runs = measurement.runs();
-        measurement.map_readings(|run, target_index, value_mm| {
+        let kind = measurement.kind();
+        measurement.map_readings(|run, target_index, value| {
             // Runs are unique by direction and number (`Measurement`'s invariant).
             let run_index = runs
                 .iter()
@@ -519,7 +523,7 @@ impl Effect {
                 .unwrap_or(0);
             let reading = Reading {
                 target_index,
-                target: targets_mm[target_index],
+                target: targets[target_index],
                 direction: run.direction,
                 run: run.number,
                 run_index,
@@ -529,7 +533,7 @@ impl Effect {
                     .copied()
                     .unwrap_or(0.0),
             };
-            value_mm + um_to_mm(self.value_um(&reading, &line))
+            value + deviation_as_position(kind, self.value(&reading, &line))
         })
     }
 

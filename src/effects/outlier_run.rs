@@ -43,7 +43,7 @@ fn direction<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Direction, D:
 }
 
 impl Model for OutlierRun {
-    fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
+    fn value(&self, reading: &Reading, _: &Line<'_>) -> f64 {
         if reading.run == self.run && reading.direction == self.direction {
             self.offset
         } else {
@@ -52,7 +52,7 @@ impl Model for OutlierRun {
     }
 
     /// Not systematic in position: a table cannot take it.
-    fn systematic_um(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
+    fn systematic(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
         None
     }
 

@@ -47,7 +47,7 @@ impl Periodic {
         per_revolution(self.period)
     }
 
-    fn at_um(&self, x_mm: f64) -> f64 {
+    fn at(&self, x_mm: f64) -> f64 {
         self.amplitude * (TAU * x_mm / self.period + self.phase_rad).sin()
     }
 }
@@ -60,12 +60,12 @@ pub(super) fn per_revolution(period_deg: f64) -> Option<u32> {
 }
 
 impl Model for Periodic {
-    fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
-        self.at_um(reading.target)
+    fn value(&self, reading: &Reading, _: &Line<'_>) -> f64 {
+        self.at(reading.target)
     }
 
-    fn systematic_um(&self, x_mm: f64, _: Direction, _: f64) -> Option<f64> {
-        Some(self.at_um(x_mm))
+    fn systematic(&self, x_mm: f64, _: Direction, _: f64) -> Option<f64> {
+        Some(self.at(x_mm))
     }
 
     /// Linear interpolation between points h apart leaves up to

@@ -22,11 +22,11 @@ pub struct Reversal {
 }
 
 impl Model for Reversal {
-    fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
+    fn value(&self, reading: &Reading, _: &Line<'_>) -> f64 {
         reading.direction.reversal_share(self.b)
     }
 
-    fn systematic_um(&self, _: f64, direction: Direction, _: f64) -> Option<f64> {
+    fn systematic(&self, _: f64, direction: Direction, _: f64) -> Option<f64> {
         Some(direction.reversal_share(self.b))
     }
 

@@ -80,7 +80,7 @@ fn columns_and_values_agree() {
                 .map(|(c, b)| c[i] * b)
                 .sum();
             assert!(
-                (effect.value_um(r, &line) - from_columns).abs() < 1e-12,
+                (effect.value(r, &line) - from_columns).abs() < 1e-12,
                 "{shape:?}"
             );
         }
@@ -91,7 +91,7 @@ fn columns_and_values_agree() {
 fn values_by_hand() {
     let up = reading(250.0, Direction::Up, 1, 0.25);
     assert_eq!(
-        Effect::Reversal(Reversal { b: -3.0 }).value_um(&up, &ORIGIN),
+        Effect::Reversal(Reversal { b: -3.0 }).value(&up, &ORIGIN),
         -1.5
     );
     let from_50 = Line {
@@ -102,11 +102,11 @@ fn values_by_hand() {
         Effect::Scale(Scale {
             scale_um_per_m: 8.0
         })
-        .value_um(&up, &from_50),
+        .value(&up, &from_50),
         1.6
     );
     assert_eq!(
-        Effect::Drift(Drift::PerHour { rate_um_per_h: 4.0 }).value_um(&up, &ORIGIN),
+        Effect::Drift(Drift::PerHour { rate_um_per_h: 4.0 }).value(&up, &ORIGIN),
         1.0
     );
     let periodic = Effect::Periodic(Periodic {
@@ -115,7 +115,7 @@ fn values_by_hand() {
         phase_rad: 0.0,
     });
     assert!(
-        (periodic.value_um(&up, &ORIGIN) - 2.0).abs() < 1e-12,
+        (periodic.value(&up, &ORIGIN) - 2.0).abs() < 1e-12,
         "quarter period: the crest"
     );
 }
@@ -301,7 +301,7 @@ fn a_drift_per_run_counts_runs_not_hours() {
         rate_um_per_run: 2.0,
     });
     let late = reading(0.0, Direction::Up, 2, 0.75);
-    assert!((drift.value_um(&late, &ORIGIN) - 3.0).abs() < 1e-12);
+    assert!((drift.value(&late, &ORIGIN) - 3.0).abs() < 1e-12);
     assert_eq!(
         drift.parameters(),
         vec![Parameter::number("rate_um_per_run", "rate", "µm/run", 2.0)]

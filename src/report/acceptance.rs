@@ -736,7 +736,7 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
             .map(|(i, r)| {
                 (
                     (i + 1) as f64,
-                    accepted.effect.value_um(
+                    accepted.effect.value(
                         &r.reading,
                         &Line {
                             first_target_mm,
