@@ -531,7 +531,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         &folds,
         reversal_b,
         &kinds,
-        input.known_periods,
+        known_periods(input),
         background,
         &mut rejected,
     );
@@ -572,7 +572,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
                 period,
                 tests,
                 &aliases_mm,
-                input.known_periods,
+                known_periods(input),
             ));
         }
         accepted.push(effect);
@@ -736,6 +736,16 @@ fn no_reversal_change(
         _ => format!(
             "no change since the first test, whose B̄ = {first} the prediction carries ({why})"
         ),
+    }
+}
+
+/// The axis' known periods, a linear axis' only: they are lengths (a screw
+/// lead, a scale period, mm), and a rotary axis' periods are whole orders
+/// per revolution, in degrees.
+fn known_periods<'a>(input: &DiagnoseInput<'a>) -> &'a [KnownPeriod] {
+    match input.after.kind() {
+        AxisKind::Linear => input.known_periods,
+        AxisKind::Rotary => &[],
     }
 }
 

@@ -3,8 +3,8 @@
 //! where one effect names another.
 
 use axcomp::cycle::{CycleTiming, reading_times_h};
-use axcomp::diagnose::{DiagnoseInput, diagnose};
-use axcomp::effects::{Effect, OutlierRun, Reversal};
+use axcomp::diagnose::{DiagnoseInput, KnownPeriod, diagnose};
+use axcomp::effects::{Effect, OutlierRun, Periodic, Reversal};
 use axcomp::evaluate::ISO_230_2;
 use axcomp::measurement::Direction;
 use axcomp::read::read_path;
@@ -67,4 +67,50 @@ fn a_rotary_reversal_names_an_outlier_run_in_arc_seconds() {
     for text in [reversal, outlier] {
         assert!(!text.contains("µm") && !text.contains(" mm"), "{text}");
     }
+}
+
+/// A machine profile's periods are lengths (a screw lead, a scale period,
+/// mm): a rotary axis' twice-per-revolution error of 180° is not said to be
+/// "the screw lead the machine profile gives (180 mm)".
+#[test]
+fn a_rotary_harmonic_is_no_screw_lead() {
+    let read = read_path(&test_data("rotary/c-outlier-run.csv"), None).unwrap();
+    let (times, _) = reading_times_h(&read.measurement, CycleTiming::ASSUMED);
+    let before = read.measurement;
+    // 2 m° = 7.2″, twice per revolution.
+    let harmonic = Effect::Periodic(Periodic {
+        period: 180.0,
+        amplitude: 2.0,
+        phase_rad: 0.3,
+    });
+    let mut after = harmonic.added_to(&before, &times).unwrap();
+    // Another test, not the first one again.
+    after.metadata.source_file = None;
+    let diagnosis = diagnose(&DiagnoseInput {
+        angle: Default::default(),
+        after: &after,
+        before: Some(&before),
+        table: None,
+        backlash_set: false,
+        angular: None,
+        timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
+        known_periods: &[KnownPeriod::screw_lead(180.0)],
+    })
+    .unwrap();
+    let found = diagnosis
+        .accepted
+        .iter()
+        .find(|a| matches!(a.effect, Effect::Periodic(_)))
+        .unwrap_or_else(|| panic!("{:?}", diagnosis.rejected));
+    assert!(
+        found.explanation.contains("Twice-per-revolution"),
+        "{}",
+        found.explanation
+    );
+    let notes = found.warnings.join(" ");
+    assert!(
+        !notes.contains("screw lead") && !notes.contains(" mm"),
+        "{notes}"
+    );
 }
