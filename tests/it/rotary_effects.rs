@@ -3,13 +3,33 @@
 //! where one effect names another.
 
 use axcomp::cycle::{CycleTiming, reading_times_h};
-use axcomp::diagnose::{DiagnoseInput, KnownPeriod, diagnose};
+use axcomp::diagnose::{DiagnoseInput, Diagnosis, KnownPeriod, diagnose};
 use axcomp::effects::{Effect, OutlierRun, Periodic, Reversal};
 use axcomp::evaluate::ISO_230_2;
-use axcomp::measurement::Direction;
+use axcomp::measurement::{Direction, Measurement};
 use axcomp::read::read_path;
 
 use crate::util::test_data;
+
+/// The diagnosis of `after` (against `before`), in ″.
+fn diagnosed(
+    after: &Measurement,
+    before: Option<&Measurement>,
+    known: &[KnownPeriod],
+) -> Diagnosis {
+    diagnose(&DiagnoseInput {
+        angle: Default::default(),
+        after,
+        before,
+        table: None,
+        backlash_set: false,
+        angular: None,
+        timing: CycleTiming::ASSUMED,
+        standard: &ISO_230_2,
+        known_periods: known,
+    })
+    .unwrap()
+}
 
 /// The synthetic rotary test with a reversal of 10 m° (36″) and run 1↑ put
 /// 5 m° (18″) off the others added: the reversal fitted with that run
@@ -31,18 +51,7 @@ fn a_rotary_reversal_names_an_outlier_run_in_arc_seconds() {
     ] {
         after = effect.added_to(&after, &times).unwrap();
     }
-    let diagnosis = diagnose(&DiagnoseInput {
-        angle: Default::default(),
-        after: &after,
-        before: None,
-        table: None,
-        backlash_set: false,
-        angular: None,
-        timing: CycleTiming::ASSUMED,
-        standard: &ISO_230_2,
-        known_periods: &[],
-    })
-    .unwrap();
+    let diagnosis = diagnosed(&after, None, &[]);
     let sentence = |kind: &str| {
         diagnosis
             .accepted
@@ -86,18 +95,7 @@ fn a_rotary_harmonic_is_no_screw_lead() {
     let mut after = harmonic.added_to(&before, &times).unwrap();
     // Another test, not the first one again.
     after.metadata.source_file = None;
-    let diagnosis = diagnose(&DiagnoseInput {
-        angle: Default::default(),
-        after: &after,
-        before: Some(&before),
-        table: None,
-        backlash_set: false,
-        angular: None,
-        timing: CycleTiming::ASSUMED,
-        standard: &ISO_230_2,
-        known_periods: &[KnownPeriod::screw_lead(180.0)],
-    })
-    .unwrap();
+    let diagnosis = diagnosed(&after, Some(&before), &[KnownPeriod::screw_lead(180.0)]);
     let found = diagnosis
         .accepted
         .iter()
