@@ -33,6 +33,7 @@ pub mod profile;
 mod refusal;
 pub mod sinumerik840d;
 pub mod tnc640;
+mod written;
 
 use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::{CompensationTable, TableValues};
@@ -45,6 +46,7 @@ pub use fagor::{TextEncoding, decode as decode_table, encode as encode_table};
 pub use number::{minimal, signed_fixed, signed_minimal};
 pub use profile::{AxisPeriods, AxisProfile, CecValues, MachineProfile};
 pub use refusal::{EmitError, check_table};
+pub use written::{Written, check_request, fanuc_rescaled, grid, write_updated};
 
 /// What every writer needs besides the table. Filled by the caller from the
 /// command line and the machine profile; no `Default`.
