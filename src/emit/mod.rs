@@ -29,6 +29,7 @@ pub mod itnc530;
 pub mod linuxcnc;
 pub mod linuxcnc_thermal;
 mod number;
+mod one_machine;
 pub mod profile;
 mod refusal;
 pub mod sinumerik840d;
@@ -44,6 +45,7 @@ pub use controller::{BacklashAdvice, BacklashParameter, Controller, resolution_m
 pub use detect::{detect, read_any};
 pub use fagor::{TextEncoding, decode as decode_table, encode as encode_table};
 pub use number::{minimal, signed_fixed, signed_minimal};
+pub use one_machine::{MachineTable, overwrites};
 pub use profile::{AxisPeriods, AxisProfile, CecValues, MachineProfile};
 pub use refusal::{EmitError, check_table};
 pub use written::{Written, check_request, fanuc_rescaled, grid, write_updated};
