@@ -261,7 +261,7 @@ mod tests {
                 );
             }
         }
-        // The walk sees the flags the issue names (and so cannot pass by seeing none).
+        // The walk sees the flags that take negative numbers (and so cannot pass by seeing none).
         for flag in [
             "convert --step",
             "convert --start",

@@ -8,7 +8,7 @@ use anyhow::{Result, bail};
 use axcomp::compensate::cross_axis::CrossAxisTable;
 use axcomp::compensate::{CompensationTable, TableMode};
 use axcomp::effects::Effect;
-use axcomp::emit::{Controller, fanuc, sinumerik840d, tnc640};
+use axcomp::emit::{MachineTable, fanuc, overwrites, sinumerik840d, tnc640};
 use axcomp::error::{ParseError, Warning};
 use axcomp::measurement::{AxisKind, Measurement};
 use axcomp::model::{GeometricErrors, Optics, read_error_description};
@@ -360,9 +360,7 @@ fn load_table(
 }
 
 /// Refuses table files of one machine that would overwrite each other in
-/// the control: two Sinumerik programs writing the same CEC table number,
-/// or two TNC 640 tables of one table axis, which has one active table
-/// (MANUALplus 620 technical manual p.718).
+/// the control (`emit::overwrites`).
 fn check_one_machine(args: &PredictArgs, measurements: &[(Measurement, [f64; 3])]) -> Result<()> {
     // (file, the axis the table is a function of)
     let mut files: Vec<(&str, String)> = Vec::new();
@@ -387,34 +385,31 @@ fn check_one_machine(args: &PredictArgs, measurements: &[(Measurement, [f64; 3])
                 .ok()
                 .is_some_and(|a| std::fs::canonicalize(b).ok() == Some(a))
     };
-    let mut seen: Vec<(&str, &str, Controller, Vec<usize>)> = Vec::new();
-    for (path, axis) in &files {
-        let Ok(text) = std::fs::read_to_string(path) else {
-            continue;
-        };
-        let Some(controller) = axcomp::emit::detect(&text) else {
-            continue;
-        };
-        let numbers = match controller {
-            Controller::Sinumerik840d => sinumerik840d::cec_tables(&text).unwrap_or_default(),
-            _ => Vec::new(),
-        };
-        for (other, other_axis, other_controller, other_numbers) in &seen {
-            if same_file(path, other) || *other_controller != controller {
-                continue;
-            }
-            if let Some(t) = numbers.iter().find(|t| other_numbers.contains(t)) {
-                bail!(
-                    "{other} and {path} both write Sinumerik CEC table {t}: loaded one after the other, the second overwrites the first in the control; write them again with convert, which numbers the tables of one machine from its profile (formats/sinumerik840d/README.md)"
-                );
-            }
-            if controller == Controller::Tnc640 && other_axis == axis {
-                bail!(
-                    "{other} and {path} are both tables of axis {axis}, and the TNC 640 has one active compensation table per axis (MANUALplus 620 technical manual p.718): put the columns into one table (convert STRAIGHTNESS --controller tnc640 --existing {other})"
-                );
+    // Read once each; a file that cannot be read is refused where it is loaded.
+    let texts: Vec<Option<String>> = files
+        .iter()
+        .map(|(path, _)| std::fs::read_to_string(path).ok())
+        .collect();
+    let tables: Vec<MachineTable<'_>> = files
+        .iter()
+        .zip(&texts)
+        .filter_map(|((name, axis), text)| {
+            Some(MachineTable {
+                name,
+                axis,
+                text: text.as_deref()?,
+            })
+        })
+        .collect();
+    for (i, second) in tables.iter().enumerate() {
+        for first in tables[..i]
+            .iter()
+            .filter(|f| !same_file(f.name, second.name))
+        {
+            if let Some(why) = overwrites(first, second) {
+                bail!("{why}");
             }
         }
-        seen.push((path, axis, controller, numbers));
     }
     Ok(())
 }

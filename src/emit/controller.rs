@@ -98,6 +98,19 @@ impl Controller {
         !matches!(self, Controller::Itnc530 | Controller::Fanuc)
     }
 
+    /// Whether axcomp writes a straightness test's cross-axis table for it:
+    /// a TNC 640 `.COM` with a dependent column, a Sinumerik CEC table with
+    /// another output axis.
+    pub fn writes_cross_axis(self) -> bool {
+        matches!(self, Controller::Tnc640 | Controller::Sinumerik840d)
+    }
+
+    /// Whether a cross-axis table goes into the axis' existing table (the
+    /// TNC 640's one active `.COM` per axis) rather than a file of its own.
+    pub fn cross_axis_into_existing(self) -> bool {
+        self == Controller::Tnc640
+    }
+
     /// What a table's plan needs to know of this controller
     /// (`compensate::plan`), for a machine in `machine_unit`.
     pub fn capabilities(self, machine_unit: LengthUnit) -> Capabilities {

@@ -29,10 +29,12 @@ pub mod itnc530;
 pub mod linuxcnc;
 pub mod linuxcnc_thermal;
 mod number;
+mod one_machine;
 pub mod profile;
 mod refusal;
 pub mod sinumerik840d;
 pub mod tnc640;
+mod written;
 
 use crate::compensate::cross_axis::CrossAxisTable;
 use crate::compensate::{CompensationTable, TableValues};
@@ -43,8 +45,10 @@ pub use controller::{BacklashAdvice, BacklashParameter, Controller, resolution_m
 pub use detect::{detect, read_any};
 pub use fagor::{TextEncoding, decode as decode_table, encode as encode_table};
 pub use number::{minimal, signed_fixed, signed_minimal};
+pub use one_machine::{MachineTable, overwrites};
 pub use profile::{AxisPeriods, AxisProfile, CecValues, MachineProfile};
 pub use refusal::{EmitError, check_table};
+pub use written::{Written, check_request, fanuc_rescaled, grid, write_updated};
 
 /// What every writer needs besides the table. Filled by the caller from the
 /// command line and the machine profile; no `Default`.

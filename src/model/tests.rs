@@ -134,7 +134,7 @@ fn rotation_is_the_sum_of_the_angles() {
 
 #[test]
 fn full_transforms_agree_with_first_order_for_micrometre_errors() {
-    // The criterion: 1e-9 mm for µm-level errors. The two differ by
+    // Agreement to 1e-9 mm for µm-level errors. The two differ by
     // products of two errors; with every pair of errors at 1 µm or 1 µrad
     // (constant, so at full size everywhere) each product stays below 1e-9 mm
     // on the whole grid (largest found: 9.0e-10 mm, ECY with EXOY on ZFYX).

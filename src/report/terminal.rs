@@ -179,7 +179,7 @@ const PER_TARGET_COLUMNS: usize = 12;
 /// Drawn here rather than by `tabled::Table`, which keeps every cell as a
 /// `String` with its own layout state (a large test has 120 000 cells);
 /// the small tables keep `tabled`.
-/// Fast path: with it and the others of the evaluate report, a 10 000-target × 10-run `evaluate` takes 0.009 s cpu whole process (farm-bench, quiet, 2026-11-27); with `tabled` and `{:.2}` it took 2× that.
+/// Fast path: with it and the others of the evaluate report, a 10 000-target × 10-run `evaluate` takes 0.009 s cpu whole process (quiet 2-core machine, 2026-11-27); with `tabled` and `{:.2}` it took 2× that.
 fn per_target_table(out: &mut String, r: &EvaluationJson) {
     let target_header = format!("target [{}]", r.position_unit().trim_start());
     let header: [&str; PER_TARGET_COLUMNS] = [

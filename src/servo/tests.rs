@@ -86,7 +86,7 @@ fn check_tab_6_4(axis_name: &str, circle_axis: CircleAxis, expected: &Tab64) {
                 kind.thesis_label(),
                 FEEDS_M_PER_MIN[column]
             );
-            // The tolerance against Mendřický's simulated values.
+            // Within 1 µm of Mendřický's simulated values.
             if (error_um - expected.error_um[model][column]).abs() > 1.0 {
                 failures.push(format!(
                     "{label}: error {error_um:.2} µm vs thesis {}",
@@ -94,7 +94,7 @@ fn check_tab_6_4(axis_name: &str, circle_axis: CircleAxis, expected: &Tab64) {
                 ));
             }
             // Mendřický (2006) prints currents to 0.1 A, so its simulated value lies
-            // within ±0.05 A of the printed figure; the 0.2 A is
+            // within ±0.05 A of the printed figure; the tolerance of 0.2 A is
             // measured from that interval. Two Y cells need it: B2 at 24 m/min
             // (13.69 A against a printed 13.9; the notes' independent model
             // also gets 13.69) and at 48 m/min (44.80 against 45.0), 0.01 and

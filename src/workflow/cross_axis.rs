@@ -79,10 +79,7 @@ fn refused(message: String) -> WorkflowError {
 /// The cross-axis table of `request`'s straightness test.
 pub fn cross_axis(request: &CrossAxisRequest<'_>) -> Result<CrossAxis, WorkflowError> {
     let file = request.file;
-    if !matches!(
-        request.controller,
-        Controller::Tnc640 | Controller::Sinumerik840d
-    ) {
+    if !request.controller.writes_cross_axis() {
         return Err(refused(format!(
             "{file}: a straightness test gives a cross-axis table, which axcomp writes for {CONTROLLERS}; {} has none here",
             request.controller.name()

@@ -21,7 +21,6 @@ pub mod thermal;
 
 use crate::compensate::effects::build_table_with_effects;
 use crate::compensate::plan::{PlanContext, Request, plan};
-use crate::compensate::update::{UpdatePlan, UpdateSummary};
 use crate::compensate::{CompensateError, CompensationTable};
 use crate::diagnose::KnownPeriod;
 use crate::effects::Effect;
@@ -250,13 +249,7 @@ pub fn convert(
     warnings: &mut Vec<Warning>,
     table: &TableRequest<'_>,
 ) -> Result<Converted, WorkflowError> {
-    if table.controller == Controller::Fagor8065
-        && !table
-            .existing
-            .is_some_and(emit::fagor8065::is_parameter_file)
-    {
-        return Err(EmitError::Profile(emit::fagor8065::NEEDS_EXPORT.to_string()).into());
-    }
+    emit::check_request(table.controller, table.existing, table.fanuc_rescaled)?;
     let evaluation = evaluate(measurement);
     warnings.extend(evaluation.warnings.iter().cloned());
     // The file records its source where the format has comments.
@@ -270,10 +263,7 @@ pub fn convert(
         [false, true] => Some(Direction::Down),
         _ => None,
     };
-    if table.fanuc_rescaled && table.controller != Controller::Fanuc {
-        return Err(EmitError::Profile("--fanuc-rescaled is for --controller fanuc".into()).into());
-    }
-    let request = table::fanuc_grid(
+    let request = emit::grid(
         table.controller,
         table.request,
         options,
@@ -290,29 +280,18 @@ pub fn convert(
             existing: table.active,
         },
     )?;
-    let mut compensation =
+    let compensation =
         build_table_with_effects(measurement, &evaluation, &plan.options, table.effects)?;
-    // A Fanuc pitch file is updated in place point by point (its data are
-    // increments, emit::fanuc::update): the points outside the table keep
-    // their increments, which its own summary says (`fanuc_update`).
-    let update = plan
-        .update
-        .as_ref()
-        .filter(|_| table.controller != Controller::Fanuc)
-        .map(|update| {
-            let (updated, summary) = update.apply(compensation.clone());
-            compensation = updated;
-            summary
-        });
-    let bytes = emit::write_bytes(table.controller, &compensation, options, table.existing)?;
-    let update = update.or(fanuc_update(
-        table,
-        plan.update.as_ref(),
-        &compensation,
+    let written = emit::write_updated(
+        table.controller,
+        compensation,
         options,
-    )?);
+        table.existing,
+        plan.update.as_ref(),
+    )?;
+    let compensation = written.table;
     let rescaled = match table.fanuc_rescaled {
-        true => Some(table::fanuc_rescaled(
+        true => Some(emit::fanuc_rescaled(
             table.existing,
             &compensation,
             options,
@@ -320,9 +299,7 @@ pub fn convert(
         false => None,
     };
     let activation = emit::activation(table.controller, &compensation, &table.file_name, options);
-    // A Fanuc file written says what an unknown 3605 bit means for it
-    // (`emit::fanuc::notes`): the table read beside it does not say it again.
-    if table.controller == Controller::Fanuc {
+    if written.notes_say_how_read {
         warnings.retain(|w| !matches!(w, Warning::TableReadAs { .. }));
     }
     let warning_texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
@@ -336,11 +313,7 @@ pub fn convert(
     );
     report.effects = plan.notes;
     report.notes = plan.table_notes;
-    if table.controller == Controller::Fanuc {
-        report
-            .notes
-            .extend(emit::fanuc::notes(&compensation, options));
-    }
+    report.notes.extend(written.notes);
     if measurement.kind() == AxisKind::Linear {
         let file_unit = table.controller.file_unit(options.machine_unit);
         report.file_unit = file_unit.as_str();
@@ -348,40 +321,18 @@ pub fn convert(
             file_unit.from_mm(emit::resolution_mm(table.controller, options.machine_unit));
         report.file_decimals = (-resolution.log10()).round().max(0.0) as usize;
     }
-    report.update = update.map(|summary| UpdateJson::new(&summary, report.file_unit));
+    report.update = written
+        .update
+        .map(|summary| UpdateJson::new(&summary, report.file_unit));
     if let Some(backlash_mm) = compensation.suggested_backlash {
         report.set_backlash(table.controller.backlash_parameter(backlash_mm, options));
     }
     Ok(Converted {
-        bytes,
+        bytes: written.bytes,
         report,
         table: compensation,
         rescaled,
     })
-}
-
-/// What a Fanuc update changed in the pitch file that was active
-/// (`emit::fanuc::update_summary`), when one was given.
-fn fanuc_update(
-    table: &TableRequest<'_>,
-    plan: Option<&UpdatePlan>,
-    compensation: &CompensationTable,
-    options: &EmitOptions,
-) -> Result<Option<UpdateSummary>, WorkflowError> {
-    let existing = table
-        .existing
-        .and_then(|bytes| emit::decode_table(bytes).ok());
-    match (table.controller, plan, existing) {
-        (Controller::Fanuc, Some(plan), Some((text, _))) if emit::fanuc::looks_like(&text) => {
-            Ok(Some(emit::fanuc::update_summary(
-                &text,
-                compensation,
-                options,
-                plan,
-            )?))
-        }
-        _ => Ok(None),
-    }
 }
 
 /// A test of the acceptance report: read, named, evaluated, with every

@@ -4,7 +4,6 @@
 //! --existing`, `diagnose --table`, `report --table`, the web app's `table`).
 
 use crate::compensate::CompensationTable;
-use crate::compensate::plan::Request;
 use crate::emit::{self, Controller, EmitError, EmitOptions, MachineProfile};
 use crate::error::Warning;
 use crate::measurement::{AxisKind, Measurement};
@@ -138,52 +137,4 @@ pub fn recorded_axis<'a>(test: &'a Measurement, how: &str) -> Result<&'a str, Wo
         ),
         how: how.to_string(),
     })
-}
-
-/// The grid of a table: `request`, or for a Fanuc control with a parameter
-/// backup the control's points (3620–3624) inside the measured range, zero
-/// at its reference point; a grid given beside the backup is refused.
-pub fn fanuc_grid(
-    controller: Controller,
-    request: &Request,
-    options: &EmitOptions,
-    targets_mm: &[f64],
-) -> Result<Request, EmitError> {
-    let parameters = match (
-        controller,
-        options.axes.first().and_then(|a| a.fanuc.as_ref()),
-    ) {
-        (Controller::Fanuc, Some(parameters)) => parameters,
-        _ => return Ok(*request),
-    };
-    if request.step.is_some() || request.start.is_some() || request.reference.is_some() {
-        return Err(EmitError::Profile(format!(
-            "the Fanuc parameter backup fixes the compensation points and the reference ({}): leave out --step, --start, --count and --reference",
-            parameters.settings()
-        )));
-    }
-    let (Some(first), Some(last)) = (targets_mm.first(), targets_mm.last()) else {
-        return Ok(*request);
-    };
-    let (start_mm, count) =
-        emit::fanuc::points_in(parameters, *first, *last).map_err(EmitError::Profile)?;
-    Ok(Request {
-        step: Some(parameters.interval),
-        start: Some(start_mm),
-        count: Some(count),
-        reference: Some(parameters.position(parameters.reference_point)),
-        ..*request
-    })
-}
-
-/// `--fanuc-rescaled`: the table at the finest magnification that holds it,
-/// in the file that was active (`existing`) or a new one.
-pub fn fanuc_rescaled(
-    existing: Option<&[u8]>,
-    table: &CompensationTable,
-    options: &EmitOptions,
-) -> Result<emit::fanuc::Rescaled, EmitError> {
-    let existing = existing.and_then(|bytes| emit::decode_table(bytes).ok());
-    let existing = existing.as_ref().map(|(text, _)| text.as_str());
-    emit::fanuc::rescaled(existing, table, options, None)
 }

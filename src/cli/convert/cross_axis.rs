@@ -9,7 +9,6 @@ use std::path::Path;
 
 use anyhow::{Result, bail};
 
-use axcomp::emit::Controller;
 use axcomp::output::write_new;
 use axcomp::read;
 use axcomp::workflow::cross_axis::{CrossAxis, CrossAxisRequest, cross_axis};
@@ -88,7 +87,7 @@ fn refuse_positioning_flags(args: &ConvertArgs) -> Result<()> {
         ("--mode", args.mode.is_some()),
         (
             "--existing (a cross-axis table goes into an existing table only on the tnc640)",
-            args.existing.is_some() && args.controller != Controller::Tnc640,
+            args.existing.is_some() && !args.controller.cross_axis_into_existing(),
         ),
         ("--effects", args.effects.is_some()),
         ("--also", !args.also.is_empty()),
