@@ -59,7 +59,7 @@ pub(super) fn accepted_effect(
     let (uncertainty, mut warnings) = effect.uncertainty(&FitSummary {
         coefficients,
         errors,
-        span: problem.targets_mm[problem.targets_mm.len() - 1] - problem.targets_mm[0],
+        span: problem.targets[problem.targets.len() - 1] - problem.targets[0],
         n,
         target_spacing: context.target_spacing,
         kind: context.kind,

@@ -490,9 +490,9 @@ pub enum DiagnoseError {
 pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     let (problem, time_assumed) = problem(input)?;
     let y: Vec<f64> = problem
-        .measured_um
+        .measured
         .iter()
-        .zip(&problem.predicted_um)
+        .zip(&problem.predicted)
         .map(|(m, p)| m - p)
         .collect();
     let n = y.len();
@@ -581,8 +581,8 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // The model: per target, the level along the axis (with a prediction: the constant and the
     // effects along the axis; without: the re-test's own level), ±B/2 by direction, and the
     // between-runs effects of each reading. The scatter is what the cells leave.
-    let mut level_at_target = vec![0.0; problem.targets_mm.len()];
-    let mut model_at_target = vec![0.0; problem.targets_mm.len()];
+    let mut level_at_target = vec![0.0; problem.targets.len()];
+    let mut model_at_target = vec![0.0; problem.targets.len()];
     for (level, fitted) in levels.iter().zip(&along_fit.fitted) {
         level_at_target[level.target_index] = level.value_um;
         model_at_target[level.target_index] = if with_prediction {
@@ -592,7 +592,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         };
     }
     let half_reversal = |d: Direction| d.reversal_share(reversal_b);
-    let between_um = problem.between_runs_um(&between, &between_fit.coefficients);
+    let between_um = problem.between_runs(&between, &between_fit.coefficients);
     let scatter: Vec<f64> = y
         .iter()
         .zip(&between_fit.fitted)
@@ -635,7 +635,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         } else {
             level_at_target[r.target_index]
         };
-        problem.predicted_um[i] + systematic + scatter[i]
+        problem.predicted[i] + systematic + scatter[i]
     })?;
     // The reversal's sentence says the B̄ the figures show; where the fitted
     // B differs from the change they show, it says why.
