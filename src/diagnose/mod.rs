@@ -101,7 +101,9 @@ pub struct DiagnoseInput<'a> {
     /// The axis' angular error (pitch or yaw) along the stroke, for Abbe.
     pub angular: Option<&'a AngularProfile>,
     /// Periods the axis is known to have (its screw lead, its scale period:
-    /// the machine profile's), looked for before the scan of every period.
+    /// the machine profile's, mm), looked for before the scan of every
+    /// period; a linear axis' only (a rotary axis' are whole orders per
+    /// revolution, and these are not used there).
     pub known_periods: &'a [KnownPeriod],
     /// Cycle timing to assume when the file records no duration.
     pub timing: CycleTiming,
@@ -213,7 +215,9 @@ impl<D> Evidence<D> {
 pub struct AcceptedEffect {
     /// The effect and its parameters.
     pub effect: Effect,
-    /// Standard uncertainty of each parameter, by key.
+    /// Standard uncertainty of each parameter, by its key
+    /// (`effects::Parameter::key`), in the parameter's unit; typed with the
+    /// parameters by [`Effect::typed`] ([`DiagnosisIn::effects`]).
     pub uncertainty: Vec<(&'static str, f64)>,
     /// Why it was accepted.
     pub evidence: Evidence,

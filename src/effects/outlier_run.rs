@@ -24,7 +24,7 @@ pub struct OutlierRun {
     #[serde(deserialize_with = "direction")]
     pub direction: Direction,
     /// How far the run sits off the others: µm, or m° (1/1000 °) on a
-    /// rotary axis ([`OutlierRun::typed`]). The effects file (a linear
+    /// rotary axis ([`super::Effect::typed`]). The effects file (a linear
     /// axis' only) keys it `offset_um`.
     #[serde(rename = "offset_um")]
     pub offset: f64,

@@ -2,7 +2,7 @@
 //! lead, a scale period). On a rotary axis the period is 360°/k,
 //! a whole order k per revolution (once from eccentricity, twice from the
 //! encoder's mounting, a worm gear's tooth count), and the sentences say so
-//! in ° and ″ ([`Periodic::per_revolution`]).
+//! in ° and ″ ([`super::EffectIn::per_revolution`]).
 
 use std::f64::consts::{PI, TAU};
 
@@ -23,7 +23,7 @@ pub const AMPLITUDE_KEY: &str = "amplitude_um";
 
 /// Periodic error `amplitude · sin(2πx/period + phase)`, in the axis'
 /// units: period in mm and amplitude in µm, or on a rotary axis period in °
-/// and amplitude in m° (1/1000 °) ([`Periodic::typed`]).
+/// and amplitude in m° (1/1000 °) ([`super::Effect::typed`]).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Periodic {

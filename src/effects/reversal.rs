@@ -11,7 +11,7 @@ use crate::measurement::Direction;
 pub const B_KEY: &str = "B_um";
 
 /// Reversal B = ↑ − ↓, in the axis' deviation unit: µm, or m° (1/1000 °)
-/// on a rotary axis ([`Reversal::typed`]).
+/// on a rotary axis ([`super::Effect::typed`]).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Reversal {
