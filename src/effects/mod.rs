@@ -246,10 +246,12 @@ pub struct Parameter {
     pub value: ParameterValue,
 }
 
-/// A parameter's value: a number in the key's unit, or a run's number.
+/// A parameter's value: a number in the unit the key names on a linear axis
+/// (a rotary axis' µm and mm are m° and °: [`Effect::typed`]), or a run's
+/// number.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ParameterValue {
-    /// A measured quantity, in the unit its key names.
+    /// A measured quantity, in the unit its key names on a linear axis.
     Number(f64),
     /// A run, by its number within its direction.
     Run(u32),
