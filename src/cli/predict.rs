@@ -489,7 +489,7 @@ fn notes(prediction: &Prediction, effects: &[Effect]) -> Vec<String> {
     }
     for effect in effects {
         if effect
-            .systematic_um(0.0, axcomp::measurement::Direction::Up, 0.0)
+            .systematic(0.0, axcomp::measurement::Direction::Up, 0.0)
             .is_none()
         {
             notes.push(format!(

@@ -5,7 +5,7 @@
 //!   between) cannot follow a short period. The periodic error is taken out of
 //!   the readings, the smooth rest is interpolated to the table's points, and
 //!   the periodic error is put back *at the points*: with a step of at most
-//!   period / 10 ([`finest_step_mm`]) the controller's linear interpolation
+//!   period / 10 ([`finest_step`]) the controller's linear interpolation
 //!   leaves less than 5 % of its amplitude (A·(1 − cos(π·h/p)) for a step h).
 //! - **scale**: a scale the re-test showed beyond the prediction is the
 //!   thermal or alignment state of that test, not the machine's: it is taken
@@ -24,12 +24,14 @@ use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::Measurement;
 use crate::units::{per_m_over_mm, um_to_mm};
 
-/// The finest step the periodic effects ask for: the shortest period / 10, mm.
-pub fn finest_step_mm(effects: &[Effect]) -> Option<f64> {
+/// The finest step the periodic effects ask for: the shortest period / 10,
+/// in the axis' unit (mm: the effects come from an effects file, a linear
+/// axis' only, `workflow::rotary`).
+pub fn finest_step(effects: &[Effect]) -> Option<f64> {
     effects
         .iter()
         .filter_map(|e| match e.in_table() {
-            TableRole::AtPoints { finest_step_mm } => Some(finest_step_mm),
+            TableRole::AtPoints { finest_step } => Some(finest_step),
             _ => None,
         })
         .min_by(f64::total_cmp)
@@ -47,7 +49,7 @@ pub fn build_table_with_effects(
         effects
             .iter()
             .filter(|e| matches!(e.in_table(), TableRole::AtPoints { .. }))
-            .filter_map(|e| e.systematic_um(x, crate::measurement::Direction::Up, 0.0))
+            .filter_map(|e| e.systematic(x, crate::measurement::Direction::Up, 0.0))
             .sum()
     };
     let scale_um_per_m: f64 = effects
@@ -57,7 +59,7 @@ pub fn build_table_with_effects(
             _ => 0.0,
         })
         .sum();
-    let mut table = if finest_step_mm(effects).is_some() {
+    let mut table = if finest_step(effects).is_some() {
         // The readings less the periodic error at their targets.
         let targets = measurement.targets();
         let smooth = measurement.map_readings(|_, i, v| v - um_to_mm(periodic_um(targets[i])))?;
@@ -116,11 +118,11 @@ mod tests {
     #[test]
     fn the_periodic_error_is_put_back_at_the_finer_points_by_hand() {
         let effects = [Effect::Periodic(Periodic {
-            period_mm: 5.0,
-            amplitude_um: 2.0,
+            period: 5.0,
+            amplitude: 2.0,
             phase_rad: 0.0,
         })];
-        assert_eq!(finest_step_mm(&effects), Some(0.5));
+        assert_eq!(finest_step(&effects), Some(0.5));
         let options = TableOptions {
             mode: TableMode::Mean,
             grid: GridSpec::Regular {

@@ -41,7 +41,10 @@ pub struct Capabilities {
     pub bidirectional: bool,
     /// Whether its table may have unevenly spaced points.
     pub free_positions: bool,
-    /// The smallest step its format writes exactly, mm.
+    /// The smallest step its format writes exactly, mm. Used only to round
+    /// the step a periodic effect asks for ([`TableRole::AtPoints`]), and
+    /// the effects come from an effects file, which a rotary axis is refused
+    /// (`workflow::rotary`): never taken as degrees.
     pub resolution_mm: f64,
     /// Where it keeps a mean table and how it applies it ("the positive
     /// column …, applied in both directions").
@@ -223,7 +226,7 @@ fn mode(
     notes: &mut Vec<String>,
 ) -> TableMode {
     let reversal = effects.iter().find_map(|e| match e.in_table() {
-        TableRole::Bidirectional { b_um } => Some(b_um),
+        TableRole::Bidirectional { b } => Some(b),
         _ => None,
     });
     match (request.mode, reversal) {
@@ -232,6 +235,7 @@ fn mode(
             notes.push("reversal: a bidirectional table (one column per direction)".to_string());
             TableMode::Bidirectional
         }
+        // B in µm: the effects are a linear axis' (`Capabilities::resolution_mm`).
         (None, Some(b)) => {
             notes.push(format!(
                 "reversal: {} takes no bidirectional table; set the backlash parameter (the suggested value below; the diagnosis found B = {b:.2} µm)",
@@ -255,7 +259,7 @@ fn effects_step(
     let finest = effects
         .iter()
         .filter_map(|e| match e.in_table() {
-            TableRole::AtPoints { finest_step_mm } => Some(finest_step_mm),
+            TableRole::AtPoints { finest_step } => Some(finest_step),
             _ => None,
         })
         .min_by(f64::total_cmp)?;
@@ -369,7 +373,7 @@ mod tests {
 
     #[test]
     fn a_reversal_makes_it_bidirectional_where_the_controller_takes_it() {
-        let effects = [Effect::Reversal(Reversal { b_um: -3.0 })];
+        let effects = [Effect::Reversal(Reversal { b: -3.0 })];
         let bidirectional = linear_plan(
             &effects,
             &ITNC,
@@ -415,8 +419,8 @@ mod tests {
         // Period 5.3 mm: a tenth is 0.53 mm, a step the iTNC writes exactly.
         let effects = [
             Effect::Periodic(Periodic {
-                period_mm: 5.3,
-                amplitude_um: 1.0,
+                period: 5.3,
+                amplitude: 1.0,
                 phase_rad: 0.0,
             }),
             Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),

@@ -41,7 +41,7 @@ pub(super) fn level_covariance(problem: &Problem, levels: &[Level]) -> Covarianc
             .iter()
             .map(|l| problem.prediction_weights[l.target_index].clone())
             .collect(),
-        problem.first_test_variance_um2.clone(),
+        problem.first_test_variance.clone(),
     )
 }
 
@@ -111,7 +111,7 @@ fn level_columns(problem: &Problem, levels: &[Level], shape: Shape) -> Vec<Vec<f
     let readings = at(&mut levels.iter().map(|l| (l.target_index, l.target_mm)));
     let mut columns = crate::effects::columns(shape, &readings, &problem.line());
     if let Shape::Period(_, PeriodicIn::BothTests) = shape {
-        let first = at(&mut problem.first_test_positions_mm.iter().map(|&x| (0, x)));
+        let first = at(&mut problem.first_test_positions.iter().map(|&x| (0, x)));
         let carried = crate::effects::columns(shape, &first, &problem.line());
         for (column, samples) in columns.iter_mut().zip(&carried) {
             for (value, level) in column.iter_mut().zip(levels) {
@@ -172,7 +172,7 @@ pub(super) fn select_along_axis(
         covariance: &covariance,
         // A rotary axis' orders are its own (`shape_sets`): no scan, no aliases in mm.
         periods: (problem.kind == AxisKind::Linear)
-            .then(|| period_range(&problem.targets_mm, min_periods))
+            .then(|| period_range(&problem.targets, min_periods))
             .flatten(),
         min_periods,
         known,
@@ -251,7 +251,7 @@ struct AlongAxis<'a> {
 
 impl AlongAxis<'_> {
     fn span_mm(&self) -> f64 {
-        let targets = &self.problem.targets_mm;
+        let targets = &self.problem.targets;
         targets[targets.len() - 1] - targets[0]
     }
 
@@ -319,7 +319,7 @@ impl Search for AlongAxis<'_> {
             // revolution, the period 360°/k, each tried on its own.
             Kind::Periodic if self.problem.kind == AxisKind::Rotary => {
                 let against_prediction = self.background == Background::Constant;
-                let orders = rotary_orders(&self.problem.targets_mm, against_prediction);
+                let orders = rotary_orders(&self.problem.targets, against_prediction);
                 vec![ShapeSet::each(orders.map_or_else(
                     Vec::new,
                     |(lowest, highest)| {
@@ -333,7 +333,7 @@ impl Search for AlongAxis<'_> {
             }
             Kind::Periodic => {
                 // Against a prediction, the error may be in both tests (see `periodogram`).
-                let first = &self.problem.first_test_positions_mm;
+                let first = &self.problem.first_test_positions;
                 let unresolved_below_mm = (first.len() >= 2).then(|| {
                     let mut gaps: Vec<f64> = first.windows(2).map(|p| p[1] - p[0]).collect();
                     gaps.sort_by(f64::total_cmp);
@@ -551,7 +551,7 @@ pub(super) fn along_axis_cv(
     reversal_b: f64,
 ) -> f64 {
     let (mut sum, mut count) = (0.0, 0usize);
-    let targets = problem.targets_mm.len();
+    let targets = problem.targets.len();
     let mut row_of_target = vec![None; targets];
     for (row, l) in levels.iter().enumerate() {
         row_of_target[l.target_index].get_or_insert(row);

@@ -131,13 +131,13 @@ fn constant_reversal(problem: &Problem, differences: &[(usize, f64, f64)]) -> (f
     let covariance = Covariance::new(
         differences
             .iter()
-            .map(|(t, _, v)| v.max(1e-300) - problem.reversal_prediction_variance_um2(*t))
+            .map(|(t, _, v)| v.max(1e-300) - problem.reversal_prediction_variance(*t))
             .collect(),
         differences
             .iter()
             .map(|(t, _, _)| problem.prediction_weights[*t].clone())
             .collect(),
-        problem.first_test_reversal_variance_um2.clone(),
+        problem.first_test_reversal_variance.clone(),
     );
     let d: Vec<f64> = differences.iter().map(|(_, d, _)| *d).collect();
     let (Some(inverse_d), Some(inverse_ones)) =

@@ -30,14 +30,14 @@ pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context 
     Context {
         kind: input.after.kind(),
         angle: input.angle,
-        table_step_mm: input.table.and_then(CompensationTable::regular_step),
-        target_spacing_mm: crate::compensate::regular_step(input.after.targets()),
+        table_step: input.table.and_then(CompensationTable::regular_step),
+        target_spacing: crate::compensate::regular_step(input.after.targets()),
         expansion_coefficient_ppm_per_k: input.after.environment.expansion_coefficient_ppm_per_k,
         material_change_k,
         time_assumed,
-        first_test_reversal_um: first_test_reversal_um(input),
+        first_test_reversal: first_test_reversal_um(input),
         // Known once the figures are: `diagnose` says them then.
-        retest_mean_reversal_um: None,
+        retest_mean_reversal: None,
     }
 }
 
@@ -59,9 +59,9 @@ pub(super) fn accepted_effect(
     let (uncertainty, mut warnings) = effect.uncertainty(&FitSummary {
         coefficients,
         errors,
-        span_mm: problem.targets_mm[problem.targets_mm.len() - 1] - problem.targets_mm[0],
+        span: problem.targets[problem.targets.len() - 1] - problem.targets[0],
         n,
-        target_spacing_mm: context.target_spacing_mm,
+        target_spacing: context.target_spacing,
         kind: context.kind,
     });
     if context.time_assumed && effect.kind() == Kind::Drift {

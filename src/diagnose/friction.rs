@@ -21,10 +21,10 @@
 //! positive one is not explained here.
 
 use super::Diagnosis;
-use crate::effects::Effect;
+use crate::effects::{Effect, EffectIn};
 use crate::servo::axis::Axis;
 use crate::servo::reversal::{friction_from_reversal_n, reversal_from_friction_um};
-use crate::units::m_to_um;
+use crate::units::{Um, m_to_um};
 
 /// The friction force a found reversal means.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,24 +64,27 @@ pub fn friction_behind_reversal(
         .accepted
         .iter()
         .find(|a| matches!(a.effect, Effect::Reversal(_)))?;
-    let Effect::Reversal(reversal) = accepted.effect else {
+    // A servo description's friction is a linear axis' (N against µm).
+    let EffectIn::Reversal {
+        b: Um(reversal_um),
+        b_uncertainty: Um(uncertainty_um),
+    } = accepted
+        .effect
+        .typed(diagnosis.kind, &accepted.uncertainty)?
+        .linear()?
+    else {
         return None;
     };
     let change = diagnosis.predicted_from_first_test;
-    if !change && reversal.b_um >= 0.0 {
+    if !change && reversal_um >= 0.0 {
         return None;
     }
-    let uncertainty_um = accepted
-        .uncertainty
-        .iter()
-        .find(|(key, _)| *key == "B_um")
-        .map_or(0.0, |(_, u)| *u);
     // B = −2·F/k_c: the force is the inverse of the (negative) reversal.
-    let friction_n = friction_from_reversal_n(-reversal.b_um, stiffness_n_per_um);
+    let friction_n = friction_from_reversal_n(-reversal_um, stiffness_n_per_um);
     let increment_um = m_to_um(axis.position_loop.increment_m);
     let axis_coulomb_n = axis.friction.coulomb_n;
     Some(ReversalFriction {
-        reversal_um: reversal.b_um,
+        reversal_um,
         reversal_uncertainty_um: uncertainty_um,
         change_since_first_test: change,
         friction_n,

@@ -44,7 +44,7 @@ pub(super) fn cell_levels(problem: &Problem, fitted: &Fit) -> Vec<Cell> {
             direction: *d,
             value_um: fitted.coefficients[c],
             variance_um2: fitted.standard_errors[c].powi(2),
-            reversal_prediction_variance_um2: problem.reversal_prediction_variance_um2(*t) / 2.0,
+            reversal_prediction_variance_um2: problem.reversal_prediction_variance(*t) / 2.0,
         })
         .collect()
 }
@@ -96,7 +96,7 @@ pub(super) fn cross_validation_folds(
         let fitted = fit::fit(between_model, y, Some(&training));
         let cells = cell_levels(problem, &fitted);
         let levels = target_levels(problem, &cells);
-        let effects = problem.between_runs_um(between, &fitted.coefficients);
+        let effects = problem.between_runs(between, &fitted.coefficients);
         let held: Vec<(usize, Direction, f64)> = (0..y.len())
             .filter(|&i| run_of[i] == held_out)
             .map(|i| {
@@ -116,7 +116,7 @@ pub(super) fn cross_validation_folds(
 /// The per-target levels: both directions pooled (their mean), with the
 /// variance of the scatter and of the prediction.
 pub(super) fn target_levels(problem: &Problem, cells: &[Cell]) -> Vec<Level> {
-    let mut at_target: Vec<Vec<&Cell>> = vec![Vec::new(); problem.targets_mm.len()];
+    let mut at_target: Vec<Vec<&Cell>> = vec![Vec::new(); problem.targets.len()];
     for c in cells {
         at_target[c.target_index].push(c);
     }
@@ -130,11 +130,11 @@ pub(super) fn target_levels(problem: &Problem, cells: &[Cell]) -> Vec<Level> {
         let scatter = here.iter().map(|c| c.variance_um2).sum::<f64>() / (k * k);
         let prediction: f64 = problem.prediction_weights[t]
             .iter()
-            .map(|(i, w)| w * w * problem.first_test_variance_um2[*i])
+            .map(|(i, w)| w * w * problem.first_test_variance[*i])
             .sum();
         levels.push(Level {
             target_index: t,
-            target_mm: problem.targets_mm[t],
+            target_mm: problem.targets[t],
             value_um: value,
             scatter_variance_um2: scatter,
             variance_um2: scatter + prediction,

@@ -53,11 +53,14 @@ pub use angular_profile::AngularProfile;
 use crate::compensate::CompensateError;
 use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
-use crate::effects::{Context, Effect, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape};
+use crate::effects::{
+    Context, Effect, EffectIn, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape, held_angle,
+    reversal,
+};
 use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
 use crate::measurement::{AxisKind, ByKind, Direction, Measurement};
 use crate::together::NotTogether;
-use crate::units::{Deg, Mm, Um, millideg_to_deg, mm_to_um};
+use crate::units::{Deg, Mm, Um, mm_to_um};
 use along_axis::{AlongAxisSelection, Background, select_along_axis};
 use between_runs::{select_between_runs, select_reversal};
 use findings::{accepted_effect, context, figures, stats};
@@ -98,7 +101,9 @@ pub struct DiagnoseInput<'a> {
     /// The axis' angular error (pitch or yaw) along the stroke, for Abbe.
     pub angular: Option<&'a AngularProfile>,
     /// Periods the axis is known to have (its screw lead, its scale period:
-    /// the machine profile's), looked for before the scan of every period.
+    /// the machine profile's, mm), looked for before the scan of every
+    /// period; a linear axis' only (a rotary axis' are whole orders per
+    /// revolution, and these are not used there).
     pub known_periods: &'a [KnownPeriod],
     /// Cycle timing to assume when the file records no duration.
     pub timing: CycleTiming,
@@ -210,7 +215,9 @@ impl<D> Evidence<D> {
 pub struct AcceptedEffect {
     /// The effect and its parameters.
     pub effect: Effect,
-    /// Standard uncertainty of each parameter, by key.
+    /// Standard uncertainty of each parameter, by its key
+    /// (`effects::Parameter::key`), in the parameter's unit; typed with the
+    /// parameters by [`Effect::typed`] ([`DiagnosisIn::effects`]).
     pub uncertainty: Vec<(&'static str, f64)>,
     /// Why it was accepted.
     pub evidence: Evidence,
@@ -365,6 +372,10 @@ pub struct DiagnosisIn<P, D> {
     /// Why each accepted effect was accepted, in the order of
     /// [`Diagnosis::accepted`].
     pub evidence: Vec<Evidence<D>>,
+    /// Each accepted effect's parameters that are positions or deviations,
+    /// with their uncertainties ([`Effect::typed`]), in the same order;
+    /// `None` for a kind that has none (scale, drift, Abbe).
+    pub effects: Vec<Option<EffectIn<P, D>>>,
     /// What none of the effects explains.
     pub unexplained: Unexplained<P, D>,
     /// Every reading of the re-test, as [`Diagnosis::readings`].
@@ -380,6 +391,11 @@ impl<P, D> DiagnosisIn<P, D> {
             residual_after: self.residual_after.map(convert),
             noise: convert(self.noise),
             evidence: self.evidence.into_iter().map(|e| e.map(convert)).collect(),
+            effects: self
+                .effects
+                .into_iter()
+                .map(|effect| effect.map(|effect| effect.map_deviations(convert)))
+                .collect(),
             unexplained: self.unexplained.map(|place| place, convert),
             readings: self.readings.into_iter().map(|r| r.map(convert)).collect(),
         }
@@ -389,7 +405,8 @@ impl<P, D> DiagnosisIn<P, D> {
 impl Diagnosis {
     /// Its numbers with their units as types: on a linear axis positions in
     /// [`Mm`] and deviations in [`Um`], on a rotary one both in [`Deg`] (the
-    /// deviations held in m°). A rotary axis' residual is no `Um`:
+    /// deviations held in m°), and so are the accepted effects' parameters
+    /// ([`DiagnosisIn::effects`]). A rotary axis' residual is no `Um`:
     /// ```
     /// # fn f(diagnosis: &axcomp::diagnose::Diagnosis) {
     /// use axcomp::units::Deg;
@@ -408,14 +425,20 @@ impl Diagnosis {
     /// ```
     pub fn typed(&self) -> ByKind<DiagnosisIn<Mm, Um>, DiagnosisIn<Deg, Deg>> {
         match self.kind {
-            AxisKind::Linear => ByKind::Linear(self.in_units(Mm, Um)),
-            AxisKind::Rotary => {
-                ByKind::Rotary(self.in_units(Deg, |millideg| Deg(millideg_to_deg(millideg))))
-            }
+            AxisKind::Linear => ByKind::Linear(self.in_units(Mm, Um, ByKind::linear)),
+            AxisKind::Rotary => ByKind::Rotary(self.in_units(Deg, held_angle, ByKind::rotary)),
         }
     }
 
-    fn in_units<P, D>(&self, position: fn(f64) -> P, deviation: fn(f64) -> D) -> DiagnosisIn<P, D> {
+    /// Its numbers with positions by `position`, deviations by `deviation`,
+    /// and the effects' parameters in the branch `branch` takes of
+    /// [`Effect::typed`] (the same units).
+    fn in_units<P, D>(
+        &self,
+        position: fn(f64) -> P,
+        deviation: fn(f64) -> D,
+        branch: fn(TypedEffect) -> Option<EffectIn<P, D>>,
+    ) -> DiagnosisIn<P, D> {
         DiagnosisIn {
             residual_before: self.residual_before.map(deviation),
             residual_after: self.residual_after.map(deviation),
@@ -425,11 +448,24 @@ impl Diagnosis {
                 .iter()
                 .map(|accepted| accepted.evidence.map(deviation))
                 .collect(),
+            effects: self
+                .accepted
+                .iter()
+                .map(|accepted| {
+                    accepted
+                        .effect
+                        .typed(self.kind, &accepted.uncertainty)
+                        .and_then(branch)
+                })
+                .collect(),
             unexplained: self.unexplained.clone().map(position, deviation),
             readings: self.readings.iter().map(|r| r.map(deviation)).collect(),
         }
     }
 }
+
+/// An effect's parameters typed by the axis' kind ([`Effect::typed`]).
+type TypedEffect = ByKind<EffectIn<Mm, Um>, EffectIn<Deg, Deg>>;
 
 /// Why a diagnosis cannot be made.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -458,9 +494,9 @@ pub enum DiagnoseError {
 pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     let (problem, time_assumed) = problem(input)?;
     let y: Vec<f64> = problem
-        .measured_um
+        .measured
         .iter()
-        .zip(&problem.predicted_um)
+        .zip(&problem.predicted)
         .map(|(m, p)| m - p)
         .collect();
     let n = y.len();
@@ -499,7 +535,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         &folds,
         reversal_b,
         &kinds,
-        input.known_periods,
+        known_periods(input),
         background,
         &mut rejected,
     );
@@ -507,11 +543,11 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
 
     let mut accepted: Vec<AcceptedEffect> = Vec::new();
     if let Some(r) = reversal {
-        let effect = Effect::Reversal(Reversal { b_um: r.b_um });
+        let effect = Effect::Reversal(Reversal { b: r.b_um });
         accepted.push(AcceptedEffect {
             explanation: effect.explanation(&context),
             effect,
-            uncertainty: vec![("B_um", r.standard_error_um)],
+            uncertainty: vec![(reversal::B_KEY, r.standard_error_um)],
             evidence: r.evidence,
             warnings: Vec::new(),
         });
@@ -540,7 +576,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
                 period,
                 tests,
                 &aliases_mm,
-                input.known_periods,
+                known_periods(input),
             ));
         }
         accepted.push(effect);
@@ -549,8 +585,8 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // The model: per target, the level along the axis (with a prediction: the constant and the
     // effects along the axis; without: the re-test's own level), ±B/2 by direction, and the
     // between-runs effects of each reading. The scatter is what the cells leave.
-    let mut level_at_target = vec![0.0; problem.targets_mm.len()];
-    let mut model_at_target = vec![0.0; problem.targets_mm.len()];
+    let mut level_at_target = vec![0.0; problem.targets.len()];
+    let mut model_at_target = vec![0.0; problem.targets.len()];
     for (level, fitted) in levels.iter().zip(&along_fit.fitted) {
         level_at_target[level.target_index] = level.value_um;
         model_at_target[level.target_index] = if with_prediction {
@@ -560,7 +596,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         };
     }
     let half_reversal = |d: Direction| d.reversal_share(reversal_b);
-    let between_um = problem.between_runs_um(&between, &between_fit.coefficients);
+    let between_um = problem.between_runs(&between, &between_fit.coefficients);
     let scatter: Vec<f64> = y
         .iter()
         .zip(&between_fit.fitted)
@@ -603,7 +639,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         } else {
             level_at_target[r.target_index]
         };
-        problem.predicted_um[i] + systematic + scatter[i]
+        problem.predicted[i] + systematic + scatter[i]
     })?;
     // The reversal's sentence says the B̄ the figures show; where the fitted
     // B differs from the change they show, it says why.
@@ -611,7 +647,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         (figures.predicted.b_mean, figures.measured.b_mean)
     {
         let context = Context {
-            retest_mean_reversal_um: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),
+            retest_mean_reversal: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),
             ..context
         };
         let others: Vec<String> = accepted
@@ -619,7 +655,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             .filter(|a| {
                 !matches!(a.effect, Effect::Reversal(_)) && !a.effect.kind().is_positional()
             })
-            .map(|a| a.effect.model().label(&|v| format!("{v:.2}")))
+            .map(|a| a.effect.model().label(&context, &|v| format!("{v:.2}")))
             .collect();
         for found in accepted.iter_mut() {
             let Effect::Reversal(reversal) = found.effect else {
@@ -631,7 +667,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
                 mm_to_um(measured_mm)
             };
             found.explanation = found.effect.explanation(&context);
-            if context.deviation(reversal.b_um) != context.deviation(shown_um) {
+            if context.deviation(reversal.b) != context.deviation(shown_um) {
                 let why = if others.is_empty() {
                     "it weighs each target by its readings, where B̄ is the plain mean of the targets' reversals".to_string()
                 } else {
@@ -642,7 +678,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
                 };
                 found.explanation.push_str(&format!(
                     " The fit's B = {} differs from that {}: {why}.",
-                    context.deviation(reversal.b_um),
+                    context.deviation(reversal.b),
                     if with_prediction { "change" } else { "B̄" },
                 ));
             }
@@ -651,7 +687,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // With a first test the prediction carries its reversal (what the table
     // leaves of it): a reversal found is a change, and none found is none.
     if reversal.is_none()
-        && let Some(first_um) = context.first_test_reversal_um
+        && let Some(first_um) = context.first_test_reversal
         && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
     {
         let predicted_um = figures.predicted.b_mean.map(mm_to_um);
@@ -707,6 +743,16 @@ fn no_reversal_change(
     }
 }
 
+/// The axis' known periods, a linear axis' only: they are lengths (a screw
+/// lead, a scale period, mm), and a rotary axis' periods are whole orders
+/// per revolution, in degrees.
+fn known_periods<'a>(input: &DiagnoseInput<'a>) -> &'a [KnownPeriod] {
+    match input.after.kind() {
+        AxisKind::Linear => input.known_periods,
+        AxisKind::Rotary => &[],
+    }
+}
+
 /// What a user should know of a periodic error's period: that it is a known
 /// period of the axis, and which periods the targets cannot tell from it.
 fn period_notes(
@@ -756,7 +802,7 @@ pub(crate) mod tests {
             effect: Effect::OutlierRun(OutlierRun {
                 run: 1,
                 direction: Direction::Down,
-                offset_um: 10.0,
+                offset: 10.0,
             }),
             uncertainty: vec![("offset_um", 1.0)],
             evidence: Evidence {

@@ -18,31 +18,38 @@ use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::together::{Input, Pairing, check_together};
 use crate::units::{DeviationUnit, mm_to_um};
 
-/// The readings with their prediction, as one table.
+/// The readings with their prediction, as one table. Its positions are in
+/// the axis' unit (mm, or ° on a rotary axis) and its deviations in the
+/// diagnosis' (µm, or m°, 1/1000 °; variances in their square): the
+/// statistics are the same arithmetic in either.
 pub(super) struct Problem {
     pub(super) readings: Vec<Reading>,
-    pub(super) measured_um: Vec<f64>,
-    pub(super) predicted_um: Vec<f64>,
+    /// Each reading's deviation as measured.
+    pub(super) measured: Vec<f64>,
+    /// Each reading's deviation as predicted (0 without a first test).
+    pub(super) predicted: Vec<f64>,
     /// The prediction at each target of the re-test interpolates the first
-    /// test's means: (index into `first_test_variance_um2`, weight) pairs.
+    /// test's means: (index into `first_test_variance`, weight) pairs.
     pub(super) prediction_weights: Vec<Vec<(usize, f64)>>,
     /// The predicted re-test as `predict` gives it on the measured line: the
     /// first test's readings with the predicted systematic error.
     pub(super) first_test_prediction: Option<Measurement>,
-    /// The first test's targets that `prediction_weights` index, mm (none without one).
-    pub(super) first_test_positions_mm: Vec<f64>,
-    /// Variance of the first test's bidirectional mean at each of its targets, µm².
-    pub(super) first_test_variance_um2: Vec<f64>,
+    /// The first test's targets that `prediction_weights` index (none without one).
+    pub(super) first_test_positions: Vec<f64>,
+    /// Variance of the first test's bidirectional mean at each of its targets.
+    pub(super) first_test_variance: Vec<f64>,
     /// Variance of the first test's reversal x̄↑ − x̄↓ at each of its targets
-    /// (which the prediction carries), µm²; 0 for a unidirectional test.
-    pub(super) first_test_reversal_variance_um2: Vec<f64>,
+    /// (which the prediction carries); 0 for a unidirectional test.
+    pub(super) first_test_reversal_variance: Vec<f64>,
     pub(super) run_count: usize,
     /// Whether the reading times are the cycle model's, not the file's.
     pub(super) time_assumed: bool,
     /// One run's mean duration on the clock of the readings' `time_h`, h.
     pub(super) run_h: f64,
-    pub(super) targets_mm: Vec<f64>,
-    /// Linear or rotary: on a rotary axis `_mm` holds ° and `_um` m° (1/1000 °).
+    /// The re-test's targets.
+    pub(super) targets: Vec<f64>,
+    /// Linear or rotary: the units above, and of what the diagnosis derives
+    /// from them (its locals named `_mm` and `_um` hold ° and m° then).
     pub(super) kind: AxisKind,
     /// The unit its sentences say a deviation in (µm, ″ or µrad).
     pub(super) deviation: DeviationUnit,
@@ -55,28 +62,28 @@ pub(super) struct Problem {
 
 impl Problem {
     pub(super) fn first_target_mm(&self) -> f64 {
-        self.targets_mm[0]
+        self.targets[0]
     }
 
     /// Covariance of the predicted reversals at the re-test's targets `a` and
-    /// `b`, µm²: what they share of the first test's reversals.
-    pub(super) fn shared_reversal_variance_um2(&self, a: usize, b: usize) -> f64 {
+    /// `b`: what they share of the first test's reversals.
+    pub(super) fn shared_reversal_variance(&self, a: usize, b: usize) -> f64 {
         self.prediction_weights[a]
             .iter()
             .flat_map(|(ka, wa)| {
                 self.prediction_weights[b]
                     .iter()
                     .filter(move |(kb, _)| kb == ka)
-                    .map(move |(_, wb)| wa * wb * self.first_test_reversal_variance_um2[*ka])
+                    .map(move |(_, wb)| wa * wb * self.first_test_reversal_variance[*ka])
             })
             .sum()
     }
 
-    /// Variance of the predicted reversal at the re-test's target `t`, µm²:
+    /// Variance of the predicted reversal at the re-test's target `t`:
     /// the first test's reversals through the spline weights (independent
     /// between the first test's targets).
-    pub(super) fn reversal_prediction_variance_um2(&self, t: usize) -> f64 {
-        self.shared_reversal_variance_um2(t, t)
+    pub(super) fn reversal_prediction_variance(&self, t: usize) -> f64 {
+        self.shared_reversal_variance(t, t)
     }
 
     /// What the effects need of the test besides a reading.
@@ -98,7 +105,7 @@ impl Problem {
     }
 
     /// What the between-runs effects (drift, outlier runs) add to each reading.
-    pub(super) fn between_runs_um(&self, chosen: &[Chosen], coefficients: &[f64]) -> Vec<f64> {
+    pub(super) fn between_runs(&self, chosen: &[Chosen], coefficients: &[f64]) -> Vec<f64> {
         let mut sum = vec![0.0; self.readings.len()];
         for c in chosen {
             for (j, column) in self.columns(c.shape).iter().enumerate() {
@@ -151,31 +158,31 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         _ => None,
     };
     let mut readings = Vec::new();
-    let mut measured_um = Vec::new();
-    let mut predicted_um = Vec::new();
+    let mut measured = Vec::new();
+    let mut predicted = Vec::new();
     for (run_index, run) in after.runs().iter().enumerate() {
-        for (target_index, (value, &target_mm)) in
+        for (target_index, (value, &target)) in
             run.deviations.iter().zip(after.targets()).enumerate()
         {
             let Some(value) = value else { continue };
             readings.push(Reading {
                 target_index,
-                target: target_mm,
+                target,
                 direction: run.direction,
                 run: run.number,
                 run_index,
                 time_h: times[run_index][target_index],
             });
-            measured_um.push(mm_to_um(*value));
-            let predicted = first.as_ref().map_or(0.0, |(known, _)| {
+            measured.push(mm_to_um(*value));
+            let at_reading = first.as_ref().map_or(0.0, |(known, _)| {
                 mm_to_um(predicted_deviation_mm(
                     known,
                     applied,
-                    target_mm,
+                    target,
                     run.direction,
                 ))
             });
-            predicted_um.push(predicted);
+            predicted.push(at_reading);
         }
     }
     if readings.len() < 4 || after.runs().len() < 2 {
@@ -183,9 +190,9 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     }
     let (
         prediction_weights,
-        first_test_positions_mm,
-        first_test_variance_um2,
-        first_test_reversal_variance_um2,
+        first_test_positions,
+        first_test_variance,
+        first_test_reversal_variance,
     ) = match &first {
         Some((_, variances)) => (
             interpolation_weights(&variances.positions_mm, after.targets()),
@@ -235,17 +242,17 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     });
     let problem = Problem {
         readings,
-        measured_um,
-        predicted_um,
+        measured,
+        predicted,
         prediction_weights,
         first_test_prediction,
-        first_test_positions_mm,
-        first_test_variance_um2,
-        first_test_reversal_variance_um2,
+        first_test_positions,
+        first_test_variance,
+        first_test_reversal_variance,
         run_count: after.runs().len(),
         time_assumed,
         run_h: cycle::run_h(&times),
-        targets_mm: after.targets().to_vec(),
+        targets: after.targets().to_vec(),
         kind: after.kind(),
         deviation: after.kind().deviation_unit(input.angle),
         angle_urad,

@@ -34,7 +34,7 @@ pub(super) fn unexplained(
         for (t, d, v) in reversals(cells) {
             let z = (d - reversal_b) / v.max(1e-300).sqrt();
             if z.abs() > 3.0 {
-                flagged.push((problem.targets_mm[t], z.abs()));
+                flagged.push((problem.targets[t], z.abs()));
             }
         }
     }

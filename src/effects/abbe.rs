@@ -25,13 +25,13 @@ fn angle_at(reading: &Reading, line: &Line<'_>) -> f64 {
 }
 
 impl Model for Abbe {
-    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+    fn value(&self, reading: &Reading, line: &Line<'_>) -> f64 {
         urad_times_mm_to_um(self.offset_mm * angle_at(reading, line))
     }
 
     /// The volumetric model gives it from the line and the angular errors
     /// rather than from an effect.
-    fn systematic_um(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
+    fn systematic(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
         None
     }
 
@@ -55,7 +55,7 @@ impl Model for Abbe {
         ]
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, _: &Context, number: &dyn Fn(f64) -> String) -> String {
         format!("Abbe, offset {} mm", number(self.offset_mm))
     }
 }

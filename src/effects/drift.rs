@@ -75,7 +75,7 @@ impl Drift {
 }
 
 impl Model for Drift {
-    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+    fn value(&self, reading: &Reading, line: &Line<'_>) -> f64 {
         match *self {
             Drift::PerHour { rate_um_per_h } => rate_um_per_h * reading.time_h,
             Drift::PerRun { rate_um_per_run } => rate_um_per_run * line.runs_at(reading.time_h),
@@ -83,7 +83,7 @@ impl Model for Drift {
     }
 
     /// Not systematic in position: a table cannot take it.
-    fn systematic_um(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
+    fn systematic(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
         None
     }
 
@@ -120,7 +120,7 @@ impl Model for Drift {
         parameter.parameters(rate)
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, _: &Context, number: &dyn Fn(f64) -> String) -> String {
         let (rate, parameter) = self.rate();
         parameter.label(Self::NAME, rate, number)
     }
@@ -160,13 +160,13 @@ mod tests {
         Context {
             kind: AxisKind::Linear,
             angle: Default::default(),
-            table_step_mm: None,
-            target_spacing_mm: None,
+            table_step: None,
+            target_spacing: None,
             expansion_coefficient_ppm_per_k: None,
             material_change_k: None,
             time_assumed: false,
-            first_test_reversal_um: None,
-            retest_mean_reversal_um: None,
+            first_test_reversal: None,
+            retest_mean_reversal: None,
         }
     }
 

@@ -17,9 +17,10 @@
 //! phase_rad = 0.69
 //! ```
 //!
-//! Each kind's keys are its struct's fields ([`super::Reversal`] `B_um`,
-//! [`super::Scale`] `scale_um_per_m`, …). A `tests` key (synth's) is
-//! accepted and ignored.
+//! Each kind's keys are its struct's fields, under names with a linear
+//! axis' units ([`super::Reversal`]'s `b` as `B_um`, [`super::Scale`]'s
+//! `scale_um_per_m`, …): the file is written and read for linear axes only
+//! (`workflow::rotary`). A `tests` key (synth's) is accepted and ignored.
 
 use std::fmt::Write;
 
@@ -56,7 +57,7 @@ impl<'de, T: serde::de::DeserializeOwned> Deserialize<'de> for Tested<T> {
 /// use axcomp::effects::{Effect, Reversal, read_effects};
 ///
 /// let effects = read_effects("[[effect]]\nkind = \"reversal\"\nB_um = -3.0\n")?;
-/// assert_eq!(effects, [Effect::Reversal(Reversal { b_um: -3.0 })]);
+/// assert_eq!(effects, [Effect::Reversal(Reversal { b: -3.0 })]);
 /// # Ok::<(), axcomp::error::ParseError>(())
 /// ```
 pub fn read_effects(text: &str) -> Result<Vec<Effect>, ParseError> {

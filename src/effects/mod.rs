@@ -30,6 +30,7 @@ pub mod outlier_run;
 pub mod periodic;
 pub mod reversal;
 pub mod scale;
+pub mod typed;
 
 use serde::Deserialize;
 
@@ -43,6 +44,7 @@ pub use outlier_run::OutlierRun;
 pub use periodic::Periodic;
 pub use reversal::Reversal;
 pub use scale::Scale;
+pub use typed::{EffectIn, held_angle};
 
 /// One reading, as the effects see it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,7 +67,8 @@ pub struct Reading {
 /// stroke starts (scale is zero there) and the angular profile (Abbe).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Line<'a> {
-    /// The first target, mm.
+    /// The first target, mm: only a scale error reads it, and a scale error
+    /// is looked for on a linear axis only (`diagnose::gates`).
     pub first_target_mm: f64,
     /// The angular error at each target, µrad (Abbe), if given.
     pub angle_urad: Option<&'a [f64]>,
@@ -105,7 +108,7 @@ pub enum PeriodicIn {
 pub enum Shape {
     /// No free shape.
     Fixed(Kind),
-    /// A periodic error of this period, mm, in these tests.
+    /// A periodic error of this period (mm, or °), in these tests.
     Period(f64, PeriodicIn),
     /// One run: (direction, number).
     Run(Direction, u32),
@@ -122,58 +125,89 @@ impl Shape {
     }
 }
 
-/// Context for the sentence a user reads.
+/// Context for the sentence a user reads. Its positions are in the axis'
+/// unit (mm, or ° on a rotary axis) and its deviations in the effects'
+/// deviation unit (µm, or m°, 1/1000 °, on a rotary axis); the sentences say
+/// them in mm and µm, or ° and ″ (µrad) ([`Context::position`],
+/// [`Context::deviation`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Context {
-    /// Linear or rotary: on a rotary axis the values held as mm and µm are °
-    /// and m° (1/1000 °), and the sentences say ° and ″ ([`Context::deviation`]).
+    /// Linear or rotary: the units of the values below.
     pub kind: AxisKind,
     /// The unit a rotary axis' deviations are said in (″ or µrad).
     pub angle: AngleUnit,
-    /// The table's step, mm, if a regular table was applied.
-    pub table_step_mm: Option<f64>,
-    /// Spacing of the targets, when regular, mm.
-    pub target_spacing_mm: Option<f64>,
+    /// The table's step (mm, or °), if a regular table was applied.
+    pub table_step: Option<f64>,
+    /// Spacing of the targets (mm, or °), when regular.
+    pub target_spacing: Option<f64>,
     /// Expansion coefficient the laser used, ppm/K.
     pub expansion_coefficient_ppm_per_k: Option<f64>,
     /// Material temperature change between the tests, K, if both recorded.
     pub material_change_k: Option<f64>,
     /// Whether the times of the readings are assumed (no recorded duration).
     pub time_assumed: bool,
-    /// The first test's mean reversal B̄, µm, which the prediction carries (a
-    /// reversal found is then the change since that test).
-    pub first_test_reversal_um: Option<f64>,
-    /// The re-test's mean reversal B̄ as predicted and as measured, µm (the
-    /// diagnosis' figures): the sentence says these, and the backlash
-    /// parameter follows the measured one.
-    pub retest_mean_reversal_um: Option<(f64, f64)>,
+    /// The first test's mean reversal B̄ (µm, or m°), which the prediction
+    /// carries (a reversal found is then the change since that test).
+    pub first_test_reversal: Option<f64>,
+    /// The re-test's mean reversal B̄ as predicted and as measured (µm, or
+    /// m°; the diagnosis' figures): the sentence says these, and the
+    /// backlash parameter follows the measured one.
+    pub retest_mean_reversal: Option<(f64, f64)>,
 }
 
-/// A deviation held in µm (m°, 1/1000 °, on a rotary axis) as a sentence
-/// writes it in `unit` with `decimals`: `2.40 µm`, or in arc-seconds `8.64″`
-/// (`41.89 µrad`).
-pub fn deviation_text(unit: DeviationUnit, value_um: f64, decimals: usize) -> String {
-    let suffix = unit.suffix();
+/// A deviation held in the effects' unit (µm, or m°, 1/1000 °, with an
+/// angle `unit`) as a sentence writes it in `unit` with `decimals`:
+/// `2.40 µm`, or in arc-seconds `8.64″` (`41.89 µrad`).
+pub fn deviation_text(unit: DeviationUnit, value: f64, decimals: usize) -> String {
+    format!("{:.decimals$}{}", in_unit(unit, value), unit.suffix())
+}
+
+/// A deviation held in the effects' unit (µm, or m° on a rotary axis) in
+/// the unit of the axis' positions and readings (mm, or °): a thousandth of
+/// it either way.
+pub fn deviation_as_position(kind: AxisKind, value: f64) -> f64 {
+    match kind {
+        AxisKind::Linear => um_to_mm(value),
+        AxisKind::Rotary => held_angle(value).0,
+    }
+}
+
+/// A deviation held in µm (with an angle `unit`, m°) in `unit`.
+fn in_unit(unit: DeviationUnit, value: f64) -> f64 {
     match unit {
-        DeviationUnit::Micrometre => format!("{value_um:.decimals$}{suffix}"),
-        DeviationUnit::Angle(angle) => {
-            format!("{:.decimals$}{suffix}", angle.from_deg(um_to_mm(value_um)))
-        }
+        DeviationUnit::Micrometre => value,
+        DeviationUnit::Angle(angle) => angle.from_deg(held_angle(value).0),
     }
 }
 
 impl Context {
-    /// A deviation as a sentence writes it ([`deviation_text`], 2 decimals).
-    pub fn deviation(&self, value_um: f64) -> String {
-        deviation_text(self.kind.deviation_unit(self.angle), value_um, 2)
+    /// A deviation (µm, or m°) as a sentence writes it ([`deviation_text`],
+    /// 2 decimals).
+    pub fn deviation(&self, value: f64) -> String {
+        deviation_text(self.kind.deviation_unit(self.angle), value, 2)
     }
 
-    /// A position or a length held in mm (° on a rotary axis): `18 mm`, `18°`.
-    pub fn position(&self, value_mm: f64, decimals: usize) -> String {
-        match self.kind {
-            AxisKind::Linear => format!("{value_mm:.decimals$} mm"),
-            AxisKind::Rotary => format!("{value_mm:.decimals$}°"),
-        }
+    /// A deviation (µm, or m°) for a legend label, written by `number` in
+    /// the unit the sentences say it in: `2.5 µm`, `9″`.
+    pub fn deviation_label(&self, value: f64, number: &dyn Fn(f64) -> String) -> String {
+        let unit = self.kind.deviation_unit(self.angle);
+        format!("{}{}", number(in_unit(unit, value)), unit.suffix())
+    }
+
+    /// A position or a length (mm, or °) for a legend label, written by
+    /// `number`: `5 mm`, `180°`.
+    pub fn position_label(&self, value: f64, number: &dyn Fn(f64) -> String) -> String {
+        format!("{}{}", number(value), self.kind.unit_after_number())
+    }
+
+    /// A deviation (µm, or m°) in the axis' position unit ([`deviation_as_position`]).
+    pub fn deviation_as_position(&self, value: f64) -> f64 {
+        deviation_as_position(self.kind, value)
+    }
+
+    /// A position or a length (mm, or °): `18 mm`, `18°`.
+    pub fn position(&self, value: f64, decimals: usize) -> String {
+        format!("{value:.decimals$}{}", self.kind.unit_after_number())
     }
 }
 
@@ -184,33 +218,40 @@ pub struct FitSummary<'a> {
     pub coefficients: &'a [f64],
     /// Their standard errors.
     pub errors: &'a [f64],
-    /// The stroke, last − first target, mm.
-    pub span_mm: f64,
+    /// The stroke, last − first target (mm, or °).
+    pub span: f64,
     /// Number of readings.
     pub n: usize,
-    /// Spacing of the targets, when regular, mm.
-    pub target_spacing_mm: Option<f64>,
-    /// Linear or rotary (the spacing then in °).
+    /// Spacing of the targets (mm, or °), when regular.
+    pub target_spacing: Option<f64>,
+    /// Linear or rotary: the unit of the span and the spacing.
     pub kind: AxisKind,
 }
 
 /// One parameter as it is shown and saved.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parameter {
-    /// Its key in JSON and TOML, with the unit (`B_um`, `period_mm`, `run`).
+    /// Its key in the effects file and in a linear axis' JSON, with the
+    /// linear unit (`B_um`, `period_mm`, `run`): both are written for a
+    /// linear axis only. On a rotary axis the key only names the parameter
+    /// (among a fit's [`Uncertainty`]); its value and the keys a report
+    /// writes come from [`Effect::typed`].
     pub key: &'static str,
     /// Its name in a sentence or a table (`B`, `period`, `run`).
     pub name: &'static str,
-    /// The unit of a number as a reader writes it (`µm`, `µm/m`), empty for a run.
+    /// The unit of a number on a linear axis, as a reader writes it (`µm`,
+    /// `µm/m`), empty for a run.
     pub unit: &'static str,
     /// Its value.
     pub value: ParameterValue,
 }
 
-/// A parameter's value: a number in the key's unit, or a run's number.
+/// A parameter's value: a number in the unit the key names on a linear axis
+/// (a rotary axis' µm and mm are m° and °: [`Effect::typed`]), or a run's
+/// number.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ParameterValue {
-    /// A measured quantity, in the unit its key names.
+    /// A measured quantity, in the unit its key names on a linear axis.
     Number(f64),
     /// A run, by its number within its direction.
     Run(u32),
@@ -255,23 +296,25 @@ impl OneNumber {
     }
 }
 
-/// The standard uncertainty of one parameter, by its key.
+/// The standard uncertainty of one parameter, by its key
+/// ([`Parameter::key`]: a linear axis' key, the parameter's name on a rotary
+/// one), in the parameter's unit.
 pub type Uncertainty = (&'static str, f64);
 
 /// What an effect does to a compensation table (`compensate::plan`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum TableRole {
-    /// A direction-dependent offset B, µm: a bidirectional table, or the
+    /// A direction-dependent offset B: a bidirectional table, or the
     /// backlash parameter where the controller takes no such table.
     Bidirectional {
-        /// B = ↑ − ↓, µm.
-        b_um: f64,
+        /// B = ↑ − ↓ (µm, or m° on a rotary axis, as [`Reversal::b`]).
+        b: f64,
     },
     /// An error the table's points must follow: put back at each point, the
-    /// points at most `finest_step_mm` apart.
+    /// points at most `finest_step` apart.
     AtPoints {
-        /// The largest step that still follows it, mm.
-        finest_step_mm: f64,
+        /// The largest step that still follows it (mm, or °).
+        finest_step: f64,
     },
     /// Taken out of the table; the note says why.
     TakenOut {
@@ -288,13 +331,14 @@ pub enum TableRole {
 /// What an effect with its parameters is: the part every user of an effect
 /// asks of it.
 pub trait Model {
-    /// The effect's contribution to one reading, µm.
-    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64;
+    /// The effect's contribution to one reading: µm, or m° on a rotary axis.
+    fn value(&self, reading: &Reading, line: &Line<'_>) -> f64;
 
-    /// The effect's systematic part at `x_mm` moving in `direction`, µm: what
-    /// a table or a prediction can account for (`predict --effects`). `None`
-    /// for what is not systematic in position.
-    fn systematic_um(&self, x_mm: f64, direction: Direction, first_target_mm: f64) -> Option<f64>;
+    /// The effect's systematic part at `x` (mm, or °) moving in
+    /// `direction` (µm, or m°): what a table or a prediction can account for
+    /// (`predict --effects`). `None` for what is not systematic in position.
+    /// `first_target_mm` is [`Line::first_target_mm`].
+    fn systematic(&self, x: f64, direction: Direction, first_target_mm: f64) -> Option<f64>;
 
     /// What it does to a compensation table.
     fn in_table(&self) -> TableRole;
@@ -306,8 +350,10 @@ pub trait Model {
     fn parameters(&self) -> Vec<Parameter>;
 
     /// A short legend label with the fitted parameters, each number written
-    /// by `number` (the plot's own tick format).
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String;
+    /// by `number` (the plot's own tick format) in the unit `context` says
+    /// it in (a rotary axis' deviations in ″ or µrad, its positions in °;
+    /// the kinds looked for on a linear axis only say mm and µm).
+    fn label(&self, context: &Context, number: &dyn Fn(f64) -> String) -> String;
 
     /// A check beyond the types, for an effect read from a file.
     fn check(&self) -> Result<(), String> {
@@ -442,40 +488,36 @@ registry! {
 }
 
 impl Effect {
-    /// The effect's contribution to one reading, µm.
-    pub fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
-        self.model().value_um(reading, line)
+    /// The effect's contribution to one reading ([`Model::value`]).
+    pub fn value(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+        self.model().value(reading, line)
     }
 
-    /// The effect's systematic part at `x_mm` moving in `direction`, µm
-    /// ([`Model::systematic_um`]).
-    pub fn systematic_um(
-        &self,
-        x_mm: f64,
-        direction: Direction,
-        first_target_mm: f64,
-    ) -> Option<f64> {
-        self.model().systematic_um(x_mm, direction, first_target_mm)
+    /// The effect's systematic part at `x` moving in `direction`
+    /// ([`Model::systematic`]).
+    pub fn systematic(&self, x: f64, direction: Direction, first_target_mm: f64) -> Option<f64> {
+        self.model().systematic(x, direction, first_target_mm)
     }
 
     /// The measurement with this effect added to every reading, at the
     /// times `times_h` (`[run][target]`, hours, as `cycle::reading_times_h`
     /// gives them): a known effect put into a measured test, defined by the
-    /// same [`Model::value_um`] the diagnosis fits (tests on real files).
+    /// same [`Model::value`] the diagnosis fits (tests on real files).
     pub fn added_to(
         &self,
         measurement: &Measurement,
         times_h: &[Vec<f64>],
     ) -> Result<Measurement, MeasurementError> {
-        let targets_mm = measurement.targets();
+        let targets = measurement.targets();
         let line = Line {
-            first_target_mm: targets_mm.first().copied().unwrap_or(0.0),
+            first_target_mm: targets.first().copied().unwrap_or(0.0),
             angle_urad: None,
             times_recorded: measurement.metadata.duration_s().is_some(),
             run_h: crate::cycle::run_h(times_h),
         };
         let runs = measurement.runs();
-        measurement.map_readings(|run, target_index, value_mm| {
+        let kind = measurement.kind();
+        measurement.map_readings(|run, target_index, value| {
             // Runs are unique by direction and number (`Measurement`'s invariant).
             let run_index = runs
                 .iter()
@@ -483,7 +525,7 @@ impl Effect {
                 .unwrap_or(0);
             let reading = Reading {
                 target_index,
-                target: targets_mm[target_index],
+                target: targets[target_index],
                 direction: run.direction,
                 run: run.number,
                 run_index,
@@ -493,7 +535,7 @@ impl Effect {
                     .copied()
                     .unwrap_or(0.0),
             };
-            value_mm + um_to_mm(self.value_um(&reading, &line))
+            value + deviation_as_position(kind, self.value(&reading, &line))
         })
     }
 

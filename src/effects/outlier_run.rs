@@ -9,6 +9,11 @@ use super::{
 };
 use crate::measurement::Direction;
 
+/// The offset's key in the effects file and in a linear axis' JSON, and
+/// among a fit's uncertainties ([`super::Uncertainty`]); it names µm, the
+/// unit of the offset on a linear axis, the only one these are written for.
+pub const OFFSET_KEY: &str = "offset_um";
+
 /// One run offset.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -18,8 +23,11 @@ pub struct OutlierRun {
     /// ↑ or ↓.
     #[serde(deserialize_with = "direction")]
     pub direction: Direction,
-    /// µm.
-    pub offset_um: f64,
+    /// How far the run sits off the others: µm, or m° (1/1000 °) on a
+    /// rotary axis ([`super::Effect::typed`]). The effects file (a linear
+    /// axis' only) keys it `offset_um`.
+    #[serde(rename = "offset_um")]
+    pub offset: f64,
 }
 
 /// `"up"` or `"down"`.
@@ -35,16 +43,16 @@ fn direction<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Direction, D:
 }
 
 impl Model for OutlierRun {
-    fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
+    fn value(&self, reading: &Reading, _: &Line<'_>) -> f64 {
         if reading.run == self.run && reading.direction == self.direction {
-            self.offset_um
+            self.offset
         } else {
             0.0
         }
     }
 
     /// Not systematic in position: a table cannot take it.
-    fn systematic_um(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
+    fn systematic(&self, _: f64, _: Direction, _: f64) -> Option<f64> {
         None
     }
 
@@ -60,14 +68,14 @@ impl Model for OutlierRun {
 
     fn explanation(&self, context: &Context) -> String {
         let (run, direction) = (self.run, self.direction);
-        let sign = if self.offset_um.is_sign_negative() {
+        let sign = if self.offset.is_sign_negative() {
             ""
         } else {
             "+"
         };
         format!(
             "Run {run}{direction} sits {sign}{} off the others (typically the first run after start-up, before the axis is warm); leave it out with --exclude-run {run}:{} if that is why, or warm the axis up before the test.",
-            context.deviation(self.offset_um),
+            context.deviation(self.offset),
             direction.as_str()
         )
     }
@@ -82,16 +90,16 @@ impl Model for OutlierRun {
                 unit: "",
                 value: ParameterValue::Run(self.run),
             },
-            Parameter::number("offset_um", "offset", "µm", self.offset_um),
+            Parameter::number(OFFSET_KEY, "offset", "µm", self.offset),
         ]
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, context: &Context, number: &dyn Fn(f64) -> String) -> String {
         format!(
-            "run {}{} offset {} µm",
+            "run {}{} offset {}",
             self.run,
             self.direction,
-            number(self.offset_um)
+            context.deviation_label(self.offset, number)
         )
     }
 }
@@ -120,11 +128,11 @@ impl Fit for OutlierRun {
         OutlierRun {
             run,
             direction,
-            offset_um: coefficients[0],
+            offset: coefficients[0],
         }
     }
 
     fn uncertainty(&self, fit: &FitSummary<'_>) -> (Vec<Uncertainty>, Vec<String>) {
-        (vec![("offset_um", fit.errors[0])], Vec::new())
+        (vec![(OFFSET_KEY, fit.errors[0])], Vec::new())
     }
 }

@@ -2,7 +2,7 @@
 //! lead, a scale period). On a rotary axis the period is 360°/k,
 //! a whole order k per revolution (once from eccentricity, twice from the
 //! encoder's mounting, a worm gear's tooth count), and the sentences say so
-//! in ° and ″ ([`Periodic::per_revolution`]).
+//! in ° and ″ ([`super::EffectIn::per_revolution`]).
 
 use std::f64::consts::{PI, TAU};
 
@@ -14,14 +14,27 @@ use super::{
 use crate::evaluate::conformance::FULL_TURN_DEG;
 use crate::measurement::{AxisKind, Direction};
 
-/// Periodic error `amplitude · sin(2πx/period + phase)`.
+/// The period's key in the effects file and in a linear axis' JSON, and
+/// among a fit's uncertainties ([`super::Uncertainty`]); it names mm, the
+/// unit of the period on a linear axis, the only one these are written for.
+pub const PERIOD_KEY: &str = "period_mm";
+/// The amplitude's key, as [`PERIOD_KEY`]: µm on a linear axis.
+pub const AMPLITUDE_KEY: &str = "amplitude_um";
+
+/// Periodic error `amplitude · sin(2πx/period + phase)`, in the axis'
+/// units: period in mm and amplitude in µm, or on a rotary axis period in °
+/// and amplitude in m° (1/1000 °) ([`super::Effect::typed`]).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Periodic {
-    /// mm.
-    pub period_mm: f64,
-    /// µm.
-    pub amplitude_um: f64,
+    /// Period: mm, or ° on a rotary axis. The effects file (a linear axis'
+    /// only) keys it `period_mm`.
+    #[serde(rename = "period_mm")]
+    pub period: f64,
+    /// Amplitude: µm, or m° on a rotary axis. The effects file keys it
+    /// `amplitude_um`.
+    #[serde(rename = "amplitude_um")]
+    pub amplitude: f64,
     /// rad.
     #[serde(default)]
     pub phase_rad: f64,
@@ -30,30 +43,36 @@ pub struct Periodic {
 impl Periodic {
     /// On a rotary axis, the whole number of periods per revolution
     /// (360°/period), when the period is one.
-    pub fn per_revolution(&self) -> Option<u32> {
-        let order = FULL_TURN_DEG / self.period_mm;
-        ((order - order.round()).abs() < 1e-9 && order >= 0.5).then(|| order.round() as u32)
+    fn per_revolution(&self) -> Option<u32> {
+        per_revolution(self.period)
     }
 
-    fn at_um(&self, x_mm: f64) -> f64 {
-        self.amplitude_um * (TAU * x_mm / self.period_mm + self.phase_rad).sin()
+    fn at(&self, x_mm: f64) -> f64 {
+        self.amplitude * (TAU * x_mm / self.period + self.phase_rad).sin()
     }
 }
 
+/// The whole number of periods of `period_deg` in a revolution
+/// (360°/period), when it is one.
+pub(super) fn per_revolution(period_deg: f64) -> Option<u32> {
+    let order = FULL_TURN_DEG / period_deg;
+    ((order - order.round()).abs() < 1e-9 && order >= 0.5).then(|| order.round() as u32)
+}
+
 impl Model for Periodic {
-    fn value_um(&self, reading: &Reading, _: &Line<'_>) -> f64 {
-        self.at_um(reading.target)
+    fn value(&self, reading: &Reading, _: &Line<'_>) -> f64 {
+        self.at(reading.target)
     }
 
-    fn systematic_um(&self, x_mm: f64, _: Direction, _: f64) -> Option<f64> {
-        Some(self.at_um(x_mm))
+    fn systematic(&self, x_mm: f64, _: Direction, _: f64) -> Option<f64> {
+        Some(self.at(x_mm))
     }
 
     /// Linear interpolation between points h apart leaves up to
     /// A·(1 − cos(πh/p)) of a sine: under 5 % of A for h ≤ p/10.
     fn in_table(&self) -> TableRole {
         TableRole::AtPoints {
-            finest_step_mm: self.period_mm / 10.0,
+            finest_step: self.period / 10.0,
         }
     }
 
@@ -62,38 +81,38 @@ impl Model for Periodic {
             return self.rotary_explanation(context);
         }
         let table = context
-            .table_step_mm
+            .table_step
             .map(|s| format!("; the table's step of {s} mm cannot follow it"))
             .unwrap_or_default();
         format!(
             "Periodic error of {:.2} µm amplitude and {:.2} mm period (screw lead or scale period){table}; compensate with a step of at most {:.2} mm (convert --effects) or the control's pitch compensation, or check the screw.",
-            self.amplitude_um,
-            self.period_mm,
-            self.period_mm / 10.0
+            self.amplitude,
+            self.period,
+            self.period / 10.0
         )
     }
 
     fn parameters(&self) -> Vec<Parameter> {
         vec![
-            Parameter::number("period_mm", "period", "mm", self.period_mm),
-            Parameter::number("amplitude_um", "amplitude", "µm", self.amplitude_um),
+            Parameter::number(PERIOD_KEY, "period", "mm", self.period),
+            Parameter::number(AMPLITUDE_KEY, "amplitude", "µm", self.amplitude),
             Parameter::number("phase_rad", "phase", "rad", self.phase_rad),
         ]
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, context: &Context, number: &dyn Fn(f64) -> String) -> String {
         format!(
-            "periodic {} µm, period {} mm",
-            number(self.amplitude_um),
-            number(self.period_mm)
+            "periodic {}, period {}",
+            context.deviation_label(self.amplitude, number),
+            context.position_label(self.period, number)
         )
     }
 
     fn check(&self) -> Result<(), String> {
-        if self.period_mm > 0.0 && self.period_mm.is_finite() {
+        if self.period > 0.0 && self.period.is_finite() {
             Ok(())
         } else {
-            Err(format!("period_mm must be > 0, found {}", self.period_mm))
+            Err(format!("period_mm must be > 0, found {}", self.period))
         }
     }
 }
@@ -112,15 +131,15 @@ impl Periodic {
         // Linear interpolation follows the order within 5 % at a step of
         // period/10 (`in_table`); a coarser table cannot.
         let table = context
-            .table_step_mm
-            .filter(|s| *s > self.period_mm / 10.0)
+            .table_step
+            .filter(|s| *s > self.period / 10.0)
             .map(|s| format!("; the table's step of {s}° cannot follow it"))
             .unwrap_or_default();
         format!(
             "{order} of {} amplitude and {:.2}° period{table}; the re-test's own table takes it out at a step of at most {:.2}° (convert the re-test with --existing and the active table), or check the encoder's mounting and the table's run-out.",
-            context.deviation(self.amplitude_um),
-            self.period_mm,
-            self.period_mm / 10.0
+            context.deviation(self.amplitude),
+            self.period,
+            self.period / 10.0
         )
     }
 }
@@ -146,14 +165,14 @@ impl Fit for Periodic {
     }
 
     fn from_fit(shape: Shape, coefficients: &[f64], _: &Line<'_>) -> Periodic {
-        let Shape::Period(period_mm, _) = shape else {
+        let Shape::Period(period, _) = shape else {
             unreachable!("a periodic effect's shape is its period")
         };
         // a·sin θ + b·cos θ = A·sin(θ + φ) with A cos φ = a, A sin φ = b.
         let (a, b) = (coefficients[0], coefficients[1]);
         Periodic {
-            period_mm,
-            amplitude_um: a.hypot(b),
+            period,
+            amplitude: a.hypot(b),
             phase_rad: b.atan2(a),
         }
     }
@@ -165,13 +184,13 @@ impl Fit for Periodic {
     fn uncertainty(&self, fit: &FitSummary<'_>) -> (Vec<Uncertainty>, Vec<String>) {
         let (coefficients, errors, n) = (fit.coefficients, fit.errors, fit.n);
         let (a, b) = (coefficients[0], coefficients[1]);
-        let sigma_amplitude = ((a * errors[0]).powi(2) + (b * errors[1]).powi(2)).sqrt()
-            / self.amplitude_um.max(1e-12);
+        let sigma_amplitude =
+            ((a * errors[0]).powi(2) + (b * errors[1]).powi(2)).sqrt() / self.amplitude.max(1e-12);
         let noise = sigma_amplitude * (n as f64 / 2.0).sqrt();
-        let sigma_frequency = 6f64.sqrt() * noise
-            / (PI * self.amplitude_um.max(1e-12) * fit.span_mm * (n as f64).sqrt());
+        let sigma_frequency =
+            6f64.sqrt() * noise / (PI * self.amplitude.max(1e-12) * fit.span * (n as f64).sqrt());
         let mut warnings = Vec::new();
-        match (fit.target_spacing_mm, fit.kind, self.per_revolution()) {
+        match (fit.target_spacing, fit.kind, self.per_revolution()) {
             // Samples N = 360°/spacing per revolution: orders N − k and N + k
             // give the same readings as k.
             (Some(spacing), AxisKind::Rotary, Some(k)) => {
@@ -185,7 +204,7 @@ impl Fit for Periodic {
             }
             (Some(spacing), _, _) => {
                 let aliases: Vec<String> = (1..=2)
-                    .map(|k| 1.0 / (f64::from(k) / spacing - 1.0 / self.period_mm).abs())
+                    .map(|k| 1.0 / (f64::from(k) / spacing - 1.0 / self.period).abs())
                     .filter(|p| p.is_finite())
                     .map(|p| format!("{p:.2} mm"))
                     .collect();
@@ -199,13 +218,10 @@ impl Fit for Periodic {
         // A rotary order is chosen among whole numbers, not estimated: its
         // period has no uncertainty to give.
         let uncertainty = match (fit.kind, self.per_revolution()) {
-            (AxisKind::Rotary, Some(_)) => vec![("amplitude_um", sigma_amplitude)],
+            (AxisKind::Rotary, Some(_)) => vec![(AMPLITUDE_KEY, sigma_amplitude)],
             _ => vec![
-                (
-                    "period_mm",
-                    self.period_mm * self.period_mm * sigma_frequency,
-                ),
-                ("amplitude_um", sigma_amplitude),
+                (PERIOD_KEY, self.period * self.period * sigma_frequency),
+                (AMPLITUDE_KEY, sigma_amplitude),
             ],
         };
         (uncertainty, warnings)

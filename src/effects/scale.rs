@@ -22,11 +22,11 @@ const SCALE: OneNumber = OneNumber {
 };
 
 impl Model for Scale {
-    fn value_um(&self, reading: &Reading, line: &Line<'_>) -> f64 {
+    fn value(&self, reading: &Reading, line: &Line<'_>) -> f64 {
         per_m_over_mm(self.scale_um_per_m, reading.target - line.first_target_mm)
     }
 
-    fn systematic_um(&self, x_mm: f64, _: Direction, first_target_mm: f64) -> Option<f64> {
+    fn systematic(&self, x_mm: f64, _: Direction, first_target_mm: f64) -> Option<f64> {
         Some(per_m_over_mm(self.scale_um_per_m, x_mm - first_target_mm))
     }
 
@@ -62,7 +62,7 @@ impl Model for Scale {
         SCALE.parameters(self.scale_um_per_m)
     }
 
-    fn label(&self, number: &dyn Fn(f64) -> String) -> String {
+    fn label(&self, _: &Context, number: &dyn Fn(f64) -> String) -> String {
         SCALE.label(Self::NAME, self.scale_um_per_m, number)
     }
 }

@@ -21,20 +21,20 @@ const ORIGIN: Line<'static> = Line {
 /// One effect of every kind (the registry's order).
 fn one_of_each() -> Vec<Effect> {
     vec![
-        Effect::Reversal(Reversal { b_um: -3.0 }),
+        Effect::Reversal(Reversal { b: -3.0 }),
         Effect::Scale(Scale {
             scale_um_per_m: 11.5,
         }),
         Effect::Drift(Drift::PerHour { rate_um_per_h: 2.0 }),
         Effect::Periodic(Periodic {
-            period_mm: 5.0,
-            amplitude_um: 1.25,
+            period: 5.0,
+            amplitude: 1.25,
             phase_rad: 0.5,
         }),
         Effect::OutlierRun(OutlierRun {
             run: 2,
             direction: Direction::Down,
-            offset_um: 4.5,
+            offset: 4.5,
         }),
         Effect::Abbe(Abbe {
             offset_mm: 100.0,
@@ -80,7 +80,7 @@ fn columns_and_values_agree() {
                 .map(|(c, b)| c[i] * b)
                 .sum();
             assert!(
-                (effect.value_um(r, &line) - from_columns).abs() < 1e-12,
+                (effect.value(r, &line) - from_columns).abs() < 1e-12,
                 "{shape:?}"
             );
         }
@@ -91,7 +91,7 @@ fn columns_and_values_agree() {
 fn values_by_hand() {
     let up = reading(250.0, Direction::Up, 1, 0.25);
     assert_eq!(
-        Effect::Reversal(Reversal { b_um: -3.0 }).value_um(&up, &ORIGIN),
+        Effect::Reversal(Reversal { b: -3.0 }).value(&up, &ORIGIN),
         -1.5
     );
     let from_50 = Line {
@@ -102,20 +102,20 @@ fn values_by_hand() {
         Effect::Scale(Scale {
             scale_um_per_m: 8.0
         })
-        .value_um(&up, &from_50),
+        .value(&up, &from_50),
         1.6
     );
     assert_eq!(
-        Effect::Drift(Drift::PerHour { rate_um_per_h: 4.0 }).value_um(&up, &ORIGIN),
+        Effect::Drift(Drift::PerHour { rate_um_per_h: 4.0 }).value(&up, &ORIGIN),
         1.0
     );
     let periodic = Effect::Periodic(Periodic {
-        period_mm: 1000.0,
-        amplitude_um: 2.0,
+        period: 1000.0,
+        amplitude: 2.0,
         phase_rad: 0.0,
     });
     assert!(
-        (periodic.value_um(&up, &ORIGIN) - 2.0).abs() < 1e-12,
+        (periodic.value(&up, &ORIGIN) - 2.0).abs() < 1e-12,
         "quarter period: the crest"
     );
 }
@@ -124,7 +124,7 @@ fn values_by_hand() {
 fn every_explanation_is_one_sentence_with_an_action() {
     let context = Context {
         expansion_coefficient_ppm_per_k: Some(11.5),
-        table_step_mm: Some(50.0),
+        table_step: Some(50.0),
         ..Context::default()
     };
     for effect in one_of_each() {
@@ -143,16 +143,11 @@ fn every_explanation_is_one_sentence_with_an_action() {
 #[test]
 fn every_kind_says_what_it_does_to_a_table() {
     let roles: Vec<TableRole> = one_of_each().iter().map(Effect::in_table).collect();
-    assert_eq!(roles[0], TableRole::Bidirectional { b_um: -3.0 });
+    assert_eq!(roles[0], TableRole::Bidirectional { b: -3.0 });
     assert!(matches!(roles[1], TableRole::TakenOut { .. }));
     assert!(matches!(roles[2], TableRole::NotATable { .. }));
     // A tenth of the period: linear interpolation leaves < 5 % of a sine.
-    assert_eq!(
-        roles[3],
-        TableRole::AtPoints {
-            finest_step_mm: 0.5
-        }
-    );
+    assert_eq!(roles[3], TableRole::AtPoints { finest_step: 0.5 });
     assert!(
         matches!(roles[4], TableRole::NotATable { ref note } if note.contains("--exclude-run 2:down"))
     );
@@ -219,7 +214,7 @@ fn every_kind_labels_itself_with_the_numbers_it_is_given() {
     let two_decimals = |v: f64| format!("{v:.2}");
     let labels: Vec<String> = one_of_each()
         .iter()
-        .map(|e| e.model().label(&two_decimals))
+        .map(|e| e.model().label(&Context::default(), &two_decimals))
         .collect();
     assert_eq!(labels[0], "reversal B = -3.00 µm");
     assert_eq!(labels[3], "periodic 1.25 µm, period 5.00 mm");
@@ -249,8 +244,52 @@ fn one_number_kinds_show_their_parameter_and_label() {
         drift.parameters(),
         vec![Parameter::number("rate_um_per_h", "rate", "µm/h", 2.0)]
     );
-    assert_eq!(scale.model().label(&two_decimals), "scale 11.50 µm/m");
-    assert_eq!(drift.model().label(&two_decimals), "drift 2.00 µm/h");
+    let linear = Context::default();
+    assert_eq!(
+        scale.model().label(&linear, &two_decimals),
+        "scale 11.50 µm/m"
+    );
+    assert_eq!(
+        drift.model().label(&linear, &two_decimals),
+        "drift 2.00 µm/h"
+    );
+}
+
+/// A rotary axis' effects label themselves in its units: held in m° and °,
+/// said in ″ (or µrad) and °, never in µm or mm.
+#[test]
+fn a_rotary_axis_effects_label_themselves_in_its_units() {
+    let two_decimals = |v: f64| format!("{v:.2}");
+    let rotary = |angle| Context {
+        kind: AxisKind::Rotary,
+        angle,
+        ..Context::default()
+    };
+    let label = |effect: Effect, angle| effect.model().label(&rotary(angle), &two_decimals);
+    // 10 m° = 0.01° = 36″ = 0.01·π/180·10⁶ µrad = 174.53 µrad.
+    let reversal = Effect::Reversal(Reversal { b: 10.0 });
+    assert_eq!(
+        label(reversal.clone(), AngleUnit::Arcsec),
+        "reversal B = 36.00″"
+    );
+    assert_eq!(label(reversal, AngleUnit::Urad), "reversal B = 174.53 µrad");
+    // 1.25 m° = 4.5″, twice per revolution.
+    let periodic = Effect::Periodic(Periodic {
+        period: 180.0,
+        amplitude: 1.25,
+        phase_rad: 0.0,
+    });
+    assert_eq!(
+        label(periodic, AngleUnit::Arcsec),
+        "periodic 4.50″, period 180.00°"
+    );
+    // 4.5 m° = 16.2″.
+    let run = Effect::OutlierRun(OutlierRun {
+        run: 2,
+        direction: Direction::Down,
+        offset: 4.5,
+    });
+    assert_eq!(label(run, AngleUnit::Arcsec), "run 2↓ offset 16.20″");
 }
 
 /// A drift per run (a test that records no times) grows by its rate each
@@ -262,7 +301,7 @@ fn a_drift_per_run_counts_runs_not_hours() {
         rate_um_per_run: 2.0,
     });
     let late = reading(0.0, Direction::Up, 2, 0.75);
-    assert!((drift.value_um(&late, &ORIGIN) - 3.0).abs() < 1e-12);
+    assert!((drift.value(&late, &ORIGIN) - 3.0).abs() < 1e-12);
     assert_eq!(
         drift.parameters(),
         vec![Parameter::number("rate_um_per_run", "rate", "µm/run", 2.0)]

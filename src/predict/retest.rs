@@ -112,7 +112,7 @@ pub(super) fn predicted_retest(
     let deviation = |x: f64, direction: Direction| {
         let effects_um: f64 = effects
             .iter()
-            .filter_map(|e| e.systematic_um(x, direction, first_target))
+            .filter_map(|e| e.systematic(x, direction, first_target))
             .sum();
         let reversal = known
             .as_ref()

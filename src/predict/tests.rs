@@ -94,7 +94,7 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         let b_measured = first.b_mean.unwrap() * 1000.0;
         assert!((retest.measured_mean_reversal_mm.unwrap() * 1000.0 - b_measured).abs() < 1e-9);
         let b_with_effect = predict(&PredictInput {
-            effects: &[Effect::Reversal(Reversal { b_um: -1.0 })],
+            effects: &[Effect::Reversal(Reversal { b: -1.0 })],
             ..input(&machine, &errors, &measured, &tables, line)
         })
         .unwrap()

@@ -6,19 +6,22 @@
 //! `Evaluation` of each test (as `evaluate`), the table as read back from its
 //! file (as `convert --existing` reads it), the workflow's prediction of
 //! the re-test with it (`compensate::retest`) and the `Diagnosis` (as `diagnose`). Deviations are
-//! drawn in µm through `crate::units`.
+//! drawn in µm through `crate::units`. The diagnosis' charts are a linear
+//! axis' (mm and µm): they read the diagnosis as `Diagnosis::typed` gives a
+//! linear axis', and a rotary one has none (the report refuses it before,
+//! `workflow::rotary`).
 
 use crate::compensate::CompensationTable;
 use crate::compensate::retest::KnownError;
-use crate::diagnose::{Diagnosis, ReadingResidual};
-use crate::effects::{Effect, Line};
+use crate::diagnose::{Diagnosis, DiagnosisIn, ReadingResidual};
+use crate::effects::{Context, Effect, Line};
 use crate::emit::Controller;
 use crate::error::Warning;
 use crate::evaluate::{DirectionStats, Evaluation, Standard, StandardFigure, TargetStats};
-use crate::measurement::AxisKind;
+use crate::measurement::{AxisKind, ByKind};
 use crate::measurement::{Direction, Measurement};
 use crate::report::chart::{Chart, Mark, Polar, Rgb, Series};
-use crate::units::{AngleUnit, DeviationUnit, mm_to_um};
+use crate::units::{AngleUnit, DeviationUnit, Mm, Um, mm_to_um};
 
 /// One test (the first, or the re-test) as the report shows it.
 #[derive(Clone, Copy, Debug)]
@@ -221,23 +224,39 @@ pub fn charts(input: &ReportInput<'_>) -> Vec<NamedChart> {
         }
     }
     if let (Some(diagnosis), Some(after)) = (input.diagnosis, &input.after) {
-        charts.push(NamedChart {
-            name: "residual",
-            chart: residual_chart(diagnosis),
-        });
-        charts.push(NamedChart {
-            name: "residual-along-axis",
-            chart: residual_along_axis_chart(diagnosis),
-        });
-        if !diagnosis.accepted.is_empty() {
-            charts.push(NamedChart {
-                name: "effects",
-                chart: effects_chart(diagnosis, after.measurement),
-            });
-        }
+        charts.extend(diagnosis_charts(diagnosis, after.measurement));
     }
     charts
 }
+
+/// The diagnosis' charts, in mm and µm: a linear axis' only. A rotary
+/// axis' diagnosis has none (`workflow::rotary` refuses `report --diagnose`
+/// on a rotary axis; given one anyway, no chart is drawn in the wrong unit).
+fn diagnosis_charts(diagnosis: &Diagnosis, after: &Measurement) -> Vec<NamedChart> {
+    let ByKind::Linear(typed) = diagnosis.typed() else {
+        return Vec::new();
+    };
+    let mut charts = vec![
+        NamedChart {
+            name: "residual",
+            chart: residual_chart(&typed),
+        },
+        NamedChart {
+            name: "residual-along-axis",
+            chart: residual_along_axis_chart(&typed),
+        },
+    ];
+    if !diagnosis.accepted.is_empty() {
+        charts.push(NamedChart {
+            name: "effects",
+            chart: effects_chart(diagnosis, &typed, after),
+        });
+    }
+    charts
+}
+
+/// A linear axis' diagnosis: positions in mm, deviations in µm.
+type LinearDiagnosis = DiagnosisIn<Mm, Um>;
 
 /// ` of axis X` when the axis name is plain ASCII (plots draw only the
 /// characters of the embedded font; file text is shown in the HTML).
@@ -580,7 +599,7 @@ fn prediction_chart(prediction: &Prediction, after: Option<&Evaluation>) -> Char
 
 /// The residual of every reading (measured − predicted) in the order
 /// measured, and the fitted model through them.
-fn residual_chart(diagnosis: &Diagnosis) -> Chart {
+fn residual_chart(diagnosis: &LinearDiagnosis) -> Chart {
     let ordered = in_measured_order(diagnosis);
     let numbered = ordered
         .iter()
@@ -590,7 +609,7 @@ fn residual_chart(diagnosis: &Diagnosis) -> Chart {
         numbered
             .clone()
             .filter(|(_, r)| r.reading.direction == direction)
-            .map(|(x, r)| (x, r.residual))
+            .map(|(x, r)| (x, r.residual.0))
             .collect()
     };
     let count = diagnosis.readings.len() as f64;
@@ -604,7 +623,7 @@ fn residual_chart(diagnosis: &Diagnosis) -> Chart {
                 Some("fitted model".into()),
                 MODEL,
                 Mark::Line(2),
-                numbered.clone().map(|(x, r)| (x, r.fitted)).collect(),
+                numbered.clone().map(|(x, r)| (x, r.fitted.0)).collect(),
             ),
             series(
                 Some("residual ↑".into()),
@@ -626,8 +645,8 @@ fn residual_chart(diagnosis: &Diagnosis) -> Chart {
 
 /// The readings in the order measured: by run, then by time within the run
 /// (a run moving ↓ visits the targets from the last to the first).
-fn in_measured_order(diagnosis: &Diagnosis) -> Vec<&ReadingResidual> {
-    let mut ordered: Vec<&ReadingResidual> = diagnosis.readings.iter().collect();
+fn in_measured_order(diagnosis: &LinearDiagnosis) -> Vec<&ReadingResidual<Um>> {
+    let mut ordered: Vec<&ReadingResidual<Um>> = diagnosis.readings.iter().collect();
     ordered.sort_by(|a, b| {
         (a.reading.run_index, a.reading.time_h)
             .partial_cmp(&(b.reading.run_index, b.reading.time_h))
@@ -638,7 +657,7 @@ fn in_measured_order(diagnosis: &Diagnosis) -> Vec<&ReadingResidual> {
 
 /// The residual along the axis: every reading, the fitted model per
 /// direction, and the targets where structure is left unexplained.
-fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
+fn residual_along_axis_chart(diagnosis: &LinearDiagnosis) -> Chart {
     let mut all = Vec::new();
     for (direction, color, mark) in [
         (Direction::Up, UP, Mark::Up),
@@ -648,7 +667,7 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
             .readings
             .iter()
             .filter(|r| r.reading.direction == direction)
-            .map(|r| (r.reading.target, r.residual))
+            .map(|r| (r.reading.target, r.residual.0))
             .collect();
         all.push(series(
             Some(format!("residual {direction}")),
@@ -658,7 +677,7 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
         ));
     }
     for (direction, color) in [(Direction::Up, UP), (Direction::Down, DOWN)] {
-        let fitted = mean_per_target(diagnosis, direction, |r| r.fitted);
+        let fitted = mean_per_target(diagnosis, direction, |r| r.fitted.0);
         if !fitted.is_empty() {
             all.push(series(
                 Some(format!("fitted model {direction} (mean per target)")),
@@ -669,12 +688,12 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
         }
     }
     if diagnosis.unexplained.significant && !diagnosis.unexplained.targets.is_empty() {
-        let (low, _) = extent(diagnosis.readings.iter().map(|r| r.residual));
+        let (low, _) = extent(diagnosis.readings.iter().map(|r| r.residual.0));
         let marks = diagnosis
             .unexplained
             .targets
             .iter()
-            .map(|x| (*x, low))
+            .map(|&Mm(x)| (x, low))
             .collect();
         all.push(series(
             Some("unexplained structure".into()),
@@ -695,9 +714,9 @@ fn residual_along_axis_chart(diagnosis: &Diagnosis) -> Chart {
 
 /// Mean over the readings of each target in one direction, (target, value).
 fn mean_per_target(
-    diagnosis: &Diagnosis,
+    diagnosis: &LinearDiagnosis,
     direction: Direction,
-    value: impl Fn(&ReadingResidual) -> f64,
+    value: impl Fn(&ReadingResidual<Um>) -> f64,
 ) -> Vec<(f64, f64)> {
     let mut sums: Vec<(f64, f64, usize)> = Vec::new();
     for r in diagnosis
@@ -723,20 +742,21 @@ fn extent(values: impl Iterator<Item = f64>) -> (f64, f64) {
     values.fold((0.0, 0.0), |(low, high), v| (low.min(v), high.max(v)))
 }
 
-/// Each accepted effect's contribution to every reading, in the order measured.
-fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
+/// Each accepted effect's contribution to every reading (µm: a linear
+/// axis' effects), in the order measured.
+fn effects_chart(diagnosis: &Diagnosis, typed: &LinearDiagnosis, after: &Measurement) -> Chart {
     let first_target_mm = after.targets().first().copied().unwrap_or(0.0);
     let mut all = Vec::new();
     for (index, accepted) in diagnosis.accepted.iter().enumerate() {
         // The Abbe effect needs the angular profile, which the report is not
         // given: its contribution is drawn as 0 (the report never has one).
-        let points = in_measured_order(diagnosis)
+        let points = in_measured_order(typed)
             .into_iter()
             .enumerate()
             .map(|(i, r)| {
                 (
                     (i + 1) as f64,
-                    accepted.effect.value_um(
+                    accepted.effect.value(
                         &r.reading,
                         &Line {
                             first_target_mm,
@@ -765,8 +785,51 @@ fn effects_chart(diagnosis: &Diagnosis, after: &Measurement) -> Chart {
     }
 }
 
-/// A short legend label with the fitted parameters, in the plot font's characters.
+/// A short legend label with the fitted parameters of a linear axis' effect
+/// (mm and µm), in the plot font's characters.
 pub fn effect_label(effect: &Effect) -> String {
     let signed = |v: f64| crate::report::chart::tick_label((v * 100.0).round() / 100.0);
-    effect.model().label(&signed)
+    let linear = Context {
+        kind: AxisKind::Linear,
+        ..Context::default()
+    };
+    effect.model().label(&linear, &signed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cycle::CycleTiming;
+    use crate::diagnose::{DiagnoseInput, diagnose};
+    use crate::evaluate::ISO_230_2;
+    use crate::read::read_path;
+
+    /// A rotary diagnosis (° and m°) draws no chart in mm and µm; the same
+    /// numbers said to be a linear axis' draw the residual, the residual
+    /// along the axis and the effect found (its reversal).
+    #[test]
+    fn only_a_linear_diagnosis_is_charted() {
+        let path = std::path::Path::new("tests/data/rotary/c-outlier-run.csv");
+        let rotary = read_path(path, None).unwrap().measurement;
+        let mut diagnosis = diagnose(&DiagnoseInput {
+            after: &rotary,
+            before: None,
+            table: None,
+            backlash_set: false,
+            angular: None,
+            known_periods: &[],
+            timing: CycleTiming::ASSUMED,
+            standard: &ISO_230_2,
+            angle: AngleUnit::Arcsec,
+        })
+        .unwrap();
+        assert_eq!(diagnosis.kind, AxisKind::Rotary);
+        assert!(diagnosis_charts(&diagnosis, &rotary).is_empty());
+        diagnosis.kind = AxisKind::Linear;
+        let names: Vec<&str> = diagnosis_charts(&diagnosis, &rotary)
+            .iter()
+            .map(|chart| chart.name)
+            .collect();
+        assert_eq!(names, ["residual", "residual-along-axis", "effects"]);
+    }
 }

@@ -358,7 +358,7 @@ impl EffectSpec {
     /// parameters (`None` for what no kind describes: a sag, a step).
     pub fn as_effect(&self) -> Option<Effect> {
         Some(match *self {
-            EffectSpec::Reversal { B_um, .. } => Effect::Reversal(Reversal { b_um: B_um }),
+            EffectSpec::Reversal { B_um, .. } => Effect::Reversal(Reversal { b: B_um }),
             EffectSpec::Scale { scale_um_per_m, .. } => Effect::Scale(Scale { scale_um_per_m }),
             EffectSpec::Drift { rate_um_per_h, .. } => {
                 Effect::Drift(Drift::PerHour { rate_um_per_h })
@@ -369,8 +369,8 @@ impl EffectSpec {
                 phase_rad,
                 ..
             } => Effect::Periodic(Periodic {
-                period_mm,
-                amplitude_um,
+                period: period_mm,
+                amplitude: amplitude_um,
                 phase_rad,
             }),
             EffectSpec::OutlierRun {
@@ -385,7 +385,7 @@ impl EffectSpec {
                 } else {
                     Direction::Down
                 },
-                offset_um,
+                offset: offset_um,
             }),
             EffectSpec::Abbe {
                 offset_mm,

@@ -212,7 +212,7 @@ fn reversal_is_found_and_measured() {
             &d,
             &[(
                 "reversal",
-                &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -4.0)),
+                &|e| matches!(e, Effect::Reversal(Reversal { b }) if within(*b, -4.0)),
             )],
             seed,
             sigma,
@@ -260,7 +260,7 @@ fn a_reversal_both_tests_measured_is_carried_and_only_its_change_is_found() {
             &d,
             &[(
                 "reversal",
-                &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -2.0)),
+                &|e| matches!(e, Effect::Reversal(Reversal { b }) if within(*b, -2.0)),
             )],
             seed,
             sigma,
@@ -333,7 +333,7 @@ fn an_outlier_run_is_found_and_measured() {
     for_each_seed(|seed, sigma| {
         let effect = "[[effect]]\nkind = \"outlier-run\"\nrun = 1\ndirection = \"down\"\noffset_um = 5.0\ntests = [\"after\"]\n";
         let d = run(&truth(sigma, "", effect), seed, false);
-        let ok = |e: &Effect| matches!(e, Effect::OutlierRun(OutlierRun { run: 1, direction: Direction::Down, offset_um }) if within(*offset_um, 5.0));
+        let ok = |e: &Effect| matches!(e, Effect::OutlierRun(OutlierRun { run: 1, direction: Direction::Down, offset }) if within(*offset, 5.0));
         extras.check("outlier-run", &d, &[("outlier-run", &ok)], seed, sigma);
     });
     extras.finish();
@@ -344,7 +344,7 @@ fn a_screw_lead_error_is_found_and_measured() {
     let mut extras = Extras::default();
     for_each_seed(|seed, sigma| {
         let d = run(&periodic_truth(sigma, ""), seed, false);
-        let ok = |e: &Effect| matches!(e, Effect::Periodic(Periodic { period_mm, amplitude_um, .. }) if within(*period_mm, 5.0) && within(*amplitude_um, 1.0));
+        let ok = |e: &Effect| matches!(e, Effect::Periodic(Periodic { period, amplitude, .. }) if within(*period, 5.0) && within(*amplitude, 1.0));
         extras.check("periodic", &d, &[("periodic", &ok)], seed, sigma);
     });
     extras.finish();
@@ -355,7 +355,7 @@ fn a_screw_lead_error_is_found_in_the_retest_alone() {
     let mut extras = Extras::default();
     for_each_seed(|seed, sigma| {
         let d = run_alone(&periodic_truth(sigma, ""), seed);
-        let ok = |e: &Effect| matches!(e, Effect::Periodic(Periodic { period_mm, amplitude_um, .. }) if within(*period_mm, 5.0) && within(*amplitude_um, 1.0));
+        let ok = |e: &Effect| matches!(e, Effect::Periodic(Periodic { period, amplitude, .. }) if within(*period, 5.0) && within(*amplitude, 1.0));
         extras.check("periodic alone", &d, &[("periodic", &ok)], seed, sigma);
     });
     extras.finish();
@@ -427,7 +427,7 @@ fn two_effects_at_once() {
             "reversal + drift",
             &d,
             &[
-                ("reversal", &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -3.0))),
+                ("reversal", &|e| matches!(e, Effect::Reversal(Reversal { b }) if within(*b, -3.0))),
                 ("drift", &|e| matches!(e, Effect::Drift(Drift::PerHour { rate_um_per_h }) if within(*rate_um_per_h, 15.0))),
             ],
             seed,
@@ -440,7 +440,7 @@ fn two_effects_at_once() {
             &d,
             &[
                 ("scale", &|e| matches!(e, Effect::Scale(Scale { scale_um_per_m }) if within(*scale_um_per_m, 8.0))),
-                ("outlier-run", &|e| matches!(e, Effect::OutlierRun(OutlierRun { run: 2, direction: Direction::Up, offset_um }) if within(*offset_um, -4.0))),
+                ("outlier-run", &|e| matches!(e, Effect::OutlierRun(OutlierRun { run: 2, direction: Direction::Up, offset }) if within(*offset, -4.0))),
             ],
             seed,
             sigma,
@@ -457,8 +457,8 @@ fn two_effects_at_once() {
             "periodic + reversal",
             &d,
             &[
-                ("periodic", &|e| matches!(e, Effect::Periodic(Periodic { period_mm, amplitude_um, .. }) if within(*period_mm, 5.0) && within(*amplitude_um, 1.0))),
-                ("reversal", &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -2.0))),
+                ("periodic", &|e| matches!(e, Effect::Periodic(Periodic { period, amplitude, .. }) if within(*period, 5.0) && within(*amplitude, 1.0))),
+                ("reversal", &|e| matches!(e, Effect::Reversal(Reversal { b }) if within(*b, -2.0))),
             ],
             seed,
             sigma,
@@ -568,10 +568,10 @@ fn real_ess_files_get_a_stated_diagnosis() {
                 if let Effect::OutlierRun(OutlierRun {
                     run,
                     direction,
-                    offset_um,
+                    offset,
                 }) = a.effect
                 {
-                    Some((run, direction, offset_um))
+                    Some((run, direction, offset))
                 } else {
                     None
                 }
@@ -666,7 +666,7 @@ fn at_higher_noise_every_kind_is_still_found() {
             "reversal",
             after("kind = \"reversal\"\nB_um = -4.0"),
             false,
-            &|e| matches!(e, Effect::Reversal(Reversal { b_um }) if within(*b_um, -4.0)),
+            &|e| matches!(e, Effect::Reversal(Reversal { b }) if within(*b, -4.0)),
         ),
         (
             "scale",
@@ -684,7 +684,7 @@ fn at_higher_noise_every_kind_is_still_found() {
             "outlier-run",
             after("kind = \"outlier-run\"\nrun = 1\ndirection = \"down\"\noffset_um = 5.0"),
             false,
-            &|e| matches!(e, Effect::OutlierRun(OutlierRun { run: 1, direction: Direction::Down, offset_um }) if within(*offset_um, 5.0)),
+            &|e| matches!(e, Effect::OutlierRun(OutlierRun { run: 1, direction: Direction::Down, offset }) if within(*offset, 5.0)),
         ),
         (
             "abbe",
@@ -696,7 +696,7 @@ fn at_higher_noise_every_kind_is_still_found() {
             "periodic",
             String::new(),
             false,
-            &|e| matches!(e, Effect::Periodic(Periodic { period_mm, amplitude_um, .. }) if within(*period_mm, 5.0) && within(*amplitude_um, 1.0)),
+            &|e| matches!(e, Effect::Periodic(Periodic { period, amplitude, .. }) if within(*period, 5.0) && within(*amplitude, 1.0)),
         ),
     ];
     for (sigma, least_within) in [(1.0, 19), (2.0, 11)] {

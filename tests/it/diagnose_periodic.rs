@@ -99,11 +99,9 @@ fn miss(case: &Case, d: &Diagnosis) -> Option<String> {
     });
     match found {
         Some(Periodic {
-            period_mm,
-            amplitude_um,
-            ..
-        }) if (period_mm / case.period_mm - 1.0).abs() <= 0.02
-            && (amplitude_um / case.amplitude_um - 1.0).abs() <= 0.10 =>
+            period, amplitude, ..
+        }) if (period / case.period_mm - 1.0).abs() <= 0.02
+            && (amplitude / case.amplitude_um - 1.0).abs() <= 0.10 =>
         {
             None
         }

@@ -134,12 +134,12 @@ fn scatter_um(m: &Measurement) -> f64 {
 /// The one number of an effect that is compared: B, rate, offset, scale, amplitude.
 fn value(effect: &Effect) -> f64 {
     match effect {
-        Effect::Reversal(e) => e.b_um,
+        Effect::Reversal(e) => e.b,
         Effect::Drift(Drift::PerHour { rate_um_per_h }) => *rate_um_per_h,
         Effect::Drift(Drift::PerRun { rate_um_per_run }) => *rate_um_per_run,
-        Effect::OutlierRun(e) => e.offset_um,
+        Effect::OutlierRun(e) => e.offset,
         Effect::Scale(e) => e.scale_um_per_m,
-        Effect::Periodic(e) => e.amplitude_um,
+        Effect::Periodic(e) => e.amplitude,
         Effect::Abbe(e) => e.offset_mm,
     }
 }
@@ -156,7 +156,7 @@ fn found_like(d: &Diagnosis, put_in: &Effect) -> Option<Effect> {
             }
             // A period is found only within 2 % of the one put in.
             (Effect::Periodic(a), Effect::Periodic(b)) => {
-                (a.period_mm - b.period_mm).abs() <= 0.02 * b.period_mm
+                (a.period - b.period).abs() <= 0.02 * b.period
             }
             _ => e.kind() == put_in.kind(),
         })
@@ -169,7 +169,7 @@ fn effects_for(m: &Measurement, s_um: f64, duration_h: f64) -> Vec<Effect> {
     let targets = m.targets();
     let span_mm = targets[targets.len() - 1] - targets[0];
     let mut effects = vec![
-        Effect::Reversal(Reversal { b_um: -10.0 * s_um }),
+        Effect::Reversal(Reversal { b: -10.0 * s_um }),
         // The ecmc files record no times: the drift is per run (as diagnose gives it).
         if m.metadata.duration_s().is_some() {
             Effect::Drift(Drift::PerHour {
@@ -183,7 +183,7 @@ fn effects_for(m: &Measurement, s_um: f64, duration_h: f64) -> Vec<Effect> {
         Effect::OutlierRun(OutlierRun {
             run: 3,
             direction: Direction::Down,
-            offset_um: 10.0 * s_um,
+            offset: 10.0 * s_um,
         }),
         Effect::Scale(Scale {
             scale_um_per_m: 10.0 * s_um / (span_mm / 1000.0),
@@ -194,8 +194,8 @@ fn effects_for(m: &Measurement, s_um: f64, duration_h: f64) -> Vec<Effect> {
         // = 18.2 mm) and a screw's 12 mm lead.
         for period_mm in [span_mm / 2.2, 12.0] {
             effects.push(Effect::Periodic(Periodic {
-                period_mm,
-                amplitude_um: 5.0 * s_um,
+                period: period_mm,
+                amplitude: 5.0 * s_um,
                 phase_rad: 0.5,
             }));
         }
@@ -369,8 +369,8 @@ fn a_period_of_twice_the_even_spacing_is_seen_aliased() {
         let (times, _) = reading_times_h(&m, CycleTiming::ASSUMED);
         let amplitude_um = 5.0 * scatter_um(&m);
         let effect = Effect::Periodic(Periodic {
-            period_mm: 10.0,
-            amplitude_um,
+            period: 10.0,
+            amplitude: amplitude_um,
             phase_rad: 0.5,
         });
         let mut copy = effect.added_to(&m, &times).unwrap();
@@ -386,10 +386,10 @@ fn a_period_of_twice_the_even_spacing_is_seen_aliased() {
         };
         let seen = amplitude_um * 0.5_f64.sin();
         assert!(
-            (found.amplitude_um - seen).abs() <= 0.1 * seen,
+            (found.amplitude - seen).abs() <= 0.1 * seen,
             "{name}: {found:?}"
         );
-        assert!((found.period_mm - 10.0).abs() <= 0.2, "{name}: {found:?}");
+        assert!((found.period - 10.0).abs() <= 0.2, "{name}: {found:?}");
         assert!(
             accepted.warnings.iter().any(|w| w.contains("alias")),
             "{name}: {:?}",

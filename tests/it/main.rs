@@ -48,6 +48,7 @@ mod read_api_pos;
 mod report;
 mod retest_case;
 mod rotary;
+mod rotary_effects;
 mod rotary_units;
 mod serve;
 mod server;

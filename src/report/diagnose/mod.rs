@@ -54,9 +54,8 @@
 //!
 //! Each key's unit is the type of the value under it, and each value comes
 //! typed from the diagnosis (`Diagnosis::typed`: `Um` and `Mm`, or `Deg`
-//! converted by `Deg::to_arcsec` or `Deg::to_urad`); only an effect's
-//! parameters, bare in the effects file's units, are converted here
-//! (`ReportedDeviation::from_held`). The object, its
+//! converted by `Deg::to_arcsec` or `Deg::to_urad`), an effect's
+//! parameters and their uncertainties too (`Effect::typed`). The object, its
 //! evidence and its unexplained structure are one struct per pair of units
 //! (`LinearDiagnoseJson` with `residual_before_um: ResidualJson<Um>` and
 //! `unexplained.where_mm: Vec<Mm>`, `ArcsecDiagnoseJson`,
@@ -74,7 +73,7 @@ use crate::diagnose::{Diagnosis, DiagnosisIn, ResidualStats};
 use crate::evaluate::{StandardFigure, standard};
 use crate::measurement::{AxisKind, ByKind};
 use crate::report::json::{FiguresByUnit, FiguresJson};
-use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad, millideg_to_deg};
+use crate::units::{AngleUnit, Arcsec, Deg, DeviationUnit, Mm, Um, Urad};
 
 mod parameters;
 mod terminal;
@@ -86,42 +85,21 @@ pub use parameters::{
 pub use terminal::render;
 
 /// A deviation as a diagnosis reports it: µm ([`Um`]) on a linear axis, ″
-/// ([`Arcsec`]) or µrad ([`Urad`]) on a rotary one. The diagnosis' own
-/// numbers come typed ([`Diagnosis::typed`]); an effect's parameters are
-/// bare, in µm, a rotary axis' in m° (1/1000 °), as the effects file keeps
-/// them.
+/// ([`Arcsec`]) or µrad ([`Urad`]) on a rotary one, each converted from the
+/// diagnosis' typed numbers ([`Diagnosis::typed`]).
 pub trait ReportedDeviation: Serialize + Copy {
     /// The unit, for the terminal.
     const UNIT: DeviationUnit;
-
-    /// An effect's parameter (µm, or m°), in this unit.
-    fn from_held(value: f64) -> Self;
 
     /// The number, in this unit.
     fn number(self) -> f64;
 }
 
-impl ReportedDeviation for Um {
-    const UNIT: DeviationUnit = DeviationUnit::Micrometre;
-
-    fn from_held(value_um: f64) -> Um {
-        Um(value_um)
-    }
-
-    fn number(self) -> f64 {
-        self.0
-    }
-}
-
-/// [`ReportedDeviation`] for an angle unit: held in m°, reported in `$unit`.
-macro_rules! reported_angle {
-    ($quantity:ty, $unit:expr, $from_deg:expr) => {
+/// [`ReportedDeviation`] for `$quantity`, reported in `$unit`.
+macro_rules! reported_deviation {
+    ($quantity:ty, $unit:expr) => {
         impl ReportedDeviation for $quantity {
-            const UNIT: DeviationUnit = DeviationUnit::Angle($unit);
-
-            fn from_held(value_millideg: f64) -> $quantity {
-                $from_deg(Deg(millideg_to_deg(value_millideg)))
-            }
+            const UNIT: DeviationUnit = $unit;
 
             fn number(self) -> f64 {
                 self.0
@@ -130,8 +108,9 @@ macro_rules! reported_angle {
     };
 }
 
-reported_angle!(Arcsec, AngleUnit::Arcsec, Deg::to_arcsec);
-reported_angle!(Urad, AngleUnit::Urad, Deg::to_urad);
+reported_deviation!(Um, DeviationUnit::Micrometre);
+reported_deviation!(Arcsec, DeviationUnit::Angle(AngleUnit::Arcsec));
+reported_deviation!(Urad, DeviationUnit::Angle(AngleUnit::Urad));
 
 /// A position as a diagnosis reports it: mm ([`Mm`]) on a linear axis, °
 /// ([`Deg`]) on a rotary one.
@@ -345,7 +324,11 @@ macro_rules! diagnose_json {
             /// The model's error before adding effects.
             pub $residual_before: ResidualJson<$deviation>,
             /// Effects found.
-            pub effects: Vec<EffectJson<$params, <$params as EffectParameters>::Uncertainty, $evidence>>,
+            pub effects: Vec<EffectJson<
+                $params,
+                <$params as EffectParameters<$position, $deviation>>::Uncertainty,
+                $evidence,
+            >>,
             /// Effects looked for and not found.
             pub rejected: Vec<RejectedJson>,
             /// The model's error with the effects.
@@ -382,8 +365,9 @@ macro_rules! diagnose_json {
                         .accepted
                         .iter()
                         .zip(&typed.evidence)
-                        .map(|(accepted, evidence)| {
-                            let (params, uncertainty) = <$params>::of(accepted);
+                        .zip(typed.effects)
+                        .map(|((accepted, evidence), effect)| {
+                            let (params, uncertainty) = <$params>::of(accepted, effect);
                             EffectJson {
                                 kind: accepted.effect.kind().name(),
                                 params,
@@ -696,7 +680,11 @@ mod tests {
     #[test]
     fn a_rotary_outlier_run_is_in_its_angle_unit_under_its_key() {
         // 0.01° = 36″ = 174.532 925 µrad; 0.001° = 3.6″.
-        let (params, uncertainty) = ArcsecParameters::of(&outlier_run());
+        let run = outlier_run();
+        let typed = |kind| run.effect.typed(kind, &run.uncertainty).unwrap();
+        let rotary = typed(AxisKind::Rotary).rotary();
+        let (params, uncertainty) =
+            ArcsecParameters::of(&run, rotary.map(|r| r.map_deviations(Deg::to_arcsec)));
         assert_eq!(
             serde_json::to_string(&params).unwrap(),
             r#"{"direction":"down","offset_arcsec":36.0,"run":1}"#
@@ -705,13 +693,14 @@ mod tests {
             serde_json::to_string(&uncertainty).unwrap(),
             r#"{"offset_arcsec":3.6}"#
         );
-        let (params, _) = UradParameters::of(&outlier_run());
+        let (params, _) = UradParameters::of(&run, rotary.map(|r| r.map_deviations(Deg::to_urad)));
         let UradParameters::OutlierRun { offset_urad, .. } = params else {
             panic!("{params:?}")
         };
         assert!((offset_urad.0 - 174.532_925_199_432_95).abs() < 1e-9);
         // The same effect on a linear axis: the effect's own keys, µm.
-        let (params, uncertainty) = Map::<String, Value>::of(&outlier_run());
+        let (params, uncertainty) =
+            Map::<String, Value>::of(&run, typed(AxisKind::Linear).linear());
         assert_eq!(
             serde_json::to_string(&params).unwrap(),
             r#"{"direction":"down","offset_um":10.0,"run":1}"#

@@ -1,14 +1,15 @@
 //! An accepted effect's parameters and their uncertainties on the wire and
 //! in the terminal: a linear axis' under the keys the effect's parameter
-//! definitions give, a rotary axis' in one angle unit, one struct per unit.
+//! definitions give, a rotary axis' in one angle unit, one struct per unit,
+//! converted from the effect's typed parameters (`Effect::typed`).
 
 use serde::Serialize;
 use serde_json::{Map, Value};
 
 use super::ReportedDeviation;
 use crate::diagnose::AcceptedEffect;
-use crate::effects::{Effect, ParameterValue};
-use crate::units::{Arcsec, Deg, Urad};
+use crate::effects::{Effect, EffectIn, ParameterValue};
+use crate::units::{Arcsec, Deg, Mm, Um, Urad};
 
 /// One parameter of an effect as the terminal shows it.
 #[derive(Clone, Debug, PartialEq)]
@@ -25,23 +26,27 @@ pub trait Cells {
     fn cells(&self) -> Vec<(String, Cell)>;
 }
 
-/// An effect's parameters on the wire, under keys with their units.
-pub trait EffectParameters: Cells + Serialize + Sized {
+/// An effect's parameters on the wire, under keys with their units: on an
+/// axis whose positions are in `P` and deviations in `D`.
+pub trait EffectParameters<P, D>: Cells + Serialize + Sized {
     /// The standard uncertainties of the same parameters, under the same keys.
     type Uncertainty: Cells + Serialize;
 
-    /// An accepted effect's parameters and their uncertainties.
-    fn of(accepted: &AcceptedEffect) -> (Self, Self::Uncertainty);
+    /// An accepted effect's parameters and their uncertainties, given its
+    /// typed parameters (`DiagnosisIn::effects`).
+    fn of(accepted: &AcceptedEffect, typed: Option<EffectIn<P, D>>) -> (Self, Self::Uncertainty);
 }
 
 /// A linear axis' parameters: under the keys the effect's parameter
 /// definitions give (`effects::Parameter::key`: `period_mm`, `B_um`, `run`;
 /// its uncertainties by the same keys), in the order a JSON object keeps
-/// them (by key).
-impl EffectParameters for Map<String, Value> {
+/// them (by key). Every kind is looked for on a linear axis, and its keys
+/// name the linear units the numbers are held in, so the typed parameters
+/// are not needed.
+impl EffectParameters<Mm, Um> for Map<String, Value> {
     type Uncertainty = Map<String, Value>;
 
-    fn of(accepted: &AcceptedEffect) -> (Self, Self) {
+    fn of(accepted: &AcceptedEffect, _: Option<EffectIn<Mm, Um>>) -> (Self, Self) {
         let mut params = Map::new();
         for parameter in accepted.effect.parameters() {
             let value = match parameter.value {
@@ -146,53 +151,57 @@ macro_rules! rotary_parameters {
             },
         }
 
-        impl EffectParameters for $params {
+        impl EffectParameters<Deg, $deviation> for $params {
             type Uncertainty = $uncertainty;
 
-            fn of(accepted: &AcceptedEffect) -> ($params, $uncertainty) {
-                // The uncertainties under the keys of the effect's definitions.
-                let sigma = |key: &str| {
-                    accepted
-                        .uncertainty
-                        .iter()
-                        .find(|(k, _)| *k == key)
-                        .map_or(f64::NAN, |(_, sigma)| *sigma)
+            fn of(
+                accepted: &AcceptedEffect,
+                typed: Option<EffectIn<Deg, $deviation>>,
+            ) -> ($params, $uncertainty) {
+                let Some(typed) = typed else {
+                    unreachable!(
+                        "{} is not looked for on a rotary axis (diagnose::gates)",
+                        accepted.effect.kind().name()
+                    )
                 };
-                let angle = <$deviation>::from_held;
-                match &accepted.effect {
-                    Effect::Periodic(p) => (
+                let per_revolution = typed.per_revolution();
+                match typed {
+                    EffectIn::Periodic {
+                        period,
+                        period_uncertainty,
+                        amplitude,
+                        amplitude_uncertainty,
+                        phase_rad,
+                    } => (
                         $params::Periodic {
-                            $amplitude: angle(p.amplitude_um),
-                            per_revolution: p.per_revolution(),
-                            period_deg: Deg(p.period_mm),
-                            phase_rad: p.phase_rad,
+                            $amplitude: amplitude,
+                            per_revolution,
+                            period_deg: period,
+                            phase_rad,
                         },
                         $uncertainty::Periodic {
-                            $amplitude: angle(sigma("amplitude_um")),
-                            period_deg: accepted
-                                .uncertainty
-                                .iter()
-                                .find(|(k, _)| *k == "period_mm")
-                                .map(|(_, sigma)| Deg(*sigma)),
+                            $amplitude: amplitude_uncertainty,
+                            period_deg: period_uncertainty,
                         },
                     ),
-                    Effect::Reversal(r) => (
-                        $params::Reversal { $b: angle(r.b_um) },
-                        $uncertainty::Reversal { $b: angle(sigma("B_um")) },
+                    EffectIn::Reversal { b, b_uncertainty } => (
+                        $params::Reversal { $b: b },
+                        $uncertainty::Reversal { $b: b_uncertainty },
                     ),
-                    Effect::OutlierRun(o) => (
+                    EffectIn::OutlierRun {
+                        run,
+                        direction,
+                        offset,
+                        offset_uncertainty,
+                    } => (
                         $params::OutlierRun {
-                            direction: o.direction.as_str(),
-                            $offset: angle(o.offset_um),
-                            run: o.run,
+                            direction: direction.as_str(),
+                            $offset: offset,
+                            run,
                         },
                         $uncertainty::OutlierRun {
-                            $offset: angle(sigma("offset_um")),
+                            $offset: offset_uncertainty,
                         },
-                    ),
-                    other => unreachable!(
-                        "{} is not looked for on a rotary axis (diagnose::gates)",
-                        other.kind().name()
                     ),
                 }
             }
