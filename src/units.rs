@@ -325,6 +325,16 @@ pub fn millideg_to_deg(value_millideg: f64) -> f64 {
     value_millideg / 1000.0
 }
 
+/// Degrees to millidegrees (m°), the inverse of [`millideg_to_deg`].
+pub fn deg_to_millideg(value_deg: f64) -> f64 {
+    value_deg * 1000.0
+}
+
+/// Square degrees (a rotary axis' variance) to square millidegrees.
+pub fn deg2_to_millideg2(value_deg2: f64) -> f64 {
+    deg_to_millideg(deg_to_millideg(value_deg2))
+}
+
 /// Arc-seconds to microradians (1″ ≈ 4.848 µrad).
 pub fn arcsec_to_urad(value_arcsec: f64) -> f64 {
     deg_to_urad(arcsec_to_deg(value_arcsec))
@@ -458,6 +468,9 @@ mod tests {
         assert_eq!(arcsec_to_deg(36.0), 0.01);
         // 10 m° (a diagnosis holds a rotary axis in m°) is 0.01° = 36″.
         assert_eq!(millideg_to_deg(10.0), 0.01);
+        assert_eq!(deg_to_millideg(0.25), 250.0);
+        // A standard deviation of 0.002° (2 m°) is a variance of 4e-6 °², 4 m°².
+        assert!((deg2_to_millideg2(4e-6) - 4.0).abs() < 1e-12);
         assert_eq!(opt_deg_to_arcsec(None), None);
         assert!((arcsec_to_urad(1.0) - 4.848_136_811).abs() < 1e-9);
         assert!((deg_to_urad(180.0) - std::f64::consts::PI * 1e6).abs() < 1e-6);

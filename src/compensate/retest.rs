@@ -25,6 +25,9 @@
 //! What changed since the first test (a reversal that grew, drift, anything
 //! the first test could not show) is in the difference between this and the
 //! re-test; that is what `diagnose` explains.
+//!
+//! Positions, deviations and compensation values are in the axis' unit: mm,
+//! or ° on a rotary axis (a rotary re-test is diagnosed the same way).
 
 use std::fmt;
 
@@ -36,12 +39,12 @@ use crate::spline::CubicSpline;
 /// The axis error the model knows, from a first test: per direction.
 #[derive(Clone, Debug, PartialEq)]
 pub struct KnownError {
-    /// Targets of the first test, mm.
-    positions_mm: Vec<f64>,
-    /// Mean deviation moving ↑ there, mm.
-    up_mm: Vec<f64>,
-    /// Mean deviation moving ↓ there, mm.
-    down_mm: Vec<f64>,
+    /// Targets of the first test, in the axis' unit.
+    positions: Vec<f64>,
+    /// Mean deviation moving ↑ there, in the axis' unit.
+    up_means: Vec<f64>,
+    /// Mean deviation moving ↓ there, in the axis' unit.
+    down_means: Vec<f64>,
     up: CubicSpline,
     down: CubicSpline,
     /// Whether both directions were measured (else the reversal is unknown).
@@ -54,8 +57,8 @@ impl KnownError {
     /// `None` if no target has a mean.
     pub fn from_evaluation(evaluation: &Evaluation) -> Option<KnownError> {
         let bidirectional = evaluation.runs_up > 0 && evaluation.runs_down > 0;
-        let mut positions_mm = Vec::new();
-        let (mut up_mm, mut down_mm) = (Vec::new(), Vec::new());
+        let mut positions = Vec::new();
+        let (mut up_means, mut down_means) = (Vec::new(), Vec::new());
         for t in &evaluation.per_target {
             let means = if bidirectional {
                 t.up.mean.zip(t.down.mean)
@@ -63,15 +66,20 @@ impl KnownError {
                 t.up.mean.or(t.down.mean).map(|m| (m, m))
             };
             if let Some((up, down)) = means {
-                positions_mm.push(t.target);
-                up_mm.push(up);
-                down_mm.push(down);
+                positions.push(t.target);
+                up_means.push(up);
+                down_means.push(down);
             }
         }
-        if positions_mm.is_empty() {
+        if positions.is_empty() {
             return None;
         }
-        Some(KnownError::new(positions_mm, up_mm, down_mm, bidirectional))
+        Some(KnownError::new(
+            positions,
+            up_means,
+            down_means,
+            bidirectional,
+        ))
     }
 
     /// Through the given points: positions finite and strictly increasing, as
@@ -79,17 +87,17 @@ impl KnownError {
     /// targets are). `bidirectional` says whether the two directions were
     /// measured apart.
     pub fn new(
-        positions_mm: Vec<f64>,
-        up_mm: Vec<f64>,
-        down_mm: Vec<f64>,
+        positions: Vec<f64>,
+        up_means: Vec<f64>,
+        down_means: Vec<f64>,
         bidirectional: bool,
     ) -> KnownError {
-        let up = CubicSpline::new(&positions_mm, &up_mm);
-        let down = CubicSpline::new(&positions_mm, &down_mm);
+        let up = CubicSpline::new(&positions, &up_means);
+        let down = CubicSpline::new(&positions, &down_means);
         KnownError {
-            positions_mm,
-            up_mm,
-            down_mm,
+            positions,
+            up_means,
+            down_means,
             up,
             down,
             bidirectional,
@@ -97,20 +105,20 @@ impl KnownError {
     }
 
     /// The same error in both directions (no reversal), e.g. a geometric error.
-    pub fn same_both_ways(positions_mm: Vec<f64>, values_mm: Vec<f64>) -> KnownError {
-        KnownError::new(positions_mm, values_mm.clone(), values_mm, false)
+    pub fn same_both_ways(positions: Vec<f64>, values: Vec<f64>) -> KnownError {
+        KnownError::new(positions, values.clone(), values, false)
     }
 
-    /// Targets of the first test, mm.
-    pub fn positions_mm(&self) -> &[f64] {
-        &self.positions_mm
+    /// Targets of the first test, in the axis' unit.
+    pub fn positions(&self) -> &[f64] {
+        &self.positions
     }
 
-    /// Bidirectional mean deviation x̄_i at each target, mm.
-    pub fn mean_values_mm(&self) -> Vec<f64> {
-        self.up_mm
+    /// Bidirectional mean deviation x̄_i at each target, in the axis' unit.
+    pub fn mean_values(&self) -> Vec<f64> {
+        self.up_means
             .iter()
-            .zip(&self.down_mm)
+            .zip(&self.down_means)
             .map(|(up, down)| (up + down) / 2.0)
             .collect()
     }
@@ -120,34 +128,34 @@ impl KnownError {
         self.bidirectional
     }
 
-    /// The mean reversal value B̄ = mean of x̄_i↑ − x̄_i↓ over the targets, mm
+    /// The mean reversal value B̄ = mean of x̄_i↑ − x̄_i↓ over the targets, in the axis' unit
     /// (0 for a unidirectional test).
-    pub fn mean_reversal_mm(&self) -> f64 {
+    pub fn mean_reversal(&self) -> f64 {
         let sum: f64 = self
-            .up_mm
+            .up_means
             .iter()
-            .zip(&self.down_mm)
+            .zip(&self.down_means)
             .map(|(up, down)| up - down)
             .sum();
-        sum / self.positions_mm.len() as f64
+        sum / self.positions.len() as f64
     }
 
-    /// e(x, d), mm.
-    pub fn at(&self, x_mm: f64, direction: Direction) -> f64 {
+    /// e(x, d), in the axis' unit.
+    pub fn at(&self, x: f64, direction: Direction) -> f64 {
         match direction {
-            Direction::Up => self.up.value_at(x_mm),
-            Direction::Down => self.down.value_at(x_mm),
+            Direction::Up => self.up.value_at(x),
+            Direction::Down => self.down.value_at(x),
         }
     }
 
-    /// The bidirectional mean (e(x, ↑) + e(x, ↓)) / 2: the geometric part, mm.
-    pub fn mean_at(&self, x_mm: f64) -> f64 {
-        (self.up.value_at(x_mm) + self.down.value_at(x_mm)) / 2.0
+    /// The bidirectional mean (e(x, ↑) + e(x, ↓)) / 2: the geometric part, in the axis' unit.
+    pub fn mean_at(&self, x: f64) -> f64 {
+        (self.up.value_at(x) + self.down.value_at(x)) / 2.0
     }
 
-    /// The measured reversal's share at `x_mm` in `direction`: e(x, d) − the mean, mm.
-    pub fn reversal_share_at(&self, x_mm: f64, direction: Direction) -> f64 {
-        self.at(x_mm, direction) - self.mean_at(x_mm)
+    /// The measured reversal's share at `x` in `direction`: e(x, d) − the mean, in the axis' unit.
+    pub fn reversal_share_at(&self, x: f64, direction: Direction) -> f64 {
+        self.at(x, direction) - self.mean_at(x)
     }
 }
 
@@ -158,9 +166,9 @@ pub struct Applied<'a> {
     /// The compensation table, if any.
     pub table: Option<&'a CompensationTable>,
     /// The mean reversal B̄ (x̄↑ − x̄↓) that the backlash parameter takes out,
-    /// mm; 0 when it is not set. Set as `convert` suggests (−B̄), it takes
+    /// in the axis' unit; 0 when it is not set. Set as `convert` suggests (−B̄), it takes
     /// out the first test's B̄.
-    pub backlash_reversal_mm: f64,
+    pub backlash_reversal: f64,
 }
 
 /// Why the backlash parameter cannot be applied as said: the reason inside
@@ -192,7 +200,7 @@ impl<'a> Applied<'a> {
     pub fn table(table: &'a CompensationTable) -> Applied<'a> {
         Applied {
             table: Some(table),
-            backlash_reversal_mm: 0.0,
+            backlash_reversal: 0.0,
         }
     }
 
@@ -208,7 +216,7 @@ impl<'a> Applied<'a> {
         if !backlash_set {
             return Ok(Applied {
                 table,
-                backlash_reversal_mm: 0.0,
+                backlash_reversal: 0.0,
             });
         }
         if table.is_some_and(|t| t.values.mode() == crate::compensate::TableMode::Bidirectional) {
@@ -219,19 +227,19 @@ impl<'a> Applied<'a> {
             .ok_or(BacklashRefusal::NoMeasuredReversal)?;
         Ok(Applied {
             table,
-            backlash_reversal_mm: known.mean_reversal_mm(),
+            backlash_reversal: known.mean_reversal(),
         })
     }
 
-    /// The compensation value v(x, d) in the table's convention (actual − target), mm.
-    pub fn value_at(&self, x_mm: f64, direction: Direction) -> f64 {
-        self.table.map_or(0.0, |t| t.value_at(x_mm, direction))
-            + direction.reversal_share(self.backlash_reversal_mm)
+    /// The compensation value v(x, d) in the table's convention (actual − target), in the axis' unit.
+    pub fn value_at(&self, x: f64, direction: Direction) -> f64 {
+        self.table.map_or(0.0, |t| t.value_at(x, direction))
+            + direction.reversal_share(self.backlash_reversal)
     }
 }
 
 /// A test with its readings' per-target, per-direction means replaced by
-/// `systematic(target index, direction)`, mm: the scatter about the means is
+/// `systematic(target index, direction)`, in the axis' unit: the scatter about the means is
 /// kept. With the first test and its predicted systematic error this is the
 /// predicted re-test, whose R is the first test's and whose A and E compare
 /// with a real re-test's (`predict` and `diagnose` give these figures).
@@ -247,15 +255,15 @@ pub fn with_scatter(
     })
 }
 
-/// The deviation a re-test should show at `x_mm` moving in `direction`, mm.
-pub fn predicted_deviation_mm(
+/// The deviation a re-test should show at `x` moving in `direction`, in the axis' unit.
+pub fn predicted_deviation(
     error: &KnownError,
     applied: Applied<'_>,
-    x_mm: f64,
+    x: f64,
     direction: Direction,
 ) -> f64 {
-    let v = applied.value_at(x_mm, direction);
-    error.at(x_mm - v, direction) - v
+    let v = applied.value_at(x, direction);
+    error.at(x - v, direction) - v
 }
 
 #[cfg(test)]
@@ -263,12 +271,12 @@ mod tests {
     use super::*;
     use crate::compensate::TableValues;
 
-    fn mean_table(positions_mm: Vec<f64>, values_mm: Vec<f64>) -> CompensationTable {
+    fn mean_table(positions: Vec<f64>, values: Vec<f64>) -> CompensationTable {
         CompensationTable {
             axis: "X".into(),
             kind: crate::measurement::AxisKind::Linear,
-            positions: positions_mm,
-            values: TableValues::Mean(values_mm),
+            positions,
+            values: TableValues::Mean(values),
             reference: 0.0,
             suggested_backlash: None,
         }
@@ -291,11 +299,11 @@ mod tests {
         let error = KnownError::same_both_ways(vec![0.0, 100.0], vec![0.0, 0.010]);
         let table = mean_table(vec![0.0, 100.0], vec![0.0, 0.010]);
         // At 50 mm the table holds 5 µm: e(50 − 0.005) − 0.005 = 0.0049995 − 0.005 = −0.5 nm.
-        let predicted = predicted_deviation_mm(&error, Applied::table(&table), 50.0, Direction::Up);
+        let predicted = predicted_deviation(&error, Applied::table(&table), 50.0, Direction::Up);
         assert!((predicted + 0.0000005).abs() < 1e-12, "{predicted}");
         // Without a table the prediction is the known error itself; beyond the ends it is held.
         assert_eq!(
-            predicted_deviation_mm(&error, Applied::default(), 150.0, Direction::Down),
+            predicted_deviation(&error, Applied::default(), 150.0, Direction::Down),
             0.010
         );
     }
@@ -314,12 +322,12 @@ mod tests {
     #[test]
     fn a_mean_table_leaves_the_measured_reversal_by_hand() {
         let error = with_reversal();
-        assert!((error.mean_reversal_mm() + 0.0032).abs() < 1e-15);
+        assert!((error.mean_reversal() + 0.0032).abs() < 1e-15);
         let table = mean_table(vec![0.0, 100.0], vec![0.0, 0.010]);
         // At 100 mm v = 10 µm; e(x, ↑) = −1.6 µm + 0.1 µm/mm · x, so
         // ↑: −0.0016 + 0.009999 − 0.010 = −0.001601 mm; ↓: 0.0016 + 0.009999 − 0.010 = 0.001599 mm.
-        let up = predicted_deviation_mm(&error, Applied::table(&table), 100.0, Direction::Up);
-        let down = predicted_deviation_mm(&error, Applied::table(&table), 100.0, Direction::Down);
+        let up = predicted_deviation(&error, Applied::table(&table), 100.0, Direction::Up);
+        let down = predicted_deviation(&error, Applied::table(&table), 100.0, Direction::Down);
         assert!((up + 0.001601).abs() < 1e-12, "{up}");
         assert!((down - 0.001599).abs() < 1e-12, "{down}");
     }
@@ -330,12 +338,12 @@ mod tests {
         let table = mean_table(vec![0.0, 100.0], vec![0.0, 0.010]);
         let with_backlash = Applied {
             table: Some(&table),
-            backlash_reversal_mm: error.mean_reversal_mm(),
+            backlash_reversal: error.mean_reversal(),
         };
         // ↑: v = 0.010 − 0.0016 = 0.0084, e(99.9916, ↑) − v = −0.0016 + 0.00999916 − 0.0084 = −0.84 nm;
         // ↓: v = 0.0116, e(99.9884, ↓) − v = 0.0016 + 0.00999884 − 0.0116 = −1.16 nm.
-        let up = predicted_deviation_mm(&error, with_backlash, 100.0, Direction::Up);
-        let down = predicted_deviation_mm(&error, with_backlash, 100.0, Direction::Down);
+        let up = predicted_deviation(&error, with_backlash, 100.0, Direction::Up);
+        let down = predicted_deviation(&error, with_backlash, 100.0, Direction::Down);
         assert!((up + 0.00000084).abs() < 1e-12, "{up}");
         assert!((down + 0.00000116).abs() < 1e-12, "{down}");
         // A bidirectional table with the measured ↑ and ↓ means does the same.
@@ -346,8 +354,7 @@ mod tests {
             },
             ..table
         };
-        let up =
-            predicted_deviation_mm(&error, Applied::table(&bidirectional), 100.0, Direction::Up);
+        let up = predicted_deviation(&error, Applied::table(&bidirectional), 100.0, Direction::Up);
         assert!((up + 0.00000084).abs() < 1e-12, "{up}");
     }
 }

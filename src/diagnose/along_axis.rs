@@ -36,7 +36,7 @@ use crate::units::DeviationUnit;
 /// the same points of the first test: C = diag(s²) + W D Wᵀ.
 pub(super) fn level_covariance(problem: &Problem, levels: &[Level]) -> Covariance {
     Covariance::new(
-        levels.iter().map(|l| l.scatter_variance_um2).collect(),
+        levels.iter().map(|l| l.scatter_variance).collect(),
         levels
             .iter()
             .map(|l| problem.prediction_weights[l.target_index].clone())
@@ -69,7 +69,7 @@ fn background_columns(
     if background == Background::Constant {
         return vec![vec![1.0; m]];
     }
-    let positions: Vec<f64> = levels.iter().map(|l| l.target_mm).collect();
+    let positions: Vec<f64> = levels.iter().map(|l| l.target).collect();
     let span = positions[m - 1] - positions[0];
     let used: Vec<f64> = positions
         .iter()
@@ -98,9 +98,9 @@ fn level_columns(problem: &Problem, levels: &[Level], shape: Shape) -> Vec<Vec<f
     // (target index, position): the index is the re-test's (Abbe's angles are per target).
     let at = |positions: &mut dyn Iterator<Item = (usize, f64)>| -> Vec<Reading> {
         positions
-            .map(|(target_index, target_mm)| Reading {
+            .map(|(target_index, target)| Reading {
                 target_index,
-                target: target_mm,
+                target,
                 direction: Direction::Up,
                 run: 0,
                 run_index: 0,
@@ -108,7 +108,7 @@ fn level_columns(problem: &Problem, levels: &[Level], shape: Shape) -> Vec<Vec<f
             })
             .collect()
     };
-    let readings = at(&mut levels.iter().map(|l| (l.target_index, l.target_mm)));
+    let readings = at(&mut levels.iter().map(|l| (l.target_index, l.target)));
     let mut columns = crate::effects::columns(shape, &readings, &problem.line());
     if let Shape::Period(_, PeriodicIn::BothTests) = shape {
         let first = at(&mut problem.first_test_positions.iter().map(|&x| (0, x)));
@@ -148,7 +148,7 @@ pub(super) fn select_along_axis(
     rejected: &mut Vec<RejectedEffect>,
 ) -> AlongAxisSelection {
     let m = levels.len();
-    let values: Vec<f64> = levels.iter().map(|l| l.value_um).collect();
+    let values: Vec<f64> = levels.iter().map(|l| l.value).collect();
     let base = Design::of_columns(background_columns(background, levels, None));
     let mut covariance = level_covariance(problem, levels);
     if background == Background::Smooth {
@@ -265,7 +265,7 @@ impl AlongAxis<'_> {
         if tests != PeriodicIn::ReTest || model.groups.is_some() {
             return None;
         }
-        let positions: Vec<f64> = self.levels.iter().map(|l| l.target_mm).collect();
+        let positions: Vec<f64> = self.levels.iter().map(|l| l.target).collect();
         let fit = self.fit_extended(model, &[]);
         if let Some(weights) = self.covariance.inverse_diagonal() {
             let screened =
@@ -450,12 +450,12 @@ fn inconsistent_along_axis(
 ) -> Option<String> {
     let columns = level_columns(problem, levels, shape);
     let k = columns.len();
-    let middle = (levels[0].target_mm + levels[levels.len() - 1].target_mm) / 2.0;
+    let middle = (levels[0].target + levels[levels.len() - 1].target) / 2.0;
     let mut halves = Vec::new();
     for first_half in [true, false] {
         let rows: Vec<bool> = levels
             .iter()
-            .map(|l| (l.target_mm <= middle) == first_half)
+            .map(|l| (l.target <= middle) == first_half)
             .collect();
         if rows.iter().filter(|r| **r).count() < k + 6 {
             return None;
@@ -501,12 +501,12 @@ fn inconsistent_along_axis(
             fitted.coefficients[base.parameters()],
             fitted.coefficients[base.parameters() + 1],
         );
-        let span = levels[levels.len() - 1].target_mm - levels[0].target_mm;
+        let span = levels[levels.len() - 1].target - levels[0].target;
         let centre = |first_half: bool| {
             let here: Vec<f64> = levels
                 .iter()
-                .filter(|l| (l.target_mm <= middle) == first_half)
-                .map(|l| l.target_mm)
+                .filter(|l| (l.target <= middle) == first_half)
+                .map(|l| l.target)
                 .collect();
             here.iter().sum::<f64>() / here.len() as f64
         };
@@ -570,7 +570,7 @@ pub(super) fn along_axis_cv(
                 .map(|c| index.iter().map(|&i| c[i]).collect())
                 .collect(),
         );
-        let values: Vec<f64> = fold.levels.iter().map(|l| l.value_um).collect();
+        let values: Vec<f64> = fold.levels.iter().map(|l| l.value).collect();
         let fitted = fit_gls(
             &columns,
             &values,

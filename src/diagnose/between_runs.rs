@@ -19,8 +19,10 @@ use crate::units::DeviationUnit;
 /// The reversal found between the directions, from the cell levels.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct ReversalFit {
-    pub(super) b_um: f64,
-    pub(super) standard_error_um: f64,
+    /// B (↑ − ↓), µm (m° on a rotary axis).
+    pub(super) b: f64,
+    /// Its standard error, in the same unit.
+    pub(super) standard_error: f64,
     pub(super) evidence: Evidence,
 }
 
@@ -236,7 +238,7 @@ pub(super) fn select_reversal(
                     continue;
                 };
                 let half = direction.reversal_share(b_fold);
-                sum += (value - level.value_um - half).powi(2);
+                sum += (value - level.value - half).powi(2);
                 count += 1;
             }
         }
@@ -265,8 +267,8 @@ pub(super) fn select_reversal(
     };
     (
         Some(ReversalFit {
-            b_um: b,
-            standard_error_um: standard_error,
+            b,
+            standard_error,
             evidence,
         }),
         p_with,

@@ -7,18 +7,20 @@ use super::selection::Chosen;
 use super::{AcceptedEffect, DiagnoseError, DiagnoseInput, FigureSet, ResidualStats};
 use crate::compensate::CompensationTable;
 use crate::compensate::retest::KnownError;
-use crate::effects::{Context, Effect, FitSummary, Kind, Shape};
+use crate::effects::{
+    Context, Effect, FitSummary, Kind, Shape, deviation_as_position, position_as_deviation,
+};
 use crate::evaluate::{AxisFigures, StandardFigure, evaluate, evaluate_with};
 use crate::measurement::{Measurement, Run};
-use crate::units::um_to_mm;
 
-/// The mean reversal B̄ of the first test, µm, when it measured both directions.
-pub(super) fn first_test_reversal_um(input: &DiagnoseInput<'_>) -> Option<f64> {
+/// The mean reversal B̄ of the first test, µm (m° on a rotary axis), when it
+/// measured both directions.
+pub(super) fn first_test_reversal_of(input: &DiagnoseInput<'_>) -> Option<f64> {
     let before = input.before?;
     let known = KnownError::from_evaluation(&evaluate(before))?;
     known
         .is_bidirectional()
-        .then(|| crate::units::mm_to_um(known.mean_reversal_mm()))
+        .then(|| position_as_deviation(before.kind(), known.mean_reversal()))
 }
 
 pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context {
@@ -35,7 +37,7 @@ pub(super) fn context(input: &DiagnoseInput<'_>, time_assumed: bool) -> Context 
         expansion_coefficient_ppm_per_k: input.after.environment.expansion_coefficient_ppm_per_k,
         material_change_k,
         time_assumed,
-        first_test_reversal: first_test_reversal_um(input),
+        first_test_reversal: first_test_reversal_of(input),
         // Known once the figures are: `diagnose` says them then.
         retest_mean_reversal: None,
     }
@@ -105,7 +107,7 @@ pub(super) fn figures(
             .collect();
         for (i, reading) in problem.readings.iter().enumerate() {
             runs[reading.run_index].deviations[reading.target_index] =
-                Some(um_to_mm(value(i, with_effects)));
+                Some(deviation_as_position(after.kind(), value(i, with_effects)));
         }
         Measurement::new(
             after.axis(),

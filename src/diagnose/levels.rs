@@ -1,6 +1,8 @@
 //! Levels of the residual: per cell (target × direction) from the
 //! between-runs fit, per target (both directions pooled), and the same for
-//! each run held out (the folds of the cross-validation).
+//! each run held out (the folds of the cross-validation). Targets are in the
+//! axis' unit (mm, or ° on a rotary axis), levels in µm (m°), variances in
+//! their squares.
 
 use super::fit::{self, Design, Fit};
 use super::problem::Problem;
@@ -12,25 +14,28 @@ use crate::measurement::Direction;
 pub(super) struct Cell {
     pub(super) target_index: usize,
     pub(super) direction: Direction,
-    pub(super) value_um: f64,
-    /// Variance of the level from the re-test's scatter, µm².
-    pub(super) variance_um2: f64,
+    /// The level, µm (m°).
+    pub(super) value: f64,
+    /// Variance of the level from the re-test's scatter, µm² (m°²).
+    pub(super) variance: f64,
     /// This cell's half of the variance of the predicted reversal at its
-    /// target (the first test's x̄↑ − x̄↓, interpolated), µm²: a reversal
+    /// target (the first test's x̄↑ − x̄↓, interpolated), µm² (m°²): a reversal
     /// found is the change since the first test, uncertain by both tests.
-    pub(super) reversal_prediction_variance_um2: f64,
+    pub(super) reversal_prediction_variance: f64,
 }
 
 /// One per-target level (both directions pooled): the position-dependent part.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Level {
     pub(super) target_index: usize,
-    pub(super) target_mm: f64,
-    pub(super) value_um: f64,
-    /// Variance of the level from the re-test's scatter alone, µm².
-    pub(super) scatter_variance_um2: f64,
-    /// Its total variance, scatter plus prediction, µm².
-    pub(super) variance_um2: f64,
+    /// The target, mm (°).
+    pub(super) target: f64,
+    /// The level, µm (m°).
+    pub(super) value: f64,
+    /// Variance of the level from the re-test's scatter alone, µm² (m°²).
+    pub(super) scatter_variance: f64,
+    /// Its total variance, scatter plus prediction, µm² (m°²).
+    pub(super) variance: f64,
 }
 
 /// The cell levels of a between-runs fit, with their variance from the scatter.
@@ -42,9 +47,9 @@ pub(super) fn cell_levels(problem: &Problem, fitted: &Fit) -> Vec<Cell> {
         .map(|(c, (t, d))| Cell {
             target_index: *t,
             direction: *d,
-            value_um: fitted.coefficients[c],
-            variance_um2: fitted.standard_errors[c].powi(2),
-            reversal_prediction_variance_um2: problem.reversal_prediction_variance(*t) / 2.0,
+            value: fitted.coefficients[c],
+            variance: fitted.standard_errors[c].powi(2),
+            reversal_prediction_variance: problem.reversal_prediction_variance(*t) / 2.0,
         })
         .collect()
 }
@@ -61,11 +66,11 @@ pub(super) fn reversals(cells: &[Cell]) -> Vec<(usize, f64, f64)> {
         if let Some(down) = down_at[up.target_index] {
             list.push((
                 up.target_index,
-                up.value_um - down.value_um,
-                up.variance_um2
-                    + down.variance_um2
-                    + up.reversal_prediction_variance_um2
-                    + down.reversal_prediction_variance_um2,
+                up.value - down.value,
+                up.variance
+                    + down.variance
+                    + up.reversal_prediction_variance
+                    + down.reversal_prediction_variance,
             ));
         }
     }
@@ -126,18 +131,18 @@ pub(super) fn target_levels(problem: &Problem, cells: &[Cell]) -> Vec<Level> {
             continue;
         }
         let k = here.len() as f64;
-        let value = here.iter().map(|c| c.value_um).sum::<f64>() / k;
-        let scatter = here.iter().map(|c| c.variance_um2).sum::<f64>() / (k * k);
+        let value = here.iter().map(|c| c.value).sum::<f64>() / k;
+        let scatter = here.iter().map(|c| c.variance).sum::<f64>() / (k * k);
         let prediction: f64 = problem.prediction_weights[t]
             .iter()
             .map(|(i, w)| w * w * problem.first_test_variance[*i])
             .sum();
         levels.push(Level {
             target_index: t,
-            target_mm: problem.targets[t],
-            value_um: value,
-            scatter_variance_um2: scatter,
-            variance_um2: scatter + prediction,
+            target: problem.targets[t],
+            value,
+            scatter_variance: scatter,
+            variance: scatter + prediction,
         });
     }
     levels

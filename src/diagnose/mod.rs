@@ -55,12 +55,12 @@ use crate::compensate::CompensationTable;
 use crate::cycle::CycleTiming;
 use crate::effects::{
     Context, Effect, EffectIn, FileEntry, Kind, PeriodicIn, Reading, Reversal, Shape, held_angle,
-    reversal,
+    position_as_deviation, reversal,
 };
 use crate::evaluate::{AxisFigures, Standard, StandardFigure, StandardUsed};
 use crate::measurement::{AxisKind, ByKind, Direction, Measurement};
 use crate::together::NotTogether;
-use crate::units::{Deg, Mm, Um, mm_to_um};
+use crate::units::{Deg, Mm, Um};
 use along_axis::{AlongAxisSelection, Background, select_along_axis};
 use between_runs::{select_between_runs, select_reversal};
 use findings::{accepted_effect, context, figures, stats};
@@ -514,7 +514,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
 
     // 2. The reversal: the same difference between the directions at every target.
     let (reversal, reversal_p) = select_reversal(&problem, &cells, &folds, &kinds, &mut rejected);
-    let reversal_b = reversal.map_or(0.0, |r| r.b_um);
+    let reversal_b = reversal.map_or(0.0, |r| r.b);
     let context = context(input, time_assumed);
 
     // 3. Along the axis (scale, periodic, Abbe) on the pooled per-target levels, with a prediction only.
@@ -543,11 +543,11 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
 
     let mut accepted: Vec<AcceptedEffect> = Vec::new();
     if let Some(r) = reversal {
-        let effect = Effect::Reversal(Reversal { b: r.b_um });
+        let effect = Effect::Reversal(Reversal { b: r.b });
         accepted.push(AcceptedEffect {
             explanation: effect.explanation(&context),
             effect,
-            uncertainty: vec![(reversal::B_KEY, r.standard_error_um)],
+            uncertainty: vec![(reversal::B_KEY, r.standard_error)],
             evidence: r.evidence,
             warnings: Vec::new(),
         });
@@ -588,27 +588,29 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     let mut level_at_target = vec![0.0; problem.targets.len()];
     let mut model_at_target = vec![0.0; problem.targets.len()];
     for (level, fitted) in levels.iter().zip(&along_fit.fitted) {
-        level_at_target[level.target_index] = level.value_um;
+        level_at_target[level.target_index] = level.value;
         model_at_target[level.target_index] = if with_prediction {
             *fitted
         } else {
-            level.value_um
+            level.value
         };
     }
     let half_reversal = |d: Direction| d.reversal_share(reversal_b);
-    let between_um = problem.between_runs(&between, &between_fit.coefficients);
+    let between_values = problem.between_runs(&between, &between_fit.coefficients);
     let scatter: Vec<f64> = y
         .iter()
         .zip(&between_fit.fitted)
         .map(|(v, f)| v - f)
         .collect();
-    let model_um: Vec<f64> = problem
+    let model: Vec<f64> = problem
         .readings
         .iter()
         .enumerate()
-        .map(|(i, r)| model_at_target[r.target_index] + half_reversal(r.direction) + between_um[i])
+        .map(|(i, r)| {
+            model_at_target[r.target_index] + half_reversal(r.direction) + between_values[i]
+        })
         .collect();
-    let residual_after: Vec<f64> = y.iter().zip(&model_um).map(|(v, m)| v - m).collect();
+    let residual_after: Vec<f64> = y.iter().zip(&model).map(|(v, m)| v - m).collect();
     let residual_before: Vec<f64> = if with_prediction {
         let mean = y.iter().sum::<f64>() / n as f64;
         y.iter().map(|v| v - mean).collect()
@@ -620,7 +622,7 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             .map(|(r, v)| v - level_at_target[r.target_index])
             .collect()
     };
-    let noise_um = (between_fit.rss / n.saturating_sub(between_fit.rank).max(1) as f64).sqrt();
+    let noise_level = (between_fit.rss / n.saturating_sub(between_fit.rank).max(1) as f64).sqrt();
     let unexplained = unexplained(
         &problem,
         &levels,
@@ -635,19 +637,21 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         let r = &problem.readings[i];
         // Without effects this is only asked without a first test (see `figures`).
         let systematic = if with_effects {
-            model_at_target[r.target_index] + half_reversal(r.direction) + between_um[i]
+            model_at_target[r.target_index] + half_reversal(r.direction) + between_values[i]
         } else {
             level_at_target[r.target_index]
         };
         problem.predicted[i] + systematic + scatter[i]
     })?;
+    // The figures' B̄ (mm, or °) in the effects' unit (µm, or m°).
+    let held = |value: f64| position_as_deviation(input.after.kind(), value);
     // The reversal's sentence says the B̄ the figures show; where the fitted
     // B differs from the change they show, it says why.
-    if let (Some(predicted_mm), Some(measured_mm)) =
+    if let (Some(predicted_b), Some(measured_b)) =
         (figures.predicted.b_mean, figures.measured.b_mean)
     {
         let context = Context {
-            retest_mean_reversal: Some((mm_to_um(predicted_mm), mm_to_um(measured_mm))),
+            retest_mean_reversal: Some((held(predicted_b), held(measured_b))),
             ..context
         };
         let others: Vec<String> = accepted
@@ -661,13 +665,13 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
             let Effect::Reversal(reversal) = found.effect else {
                 continue;
             };
-            let shown_um = if with_prediction {
-                mm_to_um(measured_mm - predicted_mm)
+            let shown = if with_prediction {
+                held(measured_b - predicted_b)
             } else {
-                mm_to_um(measured_mm)
+                held(measured_b)
             };
             found.explanation = found.effect.explanation(&context);
-            if context.deviation(reversal.b) != context.deviation(shown_um) {
+            if context.deviation(reversal.b) != context.deviation(shown) {
                 let why = if others.is_empty() {
                     "it weighs each target by its readings, where B̄ is the plain mean of the targets' reversals".to_string()
                 } else {
@@ -687,11 +691,11 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
     // With a first test the prediction carries its reversal (what the table
     // leaves of it): a reversal found is a change, and none found is none.
     if reversal.is_none()
-        && let Some(first_um) = context.first_test_reversal
+        && let Some(first_reversal) = context.first_test_reversal
         && let Some(entry) = rejected.iter_mut().find(|r| r.kind == Kind::Reversal)
     {
-        let predicted_um = figures.predicted.b_mean.map(mm_to_um);
-        entry.why = no_reversal_change(&context, first_um, predicted_um, &entry.why);
+        let predicted_reversal = figures.predicted.b_mean.map(held);
+        entry.why = no_reversal_change(&context, first_reversal, predicted_reversal, &entry.why);
     }
     // A kind is either found or not: a second outlier run that fails a gate
     // after the first was accepted records a rejection of the same kind.
@@ -707,17 +711,17 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
         standard_figures,
         standard: StandardUsed::of(input.standard),
         unexplained,
-        noise: noise_um,
+        noise: noise_level,
         time_assumed,
         run_h: problem.run_h,
         readings: problem
             .readings
             .iter()
-            .zip(y.iter().zip(&model_um))
-            .map(|(reading, (residual_um, fitted_um))| ReadingResidual {
+            .zip(y.iter().zip(&model))
+            .map(|(reading, (residual, fitted))| ReadingResidual {
                 reading: *reading,
-                residual: *residual_um,
-                fitted: *fitted_um,
+                residual: *residual,
+                fitted: *fitted,
             })
             .collect(),
     })
@@ -728,12 +732,12 @@ pub fn diagnose(input: &DiagnoseInput<'_>) -> Result<Diagnosis, DiagnoseError> {
 /// some of it out (a bidirectional table), the B̄ the prediction is left with.
 fn no_reversal_change(
     context: &Context,
-    first_um: f64,
-    predicted_um: Option<f64>,
+    first_reversal: f64,
+    predicted_reversal: Option<f64>,
     why: &str,
 ) -> String {
-    let first = context.deviation(first_um);
-    match predicted_um.map(|p| context.deviation(p)) {
+    let first = context.deviation(first_reversal);
+    match predicted_reversal.map(|p| context.deviation(p)) {
         Some(predicted) if predicted != first => format!(
             "no change since the first test: its B̄ = {first} less what the table takes out leaves the B̄ = {predicted} the prediction carries ({why})"
         ),
@@ -755,8 +759,10 @@ fn known_periods<'a>(input: &DiagnoseInput<'a>) -> &'a [KnownPeriod] {
 
 /// What a user should know of a periodic error's period: that it is a known
 /// period of the axis, and which periods the targets cannot tell from it.
+/// `period` is in the axis' unit; a rotary axis' orders have no aliases and
+/// no known periods (`known_periods`), so the sentences' mm are a linear axis'.
 fn period_notes(
-    period_mm: f64,
+    period: f64,
     tests: PeriodicIn,
     aliases_mm: &[f64],
     known: &[KnownPeriod],
@@ -765,7 +771,7 @@ fn period_notes(
     if tests == PeriodicIn::BothTests {
         notes.push("it is in both tests: the first test's targets sampled it without resolving it, and the prediction and the table carry those samples; the amplitude is the axis' whole periodic error".to_string());
     }
-    let known_here = known.iter().find(|k| k.period_mm == period_mm);
+    let known_here = known.iter().find(|k| k.period_mm == period);
     if let Some(k) = known_here {
         notes.push(format!(
             "the period is {} the machine profile gives ({} mm), looked for first",
@@ -781,7 +787,7 @@ fn period_notes(
             "re-measure at other irregular targets, or give the axis' screw lead in the machine profile, to tell them apart"
         };
         notes.push(format!(
-            "these targets cannot tell a period of {period_mm:.2} mm from {} (the fits differ by less than a BIC of {MIN_DELTA_BIC}); {advice}",
+            "these targets cannot tell a period of {period:.2} mm from {} (the fits differ by less than a BIC of {MIN_DELTA_BIC}); {advice}",
             list.join(", ")
         ));
     }

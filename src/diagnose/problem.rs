@@ -8,15 +8,15 @@ use super::fit::{Design, Groups};
 use super::selection::Chosen;
 use super::{DiagnoseError, DiagnoseInput};
 use crate::compensate::retest::{
-    Applied, BacklashRefusal, KnownError, predicted_deviation_mm, with_scatter,
+    Applied, BacklashRefusal, KnownError, predicted_deviation, with_scatter,
 };
 use crate::compensate::{CompensateError, interpolate_hold};
 use crate::cycle;
-use crate::effects::{Line, Reading, Shape};
+use crate::effects::{Line, Reading, Shape, position_as_deviation, variance_as_deviation};
 use crate::evaluate::{Evaluation, evaluate};
 use crate::measurement::{AxisKind, Direction, Measurement};
 use crate::together::{Input, Pairing, check_together};
-use crate::units::{DeviationUnit, mm_to_um};
+use crate::units::DeviationUnit;
 
 /// The readings with their prediction, as one table. Its positions are in
 /// the axis' unit (mm, or ° on a rotary axis) and its deviations in the
@@ -49,7 +49,7 @@ pub(super) struct Problem {
     /// The re-test's targets.
     pub(super) targets: Vec<f64>,
     /// Linear or rotary: the units above, and of what the diagnosis derives
-    /// from them (its locals named `_mm` and `_um` hold ° and m° then).
+    /// from them (mm and µm, or ° and m°).
     pub(super) kind: AxisKind,
     /// The unit its sentences say a deviation in (µm, ″ or µrad).
     pub(super) deviation: DeviationUnit,
@@ -135,7 +135,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
             let evaluation = evaluate(before);
             let known =
                 KnownError::from_evaluation(&evaluation).ok_or(DiagnoseError::NoKnownError)?;
-            Some((known, mean_variances(&evaluation)))
+            Some((known, mean_variances(&evaluation, before.kind())))
         }
         None if input.backlash_set => {
             return Err(CompensateError::Backlash(BacklashRefusal::NoMeasuredReversal).into());
@@ -151,7 +151,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
     let first_test_prediction = match (input.before, &first) {
         (Some(before), Some((known, _))) => Some(
             with_scatter(before, &evaluate(before), |i, direction| {
-                predicted_deviation_mm(known, applied, before.targets()[i], direction)
+                predicted_deviation(known, applied, before.targets()[i], direction)
             })
             .map_err(|e| DiagnoseError::Internal(e.to_string()))?,
         ),
@@ -173,14 +173,12 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
                 run_index,
                 time_h: times[run_index][target_index],
             });
-            measured.push(mm_to_um(*value));
+            measured.push(position_as_deviation(after.kind(), *value));
             let at_reading = first.as_ref().map_or(0.0, |(known, _)| {
-                mm_to_um(predicted_deviation_mm(
-                    known,
-                    applied,
-                    target,
-                    run.direction,
-                ))
+                position_as_deviation(
+                    after.kind(),
+                    predicted_deviation(known, applied, target, run.direction),
+                )
             });
             predicted.push(at_reading);
         }
@@ -195,10 +193,10 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
         first_test_reversal_variance,
     ) = match &first {
         Some((_, variances)) => (
-            interpolation_weights(&variances.positions_mm, after.targets()),
-            variances.positions_mm.clone(),
-            variances.mean_um2.clone(),
-            variances.reversal_um2.clone(),
+            interpolation_weights(&variances.positions, after.targets()),
+            variances.positions.clone(),
+            variances.mean.clone(),
+            variances.reversal.clone(),
         ),
         None => (
             vec![Vec::new(); after.targets().len()],
@@ -264,12 +262,12 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
 
 /// The first test's uncertainty, per target where it has a mean.
 pub(super) struct FirstTestVariances {
-    /// The targets, mm.
-    pub(super) positions_mm: Vec<f64>,
-    /// Variance of the bidirectional mean, µm².
-    pub(super) mean_um2: Vec<f64>,
-    /// Variance of the reversal x̄↑ − x̄↓, µm².
-    pub(super) reversal_um2: Vec<f64>,
+    /// The targets, mm (° on a rotary axis).
+    pub(super) positions: Vec<f64>,
+    /// Variance of the bidirectional mean, µm² (m°²).
+    pub(super) mean: Vec<f64>,
+    /// Variance of the reversal x̄↑ − x̄↓, µm² (m°²).
+    pub(super) reversal: Vec<f64>,
 }
 
 /// Variance of the first test's means at each of its targets, µm²: of the
@@ -278,16 +276,16 @@ pub(super) struct FirstTestVariances {
 /// reversal; σ pooled over all targets and directions (each target's own s
 /// rests on a handful of readings and would make the weights as noisy as the
 /// data). The targets are those of `KnownError::from_evaluation`.
-pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
+pub(super) fn mean_variances(evaluation: &Evaluation, kind: AxisKind) -> FirstTestVariances {
     let both = evaluation.runs_up > 0 && evaluation.runs_down > 0;
-    let pooled_um2 = evaluation
+    let pooled = evaluation
         .pooled_variance()
-        .map_or(0.0, crate::units::mm2_to_um2);
+        .map_or(0.0, |variance| variance_as_deviation(kind, variance));
     let inverse = |n: usize| if n == 0 { 0.0 } else { 1.0 / n as f64 };
     let mut variances = FirstTestVariances {
-        positions_mm: Vec::new(),
-        mean_um2: Vec::new(),
-        reversal_um2: Vec::new(),
+        positions: Vec::new(),
+        mean: Vec::new(),
+        reversal: Vec::new(),
     };
     for t in &evaluation.per_target {
         let has_mean = if both {
@@ -299,13 +297,13 @@ pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
             continue;
         }
         let sum_of_inverses = inverse(t.up.n) + inverse(t.down.n);
-        variances.positions_mm.push(t.target);
+        variances.positions.push(t.target);
         if both {
-            variances.mean_um2.push(pooled_um2 * sum_of_inverses / 4.0);
-            variances.reversal_um2.push(pooled_um2 * sum_of_inverses);
+            variances.mean.push(pooled * sum_of_inverses / 4.0);
+            variances.reversal.push(pooled * sum_of_inverses);
         } else {
-            variances.mean_um2.push(pooled_um2 * sum_of_inverses);
-            variances.reversal_um2.push(0.0);
+            variances.mean.push(pooled * sum_of_inverses);
+            variances.reversal.push(0.0);
         }
     }
     variances

@@ -24,9 +24,9 @@ pub(super) fn unexplained(
     let mut flagged: Vec<(f64, f64)> = Vec::new();
     if along_significant {
         for (l, f) in levels.iter().zip(&along_fit.fitted) {
-            let z = (l.value_um - f) / l.variance_um2.max(1e-300).sqrt();
+            let z = (l.value - f) / l.variance.max(1e-300).sqrt();
             if z.abs() > 3.0 {
-                flagged.push((l.target_mm, z.abs()));
+                flagged.push((l.target, z.abs()));
             }
         }
     }
@@ -41,14 +41,14 @@ pub(super) fn unexplained(
     flagged.sort_by(|a, b| b.1.total_cmp(&a.1));
     flagged.dedup_by(|a, b| a.0 == b.0);
     flagged.truncate(10);
-    let mut where_mm: Vec<f64> = flagged.into_iter().map(|(x, _)| x).collect();
-    where_mm.sort_by(f64::total_cmp);
-    where_mm.dedup();
-    let rms_um = if with_prediction {
+    let mut flagged_targets: Vec<f64> = flagged.into_iter().map(|(x, _)| x).collect();
+    flagged_targets.sort_by(f64::total_cmp);
+    flagged_targets.dedup();
+    let rms = if with_prediction {
         let squares: f64 = levels
             .iter()
             .zip(&along_fit.fitted)
-            .map(|(l, f)| (l.value_um - f).powi(2))
+            .map(|(l, f)| (l.value - f).powi(2))
             .sum();
         (squares / levels.len().max(1) as f64).sqrt()
     } else {
@@ -66,7 +66,7 @@ pub(super) fn unexplained(
         } else {
             reversal_p
         },
-        targets: where_mm,
-        rms: rms_um,
+        targets: flagged_targets,
+        rms,
     }
 }

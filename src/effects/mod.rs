@@ -35,7 +35,9 @@ pub mod typed;
 use serde::Deserialize;
 
 use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError};
-use crate::units::{AngleUnit, DeviationUnit, um_to_mm};
+use crate::units::{
+    AngleUnit, DeviationUnit, deg_to_millideg, deg2_to_millideg2, mm_to_um, mm2_to_um2, um_to_mm,
+};
 
 pub use abbe::Abbe;
 pub use drift::Drift;
@@ -169,6 +171,24 @@ pub fn deviation_as_position(kind: AxisKind, value: f64) -> f64 {
     match kind {
         AxisKind::Linear => um_to_mm(value),
         AxisKind::Rotary => held_angle(value).0,
+    }
+}
+
+/// A deviation in the unit of the axis' readings (mm, or °) in the effects'
+/// unit (µm, or m°): the inverse of [`deviation_as_position`].
+pub fn position_as_deviation(kind: AxisKind, value: f64) -> f64 {
+    match kind {
+        AxisKind::Linear => mm_to_um(value),
+        AxisKind::Rotary => deg_to_millideg(value),
+    }
+}
+
+/// A variance in the square of the axis' unit (mm², or °²) in the effects'
+/// (µm², or m°²).
+pub fn variance_as_deviation(kind: AxisKind, value: f64) -> f64 {
+    match kind {
+        AxisKind::Linear => mm2_to_um2(value),
+        AxisKind::Rotary => deg2_to_millideg2(value),
     }
 }
 

@@ -100,14 +100,14 @@ pub fn calibrate_positioning(
         let sign = positioning_sign(&machine, axis)?;
         // The others' contribution on the measured line, with EAA still zero.
         let values: Vec<f64> = known
-            .positions_mm()
+            .positions()
             .iter()
-            .zip(known.mean_values_mm())
+            .zip(known.mean_values())
             .map(|(&x, mean)| {
                 mean - line_deviation(&machine, &errors, axis, sign, measured.line_mm, x)
             })
             .collect();
-        let table = ErrorTable::new(known.positions_mm().to_vec(), values, Interpolation::Spline)?;
+        let table = ErrorTable::new(known.positions().to_vec(), values, Interpolation::Spline)?;
         errors.set(name, ErrorFunction::Table(table))?;
     }
     Ok(errors)

@@ -499,7 +499,7 @@ fn with_reversal(
         let axis = axis_named("a table", &table.axis)?;
         let name = positioning_error(axis);
         let own = errors.function(name).cloned().unwrap_or_default();
-        let positions = merged_positions(grid.axis_mm(axis), known.positions_mm());
+        let positions = merged_positions(grid.axis_mm(axis), known.positions());
         let values = positions
             .iter()
             .map(|&x| own.value_at(x) + known.reversal_share_at(x, direction))

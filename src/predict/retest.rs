@@ -104,7 +104,7 @@ pub(super) fn predicted_retest(
     let measured_mean_reversal_mm = known
         .as_ref()
         .filter(|k| k.is_bidirectional())
-        .map(KnownError::mean_reversal_mm);
+        .map(KnownError::mean_reversal);
     let applied = Applied::with_backlash(Some(table), known.as_ref(), backlash_set)
         .map_err(|why| PredictError::Backlash { axis, why })?;
     let first_target = targets.first().copied().unwrap_or(0.0);
@@ -154,7 +154,7 @@ pub(super) fn predicted_retest(
         retest,
         with_measured_scatter: measured.is_some(),
         measured_mean_reversal_mm,
-        backlash_reversal_mm: applied.backlash_reversal_mm,
+        backlash_reversal_mm: applied.backlash_reversal,
         table_mode: table.values.mode(),
     })
 }

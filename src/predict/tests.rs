@@ -3,7 +3,7 @@
 //! scale error compensated by hand.
 
 use super::*;
-use crate::compensate::retest::{Applied, predicted_deviation_mm};
+use crate::compensate::retest::{Applied, predicted_deviation};
 use crate::compensate::{Extrapolate, GridSpec, TableMode, TableOptions, build_table};
 use crate::effects::Reversal;
 use crate::evaluate::ISO_230_2;
@@ -70,7 +70,7 @@ fn on_the_measured_line_it_is_the_first_tests_own_prediction() {
         for (t, target) in retest.per_target.iter().zip(before.targets()) {
             for (direction, value) in [(Direction::Up, t.up_mm), (Direction::Down, t.down_mm)] {
                 let expected =
-                    predicted_deviation_mm(&known, Applied::table(&tables[0]), *target, direction);
+                    predicted_deviation(&known, Applied::table(&tables[0]), *target, direction);
                 assert!(
                     (value - expected).abs() < 1e-9,
                     "{mode:?} {target} {direction:?}: {value} vs {expected}"

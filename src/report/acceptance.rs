@@ -456,9 +456,9 @@ fn table_chart(table: &CompensationTable, before: &Evaluation) -> Chart {
     if let Some(known) = KnownError::from_evaluation(before) {
         let at_reference = known.mean_at(table.reference);
         let points = known
-            .positions_mm()
+            .positions()
             .iter()
-            .zip(known.mean_values_mm())
+            .zip(known.mean_values())
             .map(|(x, v)| (*x, mm_to_um(v - at_reference)))
             .collect();
         all.push(series(

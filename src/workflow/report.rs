@@ -3,7 +3,7 @@
 //! diagnosis, the verdict's limits.
 
 use crate::compensate::CompensationTable;
-use crate::compensate::retest::{Applied, KnownError, predicted_deviation_mm, with_scatter};
+use crate::compensate::retest::{Applied, KnownError, predicted_deviation, with_scatter};
 use crate::diagnose::Diagnosis;
 use crate::evaluate::verdict::{Decision, Limit};
 use crate::evaluate::{Standard, evaluate_with};
@@ -113,11 +113,11 @@ pub fn predicted_retest(
     let known = KnownError::from_evaluation(before.evaluation)?;
     let targets_mm = before.measurement.targets();
     let retest = with_scatter(before.measurement, before.evaluation, |i, direction| {
-        predicted_deviation_mm(&known, Applied::table(table), targets_mm[i], direction)
+        predicted_deviation(&known, Applied::table(table), targets_mm[i], direction)
     })
     .ok()?;
-    let first = *known.positions_mm().first()?;
-    let last = *known.positions_mm().last()?;
+    let first = *known.positions().first()?;
+    let last = *known.positions().last()?;
     let positions_mm: Vec<f64> = (0..PREDICTION_SAMPLES)
         .map(|k| first + (last - first) * k as f64 / (PREDICTION_SAMPLES - 1) as f64)
         .collect();
@@ -125,7 +125,7 @@ pub fn predicted_retest(
         positions_mm
             .iter()
             .map(|&x| {
-                mm_to_um(predicted_deviation_mm(
+                mm_to_um(predicted_deviation(
                     &known,
                     Applied::table(table),
                     x,

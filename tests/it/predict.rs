@@ -1,7 +1,7 @@
 //! `axcomp predict` end to end: the bundled sample, a TNC 640 table written
 //! by `convert`, and an error description with a pitch.
 
-use axcomp::compensate::retest::{Applied, KnownError, predicted_deviation_mm};
+use axcomp::compensate::retest::{Applied, KnownError, predicted_deviation};
 use axcomp::emit::{self, Controller};
 use axcomp::evaluate::evaluate;
 use axcomp::measurement::Direction;
@@ -88,7 +88,7 @@ fn the_predicted_retest_is_the_table_applied_to_the_measurement() {
             ("predicted_down_um", Direction::Down),
         ] {
             let expected =
-                predicted_deviation_mm(&known, Applied::table(&active), x, direction) * 1000.0;
+                predicted_deviation(&known, Applied::table(&active), x, direction) * 1000.0;
             let value = row[key].as_f64().unwrap();
             assert!(
                 (value - expected).abs() < 1e-6,
