@@ -50,15 +50,15 @@ use crate::measurement::{AxisKind, Direction, Measurement, MeasurementError, Pos
 /// reversal: at 3σ a reversal-free axis passes for one in 0.3 % of tests.
 const REVERSAL_STANDARD_ERRORS: f64 = 3.0;
 
-/// The mean reversal value B̄ of a test (mm) when the test shows one beyond
+/// The mean reversal value B̄ of a test (mm, or °) when it shows one beyond
 /// its noise, so that a bidirectional table (or the backlash parameter) is
 /// worth having: |B̄| > 3 standard errors. The standard error is that of the
 /// mean of the per-target x̄_i↑ − x̄_i↓, σ·√(Σ (1/n↑ + 1/n↓)) / m with σ pooled
 /// over every target and direction. `None` for a unidirectional test, one
 /// without repeated runs (no σ) or a reversal within the noise.
-pub fn measured_reversal_mm(evaluation: &Evaluation) -> Option<f64> {
+pub fn measured_reversal(evaluation: &Evaluation) -> Option<f64> {
     let b_mean = evaluation.figures.b_mean?;
-    let variance_mm2 = evaluation.pooled_variance()?;
+    let variance = evaluation.pooled_variance()?;
     let (mut sum_of_inverses, mut targets) = (0.0, 0usize);
     for t in evaluation
         .per_target
@@ -68,7 +68,7 @@ pub fn measured_reversal_mm(evaluation: &Evaluation) -> Option<f64> {
         sum_of_inverses += 1.0 / t.up.n as f64 + 1.0 / t.down.n as f64;
         targets += 1;
     }
-    let standard_error = (variance_mm2 * sum_of_inverses).sqrt() / targets as f64;
+    let standard_error = (variance * sum_of_inverses).sqrt() / targets as f64;
     (b_mean.abs() > REVERSAL_STANDARD_ERRORS * standard_error).then_some(b_mean)
 }
 
@@ -185,7 +185,7 @@ pub(crate) fn check_kind(
     Ok(position.in_axis_unit())
 }
 
-/// The values of a table: one column, or one per direction. Axis error in mm
+/// The values of a table: one column, or one per direction. Axis error in the axis' unit (mm, or °)
 /// (actual − target), zero at the reference.
 #[derive(Clone, Debug, PartialEq)]
 pub enum TableValues {
@@ -423,14 +423,13 @@ pub enum CompensateError {
 }
 
 /// The spacing of evenly spaced positions (within 1 nm), or `None`.
-pub fn regular_step(positions_mm: &[f64]) -> Option<f64> {
+pub fn regular_step(positions: &[f64]) -> Option<f64> {
     const SAME_STEP_MM: f64 = 1e-6;
-    if positions_mm.len() < 2 {
+    if positions.len() < 2 {
         return None;
     }
-    let step =
-        (positions_mm[positions_mm.len() - 1] - positions_mm[0]) / (positions_mm.len() - 1) as f64;
-    let even = positions_mm
+    let step = (positions[positions.len() - 1] - positions[0]) / (positions.len() - 1) as f64;
+    let even = positions
         .windows(2)
         .all(|pair| ((pair[1] - pair[0]) - step).abs() <= SAME_STEP_MM);
     (even && step > 0.0).then_some(step)
@@ -512,19 +511,19 @@ pub fn build_table(
 ) -> Result<CompensationTable, CompensateError> {
     let kind = measurement.kind();
     options.check_kind(kind)?;
-    let positions_mm = grid_positions(measurement.targets(), options.grid)?;
+    let positions = grid_positions(measurement.targets(), options.grid)?;
     let has = |d: Direction| measurement.run_count(d) > 0;
     let source_curve = |pick: fn(&crate::evaluate::TargetStats) -> Option<f64>| {
         join_full_turn(source_curve(evaluation, pick), kind)
     };
-    let (raw, suggested_backlash_mm) = match options.mode {
+    let (raw, suggested_backlash) = match options.mode {
         TableMode::Mean => {
             let curve = match (has(Direction::Up), has(Direction::Down)) {
                 (true, true) => source_curve(|t| t.mean),
                 (true, false) => source_curve(|t| t.up.mean),
                 _ => source_curve(|t| t.down.mean),
             };
-            let column = resample(&curve, &positions_mm, kind, options.extrapolate)?;
+            let column = resample(&curve, &positions, kind, options.extrapolate)?;
             let backlash = evaluation.figures.b_mean.map(|b| -b);
             (TableValues::Mean(column), backlash)
         }
@@ -536,44 +535,44 @@ pub fn build_table(
             }
             let up = resample(
                 &source_curve(|t| t.up.mean),
-                &positions_mm,
+                &positions,
                 kind,
                 options.extrapolate,
             )?;
             let down = resample(
                 &source_curve(|t| t.down.mean),
-                &positions_mm,
+                &positions,
                 kind,
                 options.extrapolate,
             )?;
             (TableValues::Bidirectional { up, down }, None)
         }
     };
-    let reference_mm = options
+    let reference_at = options
         .reference
-        .map_or(positions_mm[0], Position::in_axis_unit);
-    let (first_mm, last_mm) = (positions_mm[0], positions_mm[positions_mm.len() - 1]);
-    if reference_mm < first_mm - 1e-9 || reference_mm > last_mm + 1e-9 {
+        .map_or(positions[0], Position::in_axis_unit);
+    let (first, last) = (positions[0], positions[positions.len() - 1]);
+    if reference_at < first - 1e-9 || reference_at > last + 1e-9 {
         return Err(CompensateError::ReferenceOutside {
-            reference: kind.position(reference_mm),
-            first: kind.position(first_mm),
-            last: kind.position(last_mm),
+            reference: kind.position(reference_at),
+            first: kind.position(first),
+            last: kind.position(last),
         });
     }
     let values = shift_to_reference(
         &raw,
-        &positions_mm,
-        reference_mm,
+        &positions,
+        reference_at,
         options.extrapolate == Extrapolate::Zero,
         measurement,
     );
     Ok(CompensationTable {
         axis: measurement.axis().to_string(),
         kind,
-        positions: positions_mm,
+        positions,
         values,
-        reference: reference_mm,
-        suggested_backlash: suggested_backlash_mm,
+        reference: reference_at,
+        suggested_backlash,
     })
 }
 
@@ -584,20 +583,20 @@ pub fn build_table(
 /// does not depend on the direction the controller references in.
 fn shift_to_reference(
     raw: &TableValues,
-    positions_mm: &[f64],
-    reference_mm: f64,
+    positions: &[f64],
+    reference_at: f64,
     zero_outside: bool,
     measurement: &Measurement,
 ) -> TableValues {
     let targets = measurement.targets();
     let (first, last) = (targets[0], targets[targets.len() - 1]);
     let at_reference =
-        |d: Direction| interpolate_hold(positions_mm, raw.for_direction(d), reference_mm);
+        |d: Direction| interpolate_hold(positions, raw.for_direction(d), reference_at);
     let offset = (at_reference(Direction::Up) + at_reference(Direction::Down)) / 2.0;
     raw.map(|column| {
         column
             .iter()
-            .zip(positions_mm)
+            .zip(positions)
             .map(|(value, &p)| {
                 let outside = p < first - 1e-9 || p > last + 1e-9;
                 if zero_outside && outside {
@@ -612,15 +611,15 @@ fn shift_to_reference(
 
 /// The compensation points of a grid spec, in the unit of the grid (and of
 /// the targets: [`build_table`] checks that they agree).
-pub fn grid_positions(targets_mm: &[f64], grid: GridSpec) -> Result<Vec<f64>, CompensateError> {
+pub fn grid_positions(targets: &[f64], grid: GridSpec) -> Result<Vec<f64>, CompensateError> {
     match grid {
         GridSpec::Targets => {
-            if targets_mm.len() < 2 {
+            if targets.len() < 2 {
                 return Err(CompensateError::Grid(
                     "a table needs at least 2 points; the test has 1 target".into(),
                 ));
             }
-            Ok(targets_mm.to_vec())
+            Ok(targets.to_vec())
         }
         GridSpec::Regular { start, step, count } => {
             let (start_mm, step_mm) = (start.in_axis_unit(), step.in_axis_unit());
@@ -655,7 +654,7 @@ fn round_nm(mm: f64) -> f64 {
 /// Interpolates a source curve onto the points, applying the extrapolation rule.
 fn resample(
     curve: &(Vec<f64>, Vec<f64>),
-    positions_mm: &[f64],
+    positions: &[f64],
     kind: AxisKind,
     extrapolate: Extrapolate,
 ) -> Result<Vec<f64>, CompensateError> {
@@ -663,16 +662,16 @@ fn resample(
     if xs.is_empty() {
         return Err(CompensateError::NoData);
     }
-    let (first_mm, last_mm) = (xs[0], xs[xs.len() - 1]);
-    positions_mm
+    let (first, last) = (xs[0], xs[xs.len() - 1]);
+    positions
         .iter()
         .map(|&p| {
-            let outside = p < first_mm - 1e-9 || p > last_mm + 1e-9;
+            let outside = p < first - 1e-9 || p > last + 1e-9;
             match (outside, extrapolate) {
                 (true, Extrapolate::Refuse) => Err(CompensateError::OutsideMeasuredRange {
                     position: kind.position(p),
-                    first: kind.position(first_mm),
-                    last: kind.position(last_mm),
+                    first: kind.position(first),
+                    last: kind.position(last),
                 }),
                 _ => Ok(interpolate_hold(xs, ys, p)),
             }

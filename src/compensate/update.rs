@@ -152,16 +152,15 @@ impl UpdatePlan {
         })
     }
 
-    fn inside(&self, position_mm: f64) -> bool {
-        position_mm >= self.measured.0 - 1e-9 && position_mm <= self.measured.1 + 1e-9
+    fn inside(&self, position: f64) -> bool {
+        position >= self.measured.0 - 1e-9 && position <= self.measured.1 + 1e-9
     }
 
-    /// The existing table's value at `position_mm`, the mean of its two
+    /// The existing table's value at `position`, the mean of its two
     /// directions (the value a mean table is zeroed by).
-    fn existing_at(&self, position_mm: f64) -> f64 {
+    fn existing_at(&self, position: f64) -> f64 {
         let old = &self.existing;
-        (old.value_at(position_mm, Direction::Up) + old.value_at(position_mm, Direction::Down))
-            / 2.0
+        (old.value_at(position, Direction::Up) + old.value_at(position, Direction::Down)) / 2.0
     }
 
     /// The updated table from `new` (old + residual, zero at the reference,
@@ -223,7 +222,7 @@ impl UpdatePlan {
             .copied()
             .filter(|p| !old.positions.iter().any(|q| (q - p).abs() < SAME_POINT))
             .collect();
-        let positions_mm: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let positions: Vec<f64> = rows.iter().map(|r| r.0).collect();
         let up: Vec<f64> = rows.iter().map(|r| r.1).collect();
         let values = if bidirectional {
             TableValues::Bidirectional {
@@ -234,7 +233,7 @@ impl UpdatePlan {
             TableValues::Mean(up)
         };
         let table = CompensationTable {
-            positions: positions_mm,
+            positions,
             values,
             reference: self.reference,
             ..new
