@@ -185,8 +185,8 @@ pub(crate) fn check_kind(
     Ok(position.in_axis_unit())
 }
 
-/// The values of a table: one column, or one per direction. Axis error in the axis' unit (mm, or °)
-/// (actual − target), zero at the reference.
+/// The values of a table: one column, or one per direction. Axis error
+/// (actual − target) in the axis' unit (mm, or °), zero at the reference.
 #[derive(Clone, Debug, PartialEq)]
 pub enum TableValues {
     /// One value per point, for both directions.
