@@ -135,7 +135,7 @@ pub(super) fn problem(input: &DiagnoseInput<'_>) -> Result<(Problem, bool), Diag
             let evaluation = evaluate(before);
             let known =
                 KnownError::from_evaluation(&evaluation).ok_or(DiagnoseError::NoKnownError)?;
-            Some((known, mean_variances(&evaluation, before.kind())))
+            Some((known, mean_variances(&evaluation)))
         }
         None if input.backlash_set => {
             return Err(CompensateError::Backlash(BacklashRefusal::NoMeasuredReversal).into());
@@ -276,11 +276,11 @@ pub(super) struct FirstTestVariances {
 /// reversal; σ pooled over all targets and directions (each target's own s
 /// rests on a handful of readings and would make the weights as noisy as the
 /// data). The targets are those of `KnownError::from_evaluation`.
-pub(super) fn mean_variances(evaluation: &Evaluation, kind: AxisKind) -> FirstTestVariances {
+pub(super) fn mean_variances(evaluation: &Evaluation) -> FirstTestVariances {
     let both = evaluation.runs_up > 0 && evaluation.runs_down > 0;
-    let pooled = evaluation
-        .pooled_variance()
-        .map_or(0.0, |variance| variance_as_deviation(kind, variance));
+    let pooled = evaluation.pooled_variance().map_or(0.0, |variance| {
+        variance_as_deviation(evaluation.kind(), variance)
+    });
     let inverse = |n: usize| if n == 0 { 0.0 } else { 1.0 / n as f64 };
     let mut variances = FirstTestVariances {
         positions: Vec::new(),
